@@ -1,0 +1,77 @@
+// Corner-point geometry of an Eclipse grid (paper Sec. 3): pillars (COORD) and corner depths
+// (ZCORN), or the same built from Cartesian DX/DY/DZ/TOPS; cell corners, handedness and
+// which cell faces are shared with their topological neighbours (faults break sharing).
+//
+// Contract:
+// - Corners are in double precision; MAPAXES is applied on request (not when GRIDUNIT says
+//   the grid is already in map coordinates). Depth stays positive down here; callers that
+//   show z up negate it.
+// - Corner order is ECLIPSE's: c = di + 2 dj + 4 dk (dk = 0 top, 1 bottom).
+#pragma once
+
+#include "GrdeclDeck.h"
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace resmr
+{
+
+class CornerPointGeometry
+{
+public:
+  /// Takes COORD/ZCORN from the deck (moved, not copied) or builds them from DX/DY/DZ/TOPS
+  /// (or DXV/DYV/DZV). Throws GrdeclError if the geometry is inconsistent.
+  static CornerPointGeometry FromDeck(GrdeclDeck& deck, bool applyMapAxes);
+
+  /// Switches the MAPAXES transform on or off (no effect without MAPAXES, or when GRIDUNIT
+  /// says the grid is already in map coordinates); handedness follows.
+  void SetMapAxesApplied(bool apply);
+
+  const std::array<int64_t, 3>& Dims() const { return this->Dimensions; }
+  int64_t CellCount() const { return this->Dimensions[0] * this->Dimensions[1] * this->Dimensions[2]; }
+
+  /// The 8 corners (x, y, depth) of cell (i, j, k), 0-based, ECLIPSE corner order.
+  void CellCorners(int64_t i, int64_t j, int64_t k, double corners[8][3]) const;
+
+  /// True if, with depth down and k increasing downwards, the (i, j) axes turn clockwise
+  /// seen from above (ECLIPSE "left-handed"): hexahedra need their k order mirrored to have
+  /// positive volume in a z-up frame.
+  bool IsLeftHanded() const { return this->LeftHanded; }
+
+  /// Corners merged into shared points: corners of neighbouring cells on the same pillar at
+  /// the same depth become one point, so faces are shared exactly where ECLIPSE connects
+  /// cells (faults, layer gaps and pinched-out cells keep their own points).
+  struct SharedCorners
+  {
+    std::vector<double> points;      ///< x, y, depth per point
+    std::vector<int64_t> cellPoints; ///< 8 point ids per cell, ECLIPSE corner order
+  };
+  SharedCorners BuildSharedCorners() const;
+
+  const std::vector<double>& Coord() const { return this->CoordValues; }
+  const std::vector<double>& Zcorn() const { return this->ZcornValues; }
+
+private:
+  double Z(int64_t i, int64_t j, int64_t k, int corner) const
+  {
+    const int64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
+    const int64_t di = corner & 1, dj = (corner >> 1) & 1, dk = corner >> 2;
+    return this->ZcornValues[static_cast<std::size_t>(
+      ((2 * k + dk) * 2 * ny + 2 * j + dj) * 2 * nx + 2 * i + di)];
+  }
+  void DetectHandedness();
+  void PillarPoint(int64_t pillar, double depth, double xyz[3]) const;
+
+  std::array<int64_t, 3> Dimensions{};
+  std::vector<double> CoordValues;
+  std::vector<double> ZcornValues;
+  bool MapAxesAvailable = false;
+  MapAxes Axes;
+  bool MapAxesApplied = false;
+  std::array<double, 6> MapTransform{}; ///< origin x y, unit x axis, unit y axis
+  bool LeftHanded = false;
+};
+
+} // namespace resmr

@@ -1,0 +1,1102 @@
+// Eclipse grid deck parser (paper Sec. 3: the corner-point model and its cell properties).
+#include "GrdeclParser.h"
+
+#include "EclipseBinaryReader.h"
+#include "GrdeclError.h"
+#include "GrdeclTokenizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
+#include <unistd.h>
+
+namespace resmr
+{
+
+const CellArray* GrdeclDeck::FindArray(const std::string& name) const
+{
+  for (const CellArray& array : this->arrays)
+  {
+    if (array.name == name)
+    {
+      return &array;
+    }
+  }
+  return nullptr;
+}
+
+CellArray* GrdeclDeck::FindArray(const std::string& name)
+{
+  return const_cast<CellArray*>(static_cast<const GrdeclDeck*>(this)->FindArray(name));
+}
+
+bool IsGeometryArrayName(const std::string& name)
+{
+  return name == "DX" || name == "DY" || name == "DZ" || name == "TOPS" || name == "ACTNUM";
+}
+
+int64_t MaxCellsForThisMachine()
+{
+  const long pages = sysconf(_SC_PHYS_PAGES);
+  const long pageSize = sysconf(_SC_PAGE_SIZE);
+  const double memory =
+    (pages > 0 && pageSize > 0) ? double(pages) * double(pageSize) : double(1ull << 34);
+  // ZCORN alone holds 8 doubles per cell; anything bigger than memory cannot be read here.
+  return static_cast<int64_t>(memory / 64.0);
+}
+
+int64_t CheckedCellCount(const std::array<int64_t, 3>& dims, int64_t maxCells,
+  const std::string& file, int64_t line, const std::string& keyword)
+{
+  for (int64_t d : dims)
+  {
+    if (d <= 0 || d > std::numeric_limits<int32_t>::max())
+    {
+      throw GrdeclError(file, line, keyword,
+        "grid dimensions " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
+          std::to_string(dims[2]) + " must each be between 1 and 2147483647");
+    }
+  }
+  int64_t count = 0;
+  if (__builtin_mul_overflow(dims[0], dims[1], &count) ||
+    __builtin_mul_overflow(count, dims[2], &count) || count > maxCells)
+  {
+    throw GrdeclError(file, line, keyword,
+      "grid of " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
+        std::to_string(dims[2]) + " cells is larger than this machine can hold (limit " +
+        std::to_string(maxCells) + " cells)");
+  }
+  return count;
+}
+
+namespace
+{
+constexpr int MaxIncludeDepth = 32;
+
+std::string Upper(std::string_view text)
+{
+  std::string value(text);
+  for (char& c : value)
+  {
+    if (c >= 'a' && c <= 'z')
+    {
+      c = static_cast<char>(c - 'a' + 'A');
+    }
+  }
+  return value;
+}
+
+bool LooksLikeKeyword(std::string_view word)
+{
+  if (word.empty() || word.size() > 8 || word[0] < 'A' || word[0] > 'Z')
+  {
+    return false;
+  }
+  for (char c : word)
+  {
+    const bool ok = (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '+' ||
+      c == '-';
+    if (!ok)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool IsIntegerArrayName(const std::string& name)
+{
+  return name == "ACTNUM" || (name.size() > 3 && name.compare(name.size() - 3, 3, "NUM") == 0);
+}
+
+/// Cell property keywords whose value count is checked strictly (a wrong count is an error,
+/// not an unknown keyword to skip).
+bool IsKnownCellArray(const std::string& name)
+{
+  static const std::unordered_set<std::string> names = { "ACTNUM", "PORO", "PERMX", "PERMY",
+    "PERMZ", "PERMXY", "PERMYZ", "PERMZX", "NTG", "DX", "DY", "DZ", "TOPS", "MULTX", "MULTY",
+    "MULTZ", "MULTX-", "MULTY-", "MULTZ-", "MULTPV", "PORV", "SATNUM", "FIPNUM", "EQLNUM",
+    "PVTNUM", "IMBNUM", "ROCKNUM", "MULTNUM", "FLUXNUM", "OPERNUM", "ENDNUM", "MISCNUM",
+    "SWATINIT", "SWL", "SWCR", "SWU", "SGL", "SGCR", "SGU", "SOWCR", "SOGCR", "KRW", "KRO", "KRG",
+    "PCW", "PCG", "PRESSURE", "SWAT", "SGAS", "SOIL", "RS", "RV", "FACIES", "THCONR", "DEPTH",
+    "TRANX", "TRANY", "TRANZ", "MINPV", "PORE", "DIFFMX", "DIFFMY", "DIFFMZ" };
+  return names.count(name) > 0;
+}
+
+struct Box
+{
+  std::array<int64_t, 6> range{}; ///< i1 i2 j1 j2 k1 k2, 0-based inclusive
+  int64_t Size() const
+  {
+    return (range[1] - range[0] + 1) * (range[3] - range[2] + 1) * (range[5] - range[4] + 1);
+  }
+};
+
+enum class Section
+{
+  None,
+  Runspec,
+  Grid,
+  Edit,
+  Props,
+  Regions,
+  Solution,
+  Summary,
+  Schedule
+};
+
+class Parser
+{
+public:
+  Parser(const GrdeclParseOptions& options)
+    : Options(options)
+  {
+    if (this->Options.maxCells <= 0)
+    {
+      this->Options.maxCells = MaxCellsForThisMachine();
+    }
+  }
+
+  GrdeclDeck Run(const std::string& path)
+  {
+    this->RootDirectory = DirectoryOf(path);
+    this->ParseAnyFile(path, 0);
+    this->Finish();
+    return std::move(this->Deck);
+  }
+
+private:
+  static std::string DirectoryOf(const std::string& path)
+  {
+    const auto slash = path.find_last_of('/');
+    return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+  }
+
+  void ParseAnyFile(const std::string& path, int depth)
+  {
+    this->Deck.files.push_back(path);
+    if (EclipseBinaryReader::LooksLikeEclipseBinary(path))
+    {
+      this->ParseBinaryFile(path);
+    }
+    else
+    {
+      this->ParseTextFile(path, depth);
+    }
+  }
+
+  // ---------------------------------------------------------------- errors and helpers
+  [[noreturn]] void Fail(const Token& token, const std::string& keyword, const std::string& what)
+  {
+    throw GrdeclError(this->Tokens->GetPath(), token.line, keyword, what);
+  }
+
+  [[noreturn]] void FailHere(const std::string& keyword, const std::string& what)
+  {
+    throw GrdeclError(this->CurrentFile, this->CurrentLine, keyword, what);
+  }
+
+  static std::string Describe(const Token& token)
+  {
+    switch (token.kind)
+    {
+      case TokenKind::End:
+        return "end of file";
+      case TokenKind::Slash:
+        return "'/'";
+      case TokenKind::String:
+        return "'" + std::string(token.text) + "'";
+      default:
+        break;
+    }
+    std::string text(token.text.substr(0, 40));
+    for (char& c : text)
+    {
+      if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126)
+      {
+        c = '?';
+      }
+    }
+    return "'" + text + "'";
+  }
+
+  int64_t CellCount(const std::string& keyword)
+  {
+    if (this->Deck.dims[0] == 0)
+    {
+      this->FailHere(keyword, "appears before SPECGRID or DIMENS gave the grid dimensions");
+    }
+    return this->Deck.CellCount();
+  }
+
+  Box WholeGrid() const
+  {
+    const auto& d = this->Deck.dims;
+    return Box{ { 0, d[0] - 1, 0, d[1] - 1, 0, d[2] - 1 } };
+  }
+
+  /// Record of bare words / strings / numbers up to '/', as text; `N*` expands to N "".
+  std::vector<std::string> ReadRecord(const std::string& keyword, bool* sawSlash = nullptr)
+  {
+    std::vector<std::string> items;
+    for (;;)
+    {
+      const Token& token = this->Tokens->Next();
+      if (token.kind == TokenKind::Slash)
+      {
+        if (sawSlash)
+        {
+          *sawSlash = true;
+        }
+        return items;
+      }
+      if (token.kind == TokenKind::End)
+      {
+        this->Fail(token, keyword, "unterminated keyword: reached end of file before '/'");
+      }
+      if (token.kind == TokenKind::Word && token.atLineStart && LooksLikeKeyword(token.text) &&
+        !items.empty() && sawSlash)
+      {
+        this->Fail(token, keyword,
+          "record not terminated by '/' before " + Describe(token) + " on a new line");
+      }
+      if (items.size() > 4096)
+      {
+        this->Fail(token, keyword, "record longer than 4096 items: missing '/'?");
+      }
+      NumberToken number;
+      if (token.kind == TokenKind::Word && token.text.find('*') != std::string_view::npos &&
+        ParseNumberToken(token.text, number) && number.isDefault)
+      {
+        if (number.repeat > 4096)
+        {
+          this->Fail(token, keyword, "default repeat count too large");
+        }
+        items.insert(items.end(), static_cast<std::size_t>(number.repeat), std::string());
+        continue;
+      }
+      items.emplace_back(token.text);
+    }
+  }
+
+  int64_t RecordInteger(const std::vector<std::string>& items, std::size_t index,
+    const std::string& keyword, const std::string& what, int64_t fallback, bool required)
+  {
+    if (index >= items.size() || items[index].empty())
+    {
+      if (required)
+      {
+        this->FailHere(keyword, "missing " + what);
+      }
+      return fallback;
+    }
+    double value = 0;
+    if (!ParseDouble(items[index], value) || value != std::floor(value) || std::fabs(value) > 9e18)
+    {
+      this->FailHere(keyword, what + " must be an integer, got '" + items[index] + "'");
+    }
+    return static_cast<int64_t>(value);
+  }
+
+  double RecordNumber(const std::vector<std::string>& items, std::size_t index,
+    const std::string& keyword, const std::string& what)
+  {
+    double value = 0;
+    if (index >= items.size() || !ParseDouble(items[index], value))
+    {
+      this->FailHere(keyword,
+        what + " must be a number, got '" + (index < items.size() ? items[index] : "") + "'");
+    }
+    return value;
+  }
+
+  /// Reads an optional box (i1 i2 j1 j2 k1 k2, 1-based) starting at items[first].
+  Box RecordBox(const std::vector<std::string>& items, std::size_t first, const Box& fallback,
+    const std::string& keyword)
+  {
+    Box box = fallback;
+    const auto& d = this->Deck.dims;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      for (int end = 0; end < 2; ++end)
+      {
+        const std::size_t index = first + 2 * axis + end;
+        const int64_t value = this->RecordInteger(items, index, keyword, "box bound", -1, false);
+        if (value != -1)
+        {
+          box.range[2 * axis + end] = value - 1;
+        }
+      }
+      if (box.range[2 * axis] < 0 || box.range[2 * axis] > box.range[2 * axis + 1] ||
+        box.range[2 * axis + 1] >= d[axis])
+      {
+        this->FailHere(keyword,
+          "box " + std::to_string(box.range[2 * axis] + 1) + "-" +
+            std::to_string(box.range[2 * axis + 1] + 1) + " is outside the grid's " +
+            "IJK"[axis] + " range 1-" + std::to_string(d[axis]));
+      }
+    }
+    return box;
+  }
+
+  CellArray& ArrayFor(const std::string& name)
+  {
+    if (CellArray* existing = this->Deck.FindArray(name))
+    {
+      return *existing;
+    }
+    const int64_t n = this->CellCount(name);
+    CellArray array;
+    array.name = name;
+    array.isInteger = IsIntegerArrayName(name);
+    array.values.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
+    this->Deck.arrays.push_back(std::move(array));
+    return this->Deck.arrays.back();
+  }
+
+  template <typename Visit>
+  void ForEachCell(const Box& box, Visit&& visit)
+  {
+    const auto& d = this->Deck.dims;
+    for (int64_t k = box.range[4]; k <= box.range[5]; ++k)
+    {
+      for (int64_t j = box.range[2]; j <= box.range[3]; ++j)
+      {
+        const int64_t row = (k * d[1] + j) * d[0];
+        for (int64_t i = box.range[0]; i <= box.range[1]; ++i)
+        {
+          visit(row + i);
+        }
+      }
+    }
+  }
+
+  // ---------------------------------------------------------------- number arrays
+  /// Reads numbers up to '/' and hands each to store(index, value); exactly `expected` values.
+  /// Returns false (without consuming the unexpected token) if `lenient` and the data turn
+  /// out not to be a plain numeric array.
+  template <typename Store>
+  bool ReadNumbers(const std::string& keyword, int64_t expected, bool lenient, bool allowDefaults,
+    Store&& store, int64_t alsoAccepted = -1)
+  {
+    int64_t count = 0;
+    const double undefined = std::numeric_limits<double>::quiet_NaN();
+    for (;;)
+    {
+      const Token& token = this->Tokens->Next();
+      if (token.kind == TokenKind::Slash)
+      {
+        break;
+      }
+      if (token.kind == TokenKind::End)
+      {
+        if (lenient)
+        {
+          return false;
+        }
+        this->Fail(token, keyword,
+          "unterminated keyword: reached end of file after " + std::to_string(count) +
+            " values, expected " + std::to_string(expected) + " and a '/'");
+      }
+      NumberToken number;
+      if (token.kind != TokenKind::Word || !ParseNumberToken(token.text, number))
+      {
+        if (lenient)
+        {
+          this->Tokens->PushBack();
+          return false;
+        }
+        if (token.atLineStart && token.kind == TokenKind::Word && LooksLikeKeyword(token.text))
+        {
+          this->Fail(token, keyword,
+            "missing '/' terminator: reached keyword " + Describe(token) + " after " +
+              std::to_string(count) + " of " + std::to_string(expected) + " values");
+        }
+        this->Fail(token, keyword,
+          "expected a number, got " + Describe(token) + " (value " + std::to_string(count + 1) +
+            " of " + std::to_string(expected) + ")");
+      }
+      if (!std::isfinite(number.value))
+      {
+        this->Fail(token, keyword, "value " + Describe(token) + " is not finite");
+      }
+      if (number.isDefault && !allowDefaults && !lenient)
+      {
+        this->Fail(token, keyword, "default values (" + Describe(token) + ") are not allowed here");
+      }
+      if (number.repeat > expected - count)
+      {
+        if (lenient)
+        {
+          this->Tokens->PushBack();
+          return false;
+        }
+        this->Fail(token, keyword,
+          "too many values: more than the " + std::to_string(expected) + " expected (at " +
+            Describe(token) + ")");
+      }
+      const double value = number.isDefault ? undefined : number.value;
+      for (int64_t r = 0; r < number.repeat; ++r)
+      {
+        store(count++, value);
+      }
+    }
+    if (count != expected && count != alsoAccepted)
+    {
+      if (lenient)
+      {
+        return false;
+      }
+      this->FailHere(keyword,
+        "wrong number of values: expected " + std::to_string(expected) +
+          (alsoAccepted >= 0 ? " or " + std::to_string(alsoAccepted) : std::string()) +
+          ", got " + std::to_string(count));
+    }
+    return true;
+  }
+
+  void ReadDenseArray(const std::string& keyword, std::vector<double>& target, int64_t expected)
+  {
+    target.clear();
+    target.reserve(static_cast<std::size_t>(expected));
+    this->ReadNumbers(keyword, expected, false, false,
+      [&](int64_t, double value) { target.push_back(value); });
+  }
+
+  /// Reads a cell array (PORO, ACTNUM, ...) into the current BOX; `lenient` for keywords we
+  /// do not know, which are kept only if they turn out to hold one number per cell.
+  void ReadCellArray(const std::string& keyword, bool lenient)
+  {
+    const Box box = this->CurrentBox ? *this->CurrentBox : this->WholeGrid();
+    int64_t expected = box.Size();
+    const bool wholeGrid = !this->CurrentBox;
+    if (keyword == "TOPS" && wholeGrid)
+    {
+      // TOPS may give the top layer only; accept both forms.
+      this->ReadTops();
+      return;
+    }
+    if (lenient)
+    {
+      std::vector<double> values;
+      if (!this->ReadNumbers(keyword, expected, true, true,
+            [&](int64_t, double value) { values.push_back(value); }))
+      {
+        this->SkipRestOfKeyword();
+        return;
+      }
+      CellArray& array = this->ArrayFor(keyword);
+      int64_t index = 0;
+      this->ForEachCell(box, [&](int64_t cell) { array.values[cell] = values[index++]; });
+      return;
+    }
+    CellArray& array = this->ArrayFor(keyword);
+    double* data = array.values.data();
+    if (wholeGrid)
+    {
+      this->ReadNumbers(keyword, expected, false, true,
+        [&](int64_t index, double value) { data[index] = value; });
+      return;
+    }
+    std::vector<int64_t> cells;
+    cells.reserve(static_cast<std::size_t>(expected));
+    this->ForEachCell(box, [&](int64_t cell) { cells.push_back(cell); });
+    this->ReadNumbers(keyword, expected, false, true,
+      [&](int64_t index, double value) { data[cells[index]] = value; });
+  }
+
+  void ReadTops()
+  {
+    const int64_t n = this->CellCount("TOPS");
+    const int64_t layer = this->Deck.dims[0] * this->Deck.dims[1];
+    std::vector<double> values;
+    values.reserve(static_cast<std::size_t>(layer));
+    this->ReadNumbers(
+      "TOPS", n, false, true, [&](int64_t, double value) { values.push_back(value); }, layer);
+    CellArray& tops = this->ArrayFor("TOPS");
+    std::copy(values.begin(), values.end(), tops.values.begin());
+  }
+
+  /// Skips an unknown keyword: up to its '/' or up to the next keyword on a new line.
+  void SkipRestOfKeyword()
+  {
+    for (;;)
+    {
+      const Token& token = this->Tokens->Next();
+      if (token.kind == TokenKind::Slash || token.kind == TokenKind::End)
+      {
+        return;
+      }
+      if (token.kind == TokenKind::Word && token.atLineStart && LooksLikeKeyword(token.text))
+      {
+        this->Tokens->PushBack();
+        return;
+      }
+    }
+  }
+
+  // ---------------------------------------------------------------- keywords
+  void ReadDimensions(const std::string& keyword)
+  {
+    const std::vector<std::string> items = this->ReadRecord(keyword);
+    std::array<int64_t, 3> dims{};
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      dims[axis] = this->RecordInteger(items, axis, keyword, std::string("N") + "XYZ"[axis], 0, true);
+    }
+    if (keyword == "SPECGRID" && items.size() > 3 && !items[3].empty() &&
+      this->RecordInteger(items, 3, keyword, "NUMRES", 1, false) != 1)
+    {
+      this->FailHere(keyword, "multiple reservoirs (NUMRES > 1) are not supported");
+    }
+    CheckedCellCount(dims, this->Options.maxCells, this->CurrentFile, this->CurrentLine, keyword);
+    if (this->Deck.dims[0] != 0 && this->Deck.dims != dims)
+    {
+      if (!this->Deck.arrays.empty() || !this->Deck.zcorn.empty() || !this->Deck.coord.empty())
+      {
+        this->FailHere(keyword, "redefines the grid dimensions after data were given");
+      }
+    }
+    this->Deck.dims = dims;
+  }
+
+  void ReadFaults()
+  {
+    const std::string keyword = "FAULTS";
+    for (;;)
+    {
+      bool slash = false;
+      const std::vector<std::string> items = this->ReadRecord(keyword, &slash);
+      if (items.empty())
+      {
+        return; // empty record ends the keyword
+      }
+      if (this->Deck.dims[0] == 0)
+      {
+        this->FailHere(keyword, "appears before SPECGRID or DIMENS gave the grid dimensions");
+      }
+      if (items.size() < 8)
+      {
+        this->FailHere(keyword, "record for fault '" + items[0] +
+            "' needs NAME I1 I2 J1 J2 K1 K2 FACE");
+      }
+      FaultFace face;
+      const Box box = this->RecordBox(items, 1, this->WholeGrid(), keyword);
+      for (int b = 0; b < 6; ++b)
+      {
+        face.box[b] = static_cast<int32_t>(box.range[b]);
+      }
+      const std::string direction = Upper(items[7]);
+      static const std::pair<const char*, FaultFace::Direction> directions[] = { { "I",
+                                                                                    FaultFace::IPlus },
+        { "I+", FaultFace::IPlus }, { "X", FaultFace::IPlus }, { "X+", FaultFace::IPlus },
+        { "I-", FaultFace::IMinus }, { "X-", FaultFace::IMinus }, { "J", FaultFace::JPlus },
+        { "J+", FaultFace::JPlus }, { "Y", FaultFace::JPlus }, { "Y+", FaultFace::JPlus },
+        { "J-", FaultFace::JMinus }, { "Y-", FaultFace::JMinus }, { "K", FaultFace::KPlus },
+        { "K+", FaultFace::KPlus }, { "Z", FaultFace::KPlus }, { "Z+", FaultFace::KPlus },
+        { "K-", FaultFace::KMinus }, { "Z-", FaultFace::KMinus } };
+      bool known = false;
+      for (const auto& entry : directions)
+      {
+        if (direction == entry.first)
+        {
+          face.face = entry.second;
+          known = true;
+        }
+      }
+      if (!known)
+      {
+        this->FailHere(keyword, "fault '" + items[0] + "' has unknown face '" + items[7] +
+            "' (expected I, I-, J, J-, K, K- or X, Y, Z forms)");
+      }
+      Fault* fault = nullptr;
+      auto found = this->FaultIndex.find(items[0]);
+      if (found == this->FaultIndex.end())
+      {
+        this->FaultIndex.emplace(items[0], this->Deck.faults.size());
+        this->Deck.faults.push_back(Fault{ items[0], {} });
+        fault = &this->Deck.faults.back();
+      }
+      else
+      {
+        fault = &this->Deck.faults[found->second];
+      }
+      fault->faces.push_back(face);
+    }
+  }
+
+  /// EQUALS, MULTIPLY, ADD, COPY: records operating on arrays within a box.
+  void ReadArrayOperations(const std::string& keyword)
+  {
+    Box lastBox = this->CurrentBox ? *this->CurrentBox : this->WholeGrid();
+    for (;;)
+    {
+      const std::vector<std::string> items = this->ReadRecord(keyword);
+      if (items.empty())
+      {
+        return;
+      }
+      if (items.size() < 2)
+      {
+        this->FailHere(keyword, "record needs an array name and a value");
+      }
+      const std::string target = Upper(items[0]);
+      const Box box = this->RecordBox(items, 2, lastBox, keyword);
+      lastBox = box;
+      if (keyword == "COPY")
+      {
+        const std::string destination = Upper(items[1]);
+        const CellArray* source = this->Deck.FindArray(target);
+        if (!source)
+        {
+          this->FailHere(keyword, "source array " + target + " has not been defined");
+        }
+        const std::size_t sourceIndex = static_cast<std::size_t>(source - this->Deck.arrays.data());
+        CellArray& out = this->ArrayFor(destination);
+        const CellArray& in = this->Deck.arrays[sourceIndex];
+        this->ForEachCell(box, [&](int64_t cell) { out.values[cell] = in.values[cell]; });
+        continue;
+      }
+      const double value = this->RecordNumber(items, 1, keyword, "value for " + target);
+      if (!std::isfinite(value))
+      {
+        this->FailHere(keyword, "value for " + target + " is not finite");
+      }
+      if (keyword == "EQUALS")
+      {
+        CellArray& array = this->ArrayFor(target);
+        this->ForEachCell(box, [&](int64_t cell) { array.values[cell] = value; });
+        continue;
+      }
+      CellArray* array = this->Deck.FindArray(target);
+      if (!array)
+      {
+        this->FailHere(keyword, "array " + target + " has not been defined");
+      }
+      if (keyword == "MULTIPLY")
+      {
+        this->ForEachCell(box, [&](int64_t cell) { array->values[cell] *= value; });
+      }
+      else
+      {
+        this->ForEachCell(box, [&](int64_t cell) { array->values[cell] += value; });
+      }
+    }
+  }
+
+  void ReadInclude(const std::string& keyword, int depth)
+  {
+    const std::vector<std::string> items = this->ReadRecord(keyword);
+    if (items.empty() || items[0].empty())
+    {
+      this->FailHere(keyword, "missing file name");
+    }
+    const std::string name = items[0];
+    const std::string here = DirectoryOf(this->Tokens->GetPath());
+    std::vector<std::string> candidates;
+    if (name[0] == '/')
+    {
+      candidates.push_back(name);
+    }
+    else
+    {
+      candidates.push_back(here + "/" + name);
+      candidates.push_back(this->RootDirectory + "/" + name);
+    }
+    for (const std::string& candidate : candidates)
+    {
+      if (std::FILE* probe = std::fopen(candidate.c_str(), "rb"))
+      {
+        std::fclose(probe);
+        if (depth + 1 > MaxIncludeDepth)
+        {
+          this->FailHere(keyword, "includes nested deeper than " +
+              std::to_string(MaxIncludeDepth) + " levels (does a file include itself?)");
+        }
+        const std::string savedFile = this->CurrentFile;
+        const int64_t savedLine = this->CurrentLine;
+        GrdeclTokenizer* savedTokens = this->Tokens;
+        this->ParseAnyFile(candidate, depth + 1);
+        this->Tokens = savedTokens;
+        this->CurrentFile = savedFile;
+        this->CurrentLine = savedLine;
+        return;
+      }
+    }
+    this->FailHere(keyword, "included file '" + name + "' not found (looked in " + here +
+        (here == this->RootDirectory ? "" : " and " + this->RootDirectory) + ")");
+  }
+
+  void ParseTextFile(const std::string& path, int depth)
+  {
+    GrdeclTokenizer tokens(path);
+    this->Tokens = &tokens;
+    this->CurrentFile = path;
+    for (;;)
+    {
+      if (this->Stopped)
+      {
+        return;
+      }
+      const Token& token = tokens.Next();
+      if (token.kind == TokenKind::End)
+      {
+        return;
+      }
+      // Outside a keyword only keywords in column 1 matter: anything else is the remainder
+      // of a skipped keyword (tables, well records ...).
+      if (token.kind != TokenKind::Word || !token.atLineStart || !LooksLikeKeyword(token.text))
+      {
+        continue;
+      }
+      const std::string keyword(token.text);
+      this->CurrentLine = token.line;
+      this->HandleKeyword(keyword, depth);
+    }
+  }
+
+  bool InPropertySection() const
+  {
+    return this->CurrentSection != Section::Runspec && this->CurrentSection != Section::Summary &&
+      this->CurrentSection != Section::Schedule;
+  }
+
+  void HandleKeyword(const std::string& keyword, int depth)
+  {
+    GrdeclTokenizer& tokens = *this->Tokens;
+    if (this->CurrentSection == Section::Summary)
+    {
+      static const std::unordered_set<std::string> leaving = { "SCHEDULE", "END", "RUNSPEC",
+        "GRID", "EDIT", "PROPS", "REGIONS", "SOLUTION" };
+      if (!leaving.count(keyword))
+      {
+        return; // summary vectors: nothing for the grid
+      }
+    }
+    if (keyword == "SPECGRID" || keyword == "DIMENS")
+    {
+      this->ReadDimensions(keyword);
+    }
+    else if (keyword == "COORD")
+    {
+      const auto& d = this->Deck.dims;
+      this->CellCount(keyword);
+      this->ReadDenseArray(keyword, this->Deck.coord, 6 * (d[0] + 1) * (d[1] + 1));
+    }
+    else if (keyword == "ZCORN")
+    {
+      this->ReadDenseArray(keyword, this->Deck.zcorn, 8 * this->CellCount(keyword));
+    }
+    else if (keyword == "DXV" || keyword == "DYV" || keyword == "DZV")
+    {
+      this->CellCount(keyword);
+      const int axis = keyword[1] - 'X';
+      std::vector<double>& target =
+        axis == 0 ? this->Deck.dxv : (axis == 1 ? this->Deck.dyv : this->Deck.dzv);
+      this->ReadDenseArray(keyword, target, this->Deck.dims[axis]);
+    }
+    else if (keyword == "MAPAXES")
+    {
+      std::vector<double> values;
+      this->ReadNumbers(keyword, 6, false, false, [&](int64_t, double v) { values.push_back(v); });
+      this->Deck.hasMapAxes = true;
+      this->Deck.mapAxes = MapAxes{ { values[0], values[1] }, { values[2], values[3] },
+        { values[4], values[5] } };
+    }
+    else if (keyword == "MAPUNITS")
+    {
+      const auto items = this->ReadRecord(keyword);
+      this->Deck.mapUnits = items.empty() ? "" : items[0];
+    }
+    else if (keyword == "GRIDUNIT")
+    {
+      const auto items = this->ReadRecord(keyword);
+      this->Deck.gridUnit = items.empty() ? "" : items[0];
+      this->Deck.gridUnitIsMap = items.size() > 1 && Upper(items[1]).rfind("MAP", 0) == 0;
+    }
+    else if (keyword == "GDORIENT")
+    {
+      this->Deck.gdorient = this->ReadRecord(keyword);
+    }
+    else if (keyword == "COORDSYS")
+    {
+      const auto items = this->ReadRecord(keyword);
+      const int64_t k1 = this->RecordInteger(items, 0, keyword, "K1", 1, true);
+      const int64_t k2 = this->RecordInteger(items, 1, keyword, "K2", 1, true);
+      if (k1 < 1 || k2 < k1 || (this->Deck.dims[2] > 0 && k2 > this->Deck.dims[2]))
+      {
+        this->FailHere(keyword, "layer range " + std::to_string(k1) + "-" + std::to_string(k2) +
+            " is not valid");
+      }
+      this->Deck.coordsysLayers.push_back({ static_cast<int32_t>(k1), static_cast<int32_t>(k2) });
+    }
+    else if (keyword == "INCLUDE")
+    {
+      this->ReadInclude(keyword, depth);
+    }
+    else if (keyword == "IMPORT")
+    {
+      this->ReadInclude(keyword, depth); // IMPORT names a binary GRDECL; ParseAnyFile detects it
+    }
+    else if (keyword == "FAULTS")
+    {
+      this->ReadFaults();
+    }
+    else if (keyword == "EQUALS" || keyword == "MULTIPLY" || keyword == "ADD" ||
+      keyword == "COPY")
+    {
+      this->CellCount(keyword);
+      this->ReadArrayOperations(keyword);
+    }
+    else if (keyword == "BOX")
+    {
+      this->CellCount(keyword);
+      const auto items = this->ReadRecord(keyword);
+      this->CurrentBox = this->RecordBox(items, 0, this->WholeGrid(), keyword);
+    }
+    else if (keyword == "ENDBOX")
+    {
+      this->CurrentBox.reset();
+    }
+    else if (keyword == "TITLE")
+    {
+      tokens.SkipRestOfLine();
+      const Token& next = tokens.Next(); // the title line itself, whatever it holds
+      if (next.kind != TokenKind::End)
+      {
+        tokens.SkipRestOfLine();
+      }
+    }
+    else if (keyword == "RUNSPEC")
+    {
+      this->CurrentSection = Section::Runspec;
+    }
+    else if (keyword == "GRID")
+    {
+      this->CurrentSection = Section::Grid;
+    }
+    else if (keyword == "EDIT")
+    {
+      this->CurrentSection = Section::Edit;
+    }
+    else if (keyword == "PROPS")
+    {
+      this->CurrentSection = Section::Props;
+    }
+    else if (keyword == "REGIONS")
+    {
+      this->CurrentSection = Section::Regions;
+    }
+    else if (keyword == "SOLUTION")
+    {
+      this->CurrentSection = Section::Solution;
+    }
+    else if (keyword == "SUMMARY")
+    {
+      this->CurrentSection = Section::Summary;
+    }
+    else if (keyword == "SCHEDULE" || keyword == "END")
+    {
+      this->CurrentSection = Section::Schedule;
+      this->Stopped = this->Options.stopAtSchedule || keyword == "END";
+    }
+    else if (this->CurrentSection == Section::Schedule)
+    {
+      this->SkipRestOfKeyword();
+    }
+    else if (IsKnownCellArray(keyword) && this->InPropertySection())
+    {
+      this->CellCount(keyword);
+      this->ReadCellArray(keyword, false);
+    }
+    else if (this->InPropertySection() && this->Deck.dims[0] != 0)
+    {
+      this->ReadCellArray(keyword, true);
+    }
+    else
+    {
+      this->SkipRestOfKeyword();
+    }
+  }
+
+  // ---------------------------------------------------------------- binary GRDECL
+  void ParseBinaryFile(const std::string& path)
+  {
+    EclipseBinaryReader reader(path);
+    EclipseKeywordHeader header;
+    std::vector<double> values;
+    const std::string savedFile = this->CurrentFile;
+    this->CurrentFile = path;
+    this->CurrentLine = 0;
+    while (reader.NextKeyword(header))
+    {
+      const std::string& keyword = header.name;
+      const auto fail = [&](const std::string& what) {
+        throw GrdeclError(path, 0, keyword,
+          what + " (keyword header at byte " + std::to_string(header.offset) + ")");
+      };
+      const bool numeric = header.type == "INTE" || header.type == "REAL" ||
+        header.type == "DOUB" || header.type == "LOGI";
+      if (!numeric)
+      {
+        if (keyword == "GRIDUNIT" || keyword == "MAPUNITS")
+        {
+          std::vector<std::string> strings;
+          reader.ReadStrings(strings);
+          std::string& target = keyword == "GRIDUNIT" ? this->Deck.gridUnit : this->Deck.mapUnits;
+          target = strings.empty() ? "" : strings[0];
+          if (keyword == "GRIDUNIT")
+          {
+            this->Deck.gridUnitIsMap = strings.size() > 1 && Upper(strings[1]).rfind("MAP", 0) == 0;
+          }
+        }
+        else
+        {
+          reader.SkipData();
+        }
+        continue;
+      }
+      if (keyword == "SPECGRID" || keyword == "DIMENS")
+      {
+        reader.ReadNumbers(values);
+        if (values.size() < 3)
+        {
+          fail("needs at least 3 values");
+        }
+        const std::array<int64_t, 3> dims = { static_cast<int64_t>(values[0]),
+          static_cast<int64_t>(values[1]), static_cast<int64_t>(values[2]) };
+        CheckedCellCount(dims, this->Options.maxCells, path, 0, keyword);
+        this->Deck.dims = dims;
+        continue;
+      }
+      if (keyword == "MAPAXES")
+      {
+        reader.ReadNumbers(values);
+        if (values.size() != 6)
+        {
+          fail("needs 6 values");
+        }
+        this->Deck.hasMapAxes = true;
+        this->Deck.mapAxes =
+          MapAxes{ { values[0], values[1] }, { values[2], values[3] }, { values[4], values[5] } };
+        continue;
+      }
+      if (this->Deck.dims[0] == 0)
+      {
+        reader.SkipData();
+        continue;
+      }
+      const auto& d = this->Deck.dims;
+      const int64_t n = this->Deck.CellCount();
+      int64_t expected = -1;
+      std::vector<double>* target = nullptr;
+      if (keyword == "COORD")
+      {
+        expected = 6 * (d[0] + 1) * (d[1] + 1);
+        target = &this->Deck.coord;
+      }
+      else if (keyword == "ZCORN")
+      {
+        expected = 8 * n;
+        target = &this->Deck.zcorn;
+      }
+      if (target)
+      {
+        if (header.count != expected)
+        {
+          fail("expected " + std::to_string(expected) + " values, file has " +
+            std::to_string(header.count));
+        }
+        reader.ReadNumbers(*target);
+        for (double v : *target)
+        {
+          if (!std::isfinite(v))
+          {
+            fail("holds a value that is not finite");
+          }
+        }
+        continue;
+      }
+      if (header.count != n)
+      {
+        if (IsKnownCellArray(keyword))
+        {
+          fail("expected " + std::to_string(n) + " values (one per cell), file has " +
+            std::to_string(header.count));
+        }
+        reader.SkipData();
+        continue;
+      }
+      reader.ReadNumbers(values);
+      CellArray& array = this->ArrayFor(keyword);
+      array.isInteger = header.type == "INTE" || IsIntegerArrayName(keyword);
+      array.values.swap(values);
+    }
+    this->CurrentFile = savedFile;
+  }
+
+  // ---------------------------------------------------------------- final checks
+  void Finish()
+  {
+    GrdeclDeck& deck = this->Deck;
+    const std::string& file = deck.files.front();
+    if (deck.dims[0] == 0)
+    {
+      throw GrdeclError(file, 0, "SPECGRID", "no SPECGRID or DIMENS: grid dimensions unknown");
+    }
+    if (deck.coord.empty() != deck.zcorn.empty())
+    {
+      throw GrdeclError(file, 0, deck.coord.empty() ? "COORD" : "ZCORN",
+        std::string("missing; corner-point grids need both COORD and ZCORN"));
+    }
+    if (!deck.HasCornerPointGeometry())
+    {
+      const bool hasDx = deck.FindArray("DX") || !deck.dxv.empty();
+      const bool hasDy = deck.FindArray("DY") || !deck.dyv.empty();
+      const bool hasDz = deck.FindArray("DZ") || !deck.dzv.empty();
+      if (!hasDx || !hasDy || !hasDz || !deck.FindArray("TOPS"))
+      {
+        throw GrdeclError(file, 0, "COORD",
+          "no grid geometry: need COORD and ZCORN, or DX/DXV, DY/DYV, DZ/DZV and TOPS");
+      }
+    }
+    if (CellArray* actnum = deck.FindArray("ACTNUM"))
+    {
+      for (double& value : actnum->values)
+      {
+        if (std::isnan(value))
+        {
+          value = 1; // cells outside an ACTNUM box stay active
+        }
+        else if (value != std::floor(value) || value < 0)
+        {
+          throw GrdeclError(file, 0, "ACTNUM", "values must be non-negative integers");
+        }
+      }
+    }
+  }
+
+  GrdeclParseOptions Options;
+  GrdeclDeck Deck;
+  GrdeclTokenizer* Tokens = nullptr;
+  std::string RootDirectory;
+  std::string CurrentFile;
+  int64_t CurrentLine = 0;
+  Section CurrentSection = Section::None;
+  bool Stopped = false;
+  std::optional<Box> CurrentBox;
+  std::unordered_map<std::string, std::size_t> FaultIndex;
+};
+} // namespace
+
+GrdeclDeck ParseGrdeclFile(const std::string& path, const GrdeclParseOptions& options)
+{
+  Parser parser(options);
+  return parser.Run(path);
+}
+
+} // namespace resmr

@@ -1,0 +1,426 @@
+#include "vtkGRDECLReader.h"
+
+#include "vtkCellArray.h"
+#include "vtkCellData.h"
+#include "vtkDataArraySelection.h"
+#include "vtkDataSetAttributes.h"
+#include "vtkDoubleArray.h"
+#include "vtkExplicitStructuredGrid.h"
+#include "vtkFieldData.h"
+#include "vtkIdTypeArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkObjectFactory.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStringArray.h"
+#include "vtkUnsignedCharArray.h"
+
+#include "CornerPointGeometry.h"
+#include "EclipseBinaryReader.h"
+#include "GrdeclError.h"
+#include "GrdeclParser.h"
+
+#include <cmath>
+#include <optional>
+#include <sys/stat.h>
+
+struct vtkGRDECLReader::Internals
+{
+  std::string ParsedFile;
+  long long ParsedModificationTime = -1;
+  resmr::GrdeclDeck Deck;
+  std::optional<resmr::CornerPointGeometry> Geometry;
+};
+
+vtkStandardNewMacro(vtkGRDECLReader);
+
+namespace
+{
+long long ModificationTime(const char* path)
+{
+  struct stat info;
+  if (stat(path, &info) != 0)
+  {
+    return -1;
+  }
+  return static_cast<long long>(info.st_mtim.tv_sec) * 1000000000LL + info.st_mtim.tv_nsec;
+}
+
+// ECLIPSE corner c = di + 2 dj + 4 dk for each VTK hexahedron point (k down, right-handed).
+constexpr int EclipseCornerOfVTKPoint[8] = { 0, 1, 3, 2, 4, 5, 7, 6 };
+} // namespace
+
+vtkGRDECLReader::vtkGRDECLReader()
+  : Internal(new Internals)
+{
+  this->SetNumberOfInputPorts(0);
+  this->SetNumberOfOutputPorts(2);
+}
+
+vtkGRDECLReader::~vtkGRDECLReader()
+{
+  this->SetFileName(nullptr);
+}
+
+void vtkGRDECLReader::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
+  os << indent << "ShowInactiveCells: " << this->ShowInactiveCells << "\n";
+  os << indent << "ApplyMapAxes: " << this->ApplyMapAxes << "\n";
+}
+
+int vtkGRDECLReader::FillOutputPortInformation(int port, vtkInformation* info)
+{
+  info->Set(vtkDataObject::DATA_TYPE_NAME(),
+    port == 0 ? "vtkExplicitStructuredGrid" : "vtkPolyData");
+  return 1;
+}
+
+int vtkGRDECLReader::CanReadFile(const char* fileName)
+{
+  if (!fileName)
+  {
+    return 0;
+  }
+  if (resmr::EclipseBinaryReader::LooksLikeEclipseBinary(fileName))
+  {
+    return 1;
+  }
+  FILE* file = fopen(fileName, "rb");
+  if (!file)
+  {
+    return 0;
+  }
+  fclose(file);
+  return 1;
+}
+
+vtkDataArraySelection* vtkGRDECLReader::GetCellArraySelection()
+{
+  return this->CellArraySelection;
+}
+int vtkGRDECLReader::GetNumberOfCellArrays()
+{
+  return this->CellArraySelection->GetNumberOfArrays();
+}
+const char* vtkGRDECLReader::GetCellArrayName(int index)
+{
+  return this->CellArraySelection->GetArrayName(index);
+}
+int vtkGRDECLReader::GetCellArrayStatus(const char* name)
+{
+  return this->CellArraySelection->ArrayIsEnabled(name);
+}
+void vtkGRDECLReader::SetCellArrayStatus(const char* name, int status)
+{
+  if (this->CellArraySelection->ArrayIsEnabled(name) != (status != 0) ||
+    !this->CellArraySelection->ArrayExists(name))
+  {
+    this->CellArraySelection->SetArraySetting(name, status);
+    this->Modified();
+  }
+}
+
+vtkDataArraySelection* vtkGRDECLReader::GetFaultSelection()
+{
+  return this->FaultSelection;
+}
+int vtkGRDECLReader::GetNumberOfFaultArrays()
+{
+  return this->FaultSelection->GetNumberOfArrays();
+}
+const char* vtkGRDECLReader::GetFaultArrayName(int index)
+{
+  return this->FaultSelection->GetArrayName(index);
+}
+int vtkGRDECLReader::GetFaultArrayStatus(const char* name)
+{
+  return this->FaultSelection->ArrayIsEnabled(name);
+}
+void vtkGRDECLReader::SetFaultArrayStatus(const char* name, int status)
+{
+  if (this->FaultSelection->ArrayIsEnabled(name) != (status != 0) ||
+    !this->FaultSelection->ArrayExists(name))
+  {
+    this->FaultSelection->SetArraySetting(name, status);
+    this->Modified();
+  }
+}
+
+void vtkGRDECLReader::ReportError(const std::string& message)
+{
+  this->LastError = message;
+  vtkErrorMacro(<< message);
+}
+
+bool vtkGRDECLReader::ParseIfNeeded()
+{
+  if (!this->FileName || !*this->FileName)
+  {
+    this->ReportError("no FileName set");
+    return false;
+  }
+  const long long modified = ModificationTime(this->FileName);
+  Internals& internal = *this->Internal;
+  if (internal.Geometry && internal.ParsedFile == this->FileName &&
+    internal.ParsedModificationTime == modified)
+  {
+    return true;
+  }
+  internal.Geometry.reset();
+  internal.Deck = resmr::GrdeclDeck();
+  internal.ParsedFile.clear();
+  try
+  {
+    internal.Deck = resmr::ParseGrdeclFile(this->FileName);
+    internal.Geometry = resmr::CornerPointGeometry::FromDeck(internal.Deck, this->ApplyMapAxes);
+  }
+  catch (const std::exception& error)
+  {
+    internal.Deck = resmr::GrdeclDeck();
+    internal.Geometry.reset();
+    this->ReportError(error.what());
+    return false;
+  }
+  catch (...)
+  {
+    internal.Deck = resmr::GrdeclDeck();
+    internal.Geometry.reset();
+    this->ReportError(std::string(this->FileName) + ": unexpected failure while reading");
+    return false;
+  }
+  internal.ParsedFile = this->FileName;
+  internal.ParsedModificationTime = modified;
+  for (const resmr::CellArray& array : internal.Deck.arrays)
+  {
+    if (!resmr::IsGeometryArrayName(array.name) && !this->CellArraySelection->ArrayExists(array.name.c_str()))
+    {
+      this->CellArraySelection->AddArray(array.name.c_str(), true);
+    }
+  }
+  for (const resmr::Fault& fault : internal.Deck.faults)
+  {
+    if (!this->FaultSelection->ArrayExists(fault.name.c_str()))
+    {
+      this->FaultSelection->AddArray(fault.name.c_str(), true);
+    }
+  }
+  return true;
+}
+
+int vtkGRDECLReader::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  this->LastError.clear();
+  if (!this->ParseIfNeeded())
+  {
+    return 0;
+  }
+  const auto& dims = this->Internal->Geometry->Dims();
+  int extent[6] = { 0, static_cast<int>(dims[0]), 0, static_cast<int>(dims[1]), 0,
+    static_cast<int>(dims[2]) };
+  outputVector->GetInformationObject(0)->Set(
+    vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  return 1;
+}
+
+int vtkGRDECLReader::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkExplicitStructuredGrid* grid = vtkExplicitStructuredGrid::GetData(outputVector, 0);
+  vtkPolyData* faults = vtkPolyData::GetData(outputVector, 1);
+  grid->Initialize();
+  faults->Initialize();
+  this->LastError.clear();
+  if (!this->ParseIfNeeded())
+  {
+    return 0;
+  }
+  const resmr::GrdeclDeck& deck = this->Internal->Deck;
+  resmr::CornerPointGeometry& geometry = *this->Internal->Geometry;
+  geometry.SetMapAxesApplied(this->ApplyMapAxes);
+  this->LeftHanded = geometry.IsLeftHanded();
+
+  const int64_t nx = geometry.Dims()[0], ny = geometry.Dims()[1], nz = geometry.Dims()[2];
+  const vtkIdType cellCount = static_cast<vtkIdType>(nx * ny * nz);
+  const bool mirrorK = this->LeftHanded;
+  // VTK cell id of ECLIPSE cell index (i fastest, k down).
+  const auto vtkCellOf = [&](int64_t eclipseCell) -> vtkIdType {
+    if (!mirrorK)
+    {
+      return static_cast<vtkIdType>(eclipseCell);
+    }
+    const int64_t layer = nx * ny;
+    const int64_t k = eclipseCell / layer;
+    return static_cast<vtkIdType>((nz - 1 - k) * layer + eclipseCell % layer);
+  };
+
+  try
+  {
+    resmr::CornerPointGeometry::SharedCorners shared = geometry.BuildSharedCorners();
+    const vtkIdType pointCount = static_cast<vtkIdType>(shared.points.size() / 3);
+    vtkNew<vtkDoubleArray> coordinates;
+    coordinates->SetNumberOfComponents(3);
+    coordinates->SetNumberOfTuples(pointCount);
+    double* xyz = coordinates->GetPointer(0);
+    for (vtkIdType p = 0; p < pointCount; ++p)
+    {
+      xyz[3 * p] = shared.points[3 * p];
+      xyz[3 * p + 1] = shared.points[3 * p + 1];
+      xyz[3 * p + 2] = -shared.points[3 * p + 2]; // elevation: z up
+    }
+    shared.points = std::vector<double>();
+    vtkNew<vtkPoints> points;
+    points->SetData(coordinates);
+
+    vtkNew<vtkIdTypeArray> connectivity;
+    connectivity->SetNumberOfValues(8 * cellCount);
+    vtkIdType* ids = connectivity->GetPointer(0);
+    for (int64_t cell = 0; cell < cellCount; ++cell)
+    {
+      vtkIdType* out = ids + 8 * vtkCellOf(cell);
+      const int64_t* in = &shared.cellPoints[static_cast<std::size_t>(8 * cell)];
+      for (int v = 0; v < 8; ++v)
+      {
+        // Mirrored: VTK points 0-3 take the bottom (deeper) face.
+        const int corner = EclipseCornerOfVTKPoint[v] ^ (mirrorK ? 4 : 0);
+        out[v] = static_cast<vtkIdType>(in[corner]);
+      }
+    }
+    shared.cellPoints = std::vector<int64_t>();
+    vtkNew<vtkCellArray> cells;
+    cells->SetData(8, connectivity);
+
+    grid->SetExtent(0, static_cast<int>(nx), 0, static_cast<int>(ny), 0, static_cast<int>(nz));
+    grid->SetPoints(points);
+    grid->SetCells(cells);
+    grid->ComputeFacesConnectivityFlagsArray();
+
+    vtkCellData* cellData = grid->GetCellData();
+    const resmr::CellArray* actnumArray = deck.FindArray("ACTNUM");
+    vtkNew<vtkIntArray> iArray, jArray, kArray, actnum;
+    iArray->SetName("I");
+    jArray->SetName("J");
+    kArray->SetName("K");
+    actnum->SetName("ACTNUM");
+    for (vtkIntArray* array : { iArray.Get(), jArray.Get(), kArray.Get(), actnum.Get() })
+    {
+      array->SetNumberOfValues(cellCount);
+    }
+    vtkNew<vtkUnsignedCharArray> ghosts;
+    ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
+    ghosts->SetNumberOfValues(cellCount);
+    bool anyHidden = false;
+    for (int64_t cell = 0; cell < cellCount; ++cell)
+    {
+      const vtkIdType id = vtkCellOf(cell);
+      iArray->SetValue(id, static_cast<int>(cell % nx + 1));
+      jArray->SetValue(id, static_cast<int>((cell / nx) % ny + 1));
+      kArray->SetValue(id, static_cast<int>(cell / (nx * ny) + 1));
+      const int active = actnumArray ? static_cast<int>(actnumArray->values[cell]) : 1;
+      actnum->SetValue(id, active);
+      const bool hidden = active <= 0 && !this->ShowInactiveCells;
+      ghosts->SetValue(id, hidden ? vtkDataSetAttributes::HIDDENCELL : 0);
+      anyHidden |= hidden;
+    }
+    cellData->AddArray(iArray);
+    cellData->AddArray(jArray);
+    cellData->AddArray(kArray);
+    cellData->AddArray(actnum);
+    if (anyHidden)
+    {
+      cellData->AddArray(ghosts);
+    }
+
+    for (const resmr::CellArray& property : deck.arrays)
+    {
+      if (resmr::IsGeometryArrayName(property.name) ||
+        !this->CellArraySelection->ArrayIsEnabled(property.name.c_str()))
+      {
+        continue;
+      }
+      vtkSmartPointer<vtkDataArray> array;
+      if (property.isInteger)
+      {
+        vtkNew<vtkIntArray> values;
+        values->SetNumberOfValues(cellCount);
+        for (int64_t cell = 0; cell < cellCount; ++cell)
+        {
+          const double value = property.values[cell];
+          values->SetValue(vtkCellOf(cell), std::isfinite(value) ? static_cast<int>(value) : 0);
+        }
+        array = values;
+      }
+      else
+      {
+        vtkNew<vtkDoubleArray> values;
+        values->SetNumberOfValues(cellCount);
+        for (int64_t cell = 0; cell < cellCount; ++cell)
+        {
+          values->SetValue(vtkCellOf(cell), property.values[cell]);
+        }
+        array = values;
+      }
+      array->SetName(property.name.c_str());
+      cellData->AddArray(array);
+    }
+
+    // Faults: one quad per faulted cell face, corners taken from the cell itself.
+    vtkNew<vtkPoints> faultPoints;
+    faultPoints->SetDataTypeToDouble();
+    vtkNew<vtkCellArray> faultQuads;
+    vtkNew<vtkIntArray> faultIndex;
+    faultIndex->SetName("FaultIndex");
+    vtkNew<vtkStringArray> faultNames;
+    faultNames->SetName("FaultNames");
+    static const int faceCorners[6][4] = { { 0, 2, 6, 4 }, { 1, 5, 7, 3 }, { 0, 4, 5, 1 },
+      { 2, 3, 7, 6 }, { 0, 1, 3, 2 }, { 4, 6, 7, 5 } };
+    for (std::size_t f = 0; f < deck.faults.size(); ++f)
+    {
+      const resmr::Fault& fault = deck.faults[f];
+      faultNames->InsertNextValue(fault.name);
+      if (!this->FaultSelection->ArrayIsEnabled(fault.name.c_str()))
+      {
+        continue;
+      }
+      for (const resmr::FaultFace& face : fault.faces)
+      {
+        for (int64_t k = face.box[4]; k <= face.box[5]; ++k)
+        {
+          for (int64_t j = face.box[2]; j <= face.box[3]; ++j)
+          {
+            for (int64_t i = face.box[0]; i <= face.box[1]; ++i)
+            {
+              double corners[8][3];
+              geometry.CellCorners(i, j, k, corners);
+              vtkIdType quad[4];
+              for (int c = 0; c < 4; ++c)
+              {
+                const double* p = corners[faceCorners[face.face][c]];
+                quad[c] = faultPoints->InsertNextPoint(p[0], p[1], -p[2]);
+              }
+              faultQuads->InsertNextCell(4, quad);
+              faultIndex->InsertNextValue(static_cast<int>(f));
+            }
+          }
+        }
+      }
+    }
+    faults->SetPoints(faultPoints);
+    faults->SetPolys(faultQuads);
+    faults->GetCellData()->AddArray(faultIndex);
+    faults->GetFieldData()->AddArray(faultNames);
+  }
+  catch (const std::bad_alloc&)
+  {
+    grid->Initialize();
+    faults->Initialize();
+    this->ReportError(std::string(this->FileName) + ": not enough memory to build the grid");
+    return 0;
+  }
+  return 1;
+}
