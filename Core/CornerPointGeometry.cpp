@@ -101,6 +101,17 @@ CornerPointGeometry CornerPointGeometry::FromDeck(GrdeclDeck& deck, bool applyMa
 {
   CornerPointGeometry geometry;
   geometry.Dimensions = deck.dims;
+  if (!deck.HasCornerPointGeometry())
+  {
+    const bool hasDx = deck.FindArray("DX") || !deck.dxv.empty();
+    const bool hasDy = deck.FindArray("DY") || !deck.dyv.empty();
+    const bool hasDz = deck.FindArray("DZ") || !deck.dzv.empty();
+    if (!hasDx || !hasDy || !hasDz || !deck.FindArray("TOPS"))
+    {
+      throw GrdeclError(deck.files.empty() ? std::string("deck") : deck.files.front(), 0, "COORD",
+        "no grid geometry: need COORD and ZCORN, or DX/DXV, DY/DYV, DZ/DZV and TOPS");
+    }
+  }
   if (deck.HasCornerPointGeometry())
   {
     geometry.CoordValues = std::move(deck.coord);

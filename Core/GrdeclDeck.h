@@ -71,6 +71,7 @@ struct GrdeclDeck
 
   std::vector<Fault> faults;
   std::vector<std::string> files; ///< every file read, the deck first
+  std::vector<std::string> warnings; ///< problems that did not stop the parse
 
   int64_t CellCount() const { return this->dims[0] * this->dims[1] * this->dims[2]; }
   const CellArray* FindArray(const std::string& name) const;

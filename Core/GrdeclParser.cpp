@@ -110,7 +110,7 @@ bool LooksLikeKeyword(std::string_view word)
 
 bool IsIntegerArrayName(const std::string& name)
 {
-  return name == "ACTNUM" || (name.size() > 3 && name.compare(name.size() - 3, 3, "NUM") == 0);
+  return name == "ACTNUM" || name == "FACIES" || (name.size() > 3 && name.compare(name.size() - 3, 3, "NUM") == 0);
 }
 
 /// Cell property keywords whose value count is checked strictly (a wrong count is an error,
@@ -548,8 +548,8 @@ private:
     {
       dims[axis] = this->RecordInteger(items, axis, keyword, std::string("N") + "XYZ"[axis], 0, true);
     }
-    if (keyword == "SPECGRID" && items.size() > 3 && !items[3].empty() &&
-      this->RecordInteger(items, 3, keyword, "NUMRES", 1, false) != 1)
+    double numres = 1;
+    if (keyword == "SPECGRID" && items.size() > 3 && ParseDouble(items[3], numres) && numres != 1)
     {
       this->FailHere(keyword, "multiple reservoirs (NUMRES > 1) are not supported");
     }
@@ -727,8 +727,14 @@ private:
         return;
       }
     }
-    this->FailHere(keyword, "included file '" + name + "' not found (looked in " + here +
-        (here == this->RootDirectory ? "" : " and " + this->RootDirectory) + ")");
+    const std::string message = "included file '" + name + "' not found (looked in " + here +
+      (here == this->RootDirectory ? "" : " and " + this->RootDirectory) + ")";
+    if (!this->Options.skipMissingIncludes)
+    {
+      this->FailHere(keyword, message);
+    }
+    this->Deck.warnings.push_back(
+      GrdeclError::Format(this->CurrentFile, this->CurrentLine, keyword, message + "; skipped"));
   }
 
   void ParseTextFile(const std::string& path, int depth)
@@ -1052,17 +1058,6 @@ private:
     {
       throw GrdeclError(file, 0, deck.coord.empty() ? "COORD" : "ZCORN",
         std::string("missing; corner-point grids need both COORD and ZCORN"));
-    }
-    if (!deck.HasCornerPointGeometry())
-    {
-      const bool hasDx = deck.FindArray("DX") || !deck.dxv.empty();
-      const bool hasDy = deck.FindArray("DY") || !deck.dyv.empty();
-      const bool hasDz = deck.FindArray("DZ") || !deck.dzv.empty();
-      if (!hasDx || !hasDy || !hasDz || !deck.FindArray("TOPS"))
-      {
-        throw GrdeclError(file, 0, "COORD",
-          "no grid geometry: need COORD and ZCORN, or DX/DXV, DY/DYV, DZ/DZV and TOPS");
-      }
     }
     if (CellArray* actnum = deck.FindArray("ACTNUM"))
     {

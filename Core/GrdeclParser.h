@@ -25,6 +25,8 @@ struct GrdeclParseOptions
   int64_t maxCells = 0;
   /// Stop at the first SCHEDULE keyword (grid and properties are all defined before it).
   bool stopAtSchedule = true;
+  /// Warn (GrdeclDeck::warnings) instead of failing when an INCLUDE file is missing.
+  bool skipMissingIncludes = false;
 };
 
 /// Parses an ASCII deck (.grdecl, .DATA, .inc ...) or a binary GRDECL (.bgrdecl), chosen by

@@ -1,0 +1,110 @@
+// resmr: command-line front end of the Core library (paper Sec. 3 input; later the
+// multiresolution builder of Sec. 4-6 joins here).
+//
+//   resmr info [--skip-missing-includes] DECK
+//                       prints the deck's dimensions, active cells, arrays and faults as JSON
+#include "CornerPointGeometry.h"
+#include "GrdeclError.h"
+#include "GrdeclParser.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+namespace
+{
+std::string JsonString(const std::string& text)
+{
+  std::string out = "\"";
+  for (char c : text)
+  {
+    if (c == '"' || c == '\\')
+    {
+      out += '\\';
+      out += c;
+    }
+    else if (static_cast<unsigned char>(c) < 32)
+    {
+      char escaped[8];
+      std::snprintf(escaped, sizeof(escaped), "\\u%04x", c);
+      out += escaped;
+    }
+    else
+    {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+int Info(const char* path, bool skipMissingIncludes)
+{
+  resmr::GrdeclParseOptions options;
+  options.skipMissingIncludes = skipMissingIncludes;
+  resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(path, options);
+  for (const std::string& warning : deck.warnings)
+  {
+    std::fprintf(stderr, "resmr: warning: %s\n", warning.c_str());
+  }
+  const int64_t cells = deck.CellCount();
+  int64_t active = cells;
+  if (const resmr::CellArray* actnum = deck.FindArray("ACTNUM"))
+  {
+    active = 0;
+    for (double value : actnum->values)
+    {
+      active += value > 0;
+    }
+  }
+  int64_t faultRecords = 0;
+  for (const resmr::Fault& fault : deck.faults)
+  {
+    faultRecords += static_cast<int64_t>(fault.faces.size());
+  }
+  std::string geometry = "none";
+  bool leftHanded = false;
+  if (deck.HasCornerPointGeometry() || deck.FindArray("TOPS"))
+  {
+    geometry = deck.HasCornerPointGeometry() ? "corner-point" : "cartesian";
+    leftHanded = resmr::CornerPointGeometry::FromDeck(deck, true).IsLeftHanded();
+  }
+  std::printf("{\"file\": %s, \"dims\": [%lld, %lld, %lld], \"cells\": %lld, \"active\": %lld, "
+              "\"geometry\": \"%s\", \"left_handed\": %s, \"fault_records\": %lld, \"faults\": [",
+    JsonString(path).c_str(), static_cast<long long>(deck.dims[0]),
+    static_cast<long long>(deck.dims[1]), static_cast<long long>(deck.dims[2]),
+    static_cast<long long>(cells), static_cast<long long>(active), geometry.c_str(),
+    leftHanded ? "true" : "false", static_cast<long long>(faultRecords));
+  for (std::size_t f = 0; f < deck.faults.size(); ++f)
+  {
+    std::printf("%s%s", f ? ", " : "", JsonString(deck.faults[f].name).c_str());
+  }
+  std::printf("], \"arrays\": [");
+  for (std::size_t a = 0; a < deck.arrays.size(); ++a)
+  {
+    std::printf("%s%s", a ? ", " : "", JsonString(deck.arrays[a].name).c_str());
+  }
+  std::printf("], \"files\": %zu}\n", deck.files.size());
+  return 0;
+}
+} // namespace
+
+int main(int argc, char** argv)
+{
+  const bool lenient = argc == 4 && std::strcmp(argv[2], "--skip-missing-includes") == 0;
+  if ((argc == 3 || lenient) && std::strcmp(argv[1], "info") == 0)
+  {
+    try
+    {
+      return Info(argv[argc - 1], lenient);
+    }
+    catch (const std::exception& error)
+    {
+      std::fprintf(stderr, "resmr: error: %s\n", error.what());
+      return 1;
+    }
+  }
+  std::fprintf(stderr, "usage: resmr info [--skip-missing-includes] DECK\n"
+                       "  prints dimensions, active cells, arrays and faults of an Eclipse deck\n");
+  return 2;
+}

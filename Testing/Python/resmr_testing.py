@@ -1,0 +1,82 @@
+"""Shared helpers for the pvpython tests: argument parsing, loading the plugin, reading a
+deck through the GRDECLReader proxy, and image comparison against a baseline."""
+import argparse
+import os
+import shutil
+import sys
+
+import numpy as np
+
+
+def arguments():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--plugin", required=True)
+    parser.add_argument("--data", required=True, help="shared data folder")
+    parser.add_argument("--baselines", default="")
+    parser.add_argument("--temp", default="/tmp")
+    return parser.parse_args()
+
+
+def load_plugin(path):
+    from paraview import simple
+    simple.LoadPlugin(path, remote=False, ns=vars(simple))
+
+
+def read_grid(path, **properties):
+    """Runs GRDECLReader on path and returns (proxy, vtkExplicitStructuredGrid copy)."""
+    from paraview import servermanager, simple
+    reader = simple.GRDECLReader(FileName=path, **properties)
+    reader.UpdatePipeline()
+    data = servermanager.Fetch(reader, arg1=None, arg2=None, idx=0)
+    return reader, data
+
+
+def cell_array(grid, name):
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    array = grid.GetCellData().GetArray(name)
+    if array is None:
+        raise AssertionError(f"cell array {name} missing")
+    return vtk_to_numpy(array)
+
+
+def points_and_cells(grid):
+    """Points (n, 3) and hexahedron point ids (cells, 8), in VTK order."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    points = vtk_to_numpy(grid.GetPoints().GetData()).astype(np.float64)
+    connectivity = vtk_to_numpy(grid.GetCells().GetConnectivityArray())
+    return points, connectivity.reshape(-1, 8)
+
+
+def compare_image(render_view, baseline_dir, name, temp_dir, threshold=0.05):
+    """Saves the view and compares it to baseline_dir/name. Missing baselines fail the test
+    and leave the new image in temp_dir for a person to look at."""
+    from paraview import simple
+    from paraview.vtk.test import Testing
+    os.makedirs(temp_dir, exist_ok=True)
+    produced = os.path.join(temp_dir, name)
+    simple.SaveScreenshot(produced, render_view, ImageResolution=[800, 600])
+    baseline = os.path.join(baseline_dir, name)
+    if not os.path.exists(baseline):
+        raise AssertionError(f"no baseline {baseline}; new image left at {produced}")
+    from vtkmodules.vtkIOImage import vtkPNGReader
+    from vtkmodules.vtkImagingCore import vtkImageDifference
+    images = []
+    for path in (produced, baseline):
+        reader = vtkPNGReader()
+        reader.SetFileName(path)
+        reader.Update()
+        images.append(reader.GetOutput())
+    difference = vtkImageDifference()
+    difference.SetInputData(images[0])
+    difference.SetImageData(images[1])
+    difference.Update()
+    error = difference.GetThresholdedError()
+    print(f"{name}: image difference {error:.4f} (threshold {threshold})")
+    if error > threshold:
+        raise AssertionError(f"{name} differs from its baseline by {error:.4f} > {threshold};"
+                             f" see {produced}")
+
+
+def fail(message):
+    print("FAIL", message)
+    sys.exit(1)
