@@ -355,6 +355,10 @@ const Token& GrdeclTokenizer::Next()
       }
       ++length;
     }
+    if (length > MaxTokenBytes)
+    {
+      throw GrdeclError(this->Path, this->Line, "", "token longer than 1 MiB (binary file?)");
+    }
     this->Current = Token{ TokenKind::Word,
       std::string_view(this->Buffer.data() + this->Begin, length), this->Line, atLineStart };
     this->Begin += length;

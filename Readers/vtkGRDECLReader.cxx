@@ -31,6 +31,9 @@ struct vtkGRDECLReader::Internals
 {
   std::string ParsedFile;
   long long ParsedModificationTime = -1;
+  std::string FailedFile; ///< last file that failed to parse, to report it once
+  long long FailedModificationTime = -1;
+  std::string FailedMessage;
   resmr::GrdeclDeck Deck;
   std::optional<resmr::CornerPointGeometry> Geometry;
 };
@@ -171,26 +174,36 @@ bool vtkGRDECLReader::ParseIfNeeded()
   {
     return true;
   }
+  if (internal.FailedFile == this->FileName && internal.FailedModificationTime == modified)
+  {
+    this->LastError = internal.FailedMessage; // already reported in RequestInformation
+    return false;
+  }
   internal.Geometry.reset();
   internal.Deck = resmr::GrdeclDeck();
   internal.ParsedFile.clear();
+  internal.FailedFile.clear();
+  const auto fail = [&](const std::string& message) {
+    internal.Deck = resmr::GrdeclDeck();
+    internal.Geometry.reset();
+    internal.FailedFile = this->FileName;
+    internal.FailedModificationTime = modified;
+    internal.FailedMessage = message;
+    this->ReportError(message);
+  };
   try
   {
     internal.Deck = resmr::ParseGrdeclFile(this->FileName);
     internal.Geometry = resmr::CornerPointGeometry::FromDeck(internal.Deck, this->ApplyMapAxes);
   }
-  catch (const std::exception& error)
+  catch (const std::bad_alloc&)
   {
-    internal.Deck = resmr::GrdeclDeck();
-    internal.Geometry.reset();
-    this->ReportError(error.what());
+    fail(std::string(this->FileName) + ": not enough memory to read this deck");
     return false;
   }
-  catch (...)
+  catch (const std::exception& error)
   {
-    internal.Deck = resmr::GrdeclDeck();
-    internal.Geometry.reset();
-    this->ReportError(std::string(this->FileName) + ": unexpected failure while reading");
+    fail(error.what());
     return false;
   }
   internal.ParsedFile = this->FileName;
@@ -218,7 +231,11 @@ int vtkGRDECLReader::RequestInformation(
   this->LastError.clear();
   if (!this->ParseIfNeeded())
   {
-    return 0;
+    // Let RequestData run and empty the outputs, so no stale data is shown.
+    int empty[6] = { 0, -1, 0, -1, 0, -1 };
+    outputVector->GetInformationObject(0)->Set(
+      vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), empty, 6);
+    return 1;
   }
   const auto& dims = this->Internal->Geometry->Dims();
   int extent[6] = { 0, static_cast<int>(dims[0]), 0, static_cast<int>(dims[1]), 0,

@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# Builds the GRDECL libFuzzer target (clang, ASan + UBSan) and fuzzes it on one core.
+#
+#   Testing/Fuzz/run_fuzz.sh [SECONDS]          default 60
+#
+# Environment:
+#   FUZZ_BUILD_DIR   where the fuzzer binary goes          (default /tmp/resmr-fuzz-build)
+#   RESMR_DATA_DIR   real decks to seed the run from       (default <repo>/../shared/data)
+#   FUZZ_FORK=1      keep going after a crash/timeout/OOM (libFuzzer -fork=1 -ignore_*=1)
+#   FUZZ_EXTRA       extra libFuzzer flags, e.g. "-seed=1 -only_ascii=1"
+#   CXX              clang++ with libFuzzer                (default clang++)
+#
+# Needs clang's libFuzzer runtime (Debian: apt-get install clang libclang-rt-14-dev).
+# The working corpus, crash artifacts and logs go under Testing/Fuzz/corpus-work/ (ignored
+# by git); real decks are copied there, never into the repository. Findings worth keeping
+# are copied by hand into Testing/Fuzz/findings/ and described in Testing/Fuzz/README.md.
+set -euo pipefail
+
+seconds="${1:-60}"
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+repo="$(cd "${here}/../.." && pwd)"
+build="${FUZZ_BUILD_DIR:-/tmp/resmr-fuzz-build}"
+data="${RESMR_DATA_DIR:-${repo}/../shared/data}"
+work="${here}/corpus-work"
+cxx="${CXX:-clang++}"
+max_len=65536
+
+mkdir -p "${build}" "${work}/corpus" "${work}/artifacts"
+
+# ---------------------------------------------------------------- build
+fuzzer="${build}/FuzzGrdeclParser"
+echo "== building ${fuzzer}"
+# -fno-sanitize-recover: a UBSan report is a crash with an artifact, not a line in the log.
+"${cxx}" -std=c++17 -g -O1 -fno-omit-frame-pointer \
+  -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
+  -I "${repo}/Core" "${repo}"/Core/*.cpp "${here}/FuzzGrdeclParser.cpp" -o "${fuzzer}"
+
+# ---------------------------------------------------------------- corpus
+cp -n "${here}"/seeds/* "${work}/corpus/" 2>/dev/null || true
+if [ -d "${data}" ]; then
+  n=0
+  while IFS= read -r -d '' deck; do
+    # libFuzzer would cut longer inputs to max_len anyway: keep the head of big decks.
+    name="data_$(echo "${deck#"${data}"/}" | tr '/' '_')"
+    if [ ! -e "${work}/corpus/${name}" ]; then
+      head -c "${max_len}" "${deck}" > "${work}/corpus/${name}"
+      n=$((n + 1))
+    fi
+  done < <(find "${data}/emerald" "${data}/format_variants/xtgeo_etc" \
+             "${data}/spe9/opm-data_deck" "${data}/spe1" "${data}/reek/xtgeo_testdata" \
+             -maxdepth 1 -type f \( -name '*.grdecl' -o -name '*.bgrdecl' -o -name 'SPE9.GRDECL' \
+             -o -name 'SPE1*.DATA' -o -name 'reek_sim_faults.grdecl' \) -print0 2>/dev/null)
+  echo "== seeded ${n} new real decks from ${data}"
+else
+  echo "== no data folder at ${data}: committed seeds only"
+fi
+echo "== corpus: $(ls "${work}/corpus" | wc -l) files"
+
+# ---------------------------------------------------------------- fuzz
+log="${work}/fuzz-$(date -u +%Y%m%dT%H%M%SZ).log"
+flags=(-max_len=${max_len} -timeout=10 -rss_limit_mb=2048 -dict="${here}/grdecl.dict"
+  -max_total_time="${seconds}" -print_final_stats=1 -artifact_prefix="${work}/artifacts/")
+if [ "${FUZZ_FORK:-0}" = 1 ]; then
+  flags+=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
+fi
+# shellcheck disable=SC2206
+flags+=(${FUZZ_EXTRA:-})
+echo "== fuzzing for ${seconds} s on one core; log: ${log}"
+set +e
+# Run from an empty folder: a fuzzed INCLUDE with a relative name is looked up next to the
+# input (a private temp folder), never in the repository.
+(cd "${build}" && "${fuzzer}" "${flags[@]}" "${work}/corpus") > "${log}" 2>&1
+status=$?
+set -e
+tail -n 25 "${log}"
+echo "== libFuzzer exit status ${status}; artifacts:"
+ls -la "${work}/artifacts"
+exit "${status}"
