@@ -23,7 +23,10 @@ view.ViewSize = [800, 600]
 view.OrientationAxesVisibility = 1
 
 for name, relative, exaggeration, direction, zoom in CASES:
-    reader = simple.GRDECLReader(FileName=os.path.join(DATA, relative))
+    # Open as the GUI's File > Open does: the reader factory must pick GRDECLReader.
+    reader = simple.OpenDataFile(os.path.join(DATA, relative))
+    if reader is None or reader.GetXMLName() != "GRDECLReader":
+        rt.fail(f"{relative}: ParaView's reader factory did not choose GRDECLReader")
     reader.UpdatePipeline()
     display = simple.Show(reader, view)
     display.SetRepresentationType("Surface With Edges")
