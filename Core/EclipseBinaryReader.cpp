@@ -46,9 +46,11 @@ int64_t ElementSize(const std::string& type)
   {
     return 0;
   }
-  if (type.size() == 4 && type[0] == 'C' && type[1] >= '0' && type[1] <= '9')
+  if (type.size() == 4 && type[0] == 'C' && type[1] >= '0' && type[1] <= '9' &&
+    type[2] >= '0' && type[2] <= '9' && type[3] >= '0' && type[3] <= '9')
   {
-    return std::stoi(type.substr(1)); // C0nn: strings of nn characters
+    const int length = std::stoi(type.substr(1)); // C0nn: strings of nn characters
+    return length > 0 ? length : -1;
   }
   return -1;
 }

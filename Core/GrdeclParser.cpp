@@ -540,6 +540,21 @@ private:
   }
 
   // ---------------------------------------------------------------- keywords
+  /// DIMENS and SPECGRID may both appear, but must agree: every array, BOX and FAULTS record
+  /// read so far was sized and checked against the first.
+  void SetDimensions(const std::array<int64_t, 3>& dims, const std::string& keyword)
+  {
+    const auto& old = this->Deck.dims;
+    if (old[0] != 0 && old != dims)
+    {
+      this->FailHere(keyword,
+        "grid dimensions " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
+          std::to_string(dims[2]) + " differ from the " + std::to_string(old[0]) + " x " +
+          std::to_string(old[1]) + " x " + std::to_string(old[2]) + " given before");
+    }
+    this->Deck.dims = dims;
+  }
+
   void ReadDimensions(const std::string& keyword)
   {
     const std::vector<std::string> items = this->ReadRecord(keyword);
@@ -554,14 +569,7 @@ private:
       this->FailHere(keyword, "multiple reservoirs (NUMRES > 1) are not supported");
     }
     CheckedCellCount(dims, this->Options.maxCells, this->CurrentFile, this->CurrentLine, keyword);
-    if (this->Deck.dims[0] != 0 && this->Deck.dims != dims)
-    {
-      if (!this->Deck.arrays.empty() || !this->Deck.zcorn.empty() || !this->Deck.coord.empty())
-      {
-        this->FailHere(keyword, "redefines the grid dimensions after data were given");
-      }
-    }
-    this->Deck.dims = dims;
+    this->SetDimensions(dims, keyword);
   }
 
   void ReadFaults()
@@ -973,10 +981,19 @@ private:
         {
           fail("needs at least 3 values");
         }
-        const std::array<int64_t, 3> dims = { static_cast<int64_t>(values[0]),
-          static_cast<int64_t>(values[1]), static_cast<int64_t>(values[2]) };
+        std::array<int64_t, 3> dims{};
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          // INTE data arrive as doubles; anything else (REAL NaN, 1e30 ...) is rejected here.
+          if (!(std::fabs(values[axis]) <= 4e9) || values[axis] != std::floor(values[axis]))
+          {
+            fail("dimension " + std::to_string(axis + 1) + " is not an integer");
+          }
+          dims[axis] = static_cast<int64_t>(values[axis]);
+        }
         CheckedCellCount(dims, this->Options.maxCells, path, 0, keyword);
-        this->Deck.dims = dims;
+        this->CurrentLine = 0;
+        this->SetDimensions(dims, keyword);
         continue;
       }
       if (keyword == "MAPAXES")

@@ -358,6 +358,8 @@ void TestBadInput()
     { "overflow.grdecl:1", "SPECGRID", "larger than this machine" });
   ExpectError("huge.grdecl", "SPECGRID\n 100000 100000 1000 1 F /\n",
     { "huge.grdecl:1", "SPECGRID", "larger than this machine" });
+  ExpectError("redefined.grdecl", "DIMENS\n 2 2 2 /\nBOX\n 2 2 2 2 2 2 /\nSPECGRID\n 1 1 1 1 F /\n",
+    { "redefined.grdecl:5", "SPECGRID", "differ from the 2 x 2 x 2" });
   ExpectError("noint.grdecl", "SPECGRID\n 2.5 1 1 1 F /\n", { "noint.grdecl:1", "must be an integer" });
   ExpectError("include.DATA", "INCLUDE\n 'does_not_exist.inc' /\n",
     { "include.DATA:1", "INCLUDE", "does_not_exist.inc", "not found" });
