@@ -199,31 +199,45 @@ void EclipseBinaryReader::ReadNumbers(std::vector<double>& values)
   values.clear();
   values.reserve(static_cast<std::size_t>(this->Current.count));
   const int64_t elementSize = ElementSize(type);
+  enum class Kind
+  {
+    Integer,
+    Real,
+    Double,
+    Logical
+  };
+  const Kind kind = type == "REAL" ? Kind::Real
+    : type == "DOUB"               ? Kind::Double
+    : type == "LOGI"               ? Kind::Logical
+                                   : Kind::Integer;
   this->ReadBlocks(elementSize, [&](const unsigned char* data, int64_t n) {
     for (int64_t i = 0; i < n; ++i)
     {
       const unsigned char* p = data + i * elementSize;
-      if (type == "REAL")
+      switch (kind)
       {
-        const uint32_t bits = BigEndian32(p);
-        float value;
-        std::memcpy(&value, &bits, 4);
-        values.push_back(value);
-      }
-      else if (type == "DOUB")
-      {
-        const uint64_t bits = BigEndian64(p);
-        double value;
-        std::memcpy(&value, &bits, 8);
-        values.push_back(value);
-      }
-      else if (type == "LOGI")
-      {
-        values.push_back(BigEndian32(p) != 0 ? 1.0 : 0.0);
-      }
-      else
-      {
-        values.push_back(static_cast<int32_t>(BigEndian32(p)));
+        case Kind::Real:
+        {
+          const uint32_t bits = BigEndian32(p);
+          float value;
+          std::memcpy(&value, &bits, 4);
+          values.push_back(value);
+          break;
+        }
+        case Kind::Double:
+        {
+          const uint64_t bits = BigEndian64(p);
+          double value;
+          std::memcpy(&value, &bits, 8);
+          values.push_back(value);
+          break;
+        }
+        case Kind::Logical:
+          values.push_back(BigEndian32(p) != 0 ? 1.0 : 0.0);
+          break;
+        case Kind::Integer:
+          values.push_back(static_cast<int32_t>(BigEndian32(p)));
+          break;
       }
     }
   });

@@ -127,6 +127,16 @@ bool IsKnownCellArray(const std::string& name)
   return names.count(name) > 0;
 }
 
+/// Keywords that change the deck when read (geometry, arrays, edits, sections, INCLUDE).
+bool IsActedOnKeyword(const std::string& name)
+{
+  static const std::unordered_set<std::string> names = { "SPECGRID", "DIMENS", "COORD", "ZCORN",
+    "DXV", "DYV", "DZV", "MAPAXES", "MAPUNITS", "GRIDUNIT", "GDORIENT", "COORDSYS", "INCLUDE",
+    "IMPORT", "FAULTS", "EQUALS", "MULTIPLY", "ADD", "COPY", "BOX", "ENDBOX", "RUNSPEC", "GRID",
+    "EDIT", "PROPS", "REGIONS", "SOLUTION", "SUMMARY", "SCHEDULE", "END" };
+  return names.count(name) > 0 || IsKnownCellArray(name);
+}
+
 struct Box
 {
   std::array<int64_t, 6> range{}; ///< i1 i2 j1 j2 k1 k2, 0-based inclusive
@@ -258,8 +268,10 @@ private:
       {
         this->Fail(token, keyword, "unterminated keyword: reached end of file before '/'");
       }
-      if (token.kind == TokenKind::Word && token.atLineStart && LooksLikeKeyword(token.text) &&
-        !items.empty() && sawSlash)
+      // A keyword this parser acts on, opening a new line after some items: this record
+      // lost its '/'. (Other words may start lines inside records: GDORIENT's INC, ...)
+      if (token.kind == TokenKind::Word && token.atLineStart && !items.empty() &&
+        IsActedOnKeyword(std::string(token.text)))
       {
         this->Fail(token, keyword,
           "record not terminated by '/' before " + Describe(token) + " on a new line");
@@ -1104,6 +1116,40 @@ private:
   std::unordered_map<std::string, std::size_t> FaultIndex;
 };
 } // namespace
+
+bool LooksLikeGrdeclFile(const std::string& path)
+{
+  if (EclipseBinaryReader::LooksLikeEclipseBinary(path))
+  {
+    return true;
+  }
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file)
+  {
+    return false;
+  }
+  std::string head(1 << 16, '\0');
+  head.resize(std::fread(&head[0], 1, head.size(), file));
+  std::fclose(file);
+  // Any ECLIPSE keyword name alone at the start of a line, within the first 64 KiB.
+  std::size_t start = 0;
+  while (start < head.size())
+  {
+    std::size_t end = head.find('\n', start);
+    if (end == std::string::npos)
+    {
+      end = head.size();
+    }
+    std::string_view line(head.data() + start, end - start);
+    const std::size_t word = line.find_first_of(" \t\r/");
+    if (LooksLikeKeyword(line.substr(0, word)))
+    {
+      return true;
+    }
+    start = end + 1;
+  }
+  return false;
+}
 
 GrdeclDeck ParseGrdeclFile(const std::string& path, const GrdeclParseOptions& options)
 {

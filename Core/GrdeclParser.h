@@ -33,6 +33,10 @@ struct GrdeclParseOptions
 /// content. Throws GrdeclError.
 GrdeclDeck ParseGrdeclFile(const std::string& path, const GrdeclParseOptions& options = {});
 
+/// Cheap check for file dialogs: binary GRDECL, or text with an ECLIPSE keyword in column 1
+/// within its first 64 KiB.
+bool LooksLikeGrdeclFile(const std::string& path);
+
 /// Largest cell count whose corner-point arrays fit in this machine's physical memory.
 int64_t MaxCellsForThisMachine();
 

@@ -19,7 +19,6 @@
 #include "vtkUnsignedCharArray.h"
 
 #include "CornerPointGeometry.h"
-#include "EclipseBinaryReader.h"
 #include "GrdeclError.h"
 #include "GrdeclParser.h"
 
@@ -85,21 +84,7 @@ int vtkGRDECLReader::FillOutputPortInformation(int port, vtkInformation* info)
 
 int vtkGRDECLReader::CanReadFile(const char* fileName)
 {
-  if (!fileName)
-  {
-    return 0;
-  }
-  if (resmr::EclipseBinaryReader::LooksLikeEclipseBinary(fileName))
-  {
-    return 1;
-  }
-  FILE* file = fopen(fileName, "rb");
-  if (!file)
-  {
-    return 0;
-  }
-  fclose(file);
-  return 1;
+  return fileName && resmr::LooksLikeGrdeclFile(fileName) ? 1 : 0;
 }
 
 vtkDataArraySelection* vtkGRDECLReader::GetCellArraySelection()

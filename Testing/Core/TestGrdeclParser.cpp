@@ -360,6 +360,10 @@ void TestBadInput()
     { "huge.grdecl:1", "SPECGRID", "larger than this machine" });
   ExpectError("redefined.grdecl", "DIMENS\n 2 2 2 /\nBOX\n 2 2 2 2 2 2 /\nSPECGRID\n 1 1 1 1 F /\n",
     { "redefined.grdecl:5", "SPECGRID", "differ from the 2 x 2 x 2" });
+  ExpectError("record.grdecl", "SPECGRID\n 2 1 1 1 F\nCOORD\n 1 2 3 /\n",
+    { "record.grdecl:3", "SPECGRID", "not terminated by '/'" });
+  CHECK(resmr::LooksLikeGrdeclFile(Write("looks.inc", "-- header\nPORO\n 1 /\n")));
+  CHECK(!resmr::LooksLikeGrdeclFile(Write("plain.txt", "just some text, no keyword\n")));
   ExpectError("noint.grdecl", "SPECGRID\n 2.5 1 1 1 F /\n", { "noint.grdecl:1", "must be an integer" });
   ExpectError("include.DATA", "INCLUDE\n 'does_not_exist.inc' /\n",
     { "include.DATA:1", "INCLUDE", "does_not_exist.inc", "not found" });
