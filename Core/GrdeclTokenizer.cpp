@@ -3,6 +3,7 @@
 
 #include "GrdeclError.h"
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <charconv>
@@ -191,6 +192,16 @@ GrdeclTokenizer::GrdeclTokenizer(const std::string& path, std::size_t chunkSize)
   if (!this->File)
   {
     throw GrdeclError(path, 0, "", std::string("cannot open file: ") + std::strerror(errno));
+  }
+  // Small files (most INCLUDEs) get a buffer of their own size, not a whole chunk.
+  if (std::fseek(this->File, 0, SEEK_END) == 0)
+  {
+    const long size = std::ftell(this->File);
+    std::rewind(this->File);
+    if (size >= 0 && static_cast<std::size_t>(size) + 1 < this->ChunkSize)
+    {
+      this->ChunkSize = std::max<std::size_t>(static_cast<std::size_t>(size) + 1, 4096);
+    }
   }
   this->Buffer.resize(this->ChunkSize);
 }

@@ -66,13 +66,34 @@ fi
 # shellcheck disable=SC2206
 flags+=(${FUZZ_EXTRA:-})
 echo "== fuzzing for ${seconds} s on one core; log: ${log}"
+# The target's private input folders go here: libFuzzer ends its (fork) processes without
+# running destructors, so they are removed after the run.
+scratch="${build}/tmp"
+rm -rf "${scratch}" && mkdir -p "${scratch}"
 set +e
 # Run from an empty folder: a fuzzed INCLUDE with a relative name is looked up next to the
 # input (a private temp folder), never in the repository.
-(cd "${build}" && "${fuzzer}" "${flags[@]}" "${work}/corpus") > "${log}" 2>&1
+(cd "${build}" && TMPDIR="${scratch}" "${fuzzer}" "${flags[@]}" "${work}/corpus") > "${log}" 2>&1
 status=$?
 set -e
-tail -n 25 "${log}"
-echo "== libFuzzer exit status ${status}; artifacts:"
+rm -rf "${scratch}"
+tail -n 12 "${log}"
+
+# ---------------------------------------------------------------- summary
+if grep -q '^stat::number_of_executed_units' "${log}"; then
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "${log}" | tail -n 1)
+  speed=$(sed -n 's/^stat::average_exec_per_sec: *//p' "${log}" | tail -n 1)
+else # fork mode: the last "#N: cov: ... time: Ts" line
+  last=$(grep -E '^#[0-9]+: cov:' "${log}" | tail -n 1 || true)
+  runs=$(echo "${last}" | sed -n 's/^#\([0-9]*\):.*/\1/p')
+  fuzzed=$(echo "${last}" | sed -n 's/.* time: \([0-9]*\)s.*/\1/p')
+  speed=$(( ${runs:-0} / (${fuzzed:-1} > 0 ? ${fuzzed:-1} : 1) ))
+fi
+echo "== summary: $(date -u +%Y-%m-%dT%H:%MZ) ${seconds} s, ${runs:-?} executions, ${speed:-?} exec/s," \
+  "corpus $(ls "${work}/corpus" | wc -l) files ($(du -sk "${work}/corpus" | cut -f1) KiB)," \
+  "crashes $(grep -c 'ERROR: libFuzzer: deadly signal\|ERROR: AddressSanitizer\|runtime error' "${log}" || true)," \
+  "timeouts $(grep -c 'ERROR: libFuzzer: timeout' "${log}" || true)," \
+  "ooms $(grep -c 'ERROR: libFuzzer: out-of-memory\|malloc limit' "${log}" || true)"
+echo "== libFuzzer exit status ${status}; artifacts in ${work}/artifacts:"
 ls -la "${work}/artifacts"
 exit "${status}"
