@@ -124,34 +124,32 @@ CornerPointGeometry CornerPointGeometry::FromDeck(GrdeclDeck& deck, bool applyMa
     BuildCartesian(deck, geometry.CoordValues, geometry.ZcornValues);
   }
   geometry.MapAxesAvailable = deck.hasMapAxes && !deck.gridUnitIsMap;
-  geometry.Axes = deck.mapAxes;
-  if (geometry.MapAxesAvailable)
+  if (geometry.MapAxesAvailable && !MapTransformOf(deck.mapAxes, geometry.MapTransform))
   {
-    const MapAxes& axes = deck.mapAxes;
-    const double lx = std::hypot(axes.xAxisPoint[0] - axes.origin[0], axes.xAxisPoint[1] - axes.origin[1]);
-    const double ly = std::hypot(axes.yAxisPoint[0] - axes.origin[0], axes.yAxisPoint[1] - axes.origin[1]);
-    if (!(lx > 0) || !(ly > 0) || !std::isfinite(lx) || !std::isfinite(ly))
-    {
-      throw GrdeclError(deck.files.front(), 0, "MAPAXES", "axis points coincide with the origin");
-    }
+    throw GrdeclError(deck.files.empty() ? std::string("deck") : deck.files.front(), 0, "MAPAXES",
+      "axis points coincide with the origin");
   }
   geometry.SetMapAxesApplied(applyMapAxes);
   return geometry;
 }
 
+bool CornerPointGeometry::MapTransformOf(const MapAxes& axes, std::array<double, 6>& transform)
+{
+  const double ex[2] = { axes.xAxisPoint[0] - axes.origin[0], axes.xAxisPoint[1] - axes.origin[1] };
+  const double ey[2] = { axes.yAxisPoint[0] - axes.origin[0], axes.yAxisPoint[1] - axes.origin[1] };
+  const double lx = std::hypot(ex[0], ex[1]);
+  const double ly = std::hypot(ey[0], ey[1]);
+  if (!(lx > 0) || !(ly > 0) || !std::isfinite(lx) || !std::isfinite(ly))
+  {
+    return false;
+  }
+  transform = { axes.origin[0], axes.origin[1], ex[0] / lx, ex[1] / lx, ey[0] / ly, ey[1] / ly };
+  return true;
+}
+
 void CornerPointGeometry::SetMapAxesApplied(bool apply)
 {
   this->MapAxesApplied = apply && this->MapAxesAvailable;
-  if (this->MapAxesApplied)
-  {
-    const MapAxes& axes = this->Axes;
-    const double ex[2] = { axes.xAxisPoint[0] - axes.origin[0], axes.xAxisPoint[1] - axes.origin[1] };
-    const double ey[2] = { axes.yAxisPoint[0] - axes.origin[0], axes.yAxisPoint[1] - axes.origin[1] };
-    const double lx = std::hypot(ex[0], ex[1]);
-    const double ly = std::hypot(ey[0], ey[1]);
-    this->MapTransform = { axes.origin[0], axes.origin[1], ex[0] / lx, ex[1] / lx, ey[0] / ly,
-      ey[1] / ly };
-  }
   this->DetectHandedness();
 }
 

@@ -67,8 +67,10 @@ private:
   std::array<int64_t, 3> Dimensions{};
   std::vector<double> CoordValues;
   std::vector<double> ZcornValues;
-  bool MapAxesAvailable = false;
-  MapAxes Axes;
+  /// Origin and unit axes from MAPAXES; false if an axis point coincides with the origin.
+  static bool MapTransformOf(const MapAxes& axes, std::array<double, 6>& transform);
+
+  bool MapAxesAvailable = false; ///< MAPAXES given and valid, grid not already in map units
   bool MapAxesApplied = false;
   std::array<double, 6> MapTransform{}; ///< origin x y, unit x axis, unit y axis
   bool LeftHanded = false;

@@ -525,12 +525,9 @@ private:
   {
     const int64_t n = this->CellCount("TOPS");
     const int64_t layer = this->Deck.dims[0] * this->Deck.dims[1];
-    std::vector<double> values;
-    values.reserve(static_cast<std::size_t>(layer));
+    double* tops = this->ArrayFor("TOPS").values.data();
     this->ReadNumbers(
-      "TOPS", n, false, true, [&](int64_t, double value) { values.push_back(value); }, layer);
-    CellArray& tops = this->ArrayFor("TOPS");
-    std::copy(values.begin(), values.end(), tops.values.begin());
+      "TOPS", n, false, true, [&](int64_t index, double value) { tops[index] = value; }, layer);
   }
 
   /// Skips an unknown keyword: up to its '/' or up to the next keyword on a new line.
@@ -552,6 +549,22 @@ private:
   }
 
   // ---------------------------------------------------------------- keywords
+  void SetMapAxes(const std::vector<double>& v)
+  {
+    this->Deck.hasMapAxes = true;
+    this->Deck.mapAxes = MapAxes{ { v[0], v[1] }, { v[2], v[3] }, { v[4], v[5] } };
+  }
+
+  void SetUnits(const std::string& keyword, const std::vector<std::string>& items)
+  {
+    std::string& target = keyword == "GRIDUNIT" ? this->Deck.gridUnit : this->Deck.mapUnits;
+    target = items.empty() ? "" : items[0];
+    if (keyword == "GRIDUNIT")
+    {
+      this->Deck.gridUnitIsMap = items.size() > 1 && Upper(items[1]).rfind("MAP", 0) == 0;
+    }
+  }
+
   /// DIMENS and SPECGRID may both appear, but must agree: every array, BOX and FAULTS record
   /// read so far was sized and checked against the first.
   void SetDimensions(const std::array<int64_t, 3>& dims, const std::string& keyword)
@@ -829,20 +842,11 @@ private:
     {
       std::vector<double> values;
       this->ReadNumbers(keyword, 6, false, false, [&](int64_t, double v) { values.push_back(v); });
-      this->Deck.hasMapAxes = true;
-      this->Deck.mapAxes = MapAxes{ { values[0], values[1] }, { values[2], values[3] },
-        { values[4], values[5] } };
+      this->SetMapAxes(values);
     }
-    else if (keyword == "MAPUNITS")
+    else if (keyword == "MAPUNITS" || keyword == "GRIDUNIT")
     {
-      const auto items = this->ReadRecord(keyword);
-      this->Deck.mapUnits = items.empty() ? "" : items[0];
-    }
-    else if (keyword == "GRIDUNIT")
-    {
-      const auto items = this->ReadRecord(keyword);
-      this->Deck.gridUnit = items.empty() ? "" : items[0];
-      this->Deck.gridUnitIsMap = items.size() > 1 && Upper(items[1]).rfind("MAP", 0) == 0;
+      this->SetUnits(keyword, this->ReadRecord(keyword));
     }
     else if (keyword == "GDORIENT")
     {
@@ -973,12 +977,7 @@ private:
         {
           std::vector<std::string> strings;
           reader.ReadStrings(strings);
-          std::string& target = keyword == "GRIDUNIT" ? this->Deck.gridUnit : this->Deck.mapUnits;
-          target = strings.empty() ? "" : strings[0];
-          if (keyword == "GRIDUNIT")
-          {
-            this->Deck.gridUnitIsMap = strings.size() > 1 && Upper(strings[1]).rfind("MAP", 0) == 0;
-          }
+          this->SetUnits(keyword, strings);
         }
         else
         {
@@ -1015,9 +1014,7 @@ private:
         {
           fail("needs 6 values");
         }
-        this->Deck.hasMapAxes = true;
-        this->Deck.mapAxes =
-          MapAxes{ { values[0], values[1] }, { values[2], values[3] }, { values[4], values[5] } };
+        this->SetMapAxes(values);
         continue;
       }
       if (this->Deck.dims[0] == 0)

@@ -364,6 +364,8 @@ void TestBadInput()
     { "record.grdecl:3", "SPECGRID", "not terminated by '/'" });
   CHECK(resmr::LooksLikeGrdeclFile(Write("looks.inc", "-- header\nPORO\n 1 /\n")));
   CHECK(!resmr::LooksLikeGrdeclFile(Write("plain.txt", "just some text, no keyword\n")));
+  ExpectError("mapaxes.grdecl", std::string("MAPAXES\n 0 0 0 0 1 0 /\n") + TwoCells,
+    { "mapaxes.grdecl", "MAPAXES", "coincide with the origin" });
   ExpectError("noint.grdecl", "SPECGRID\n 2.5 1 1 1 F /\n", { "noint.grdecl:1", "must be an integer" });
   ExpectError("include.DATA", "INCLUDE\n 'does_not_exist.inc' /\n",
     { "include.DATA:1", "INCLUDE", "does_not_exist.inc", "not found" });
