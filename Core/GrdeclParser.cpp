@@ -1,7 +1,7 @@
 // Eclipse grid deck parser (paper Sec. 3: the corner-point model and its cell properties).
 #include "GrdeclParser.h"
 
-#include "EclipseBinaryReader.h"
+#include "EclipseKeywordFile.h"
 #include "GrdeclError.h"
 #include "GrdeclTokenizer.h"
 
@@ -189,7 +189,7 @@ private:
   void ParseAnyFile(const std::string& path, int depth)
   {
     this->Deck.files.push_back(path);
-    if (EclipseBinaryReader::LooksLikeEclipseBinary(path))
+    if (EclipseKeywordFile::LooksLikeUnformatted(path))
     {
       this->ParseBinaryFile(path);
     }
@@ -956,38 +956,29 @@ private:
   // ---------------------------------------------------------------- binary GRDECL
   void ParseBinaryFile(const std::string& path)
   {
-    EclipseBinaryReader reader(path);
-    EclipseKeywordHeader header;
+    const EclipseKeywordFile reader(path);
     std::vector<double> values;
     const std::string savedFile = this->CurrentFile;
     this->CurrentFile = path;
     this->CurrentLine = 0;
-    while (reader.NextKeyword(header))
+    for (const EclipseRecord& header : reader.Records())
     {
       const std::string& keyword = header.name;
       const auto fail = [&](const std::string& what) {
         throw GrdeclError(path, 0, keyword,
-          what + " (keyword header at byte " + std::to_string(header.offset) + ")");
+          what + " (keyword header at byte " + std::to_string(header.headerOffset) + ")");
       };
-      const bool numeric = header.type == "INTE" || header.type == "REAL" ||
-        header.type == "DOUB" || header.type == "LOGI";
-      if (!numeric)
+      if (!header.IsNumeric())
       {
         if (keyword == "GRIDUNIT" || keyword == "MAPUNITS")
         {
-          std::vector<std::string> strings;
-          reader.ReadStrings(strings);
-          this->SetUnits(keyword, strings);
-        }
-        else
-        {
-          reader.SkipData();
+          this->SetUnits(keyword, reader.ReadStrings(header));
         }
         continue;
       }
       if (keyword == "SPECGRID" || keyword == "DIMENS")
       {
-        reader.ReadNumbers(values);
+        reader.ReadNumbers(header, values);
         if (values.size() < 3)
         {
           fail("needs at least 3 values");
@@ -1009,7 +1000,7 @@ private:
       }
       if (keyword == "MAPAXES")
       {
-        reader.ReadNumbers(values);
+        reader.ReadNumbers(header, values);
         if (values.size() != 6)
         {
           fail("needs 6 values");
@@ -1019,7 +1010,6 @@ private:
       }
       if (this->Deck.dims[0] == 0)
       {
-        reader.SkipData();
         continue;
       }
       const auto& d = this->Deck.dims;
@@ -1043,7 +1033,7 @@ private:
           fail("expected " + std::to_string(expected) + " values, file has " +
             std::to_string(header.count));
         }
-        reader.ReadNumbers(*target);
+        reader.ReadNumbers(header, *target);
         for (double v : *target)
         {
           if (!std::isfinite(v))
@@ -1060,12 +1050,11 @@ private:
           fail("expected " + std::to_string(n) + " values (one per cell), file has " +
             std::to_string(header.count));
         }
-        reader.SkipData();
         continue;
       }
-      reader.ReadNumbers(values);
+      reader.ReadNumbers(header, values);
       CellArray& array = this->ArrayFor(keyword);
-      array.isInteger = header.type == "INTE" || IsIntegerArrayName(keyword);
+      array.isInteger = header.type == EclipseDataType::Integer || IsIntegerArrayName(keyword);
       array.values.swap(values);
     }
     this->CurrentFile = savedFile;
@@ -1116,7 +1105,7 @@ private:
 
 bool LooksLikeGrdeclFile(const std::string& path)
 {
-  if (EclipseBinaryReader::LooksLikeEclipseBinary(path))
+  if (EclipseKeywordFile::LooksLikeUnformatted(path))
   {
     return true;
   }

@@ -1,0 +1,718 @@
+// ECLIPSE keyword file index and record reader (paper Sec. 3: model input; Sec. 6.1: read
+// only what is shown).
+#include "EclipseKeywordFile.h"
+
+#include "GrdeclError.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace resmr
+{
+namespace
+{
+constexpr int64_t HeaderBytes = 24;             // marker, 8 + 4 + 4 bytes, marker
+constexpr int64_t ChunkBytes = 4 << 20;         // read granularity for record data
+constexpr int64_t NumbersPerBlock = 1000;       // ECLIPSE's Fortran record sizes
+constexpr int64_t StringsPerBlock = 105;
+
+uint32_t BigEndian32(const unsigned char* p)
+{
+  uint32_t value;
+  std::memcpy(&value, p, 4);
+  return __builtin_bswap32(value);
+}
+
+uint64_t BigEndian64(const unsigned char* p)
+{
+  uint64_t value;
+  std::memcpy(&value, p, 8);
+  return __builtin_bswap64(value);
+}
+
+std::string Trimmed(const char* text, std::size_t size)
+{
+  std::string value(text, size);
+  const auto last = value.find_last_not_of(' ');
+  value.erase(last == std::string::npos ? 0 : last + 1);
+  return value;
+}
+
+/// Sets type and element size from the 4-character type name; false if unknown.
+bool ParseType(EclipseRecord& record)
+{
+  const std::string& t = record.typeName;
+  if (t == "INTE" || t == "REAL" || t == "LOGI" || t == "DOUB")
+  {
+    record.type = t == "INTE" ? EclipseDataType::Integer
+      : t == "REAL"           ? EclipseDataType::Real
+      : t == "LOGI"           ? EclipseDataType::Logical
+                              : EclipseDataType::Double;
+    record.elementSize = t == "DOUB" ? 8 : 4;
+    return true;
+  }
+  if (t == "CHAR")
+  {
+    record.type = EclipseDataType::Character;
+    record.elementSize = 8;
+    return true;
+  }
+  if (t == "MESS")
+  {
+    record.type = EclipseDataType::Message;
+    record.elementSize = 0;
+    return true;
+  }
+  if (t.size() == 4 && t[0] == 'C' && std::isdigit(static_cast<unsigned char>(t[1])) &&
+    std::isdigit(static_cast<unsigned char>(t[2])) && std::isdigit(static_cast<unsigned char>(t[3])))
+  {
+    record.type = EclipseDataType::Character;
+    record.elementSize = std::stoi(t.substr(1));
+    return record.elementSize > 0;
+  }
+  return false;
+}
+
+int64_t ItemsPerBlock(const EclipseRecord& record)
+{
+  return record.type == EclipseDataType::Character ? StringsPerBlock : NumbersPerBlock;
+}
+
+/// Converts n big-endian elements of `type` to T. Kept branch-free inside the loops so the
+/// compiler vectorizes them: this is the hot path of every grid and result load.
+template <typename T>
+void ConvertBigEndian(EclipseDataType type, const unsigned char* in, int64_t n, T* out)
+{
+  switch (type)
+  {
+    case EclipseDataType::Integer:
+      for (int64_t i = 0; i < n; ++i)
+      {
+        out[i] = static_cast<T>(static_cast<int32_t>(BigEndian32(in + 4 * i)));
+      }
+      break;
+    case EclipseDataType::Real:
+      for (int64_t i = 0; i < n; ++i)
+      {
+        const uint32_t bits = BigEndian32(in + 4 * i);
+        float value;
+        std::memcpy(&value, &bits, 4);
+        out[i] = static_cast<T>(value);
+      }
+      break;
+    case EclipseDataType::Double:
+      for (int64_t i = 0; i < n; ++i)
+      {
+        const uint64_t bits = BigEndian64(in + 8 * i);
+        double value;
+        std::memcpy(&value, &bits, 8);
+        if constexpr (std::is_integral_v<T>)
+        {
+          // Out-of-range doubles would be undefined behaviour as integers.
+          out[i] = std::fabs(value) < 2147483647.0 ? static_cast<T>(value) : T(0);
+        }
+        else
+        {
+          out[i] = static_cast<T>(value);
+        }
+      }
+      break;
+    case EclipseDataType::Logical:
+      for (int64_t i = 0; i < n; ++i)
+      {
+        out[i] = BigEndian32(in + 4 * i) != 0 ? T(1) : T(0);
+      }
+      break;
+    default:
+      break;
+  }
+}
+
+/// Sequential tokens of a formatted file, read in chunks; offsets are absolute.
+class TextCursor
+{
+public:
+  TextCursor(int descriptor, int64_t fileSize, int64_t offset)
+    : Offset(offset)
+    , Descriptor(descriptor)
+    , FileSize(fileSize)
+  {
+  }
+
+  int64_t Offset;
+
+  /// Next token: a quoted string (quotes removed) or a run of non-blank characters.
+  /// Returns false at end of file. `quoted` tells which.
+  bool Next(std::string& token, bool& quoted, int64_t& start)
+  {
+    int c;
+    while ((c = this->Peek()) >= 0 && (c == ' ' || c == '\n' || c == '\r' || c == '\t'))
+    {
+      ++this->Offset;
+    }
+    if (c < 0)
+    {
+      return false;
+    }
+    start = this->Offset;
+    token.clear();
+    quoted = c == '\'';
+    if (quoted)
+    {
+      ++this->Offset;
+      while ((c = this->Peek()) >= 0 && c != '\'')
+      {
+        if (c == '\n' || token.size() > 1024)
+        {
+          return false; // unterminated string; caller reports it
+        }
+        token.push_back(static_cast<char>(c));
+        ++this->Offset;
+      }
+      if (c < 0)
+      {
+        return false;
+      }
+      ++this->Offset;
+      return true;
+    }
+    while ((c = this->Peek()) >= 0 && c != ' ' && c != '\n' && c != '\r' && c != '\t')
+    {
+      if (token.size() > 256)
+      {
+        return true; // absurdly long; caller's conversion rejects it
+      }
+      token.push_back(static_cast<char>(c));
+      ++this->Offset;
+    }
+    return true;
+  }
+
+private:
+  int Peek()
+  {
+    if (this->Offset < this->BufferStart ||
+      this->Offset >= this->BufferStart + static_cast<int64_t>(this->Buffer.size()))
+    {
+      if (this->Offset >= this->FileSize)
+      {
+        return -1;
+      }
+      this->Buffer.resize(static_cast<std::size_t>(std::min<int64_t>(1 << 20, this->FileSize - this->Offset)));
+      const ssize_t got = pread(this->Descriptor, this->Buffer.data(), this->Buffer.size(), this->Offset);
+      if (got <= 0)
+      {
+        this->Buffer.clear();
+        return -1;
+      }
+      this->Buffer.resize(static_cast<std::size_t>(got));
+      this->BufferStart = this->Offset;
+    }
+    return static_cast<unsigned char>(this->Buffer[static_cast<std::size_t>(this->Offset - this->BufferStart)]);
+  }
+
+  int Descriptor;
+  int64_t FileSize;
+  int64_t BufferStart = 0;
+  std::vector<char> Buffer;
+};
+
+bool ParseInteger(const std::string& token, int64_t& value)
+{
+  const char* begin = token.data();
+  const char* end = begin + token.size();
+  if (begin != end && *begin == '+')
+  {
+    ++begin;
+  }
+  const auto result = std::from_chars(begin, end, value);
+  return result.ec == std::errc() && result.ptr == end;
+}
+
+bool ParseReal(std::string token, double& value)
+{
+  for (char& c : token)
+  {
+    if (c == 'D' || c == 'd')
+    {
+      c = 'E'; // Fortran double exponent
+    }
+  }
+  const char* begin = token.data();
+  const char* end = begin + token.size();
+  if (begin != end && *begin == '+')
+  {
+    ++begin;
+  }
+  const auto result = std::from_chars(begin, end, value);
+  return result.ec == std::errc() && result.ptr == end;
+}
+} // namespace
+
+EclipseKeywordFile::EclipseKeywordFile(const std::string& path)
+  : FilePath(path)
+{
+  this->Descriptor = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (this->Descriptor < 0)
+  {
+    throw GrdeclError(path, 0, "", std::string("cannot open file: ") + std::strerror(errno));
+  }
+  struct stat info;
+  if (fstat(this->Descriptor, &info) != 0 || !S_ISREG(info.st_mode))
+  {
+    close(this->Descriptor);
+    throw GrdeclError(path, 0, "", "not a regular file");
+  }
+  this->FileSize = static_cast<int64_t>(info.st_size);
+  try
+  {
+    if (LooksLikeUnformatted(path))
+    {
+      this->IndexUnformatted();
+    }
+    else if (LooksLikeFormatted(path))
+    {
+      this->Formatted = true;
+      this->IndexFormatted();
+    }
+    else
+    {
+      throw GrdeclError(path, 0, "",
+        "not an ECLIPSE keyword file (neither a binary record header nor a formatted "
+        "'KEYWORD' count 'TYPE' line at the start)");
+    }
+  }
+  catch (...)
+  {
+    close(this->Descriptor);
+    throw;
+  }
+}
+
+EclipseKeywordFile::~EclipseKeywordFile()
+{
+  if (this->Descriptor >= 0)
+  {
+    close(this->Descriptor);
+  }
+}
+
+bool EclipseKeywordFile::LooksLikeUnformatted(const std::string& path)
+{
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file)
+  {
+    return false;
+  }
+  unsigned char head[24];
+  const std::size_t got = std::fread(head, 1, sizeof(head), file);
+  std::fclose(file);
+  return got == sizeof(head) && BigEndian32(head) == 16 && BigEndian32(head + 20) == 16;
+}
+
+bool EclipseKeywordFile::LooksLikeFormatted(const std::string& path)
+{
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file)
+  {
+    return false;
+  }
+  char head[64] = {};
+  const std::size_t got = std::fread(head, 1, sizeof(head) - 1, file);
+  std::fclose(file);
+  std::size_t p = 0;
+  while (p < got && (head[p] == ' ' || head[p] == '\n' || head[p] == '\r'))
+  {
+    ++p;
+  }
+  // 'NAME    ' then a count then 'TYPE'
+  if (p + 10 > got || head[p] != '\'' || head[p + 9] != '\'')
+  {
+    return false;
+  }
+  const char* second = std::strchr(head + p + 10, '\'');
+  return second && second + 5 < head + got && second[5] == '\'';
+}
+
+void EclipseKeywordFile::Fail(const EclipseRecord* record, int64_t offset, const std::string& what) const
+{
+  throw GrdeclError(this->FilePath, 0, record ? record->name : std::string(),
+    what + " (at byte " + std::to_string(offset) + ")");
+}
+
+const EclipseRecord* EclipseKeywordFile::Find(const std::string& name, std::size_t from) const
+{
+  for (std::size_t r = from; r < this->Index.size(); ++r)
+  {
+    if (this->Index[r].name == name)
+    {
+      return &this->Index[r];
+    }
+  }
+  return nullptr;
+}
+
+void EclipseKeywordFile::ReadRaw(int64_t offset, void* data, int64_t size, const EclipseRecord* record) const
+{
+  if (offset < 0 || size < 0 || offset + size > this->FileSize)
+  {
+    this->Fail(record, offset, "file truncated: needs " + std::to_string(size) + " more bytes");
+  }
+  auto* bytes = static_cast<unsigned char*>(data);
+  while (size > 0)
+  {
+    const ssize_t got = pread(this->Descriptor, bytes, static_cast<std::size_t>(size), offset);
+    if (got < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (got <= 0)
+    {
+      this->Fail(record, offset, got < 0 ? std::string("read error: ") + std::strerror(errno)
+                                         : std::string("file truncated"));
+    }
+    bytes += got;
+    offset += got;
+    size -= got;
+  }
+}
+
+void EclipseKeywordFile::IndexUnformatted()
+{
+  int64_t position = 0;
+  while (position < this->FileSize)
+  {
+    EclipseRecord record;
+    record.headerOffset = position;
+    if (this->FileSize - position < HeaderBytes)
+    {
+      this->Fail(nullptr, position, "file truncated inside a keyword header");
+    }
+    unsigned char raw[HeaderBytes];
+    this->ReadRaw(position, raw, HeaderBytes, nullptr);
+    if (BigEndian32(raw) != 16 || BigEndian32(raw + 20) != 16)
+    {
+      this->Fail(nullptr, position,
+        "expected a 16-byte keyword header record; record markers disagree or the file is corrupt");
+    }
+    for (int c = 4; c < 20; ++c)
+    {
+      if (c >= 12 && c < 16)
+      {
+        continue; // the count
+      }
+      if (raw[c] < 32 || raw[c] > 126)
+      {
+        this->Fail(nullptr, position, "keyword header holds non-text bytes; corrupt file");
+      }
+    }
+    record.name = Trimmed(reinterpret_cast<const char*>(raw + 4), 8);
+    record.count = static_cast<int32_t>(BigEndian32(raw + 12));
+    record.typeName = std::string(reinterpret_cast<const char*>(raw + 16), 4);
+    if (!ParseType(record))
+    {
+      this->Fail(&record, position, "unknown data type '" + record.typeName + "'");
+    }
+    if (record.count < 0)
+    {
+      this->Fail(&record, position, "negative element count " + std::to_string(record.count));
+    }
+    record.dataOffset = position + HeaderBytes;
+    const int64_t payload = record.count * record.elementSize;
+    if (payload > this->FileSize - record.dataOffset)
+    {
+      this->Fail(&record, position,
+        "declares " + std::to_string(record.count) + " elements of type " + record.typeName +
+          " but the file is too short to hold them (truncated?)");
+    }
+    record.endOffset = record.dataOffset;
+    if (payload > 0)
+    {
+      // Standard layout first: full blocks of 1000 numbers / 105 strings. Checked cheaply by
+      // the first marker and the next header's marker; anything else is walked.
+      const int64_t perBlock = ItemsPerBlock(record);
+      const int64_t blocks = (record.count + perBlock - 1) / perBlock;
+      const int64_t end = record.dataOffset + payload + 8 * blocks;
+      unsigned char marker[4];
+      this->ReadRaw(record.dataOffset, marker, 4, &record);
+      bool standard = BigEndian32(marker) == std::min(record.count, perBlock) * record.elementSize &&
+        end <= this->FileSize;
+      if (standard && end < this->FileSize)
+      {
+        standard = this->FileSize - end >= 4 &&
+          (this->ReadRaw(end, marker, 4, &record), BigEndian32(marker) == 16);
+      }
+      record.endOffset = standard ? end : this->WalkBlocks(record);
+    }
+    position = record.endOffset;
+    this->Index.push_back(std::move(record));
+  }
+}
+
+int64_t EclipseKeywordFile::WalkBlocks(const EclipseRecord& record) const
+{
+  int64_t position = record.dataOffset;
+  int64_t remaining = record.count;
+  while (remaining > 0)
+  {
+    unsigned char marker[4];
+    this->ReadRaw(position, marker, 4, &record);
+    const int64_t length = BigEndian32(marker);
+    if (length == 0 || length % record.elementSize != 0 || length > remaining * record.elementSize)
+    {
+      this->Fail(&record, position,
+        "data record of " + std::to_string(length) + " bytes does not fit the " +
+          std::to_string(remaining) + " remaining elements of " + std::to_string(record.elementSize) +
+          " bytes");
+    }
+    if (length + 8 > this->FileSize - position)
+    {
+      this->Fail(&record, position, "file truncated inside a data record");
+    }
+    this->ReadRaw(position + 4 + length, marker, 4, &record);
+    if (BigEndian32(marker) != length)
+    {
+      this->Fail(&record, position + 4 + length, "data record end marker differs from its start marker");
+    }
+    position += length + 8;
+    remaining -= length / record.elementSize;
+  }
+  return position;
+}
+
+template <typename Consumer>
+void EclipseKeywordFile::ForEachBlock(const EclipseRecord& record, Consumer&& consume) const
+{
+  if (record.count == 0 || record.elementSize == 0)
+  {
+    return;
+  }
+  std::vector<unsigned char> buffer;
+  int64_t bufferStart = 0;
+  int64_t bufferEnd = 0; // absolute offsets of the bytes held in buffer
+  const auto ensure = [&](int64_t offset, int64_t size) -> const unsigned char* {
+    if (offset < bufferStart || offset + size > bufferEnd)
+    {
+      const int64_t want = std::min(std::max(size, ChunkBytes), record.endOffset - offset);
+      if (want < size)
+      {
+        this->Fail(&record, offset, "data records run past the end of the keyword");
+      }
+      buffer.resize(static_cast<std::size_t>(want));
+      this->ReadRaw(offset, buffer.data(), want, &record);
+      bufferStart = offset;
+      bufferEnd = offset + want;
+    }
+    return buffer.data() + (offset - bufferStart);
+  };
+  int64_t position = record.dataOffset;
+  int64_t remaining = record.count;
+  int64_t done = 0;
+  while (remaining > 0)
+  {
+    const int64_t length = BigEndian32(ensure(position, 4));
+    if (length == 0 || length % record.elementSize != 0 || length > remaining * record.elementSize)
+    {
+      this->Fail(&record, position,
+        "data record of " + std::to_string(length) + " bytes does not fit the " +
+          std::to_string(remaining) + " remaining elements of " + std::to_string(record.elementSize) +
+          " bytes");
+    }
+    const unsigned char* block = ensure(position, length + 8);
+    if (BigEndian32(block + 4 + length) != static_cast<uint32_t>(length))
+    {
+      this->Fail(&record, position + 4 + length, "data record end marker differs from its start marker");
+    }
+    const int64_t elements = length / record.elementSize;
+    consume(block + 4, done, elements);
+    done += elements;
+    remaining -= elements;
+    position += length + 8;
+  }
+}
+
+template <typename T>
+void EclipseKeywordFile::Read(const EclipseRecord& record, T* out) const
+{
+  if (!record.IsNumeric())
+  {
+    this->Fail(&record, record.headerOffset, "expected numeric data, found type " + record.typeName);
+  }
+  if (this->Formatted)
+  {
+    this->ReadFormatted(record, out);
+    return;
+  }
+  this->ForEachBlock(record, [&](const unsigned char* data, int64_t first, int64_t n) {
+    ConvertBigEndian(record.type, data, n, out + first);
+  });
+}
+
+template void EclipseKeywordFile::Read<int32_t>(const EclipseRecord&, int32_t*) const;
+template void EclipseKeywordFile::Read<float>(const EclipseRecord&, float*) const;
+template void EclipseKeywordFile::Read<double>(const EclipseRecord&, double*) const;
+
+void EclipseKeywordFile::ReadNumbers(const EclipseRecord& record, std::vector<double>& values) const
+{
+  values.resize(static_cast<std::size_t>(record.count));
+  this->Read(record, values.data());
+}
+
+std::vector<std::string> EclipseKeywordFile::ReadStrings(const EclipseRecord& record) const
+{
+  if (record.type != EclipseDataType::Character)
+  {
+    this->Fail(&record, record.headerOffset, "expected character data, found type " + record.typeName);
+  }
+  if (this->Formatted)
+  {
+    return this->ReadFormattedStrings(record);
+  }
+  std::vector<std::string> values;
+  values.reserve(static_cast<std::size_t>(record.count));
+  this->ForEachBlock(record, [&](const unsigned char* data, int64_t, int64_t n) {
+    for (int64_t i = 0; i < n; ++i)
+    {
+      values.push_back(Trimmed(reinterpret_cast<const char*>(data + i * record.elementSize),
+        static_cast<std::size_t>(record.elementSize)));
+    }
+  });
+  return values;
+}
+
+// ------------------------------------------------------------------ formatted files
+
+void EclipseKeywordFile::IndexFormatted()
+{
+  TextCursor cursor(this->Descriptor, this->FileSize, 0);
+  std::string token;
+  bool quoted = false;
+  int64_t start = 0;
+  while (cursor.Next(token, quoted, start))
+  {
+    EclipseRecord record;
+    record.headerOffset = start;
+    if (!quoted || token.size() > 8)
+    {
+      this->Fail(nullptr, start, "expected a quoted keyword name, found '" + token.substr(0, 20) + "'");
+    }
+    record.name = Trimmed(token.data(), token.size());
+    int64_t count = 0;
+    if (!cursor.Next(token, quoted, start) || quoted || !ParseInteger(token, count) || count < 0 ||
+      count > INT32_MAX)
+    {
+      this->Fail(&record, start, "expected an element count after the keyword name");
+    }
+    record.count = count;
+    if (!cursor.Next(token, quoted, start) || !quoted || token.size() != 4)
+    {
+      this->Fail(&record, start, "expected a quoted 4-character type after the count");
+    }
+    record.typeName = token;
+    if (!ParseType(record))
+    {
+      this->Fail(&record, start, "unknown data type '" + record.typeName + "'");
+    }
+    record.dataOffset = cursor.Offset;
+    const bool strings = record.type == EclipseDataType::Character;
+    for (int64_t i = 0; i < record.count; ++i)
+    {
+      if (!cursor.Next(token, quoted, start))
+      {
+        this->Fail(&record, cursor.Offset,
+          "file ends after " + std::to_string(i) + " of " + std::to_string(record.count) + " values");
+      }
+      if (quoted != strings)
+      {
+        this->Fail(&record, start,
+          "value " + std::to_string(i + 1) + " of " + std::to_string(record.count) +
+            (strings ? " is not a quoted string" : " is a string, expected a number") +
+            " (declared count larger than the data?)");
+      }
+    }
+    record.endOffset = cursor.Offset;
+    this->Index.push_back(std::move(record));
+  }
+  if (cursor.Offset < this->FileSize)
+  {
+    // Next() stops early only on an unterminated quoted string.
+    int64_t rest = cursor.Offset;
+    this->Fail(nullptr, rest, "unterminated quoted string");
+  }
+}
+
+template <typename T>
+void EclipseKeywordFile::ReadFormatted(const EclipseRecord& record, T* out) const
+{
+  TextCursor cursor(this->Descriptor, this->FileSize, record.dataOffset);
+  std::string token;
+  bool quoted = false;
+  int64_t start = 0;
+  for (int64_t i = 0; i < record.count; ++i)
+  {
+    if (!cursor.Next(token, quoted, start) || quoted)
+    {
+      this->Fail(&record, cursor.Offset, "missing value " + std::to_string(i + 1));
+    }
+    bool ok = true;
+    switch (record.type)
+    {
+      case EclipseDataType::Integer:
+      {
+        int64_t value = 0;
+        ok = ParseInteger(token, value) && value >= INT32_MIN && value <= INT32_MAX;
+        out[i] = static_cast<T>(value);
+        break;
+      }
+      case EclipseDataType::Logical:
+        ok = token == "T" || token == "F";
+        out[i] = token == "T" ? T(1) : T(0);
+        break;
+      default:
+      {
+        double value = 0;
+        ok = ParseReal(token, value);
+        if constexpr (std::is_integral_v<T>)
+        {
+          out[i] = std::fabs(value) < 2147483647.0 ? static_cast<T>(value) : T(0);
+        }
+        else
+        {
+          out[i] = static_cast<T>(value);
+        }
+        break;
+      }
+    }
+    if (!ok)
+    {
+      this->Fail(&record, start, "value " + std::to_string(i + 1) + " '" + token.substr(0, 30) +
+          "' is not a valid " + record.typeName);
+    }
+  }
+}
+
+std::vector<std::string> EclipseKeywordFile::ReadFormattedStrings(const EclipseRecord& record) const
+{
+  TextCursor cursor(this->Descriptor, this->FileSize, record.dataOffset);
+  std::vector<std::string> values;
+  std::string token;
+  bool quoted = false;
+  int64_t start = 0;
+  for (int64_t i = 0; i < record.count; ++i)
+  {
+    if (!cursor.Next(token, quoted, start) || !quoted)
+    {
+      this->Fail(&record, cursor.Offset, "missing string " + std::to_string(i + 1));
+    }
+    values.push_back(Trimmed(token.data(), token.size()));
+  }
+  return values;
+}
+
+} // namespace resmr
