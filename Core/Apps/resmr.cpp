@@ -3,7 +3,12 @@
 //
 //   resmr info [--skip-missing-includes] DECK
 //                       prints the deck's dimensions, active cells, arrays and faults as JSON
+//   resmr info GRID.EGRID
+//                       prints the grid's dimensions and active cells, its INIT arrays and
+//                       restart report steps as JSON
 #include "CornerPointGeometry.h"
+#include "EclipseGrid.h"
+#include "EclipseResults.h"
 #include "GrdeclError.h"
 #include "GrdeclParser.h"
 
@@ -38,8 +43,58 @@ std::string JsonString(const std::string& text)
   return out + "\"";
 }
 
+std::string JsonNames(const std::vector<resmr::EclipseResultArray>& arrays)
+{
+  std::string out = "[";
+  for (std::size_t a = 0; a < arrays.size(); ++a)
+  {
+    out += (a ? ", " : "") + JsonString(arrays[a].name);
+  }
+  return out + "]";
+}
+
+int GridInfo(const char* path)
+{
+  const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(path);
+  const resmr::EclipseResults results(path, grid);
+  for (const std::string& warning : grid.deck.warnings)
+  {
+    std::fprintf(stderr, "resmr: warning: %s\n", warning.c_str());
+  }
+  for (const std::string& warning : results.Warnings())
+  {
+    std::fprintf(stderr, "resmr: warning: %s\n", warning.c_str());
+  }
+  const auto& d = grid.deck.dims;
+  std::printf("{\"file\": %s, \"kind\": \"egrid\", \"dims\": [%lld, %lld, %lld], \"cells\": %lld, "
+              "\"active\": %lld, \"dual_porosity\": %s, \"fracture_cells\": %lld, \"lgrs\": %zu, "
+              "\"nnc\": %lld, \"units\": %s, \"init\": %s, \"init_arrays\": %s, \"restarts\": %zu, "
+              "\"unified\": %s, \"restart_arrays\": %s, \"steps\": [",
+    JsonString(path).c_str(), static_cast<long long>(d[0]), static_cast<long long>(d[1]),
+    static_cast<long long>(d[2]), static_cast<long long>(grid.deck.CellCount()),
+    static_cast<long long>(grid.activeCells), grid.dualPorosity ? "true" : "false",
+    static_cast<long long>(grid.fractureCells), grid.localGridNames.size(),
+    static_cast<long long>(grid.nonNeighbourConnections), JsonString(grid.units).c_str(),
+    JsonString(results.InitPath()).c_str(), JsonNames(results.StaticArrays()).c_str(),
+    results.RestartPaths().size(), results.UnifiedRestart() ? "true" : "false",
+    JsonNames(results.DynamicArrays()).c_str());
+  for (std::size_t s = 0; s < results.Steps().size(); ++s)
+  {
+    const resmr::EclipseReportStep& step = results.Steps()[s];
+    std::printf("%s{\"report\": %d, \"days\": %.17g, \"date\": \"%04d-%02d-%02d\", \"arrays\": %zu}",
+      s ? ", " : "", step.reportNumber, step.days, step.date[0], step.date[1], step.date[2],
+      step.names.size());
+  }
+  std::printf("]}\n");
+  return 0;
+}
+
 int Info(const char* path, bool skipMissingIncludes)
 {
+  if (resmr::LooksLikeEclipseGridFile(path))
+  {
+    return GridInfo(path);
+  }
   resmr::GrdeclParseOptions options;
   options.skipMissingIncludes = skipMissingIncludes;
   resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(path, options);
@@ -104,7 +159,8 @@ int main(int argc, char** argv)
       return 1;
     }
   }
-  std::fprintf(stderr, "usage: resmr info [--skip-missing-includes] DECK\n"
-                       "  prints dimensions, active cells, arrays and faults of an Eclipse deck\n");
+  std::fprintf(stderr, "usage: resmr info [--skip-missing-includes] DECK|GRID.EGRID\n"
+                       "  prints dimensions, active cells, arrays and faults of an Eclipse deck,\n"
+                       "  or of an EGRID with its INIT arrays and restart steps\n");
   return 2;
 }
