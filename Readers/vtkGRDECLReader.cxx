@@ -19,12 +19,12 @@
 #include "vtkUnsignedCharArray.h"
 
 #include "CornerPointGeometry.h"
+#include "ResMRExplicitGrid.h"
 #include "GrdeclError.h"
 #include "GrdeclParser.h"
 
 #include <cmath>
 #include <optional>
-#include <sys/stat.h>
 
 struct vtkGRDECLReader::Internals
 {
@@ -41,18 +41,6 @@ vtkStandardNewMacro(vtkGRDECLReader);
 
 namespace
 {
-long long ModificationTime(const char* path)
-{
-  struct stat info;
-  if (stat(path, &info) != 0)
-  {
-    return -1;
-  }
-  return static_cast<long long>(info.st_mtim.tv_sec) * 1000000000LL + info.st_mtim.tv_nsec;
-}
-
-// ECLIPSE corner c = di + 2 dj + 4 dk for each VTK hexahedron point (k down, right-handed).
-constexpr int EclipseCornerOfVTKPoint[8] = { 0, 1, 3, 2, 4, 5, 7, 6 };
 } // namespace
 
 vtkGRDECLReader::vtkGRDECLReader()
@@ -152,7 +140,7 @@ bool vtkGRDECLReader::ParseIfNeeded()
     this->ReportError("no FileName set");
     return false;
   }
-  const long long modified = ModificationTime(this->FileName);
+  const long long modified = resmr_readers::FileModificationTime(this->FileName);
   Internals& internal = *this->Internal;
   if (internal.Geometry && internal.ParsedFile == this->FileName &&
     internal.ParsedModificationTime == modified)
@@ -247,96 +235,23 @@ int vtkGRDECLReader::RequestData(
   geometry.SetMapAxesApplied(this->ApplyMapAxes);
   this->LeftHanded = geometry.IsLeftHanded();
 
-  const int64_t nx = geometry.Dims()[0], ny = geometry.Dims()[1], nz = geometry.Dims()[2];
-  const vtkIdType cellCount = static_cast<vtkIdType>(nx * ny * nz);
-  const bool mirrorK = this->LeftHanded;
-  // VTK cell id of ECLIPSE cell index (i fastest, k down).
-  const auto vtkCellOf = [&](int64_t eclipseCell) -> vtkIdType {
-    if (!mirrorK)
-    {
-      return static_cast<vtkIdType>(eclipseCell);
-    }
-    const int64_t layer = nx * ny;
-    const int64_t k = eclipseCell / layer;
-    return static_cast<vtkIdType>((nz - 1 - k) * layer + eclipseCell % layer);
-  };
-
   try
   {
-    resmr::CornerPointGeometry::SharedCorners shared = geometry.BuildSharedCorners();
-    const vtkIdType pointCount = static_cast<vtkIdType>(shared.points.size() / 3);
-    vtkNew<vtkDoubleArray> coordinates;
-    coordinates->SetNumberOfComponents(3);
-    coordinates->SetNumberOfTuples(pointCount);
-    double* xyz = coordinates->GetPointer(0);
-    for (vtkIdType p = 0; p < pointCount; ++p)
+    const int64_t cellCount = geometry.CellCount();
+    std::vector<int32_t> actnum(static_cast<std::size_t>(cellCount), 1);
+    std::vector<bool> active(static_cast<std::size_t>(cellCount), true);
+    if (const resmr::CellArray* actnumArray = deck.FindArray("ACTNUM"))
     {
-      xyz[3 * p] = shared.points[3 * p];
-      xyz[3 * p + 1] = shared.points[3 * p + 1];
-      xyz[3 * p + 2] = -shared.points[3 * p + 2]; // elevation: z up
-    }
-    shared.points = std::vector<double>();
-    vtkNew<vtkPoints> points;
-    points->SetData(coordinates);
-
-    vtkNew<vtkIdTypeArray> connectivity;
-    connectivity->SetNumberOfValues(8 * cellCount);
-    vtkIdType* ids = connectivity->GetPointer(0);
-    for (int64_t cell = 0; cell < cellCount; ++cell)
-    {
-      vtkIdType* out = ids + 8 * vtkCellOf(cell);
-      const int64_t* in = &shared.cellPoints[static_cast<std::size_t>(8 * cell)];
-      for (int v = 0; v < 8; ++v)
+      for (int64_t cell = 0; cell < cellCount; ++cell)
       {
-        // Mirrored: VTK points 0-3 take the bottom (deeper) face.
-        const int corner = EclipseCornerOfVTKPoint[v] ^ (mirrorK ? 4 : 0);
-        out[v] = static_cast<vtkIdType>(in[corner]);
+        const double value = actnumArray->values[static_cast<std::size_t>(cell)];
+        actnum[static_cast<std::size_t>(cell)] = static_cast<int32_t>(value);
+        active[static_cast<std::size_t>(cell)] = value > 0;
       }
     }
-    shared.cellPoints = std::vector<int64_t>();
-    vtkNew<vtkCellArray> cells;
-    cells->SetData(8, connectivity);
-
-    grid->SetExtent(0, static_cast<int>(nx), 0, static_cast<int>(ny), 0, static_cast<int>(nz));
-    grid->SetPoints(points);
-    grid->SetCells(cells);
-    grid->ComputeFacesConnectivityFlagsArray();
-
+    const resmr_readers::CellOrder order =
+      resmr_readers::BuildExplicitGrid(geometry, actnum, active, this->ShowInactiveCells, grid);
     vtkCellData* cellData = grid->GetCellData();
-    const resmr::CellArray* actnumArray = deck.FindArray("ACTNUM");
-    vtkNew<vtkIntArray> iArray, jArray, kArray, actnum;
-    iArray->SetName("I");
-    jArray->SetName("J");
-    kArray->SetName("K");
-    actnum->SetName("ACTNUM");
-    for (vtkIntArray* array : { iArray.Get(), jArray.Get(), kArray.Get(), actnum.Get() })
-    {
-      array->SetNumberOfValues(cellCount);
-    }
-    vtkNew<vtkUnsignedCharArray> ghosts;
-    ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
-    ghosts->SetNumberOfValues(cellCount);
-    bool anyHidden = false;
-    for (int64_t cell = 0; cell < cellCount; ++cell)
-    {
-      const vtkIdType id = vtkCellOf(cell);
-      iArray->SetValue(id, static_cast<int>(cell % nx + 1));
-      jArray->SetValue(id, static_cast<int>((cell / nx) % ny + 1));
-      kArray->SetValue(id, static_cast<int>(cell / (nx * ny) + 1));
-      const int active = actnumArray ? static_cast<int>(actnumArray->values[cell]) : 1;
-      actnum->SetValue(id, active);
-      const bool hidden = active <= 0 && !this->ShowInactiveCells;
-      ghosts->SetValue(id, hidden ? vtkDataSetAttributes::HIDDENCELL : 0);
-      anyHidden |= hidden;
-    }
-    cellData->AddArray(iArray);
-    cellData->AddArray(jArray);
-    cellData->AddArray(kArray);
-    cellData->AddArray(actnum);
-    if (anyHidden)
-    {
-      cellData->AddArray(ghosts);
-    }
 
     for (const resmr::CellArray& property : deck.arrays)
     {
@@ -345,30 +260,25 @@ int vtkGRDECLReader::RequestData(
       {
         continue;
       }
-      vtkSmartPointer<vtkDataArray> array;
+      const std::vector<double>& values = property.values;
       if (property.isInteger)
       {
-        vtkNew<vtkIntArray> values;
-        values->SetNumberOfValues(cellCount);
-        for (int64_t cell = 0; cell < cellCount; ++cell)
-        {
-          const double value = property.values[cell];
-          values->SetValue(vtkCellOf(cell), std::isfinite(value) ? static_cast<int>(value) : 0);
-        }
-        array = values;
+        cellData->AddArray(resmr_readers::MakeCellArray<vtkIntArray>(
+          property.name.c_str(), order, [&](int* out) {
+            for (int64_t cell = 0; cell < cellCount; ++cell)
+            {
+              const double value = values[static_cast<std::size_t>(cell)];
+              out[cell] = std::isfinite(value) ? static_cast<int>(value) : 0;
+            }
+          }));
       }
       else
       {
-        vtkNew<vtkDoubleArray> values;
-        values->SetNumberOfValues(cellCount);
-        for (int64_t cell = 0; cell < cellCount; ++cell)
-        {
-          values->SetValue(vtkCellOf(cell), property.values[cell]);
-        }
-        array = values;
+        cellData->AddArray(resmr_readers::MakeCellArray<vtkDoubleArray>(
+          property.name.c_str(), order, [&](double* out) {
+            std::copy(values.begin(), values.end(), out);
+          }));
       }
-      array->SetName(property.name.c_str());
-      cellData->AddArray(array);
     }
 
     // Faults: one quad per faulted cell face, corners taken from the cell itself.

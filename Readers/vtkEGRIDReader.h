@@ -1,0 +1,118 @@
+/**
+ * @class   vtkEGRIDReader
+ * @brief   Reads simulator output: an EGRID (or FEGRID) grid with its INIT static arrays and
+ *          restart report steps (UNRST, FUNRST, Xnnnn, Fnnnn) as time steps.
+ *
+ * The output follows the same contract as vtkGRDECLReader: a vtkExplicitStructuredGrid with
+ * z = -depth, corners shared where ECLIPSE connects cells, cell arrays I, J, K (from 1) and
+ * ACTNUM, HIDDENCELL for inactive cells. The grid is built by the same code.
+ *
+ * Companion files are found by the EGRID's basename. Arrays with one value per active cell
+ * are mapped to cells through the EGRID's ACTNUM; inactive cells get NaN (real arrays) or 0.
+ * Report steps become time steps in days (TIME_STEPS); only the requested step's selected
+ * arrays are read, by seeking to record offsets indexed once when the file is opened. The
+ * geometry and static arrays are built once and shared by every step's output.
+ *
+ * LGRs and non-neighbour connections are not shown (a warning names them); dual-porosity
+ * grids show the matrix grid. Field data: ReportStep, Days, Date of the step shown.
+ *
+ * Work is forwarded to resmr::ReadEclipseGrid and resmr::EclipseResults (Core). Errors name
+ * the file, keyword and byte offset and leave the output empty.
+ */
+#ifndef vtkEGRIDReader_h
+#define vtkEGRIDReader_h
+
+#include "ResMRReadersModule.h" // for export macro
+#include "vtkExplicitStructuredGridAlgorithm.h"
+#include "vtkNew.h" // for vtkNew
+
+#include <memory> // for std::unique_ptr
+#include <string> // for std::string
+
+class vtkDataArraySelection;
+
+class RESMRREADERS_EXPORT vtkEGRIDReader : public vtkExplicitStructuredGridAlgorithm
+{
+public:
+  static vtkEGRIDReader* New();
+  vtkTypeMacro(vtkEGRIDReader, vtkExplicitStructuredGridAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// The grid file (.EGRID, .FEGRID, either case).
+  vtkSetStringMacro(FileName);
+  vtkGetStringMacro(FileName);
+  ///@}
+
+  ///@{
+  /// Show inactive cells instead of hiding them. Off by default.
+  vtkSetMacro(ShowInactiveCells, bool);
+  vtkGetMacro(ShowInactiveCells, bool);
+  vtkBooleanMacro(ShowInactiveCells, bool);
+  ///@}
+
+  ///@{
+  /// Place the grid in map coordinates given by MAPAXES. On by default.
+  vtkSetMacro(ApplyMapAxes, bool);
+  vtkGetMacro(ApplyMapAxes, bool);
+  vtkBooleanMacro(ApplyMapAxes, bool);
+  ///@}
+
+  ///@{
+  /// Which INIT (static) and restart (dynamic) arrays to load. On by default for models up
+  /// to DefaultAllArraysCellLimit cells; above it only the common ones (PORO, PERMX, NTG,
+  /// PRESSURE, SWAT, SGAS, ...), as each array costs 4 bytes per cell.
+  vtkDataArraySelection* GetCellArraySelection();
+  int GetNumberOfCellArrays();
+  const char* GetCellArrayName(int index);
+  int GetCellArrayStatus(const char* name);
+  void SetCellArrayStatus(const char* name, int status);
+  ///@}
+
+  /// Models with more cells than this start with only the common arrays selected.
+  static constexpr long long DefaultAllArraysCellLimit = 5000000;
+
+  /// Number of report steps found (0 without restart files).
+  int GetNumberOfReportSteps();
+  /// Index of the report step in the last output, -1 if none.
+  vtkGetMacro(CurrentStep, int);
+
+  /// The message of the last error, empty after a successful read.
+  const char* GetLastError() { return this->LastError.c_str(); }
+  /// Warnings of the last file opened (LGRs, dual porosity, missing companions ...), one
+  /// per line.
+  const char* GetWarnings() { return this->Warnings.c_str(); }
+
+  /// Returns 1 if the file is an ECLIPSE keyword file (EGRID; old GRID files are opened only
+  /// to be refused with a message).
+  static int CanReadFile(const char* fileName);
+
+protected:
+  vtkEGRIDReader();
+  ~vtkEGRIDReader() override;
+
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+private:
+  vtkEGRIDReader(const vtkEGRIDReader&) = delete;
+  void operator=(const vtkEGRIDReader&) = delete;
+
+  bool OpenIfNeeded();
+  bool BuildBaseIfNeeded();
+  void UpdateStaticArrays();
+  void ReportError(const std::string& message);
+
+  char* FileName = nullptr;
+  bool ShowInactiveCells = false;
+  bool ApplyMapAxes = true;
+  int CurrentStep = -1;
+  std::string LastError;
+  std::string Warnings;
+  vtkNew<vtkDataArraySelection> CellArraySelection;
+
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+};
+
+#endif
