@@ -356,7 +356,8 @@ void EclipseResults::IndexRestart(
     }
     if (!this->FitsGrid(record.count))
     {
-      if (inSolution && record.count > 1)
+      static const std::set<std::string> perCell = { "PRESSURE", "SWAT", "SGAS", "SOIL", "RS", "RV" };
+      if (perCell.count(name) > 0)
       {
         this->Notes.push_back(path + ": keyword " + name + ": report step " +
           std::to_string(step->reportNumber) + " has " + std::to_string(record.count) +

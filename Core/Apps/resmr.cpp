@@ -8,10 +8,13 @@
 //                       restart report steps as JSON
 #include "CornerPointGeometry.h"
 #include "EclipseGrid.h"
+#include "EclipseKeywordFile.h"
 #include "EclipseResults.h"
 #include "GrdeclError.h"
 #include "GrdeclParser.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -67,12 +70,14 @@ int GridInfo(const char* path)
   }
   const auto& d = grid.deck.dims;
   std::printf("{\"file\": %s, \"kind\": \"egrid\", \"dims\": [%lld, %lld, %lld], \"cells\": %lld, "
-              "\"active\": %lld, \"dual_porosity\": %s, \"fracture_cells\": %lld, \"lgrs\": %zu, "
+              "\"active\": %lld, \"nonzero_actnum\": %lld, \"dual_porosity\": %s, \"fracture_cells\": %lld, \"lgrs\": %zu, "
               "\"nnc\": %lld, \"units\": %s, \"init\": %s, \"init_arrays\": %s, \"restarts\": %zu, "
               "\"unified\": %s, \"restart_arrays\": %s, \"steps\": [",
     JsonString(path).c_str(), static_cast<long long>(d[0]), static_cast<long long>(d[1]),
     static_cast<long long>(d[2]), static_cast<long long>(grid.deck.CellCount()),
-    static_cast<long long>(grid.activeCells), grid.dualPorosity ? "true" : "false",
+    static_cast<long long>(grid.activeCells),
+    static_cast<long long>(std::count_if(grid.actnum.begin(), grid.actnum.end(), [](int32_t v) { return v > 0; })),
+    grid.dualPorosity ? "true" : "false",
     static_cast<long long>(grid.fractureCells), grid.localGridNames.size(),
     static_cast<long long>(grid.nonNeighbourConnections), JsonString(grid.units).c_str(),
     JsonString(results.InitPath()).c_str(), JsonNames(results.StaticArrays()).c_str(),
@@ -81,9 +86,13 @@ int GridInfo(const char* path)
   for (std::size_t s = 0; s < results.Steps().size(); ++s)
   {
     const resmr::EclipseReportStep& step = results.Steps()[s];
-    std::printf("%s{\"report\": %d, \"days\": %.17g, \"date\": \"%04d-%02d-%02d\", \"arrays\": %zu}",
-      s ? ", " : "", step.reportNumber, step.days, step.date[0], step.date[1], step.date[2],
-      step.names.size());
+    std::printf("%s{\"report\": %d, \"days\": %.17g, \"date\": \"%04d-%02d-%02d\", \"arrays\": [",
+      s ? ", " : "", step.reportNumber, step.days, step.date[0], step.date[1], step.date[2]);
+    for (std::size_t a = 0; a < step.names.size(); ++a)
+    {
+      std::printf("%s%s", a ? ", " : "", JsonString(step.names[a]).c_str());
+    }
+    std::printf("]}");
   }
   std::printf("]}\n");
   return 0;
@@ -91,7 +100,16 @@ int GridInfo(const char* path)
 
 int Info(const char* path, bool skipMissingIncludes)
 {
-  if (resmr::LooksLikeEclipseGridFile(path))
+  std::string extension = std::strrchr(path, '.') ? std::strrchr(path, '.') : "";
+  for (char& c : extension)
+  {
+    c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  }
+  const bool keywordFile = resmr::EclipseKeywordFile::LooksLikeUnformatted(path) ||
+    resmr::EclipseKeywordFile::LooksLikeFormatted(path);
+  if (resmr::LooksLikeEclipseGridFile(path) ||
+    (keywordFile &&
+      (extension == ".EGRID" || extension == ".FEGRID" || extension == ".GRID" || extension == ".FGRID")))
   {
     return GridInfo(path);
   }
