@@ -191,23 +191,16 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
   {
     grid.actnum.assign(static_cast<std::size_t>(cells), 1);
   }
-  CellArray active;
-  active.name = "ACTNUM";
-  active.isInteger = true;
-  active.values.resize(static_cast<std::size_t>(cells));
   for (const int32_t value : grid.actnum)
   {
     grid.dualPorosity |= value > 1; // FILEHEAD missing or silent: ACTNUM 2/3 says dual porosity
   }
   for (int64_t cell = 0; cell < cells; ++cell)
   {
-    const int32_t value = grid.actnum[static_cast<std::size_t>(cell)];
-    const bool matrix = grid.IsActive(cell);
-    active.values[static_cast<std::size_t>(cell)] = matrix ? 1.0 : 0.0;
-    grid.activeCells += matrix;
-    grid.fractureCells += grid.dualPorosity && (value & 2) != 0;
+    grid.activeCells += grid.IsActive(cell);
+    grid.fractureCells +=
+      grid.dualPorosity && (grid.actnum[static_cast<std::size_t>(cell)] & 2) != 0;
   }
-  deck.arrays.push_back(std::move(active));
   if (grid.dualPorosity)
   {
     deck.warnings.push_back(path + ": dual-porosity grid: showing the matrix grid (" +

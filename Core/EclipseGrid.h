@@ -24,7 +24,7 @@ namespace resmr
 
 struct EclipseGrid
 {
-  /// dims, coord, zcorn, map axes and units; arrays holds ACTNUM (0/1: matrix active).
+  /// dims, coord, zcorn, map axes and units (no cell arrays: ACTNUM is below).
   GrdeclDeck deck;
   /// ACTNUM as written (0..3), one per cell; all 1 when the file has none.
   std::vector<int32_t> actnum;
