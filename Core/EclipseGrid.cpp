@@ -14,14 +14,9 @@ namespace resmr
 
 bool LooksLikeEclipseGridFile(const std::string& path)
 {
-  std::FILE* handle = std::fopen(path.c_str(), "rb");
-  if (!handle)
-  {
-    return false;
-  }
-  char head[64] = {};
-  const std::size_t got = std::fread(head, 1, sizeof(head) - 1, handle);
-  std::fclose(handle);
+  const std::string text = EclipseKeywordFile::FileHead(path, 63);
+  const char* head = text.c_str();
+  const std::size_t got = text.size();
   const char* name = nullptr;
   if (EclipseKeywordFile::LooksLikeUnformatted(path))
   {

@@ -223,16 +223,21 @@ private:
   std::vector<char> Buffer;
 };
 
-bool ParseInteger(const std::string& token, int64_t& value)
+/// Parses all of [begin, end) as a number of type T (a leading '+' allowed).
+template <typename T>
+bool ParseWhole(const char* begin, const char* end, T& value)
 {
-  const char* begin = token.data();
-  const char* end = begin + token.size();
   if (begin != end && *begin == '+')
   {
     ++begin;
   }
   const auto result = std::from_chars(begin, end, value);
   return result.ec == std::errc() && result.ptr == end;
+}
+
+bool ParseInteger(const std::string& token, int64_t& value)
+{
+  return ParseWhole(token.data(), token.data() + token.size(), value);
 }
 
 bool ParseReal(std::string token, double& value)
@@ -244,14 +249,7 @@ bool ParseReal(std::string token, double& value)
       c = 'E'; // Fortran double exponent
     }
   }
-  const char* begin = token.data();
-  const char* end = begin + token.size();
-  if (begin != end && *begin == '+')
-  {
-    ++begin;
-  }
-  const auto result = std::from_chars(begin, end, value);
-  return result.ec == std::errc() && result.ptr == end;
+  return ParseWhole(token.data(), token.data() + token.size(), value);
 }
 } // namespace
 
@@ -303,29 +301,30 @@ EclipseKeywordFile::~EclipseKeywordFile()
   }
 }
 
+std::string EclipseKeywordFile::FileHead(const std::string& path, std::size_t size)
+{
+  std::string head(size, '\0');
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  head.resize(file ? std::fread(&head[0], 1, size, file) : 0);
+  if (file)
+  {
+    std::fclose(file);
+  }
+  return head;
+}
+
 bool EclipseKeywordFile::LooksLikeUnformatted(const std::string& path)
 {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file)
-  {
-    return false;
-  }
-  unsigned char head[24];
-  const std::size_t got = std::fread(head, 1, sizeof(head), file);
-  std::fclose(file);
-  return got == sizeof(head) && BigEndian32(head) == 16 && BigEndian32(head + 20) == 16;
+  const std::string head = FileHead(path, 24);
+  const auto* bytes = reinterpret_cast<const unsigned char*>(head.data());
+  return head.size() == 24 && BigEndian32(bytes) == 16 && BigEndian32(bytes + 20) == 16;
 }
 
 bool EclipseKeywordFile::LooksLikeFormatted(const std::string& path)
 {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file)
-  {
-    return false;
-  }
-  char head[64] = {};
-  const std::size_t got = std::fread(head, 1, sizeof(head) - 1, file);
-  std::fclose(file);
+  const std::string text = FileHead(path, 63);
+  const char* head = text.c_str();
+  const std::size_t got = text.size();
   std::size_t p = 0;
   while (p < got && (head[p] == ' ' || head[p] == '\n' || head[p] == '\r'))
   {

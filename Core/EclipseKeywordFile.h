@@ -58,6 +58,8 @@ public:
   EclipseKeywordFile(const EclipseKeywordFile&) = delete;
   EclipseKeywordFile& operator=(const EclipseKeywordFile&) = delete;
 
+  /// The first `size` bytes of a file (fewer if it is shorter; empty if unreadable).
+  static std::string FileHead(const std::string& path, std::size_t size);
   /// True if the file starts like an unformatted keyword file (a 16-byte header record).
   static bool LooksLikeUnformatted(const std::string& path);
   /// True if the file starts like a formatted keyword file ('NAME' count 'TYPE').

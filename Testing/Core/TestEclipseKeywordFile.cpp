@@ -4,6 +4,7 @@
 #include "EclipseGrid.h"
 #include "EclipseKeywordFile.h"
 #include "EclipseResults.h"
+#include "CoreTesting.h"
 #include "GrdeclError.h"
 
 #include <cmath>
@@ -19,18 +20,8 @@
 
 namespace
 {
-int Failures = 0;
 std::string Directory;
 
-#define CHECK(condition)                                                                         \
-  do                                                                                             \
-  {                                                                                              \
-    if (!(condition))                                                                            \
-    {                                                                                            \
-      std::fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #condition);        \
-      ++Failures;                                                                                \
-    }                                                                                            \
-  } while (0)
 
 // ------------------------------------------------------------------ file writers
 
@@ -133,7 +124,7 @@ void ExpectError(const std::string& label, const std::function<void()>& action,
   {
     action();
     std::fprintf(stderr, "%s: expected an error, none thrown\n", label.c_str());
-    ++Failures;
+    ++resmr_testing::Failures;
   }
   catch (const resmr::GrdeclError& error)
   {
@@ -142,7 +133,7 @@ void ExpectError(const std::string& label, const std::function<void()>& action,
       if (std::string(error.what()).find(fragment) == std::string::npos)
       {
         std::fprintf(stderr, "%s: message lacks '%s': %s\n", label.c_str(), fragment.c_str(), error.what());
-        ++Failures;
+        ++resmr_testing::Failures;
       }
     }
   }
@@ -415,9 +406,9 @@ int main()
   TestBadUnformatted();
   TestGridAndResults();
   std::system(("rm -rf '" + Directory + "'").c_str());
-  if (Failures)
+  if (resmr_testing::Failures)
   {
-    std::fprintf(stderr, "%d check(s) failed\n", Failures);
+    std::fprintf(stderr, "%d check(s) failed\n", resmr_testing::Failures);
     return 1;
   }
   std::printf("all ECLIPSE keyword file checks passed\n");

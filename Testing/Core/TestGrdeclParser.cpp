@@ -1,6 +1,7 @@
 // Unit tests of the Core GRDECL tokenizer, parser and corner-point geometry: every keyword
 // form, and every kind of bad input giving an error that names the file, line and keyword.
 #include "CornerPointGeometry.h"
+#include "CoreTesting.h"
 #include "GrdeclError.h"
 #include "GrdeclParser.h"
 #include "GrdeclTokenizer.h"
@@ -17,18 +18,8 @@
 
 namespace
 {
-int Failures = 0;
 std::string Directory;
 
-#define CHECK(condition)                                                                         \
-  do                                                                                             \
-  {                                                                                              \
-    if (!(condition))                                                                            \
-    {                                                                                            \
-      std::fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #condition);        \
-      ++Failures;                                                                                \
-    }                                                                                            \
-  } while (0)
 
 std::string Write(const std::string& name, const std::string& text)
 {
@@ -52,7 +43,7 @@ void ExpectError(const std::string& name, const std::string& text,
     resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(path, options);
     resmr::CornerPointGeometry::FromDeck(deck, true);
     std::fprintf(stderr, "expected an error for %s, got none\n", name.c_str());
-    ++Failures;
+    ++resmr_testing::Failures;
   }
   catch (const resmr::GrdeclError& error)
   {
@@ -63,7 +54,7 @@ void ExpectError(const std::string& name, const std::string& text,
       {
         std::fprintf(stderr, "error for %s lacks '%s': %s\n", name.c_str(), fragment.c_str(),
           message.c_str());
-        ++Failures;
+        ++resmr_testing::Failures;
       }
     }
   }
@@ -409,7 +400,7 @@ int main()
     { "bad input", TestBadInput } };
   for (const auto& test : tests)
   {
-    const int before = Failures;
+    const int before = resmr_testing::Failures;
     try
     {
       test.second();
@@ -417,10 +408,10 @@ int main()
     catch (const std::exception& error)
     {
       std::fprintf(stderr, "%s: unexpected exception: %s\n", test.first, error.what());
-      ++Failures;
+      ++resmr_testing::Failures;
     }
-    std::printf("%-24s %s\n", test.first, Failures == before ? "ok" : "FAILED");
+    std::printf("%-24s %s\n", test.first, resmr_testing::Failures == before ? "ok" : "FAILED");
   }
   std::system(("rm -rf '" + Directory + "'").c_str());
-  return Failures == 0 ? 0 : 1;
+  return resmr_testing::Failures == 0 ? 0 : 1;
 }

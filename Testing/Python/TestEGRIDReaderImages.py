@@ -57,16 +57,7 @@ for name, relative, steps, exaggeration, direction, zoom in CASES:
     display.SetScalarBarVisibility(view, True)
     simple.Render(view)
     bounds = grid.GetBounds()
-    centre = [(bounds[0] + bounds[1]) / 2, (bounds[2] + bounds[3]) / 2,
-              exaggeration * (bounds[4] + bounds[5]) / 2]
-    size = max(bounds[1] - bounds[0], bounds[3] - bounds[2])
-    camera = view.GetActiveCamera()
-    camera.SetFocalPoint(centre)
-    camera.SetPosition([centre[i] + direction[i] * size for i in range(3)])
-    camera.SetViewUp(0, 0, 1)
-    view.ResetCamera(False)
-    camera.Dolly(zoom)
-    simple.Render(view)
+    rt.place_camera(view, bounds, exaggeration, direction, zoom)
     rt.compare_image(view, args.baselines, f"EGRIDReader_{name}_SWAT_last.png", args.temp)
     simple.Hide(reader, view)
     simple.Delete(reader)

@@ -39,16 +39,7 @@ for name, relative, exaggeration, direction, zoom in CASES:
     simple.Render(view)
     # paraview.simple's first Render resets the camera: place it afterwards.
     bounds = servermanager.Fetch(reader, arg1=None, arg2=None, idx=0).GetBounds()
-    centre = [(bounds[0] + bounds[1]) / 2, (bounds[2] + bounds[3]) / 2,
-              exaggeration * (bounds[4] + bounds[5]) / 2]
-    size = max(bounds[1] - bounds[0], bounds[3] - bounds[2])
-    camera = view.GetActiveCamera()
-    camera.SetFocalPoint(centre)
-    camera.SetPosition([centre[i] + direction[i] * size for i in range(3)])
-    camera.SetViewUp(0, 0, 1)
-    view.ResetCamera(False)
-    camera.Dolly(zoom)
-    simple.Render(view)
+    rt.place_camera(view, bounds, exaggeration, direction, zoom)
     rt.compare_image(view, args.baselines, f"GRDECLReader_{name}_PORO.png", args.temp)
     simple.Hide(reader, view)
 

@@ -47,6 +47,22 @@ def points_and_cells(grid):
     return points, connectivity.reshape(-1, 8)
 
 
+def place_camera(view, bounds, exaggeration, direction, zoom):
+    """Looks at the centre of `bounds` (z scaled by `exaggeration`) from `direction`, z up,
+    then dollies by `zoom`. Call after the first Render, which resets the camera."""
+    from paraview import simple
+    centre = [(bounds[0] + bounds[1]) / 2, (bounds[2] + bounds[3]) / 2,
+              exaggeration * (bounds[4] + bounds[5]) / 2]
+    size = max(bounds[1] - bounds[0], bounds[3] - bounds[2])
+    camera = view.GetActiveCamera()
+    camera.SetFocalPoint(centre)
+    camera.SetPosition([centre[i] + direction[i] * size for i in range(3)])
+    camera.SetViewUp(0, 0, 1)
+    view.ResetCamera(False)
+    camera.Dolly(zoom)
+    simple.Render(view)
+
+
 def compare_image(render_view, baseline_dir, name, temp_dir, threshold=0.05):
     """Saves the view and compares it to baseline_dir/name. Missing baselines fail the test
     and leave the new image in temp_dir for a person to look at."""
