@@ -106,6 +106,10 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
       {
         fail(&record, "needs at least 4 integers (type, nx, ny, nz)");
       }
+      if (sawGridHead)
+      {
+        fail(&record, "the global grid has a second GRIDHEAD");
+      }
       integers.resize(static_cast<std::size_t>(record.count));
       file.Read(record, integers.data());
       if (integers[0] != 1)

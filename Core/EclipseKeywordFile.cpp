@@ -103,7 +103,15 @@ void ConvertBigEndian(EclipseDataType type, const unsigned char* in, int64_t n, 
         const uint32_t bits = BigEndian32(in + 4 * i);
         float value;
         std::memcpy(&value, &bits, 4);
-        out[i] = static_cast<T>(value);
+        if constexpr (std::is_integral_v<T>)
+        {
+          // Out-of-range (or NaN) floats would be undefined behaviour as integers.
+          out[i] = std::fabs(value) < 2147483520.0f ? static_cast<T>(value) : T(0);
+        }
+        else
+        {
+          out[i] = static_cast<T>(value);
+        }
       }
       break;
     case EclipseDataType::Double:
@@ -184,11 +192,12 @@ public:
     }
     while ((c = this->Peek()) >= 0 && c != ' ' && c != '\n' && c != '\r' && c != '\t')
     {
-      if (token.size() > 256)
+      // An absurdly long token is consumed whole (so indexing and reading agree on where
+      // tokens are) but only its start is kept: the caller's conversion rejects it.
+      if (token.size() <= 256)
       {
-        return true; // absurdly long; caller's conversion rejects it
+        token.push_back(static_cast<char>(c));
       }
-      token.push_back(static_cast<char>(c));
       ++this->Offset;
     }
     return true;
@@ -559,6 +568,10 @@ template void EclipseKeywordFile::Read<double>(const EclipseRecord&, double*) co
 
 void EclipseKeywordFile::ReadNumbers(const EclipseRecord& record, std::vector<double>& values) const
 {
+  if (!record.IsNumeric())
+  {
+    this->Fail(&record, record.headerOffset, "expected numeric data, found type " + record.typeName);
+  }
   values.resize(static_cast<std::size_t>(record.count));
   this->Read(record, values.data());
 }
@@ -620,7 +633,8 @@ void EclipseKeywordFile::IndexFormatted()
     }
     record.dataOffset = cursor.Offset;
     const bool strings = record.type == EclipseDataType::Character;
-    for (int64_t i = 0; i < record.count; ++i)
+    const int64_t tokens = record.type == EclipseDataType::Message ? 0 : record.count;
+    for (int64_t i = 0; i < tokens; ++i)
     {
       if (!cursor.Next(token, quoted, start))
       {
