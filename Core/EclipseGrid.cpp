@@ -4,6 +4,7 @@
 #include "EclipseKeywordFile.h"
 #include "GrdeclError.h"
 #include "GrdeclParser.h"
+#include "LargeArrays.h"
 
 #include <cmath>
 #include <cstdio>
@@ -164,12 +165,13 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
       }
       if (name == "ACTNUM")
       {
-        grid.actnum.resize(static_cast<std::size_t>(expected));
+        ResizeLarge(grid.actnum, static_cast<std::size_t>(expected));
         file.Read(record, grid.actnum.data());
         continue;
       }
       std::vector<double>& target = name == "COORD" ? deck.coord : deck.zcorn;
-      target.resize(static_cast<std::size_t>(expected));
+      target.clear();
+      ResizeLarge(target, static_cast<std::size_t>(expected));
       file.Read(record, target.data());
       for (std::size_t v = 0; v < target.size(); ++v)
       {

@@ -3,6 +3,7 @@
 #include "EclipseResults.h"
 
 #include "GrdeclError.h"
+#include "LargeArrays.h"
 
 #include <algorithm>
 #include <cctype>
@@ -391,7 +392,8 @@ void EclipseResults::Scatter(
     file.Read(record, cellValues); // one value per cell, in cell order: no copy
     return;
   }
-  std::vector<T> values(static_cast<std::size_t>(record.count));
+  std::vector<T> values;
+  ResizeLarge(values, static_cast<std::size_t>(record.count));
   file.Read(record, values.data());
   if (!perActiveCell)
   {

@@ -9,6 +9,8 @@
 #include "vtkSmartPointer.h"
 #include "vtkType.h"
 
+#include "LargeArrays.h" // for resmr::AdviseHugePages
+
 #include <cstdint>
 #include <vector>
 
@@ -62,6 +64,7 @@ vtkSmartPointer<VTKArray> MakeCellArray(const char* name, const CellOrder& order
   array->SetName(name);
   array->SetNumberOfValues(static_cast<vtkIdType>(cells));
   Value* out = array->GetPointer(0);
+  resmr::AdviseHugePages(out, static_cast<std::size_t>(cells) * sizeof(Value));
   if (!order.mirrorK)
   {
     fill(out);
