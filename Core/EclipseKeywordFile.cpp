@@ -21,6 +21,7 @@ constexpr int64_t HeaderBytes = 24;             // marker, 8 + 4 + 4 bytes, mark
 constexpr int64_t ChunkBytes = 4 << 20;         // read granularity for record data
 constexpr int64_t NumbersPerBlock = 1000;       // ECLIPSE's Fortran record sizes
 constexpr int64_t StringsPerBlock = 105;
+constexpr std::size_t MaxNumberCharacters = 256; // formatted numbers are at most ~25 wide
 
 uint32_t BigEndian32(const unsigned char* p)
 {
@@ -194,7 +195,7 @@ public:
     {
       // An absurdly long token is consumed whole (so indexing and reading agree on where
       // tokens are) but only its start is kept: the caller's conversion rejects it.
-      if (token.size() <= 256)
+      if (token.size() <= MaxNumberCharacters)
       {
         token.push_back(static_cast<char>(c));
       }
@@ -702,10 +703,12 @@ void EclipseKeywordFile::ReadFormatted(const EclipseRecord& record, T* out) cons
         break;
       }
     }
+    ok = ok && token.size() <= MaxNumberCharacters; // longer ones were cut by the cursor
     if (!ok)
     {
       this->Fail(&record, start, "value " + std::to_string(i + 1) + " '" + token.substr(0, 30) +
-          "' is not a valid " + record.typeName);
+          (token.size() > 30 ? "...' (" + std::to_string(token.size()) + "+ characters)" : "'") +
+          " is not a valid " + record.typeName);
     }
   }
 }
