@@ -114,6 +114,13 @@ CornerPointGeometry CornerPointGeometry::FromDeck(GrdeclDeck& deck, bool applyMa
   }
   if (deck.HasCornerPointGeometry())
   {
+    const int64_t nx = deck.dims[0], ny = deck.dims[1];
+    if (static_cast<int64_t>(deck.coord.size()) != 6 * (nx + 1) * (ny + 1) ||
+      static_cast<int64_t>(deck.zcorn.size()) != 8 * deck.CellCount())
+    {
+      throw GrdeclError(deck.files.empty() ? std::string("deck") : deck.files.front(), 0, "ZCORN",
+        "COORD/ZCORN sizes do not match the grid dimensions");
+    }
     geometry.CoordValues = std::move(deck.coord);
     geometry.ZcornValues = std::move(deck.zcorn);
     deck.coord.clear();

@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
-# Builds the GRDECL libFuzzer target (clang, ASan + UBSan) and fuzzes it on one core.
+# Builds a libFuzzer target (clang, ASan + UBSan) and fuzzes it on one core.
 #
-#   Testing/Fuzz/run_fuzz.sh [SECONDS]          default 60
+#   Testing/Fuzz/run_fuzz.sh [SECONDS] [TARGET]     default 60 FuzzGrdeclParser
+#
+# TARGET: FuzzGrdeclParser   GRDECL decks (grdecl.dict; corpus-work/corpus, artifacts)
+#         FuzzEclipseOutput  EGRID/INIT/UNRST keyword files (eclipse.dict; corpus-work/eclipse/)
 #
 # Environment:
 #   FUZZ_BUILD_DIR   where the fuzzer binary goes          (default /tmp/resmr-fuzz-build)
@@ -17,27 +20,96 @@
 set -euo pipefail
 
 seconds="${1:-60}"
+target="${2:-FuzzGrdeclParser}"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 repo="$(cd "${here}/../.." && pwd)"
 build="${FUZZ_BUILD_DIR:-/tmp/resmr-fuzz-build}"
 data="${RESMR_DATA_DIR:-${repo}/../shared/data}"
-work="${here}/corpus-work"
 cxx="${CXX:-clang++}"
-max_len=65536
+case "${target}" in
+  FuzzGrdeclParser)
+    work="${here}/corpus-work"
+    max_len=65536
+    dict="${here}/grdecl.dict"
+    seeds="${here}/seeds"
+    ;;
+  FuzzEclipseOutput)
+    work="${here}/corpus-work/eclipse"
+    max_len=131072 # a small grid + INIT + restart in one input
+    dict="${here}/eclipse.dict"
+    seeds="${here}/seeds/eclipse"
+    ;;
+  *)
+    echo "run_fuzz.sh: unknown target '${target}' (FuzzGrdeclParser or FuzzEclipseOutput)" >&2
+    exit 2
+    ;;
+esac
 
 mkdir -p "${build}" "${work}/corpus" "${work}/artifacts"
 
 # ---------------------------------------------------------------- build
-fuzzer="${build}/FuzzGrdeclParser"
+fuzzer="${build}/${target}"
 echo "== building ${fuzzer}"
 # -fno-sanitize-recover: a UBSan report is a crash with an artifact, not a line in the log.
 "${cxx}" -std=c++17 -g -O1 -fno-omit-frame-pointer \
   -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-  -I "${repo}/Core" "${repo}"/Core/*.cpp "${here}/FuzzGrdeclParser.cpp" -o "${fuzzer}"
+  -I "${repo}/Core" "${repo}"/Core/*.cpp "${here}/${target}.cpp" -o "${fuzzer}"
 
 # ---------------------------------------------------------------- corpus
-cp -n "${here}"/seeds/* "${work}/corpus/" 2>/dev/null || true
-if [ -d "${data}" ]; then
+find "${seeds}" -maxdepth 1 -type f -exec cp -n {} "${work}/corpus/" \;
+if [ "${target}" = FuzzEclipseOutput ]; then
+  if [ -d "${data}" ]; then
+    # Small simulator output files as they are (the head of bigger ones), and each small
+    # grid joined with its INIT and restarts by the harness's separator (%RESMR%\n):
+    # grid, INIT, UNRST or grid, INIT, Xnnnn..., "" (an empty last part: per-step files).
+    sep=$'%RESMR%\n'
+    n=0
+    while IFS= read -r -d '' file; do
+      name="data_$(echo "${file#"${data}"/}" | tr '/' '_')"
+      if [ ! -e "${work}/corpus/${name}" ]; then
+        head -c "${max_len}" "${file}" > "${work}/corpus/${name}"
+        n=$((n + 1))
+      fi
+    done < <(find "${data}/format_variants" "${data}/spe1" "${data}/egg" -type f -size -200k \
+               \( -iname '*.EGRID' -o -iname '*.FEGRID' -o -iname '*.INIT' -o -iname '*.FINIT' \
+               -o -iname '*.UNRST' -o -iname '*.FUNRST' -o -iname '*.X[0-9][0-9][0-9][0-9]' \
+               -o -iname '*.F[0-9][0-9][0-9][0-9]' \) -print0 2>/dev/null)
+    while IFS= read -r -d '' grid; do
+      stem="${grid%.*}"
+      name="set_$(echo "${stem#"${data}"/}" | tr '/' '_')"
+      [ -e "${work}/corpus/${name}" ] && continue
+      init=$(ls "${stem}".INIT "${stem}".FINIT 2>/dev/null | head -n 1 || true)
+      unrst=$(ls "${stem}".UNRST "${stem}".FUNRST 2>/dev/null | head -n 1 || true)
+      steps=$(ls "${stem}".X[0-9][0-9][0-9][0-9] 2>/dev/null | head -n 4 || true)
+      [ -z "${init}${unrst}${steps}" ] && continue
+      # With the restarts if the whole set fits max_len, else grid and INIT only.
+      for with_restarts in 1 0; do
+        {
+          cat "${grid}"; printf '%s' "${sep}"
+          if [ -n "${init}" ]; then cat "${init}"; fi
+          if [ "${with_restarts}" = 1 ]; then
+            printf '%s' "${sep}"
+            if [ -n "${unrst}" ]; then
+              cat "${unrst}"
+            else
+              for step in ${steps}; do cat "${step}"; printf '%s' "${sep}"; done
+            fi
+          fi
+        } > "${work}/corpus/${name}.tmp"
+        if [ "$(stat -c %s "${work}/corpus/${name}.tmp")" -le "${max_len}" ]; then
+          mv "${work}/corpus/${name}.tmp" "${work}/corpus/${name}"
+          n=$((n + 1))
+          break
+        fi
+        rm -f "${work}/corpus/${name}.tmp"
+      done
+    done < <(find "${data}/format_variants" "${data}/spe1" "${data}/egg" -type f -size -200k \
+               \( -iname '*.EGRID' -o -iname '*.FEGRID' \) -print0 2>/dev/null)
+    echo "== seeded ${n} new real files and grid sets from ${data}"
+  else
+    echo "== no data folder at ${data}: committed seeds only"
+  fi
+elif [ -d "${data}" ]; then
   n=0
   while IFS= read -r -d '' deck; do
     # libFuzzer would cut longer inputs to max_len anyway: keep the head of big decks.
@@ -58,7 +130,7 @@ echo "== corpus: $(ls "${work}/corpus" | wc -l) files"
 
 # ---------------------------------------------------------------- fuzz
 log="${work}/fuzz-$(date -u +%Y%m%dT%H%M%SZ).log"
-flags=(-max_len=${max_len} -timeout=10 -rss_limit_mb=2048 -dict="${here}/grdecl.dict"
+flags=(-max_len=${max_len} -timeout=10 -rss_limit_mb=2048 -dict="${dict}"
   -max_total_time="${seconds}" -print_final_stats=1 -artifact_prefix="${work}/artifacts/")
 if [ "${FUZZ_FORK:-0}" = 1 ]; then
   flags+=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
@@ -68,7 +140,7 @@ flags+=(${FUZZ_EXTRA:-})
 echo "== fuzzing for ${seconds} s on one core; log: ${log}"
 # The target's private input folders go here: libFuzzer ends its (fork) processes without
 # running destructors, so they are removed after the run.
-scratch="${build}/tmp"
+scratch="${build}/tmp-${target}"
 rm -rf "${scratch}" && mkdir -p "${scratch}"
 set +e
 # Run from an empty folder: a fuzzed INCLUDE with a relative name is looked up next to the

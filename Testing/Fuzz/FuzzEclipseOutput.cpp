@@ -1,0 +1,612 @@
+// Fuzz target for the ECLIPSE keyword-file reader (EclipseKeywordFile), the EGRID/FEGRID grid
+// reader (ReadEclipseGrid) and the INIT/restart results beside it (EclipseResults).
+//
+// libFuzzer build (see run_fuzz.sh):
+//   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I Core Core/*.cpp FuzzEclipseOutput.cpp
+// Standalone replay build (ctest FuzzEclipseOutput.SeedCorpus): compile with
+// -DRESMR_FUZZ_STANDALONE; the executable runs the target over every file (or every file in
+// every directory) named on its command line.
+//
+// Input layout: up to 8 parts separated by the 8 bytes "%RESMR%\n" (SplitMarker). The parts
+// are written into a private, otherwise empty folder as companions of one grid:
+//   part 0            input.EGRID   (input.FEGRID if it starts like a formatted file)
+//   part 1            input.INIT    (input.FINIT)
+//   part 2, 3 parts   input.UNRST   (input.FUNRST)                     unified restart
+//   part 2.., more    input.X0000, input.X0001, ... (input.Fnnnn)      per-step restarts
+// An empty part writes no file (a missing companion). An input without the marker is a
+// single EGRID (or any keyword file: INIT, UNRST, binary GRDECL), so real files are seeds
+// as they are.
+//
+// Per input: every part is sniffed (LooksLike*), opened as an EclipseKeywordFile and every
+// record read (numeric ones as double, float and int32_t, character ones as strings, MESS
+// ones must be refused); then ReadEclipseGrid on part 0 (maxCells 1 << 20), grid invariants
+// checked, EclipseResults built and every static array and every dynamic array of every
+// step read (double, float, int32_t); last the corner-point geometry of the grid is built
+// as the reader does (FromDeck, BuildSharedCorners).
+//
+// Expected outcomes: results, or a resmr::GrdeclError (or another std::exception) for bad
+// input. Anything else -- a crash, a sanitizer report, a hang or a runaway allocation -- is
+// a finding.
+#include "CornerPointGeometry.h"
+#include "EclipseGrid.h"
+#include "EclipseKeywordFile.h"
+#include "EclipseResults.h"
+#include "GrdeclError.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <dirent.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace
+{
+constexpr std::string_view SplitMarker("%RESMR%\n", 8);
+constexpr std::size_t MaxParts = 8;
+constexpr int64_t MaxCells = int64_t(1) << 20;
+
+/// A private, initially empty directory holding only this input's files, so that companion
+/// lookup (by basename, and the Xnnnn directory scan) sees nothing else.
+class InputFiles
+{
+public:
+  InputFiles()
+  {
+    const char* tmp = std::getenv("TMPDIR");
+    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/resmr-fuzz-XXXXXX";
+    if (!mkdtemp(pattern.data()))
+    {
+      std::perror("mkdtemp");
+      std::abort();
+    }
+    this->Directory = pattern;
+  }
+  ~InputFiles()
+  {
+    this->Clear();
+    rmdir(this->Directory.c_str());
+  }
+  InputFiles(const InputFiles&) = delete;
+  InputFiles& operator=(const InputFiles&) = delete;
+
+  /// Removes the files of the previous input.
+  void Clear()
+  {
+    for (const std::string& path : this->Paths)
+    {
+      std::remove(path.c_str());
+    }
+    this->Paths.clear();
+  }
+
+  const std::string& Write(const std::string& name, std::string_view data)
+  {
+    const std::string path = this->Directory + "/" + name;
+    std::FILE* file = std::fopen(path.c_str(), "wb");
+    if (!file || (!data.empty() && std::fwrite(data.data(), 1, data.size(), file) != data.size()) ||
+      std::fclose(file) != 0)
+    {
+      std::perror(path.c_str());
+      std::abort();
+    }
+    this->Paths.push_back(path);
+    return this->Paths.back();
+  }
+
+private:
+  std::string Directory;
+  std::vector<std::string> Paths;
+};
+
+#ifdef RESMR_FUZZ_STANDALONE
+std::string LastOutcome; // what the last input did, for the replay log
+#define RESMR_FUZZ_OUTCOME(text) (LastOutcome = (text))
+#else
+#define RESMR_FUZZ_OUTCOME(text) ((void)0)
+#endif
+
+InputFiles& TheInputFiles()
+{
+  static InputFiles files; // one per process, reused across iterations
+  return files;
+}
+
+/// The input cut at every SplitMarker, at most MaxParts parts (the last keeps the rest).
+std::vector<std::string_view> SplitInput(std::string_view input)
+{
+  std::vector<std::string_view> parts;
+  while (parts.size() + 1 < MaxParts)
+  {
+    const std::size_t at = input.find(SplitMarker);
+    if (at == std::string_view::npos)
+    {
+      break;
+    }
+    parts.push_back(input.substr(0, at));
+    input.remove_prefix(at + SplitMarker.size());
+  }
+  parts.push_back(input);
+  return parts;
+}
+
+/// What EclipseKeywordFile::LooksLikeFormatted keys on: a quote after leading blanks.
+bool StartsFormatted(std::string_view data)
+{
+  const std::size_t first = data.find_first_not_of(" \r\n");
+  return first != std::string_view::npos && data[first] == '\'';
+}
+
+/// File name of part `index` of `count`, formatted or not.
+std::string PartName(std::size_t index, std::size_t count, bool formatted)
+{
+  if (index == 0)
+  {
+    return formatted ? "input.FEGRID" : "input.EGRID";
+  }
+  if (index == 1)
+  {
+    return formatted ? "input.FINIT" : "input.INIT";
+  }
+  if (count == 3)
+  {
+    return formatted ? "input.FUNRST" : "input.UNRST";
+  }
+  char name[32];
+  std::snprintf(name, sizeof(name), "input.%c%04zu", formatted ? 'F' : 'X', index - 2);
+  return name;
+}
+
+[[noreturn]] void BrokenInvariant(const std::string& what)
+{
+  std::fprintf(stderr, "==FuzzEclipseOutput== broken invariant: %s\n", what.c_str());
+  std::fflush(stderr);
+  std::abort();
+}
+
+/// RESMR_FUZZ_NO_INVARIANTS=1 skips CheckGrid, to see what a broken grid does downstream.
+bool InvariantsChecked()
+{
+  static const bool checked = [] {
+    const char* value = std::getenv("RESMR_FUZZ_NO_INVARIANTS");
+    return !(value && *value && std::strcmp(value, "0") != 0);
+  }();
+  return checked;
+}
+
+/// Whitespace-separated tokens in text, and the length of the longest.
+int64_t CountTokens(std::string_view text, std::size_t& longest)
+{
+  int64_t tokens = 0;
+  std::size_t length = 0;
+  longest = 0;
+  for (const char c : text)
+  {
+    const bool blank = c == ' ' || c == '\n' || c == '\r' || c == '\t';
+    tokens += !blank && length == 0;
+    length = blank ? 0 : length + 1;
+    longest = std::max(longest, length);
+  }
+  return tokens;
+}
+
+/// Opens one keyword file (its bytes are `contents`) and reads every record the ways a
+/// caller may.
+std::string ReadEveryRecord(const std::string& path, std::string_view contents)
+{
+  int64_t records = 0, errors = 0;
+  std::string other;
+  // The cheap sniffers of file dialogs and `resmr info` (they read the file's head only).
+  const bool unformatted = resmr::EclipseKeywordFile::LooksLikeUnformatted(path);
+  const bool formatted = resmr::EclipseKeywordFile::LooksLikeFormatted(path);
+  const bool grid = resmr::LooksLikeEclipseGridFile(path);
+  if (grid && !unformatted && !formatted)
+  {
+    BrokenInvariant(path + ": LooksLikeEclipseGridFile but neither LooksLike(Un)formatted");
+  }
+  try
+  {
+    const resmr::EclipseKeywordFile file(path);
+    std::vector<double> numbers;
+    std::vector<float> floats;
+    std::vector<int32_t> integers;
+    for (const resmr::EclipseRecord& record : file.Records())
+    {
+      ++records;
+      if (record.count < 0 || record.dataOffset < record.headerOffset ||
+        record.endOffset < record.dataOffset || record.endOffset > file.Size())
+      {
+        BrokenInvariant(path + ": record " + record.name + " has count " +
+          std::to_string(record.count) + ", offsets " + std::to_string(record.headerOffset) +
+          "/" + std::to_string(record.dataOffset) + "/" + std::to_string(record.endOffset) +
+          " in a file of " + std::to_string(file.Size()) + " bytes");
+      }
+      // Formatted numbers are one blank-separated token each (finding 04).
+      std::size_t longest = 0;
+      if (file.IsFormatted() && record.IsNumeric())
+      {
+        const int64_t tokens = CountTokens(contents.substr(static_cast<std::size_t>(record.dataOffset),
+          static_cast<std::size_t>(record.endOffset - record.dataOffset)), longest);
+        if (tokens != record.count)
+        {
+          BrokenInvariant(path + ": formatted record " + record.name + " indexed with count " +
+            std::to_string(record.count) + " but its data holds " + std::to_string(tokens) +
+            " tokens (longest " + std::to_string(longest) + " characters)");
+        }
+      }
+      if (file.Find(record.name) == nullptr)
+      {
+        BrokenInvariant(path + ": Find(\"" + record.name + "\") misses an indexed record");
+      }
+      try
+      {
+        if (record.IsNumeric())
+        {
+          file.ReadNumbers(record, numbers);
+          // TextCursor keeps 257 characters of a longer token, for the conversion to refuse
+          // (finding 05: a valid number's first 257 characters parse too).
+          if (longest > 257)
+          {
+            BrokenInvariant(path + ": formatted record " + record.name + " read although a value is " +
+              std::to_string(longest) + " characters long");
+          }
+          floats.assign(static_cast<std::size_t>(record.count), 0.0f);
+          file.Read(record, floats.data());
+          integers.assign(static_cast<std::size_t>(record.count), 0);
+          file.Read(record, integers.data()); // REAL/DOUB out of int32 range: 0 (finding 01)
+        }
+        else if (record.type == resmr::EclipseDataType::Character)
+        {
+          const std::vector<std::string> strings = file.ReadStrings(record);
+          if (strings.size() != static_cast<std::size_t>(record.count))
+          {
+            BrokenInvariant(path + ": ReadStrings(" + record.name + ") gave " +
+              std::to_string(strings.size()) + " strings for count " + std::to_string(record.count));
+          }
+        }
+        else
+        {
+          // MESS: must be refused before allocating: nothing bounds a MESS count (finding 03).
+          file.ReadNumbers(record, numbers);
+          BrokenInvariant(path + ": numeric read accepted MESS record " + record.name);
+        }
+      }
+      catch (const resmr::GrdeclError&)
+      {
+        ++errors;
+      }
+      catch (const std::exception& error)
+      {
+        ++errors; // e.g. std::bad_alloc: reported by the sanitizers' allocator when fuzzing
+        other = std::string(" std::exception: ") + error.what();
+      }
+    }
+  }
+  catch (const resmr::GrdeclError& error)
+  {
+    return std::string("index: GrdeclError: ") + error.what();
+  }
+  return std::to_string(records) + " records (" + std::to_string(errors) + " unreadable)" + other;
+}
+
+/// The promises the reader relies on: every array sized for the dimensions.
+void CheckGrid(const resmr::EclipseGrid& grid)
+{
+  if (!InvariantsChecked())
+  {
+    return;
+  }
+  const auto& d = grid.deck.dims;
+  if (d[0] <= 0 || d[1] <= 0 || d[2] <= 0 || d[0] * d[1] * d[2] > MaxCells)
+  {
+    BrokenInvariant("grid dims " + std::to_string(d[0]) + " x " + std::to_string(d[1]) + " x " +
+      std::to_string(d[2]) + " (maxCells " + std::to_string(MaxCells) + ")");
+  }
+  const auto n = static_cast<std::size_t>(grid.deck.CellCount());
+  if (grid.deck.coord.size() != static_cast<std::size_t>(6 * (d[0] + 1) * (d[1] + 1)))
+  {
+    BrokenInvariant("COORD has " + std::to_string(grid.deck.coord.size()) + " values for " +
+      std::to_string(d[0]) + " x " + std::to_string(d[1]) + " x " + std::to_string(d[2]));
+  }
+  if (grid.deck.zcorn.size() != 8 * n)
+  {
+    BrokenInvariant("ZCORN has " + std::to_string(grid.deck.zcorn.size()) + " values for " +
+      std::to_string(n) + " cells");
+  }
+  if (grid.actnum.size() != n)
+  {
+    BrokenInvariant("actnum has " + std::to_string(grid.actnum.size()) + " values for " +
+      std::to_string(n) + " cells");
+  }
+  for (const resmr::CellArray& array : grid.deck.arrays)
+  {
+    if (array.values.size() != n)
+    {
+      BrokenInvariant("array " + array.name + " has " + std::to_string(array.values.size()) +
+        " values for " + std::to_string(n) + " cells");
+    }
+  }
+  if (grid.activeCells < 0 || grid.activeCells > grid.deck.CellCount() || grid.fractureCells < 0 ||
+    grid.fractureCells > grid.deck.CellCount())
+  {
+    BrokenInvariant("active " + std::to_string(grid.activeCells) + ", fracture " +
+      std::to_string(grid.fractureCells) + " of " + std::to_string(n) + " cells");
+  }
+}
+
+/// Reads every static array and every dynamic array of every step, as double and int32_t.
+std::string ReadEveryResult(const resmr::EclipseResults& results, int64_t cells)
+{
+  const auto n = static_cast<std::size_t>(cells);
+  std::vector<double> values(n);
+  std::vector<int32_t> integers(n);
+  int64_t read = 0;
+  std::vector<float> floats(n);
+  for (const resmr::EclipseResultArray& array : results.StaticArrays())
+  {
+    if (!results.ReadStatic(array.name, values.data(), -1.0) ||
+      !results.ReadStatic(array.name, floats.data(), -1.0f) ||
+      !results.ReadStatic(array.name, integers.data(), int32_t(-1)))
+    {
+      BrokenInvariant("ReadStatic(" + array.name + ") misses a listed static array");
+    }
+    ++read;
+  }
+  for (std::size_t step = 0; step < results.Steps().size(); ++step)
+  {
+    const resmr::EclipseReportStep& info = results.Steps()[step];
+    if (info.names.size() != info.records.size())
+    {
+      BrokenInvariant("step " + std::to_string(step) + " has " + std::to_string(info.names.size()) +
+        " names and " + std::to_string(info.records.size()) + " records");
+    }
+    for (const resmr::EclipseResultArray& array : results.DynamicArrays())
+    {
+      const bool listed = std::find(info.names.begin(), info.names.end(), array.name) != info.names.end();
+      const bool got = results.ReadDynamic(step, array.name, values.data(), -1.0);
+      if (got != listed || results.ReadDynamic(step, array.name, floats.data(), -1.0f) != got ||
+        results.ReadDynamic(step, array.name, integers.data(), int32_t(-1)) != got)
+      {
+        BrokenInvariant("ReadDynamic(" + std::to_string(step) + ", " + array.name + ") returned " +
+          (got ? "true" : "false") + " for a" + (listed ? " listed" : "n unlisted") + " array");
+      }
+      read += got;
+    }
+    // Out of range: false, not a crash.
+    if (results.ReadDynamic(results.Steps().size(), info.names.empty() ? "" : info.names[0],
+          values.data(), 0.0))
+    {
+      BrokenInvariant("ReadDynamic accepted a step past the end");
+    }
+  }
+  return std::to_string(results.StaticArrays().size()) + " static, " +
+    std::to_string(results.Steps().size()) + " steps, " +
+    std::to_string(results.DynamicArrays().size()) + " dynamic names, " + std::to_string(read) +
+    " arrays read, " + std::to_string(results.Warnings().size()) + " warnings";
+}
+} // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
+{
+  InputFiles& files = TheInputFiles();
+  files.Clear();
+  const std::vector<std::string_view> parts =
+    SplitInput(std::string_view(reinterpret_cast<const char*>(data), size));
+  std::string gridPath;
+  std::string outcome;
+  for (std::size_t p = 0; p < parts.size(); ++p)
+  {
+    if (parts[p].empty() && p > 0)
+    {
+      continue; // a missing companion
+    }
+    const std::string& path = files.Write(PartName(p, parts.size(), StartsFormatted(parts[p])), parts[p]);
+    if (p == 0)
+    {
+      gridPath = path;
+    }
+    outcome += (outcome.empty() ? "" : "; ") + path.substr(path.rfind('/') + 1) + ": " +
+      ReadEveryRecord(path, parts[p]);
+  }
+  try
+  {
+    resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath, MaxCells);
+    CheckGrid(grid);
+    outcome += "; grid " + std::to_string(grid.deck.CellCount()) + " cells, " +
+      std::to_string(grid.activeCells) + " active";
+    const resmr::EclipseResults results(gridPath, grid);
+    outcome += "; " + ReadEveryResult(results, grid.deck.CellCount());
+    resmr::CornerPointGeometry geometry = resmr::CornerPointGeometry::FromDeck(grid.deck, true);
+    const resmr::CornerPointGeometry::SharedCorners shared = geometry.BuildSharedCorners();
+    const std::size_t points = shared.points.size() / 3;
+    for (const int64_t id : shared.cellPoints)
+    {
+      if (id < 0 || static_cast<std::size_t>(id) >= points)
+      {
+        BrokenInvariant("BuildSharedCorners: corner point id " + std::to_string(id) +
+          " outside [0, " + std::to_string(points) + ")");
+      }
+    }
+    outcome += "; geometry " + std::to_string(points) + " shared points";
+  }
+  catch (const resmr::GrdeclError& error)
+  {
+    // expected: bad input reported as such
+    outcome += std::string("; GrdeclError: ") + error.what();
+  }
+  catch (const std::exception& error)
+  {
+    // expected too: e.g. std::bad_alloc, std::out_of_range from the standard library
+    outcome += std::string("; std::exception: ") + error.what();
+  }
+  RESMR_FUZZ_OUTCOME(outcome);
+  (void)outcome;
+  return 0;
+}
+
+#ifdef RESMR_FUZZ_STANDALONE
+namespace
+{
+bool ReadWholeFile(const std::string& path, std::string& contents)
+{
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file)
+  {
+    return false;
+  }
+  contents.clear();
+  char buffer[1 << 16];
+  std::size_t got = 0;
+  while ((got = std::fread(buffer, 1, sizeof(buffer), file)) > 0)
+  {
+    contents.append(buffer, got);
+  }
+  const bool ok = !std::ferror(file);
+  std::fclose(file);
+  return ok;
+}
+
+void RunInput(const std::string& name, const std::string& contents, long& count)
+{
+  std::printf("%s (%zu bytes): ", name.c_str(), contents.size());
+  std::fflush(stdout); // the name is out before a crash
+  LastOutcome.clear();
+  LLVMFuzzerTestOneInput(reinterpret_cast<const uint8_t*>(contents.data()), contents.size());
+  std::printf("%s\n", LastOutcome.substr(0, 400).c_str());
+  ++count;
+}
+
+/// For an EGRID/FEGRID with an INIT or restarts beside it: grid, INIT and restarts joined by
+/// SplitMarker (per-step restarts, at most 5, end with an empty part so that they are written
+/// as Xnnnn, not as a unified restart). False for other files and sets over 1 MiB.
+bool GridSet(const std::string& path, std::string& set)
+{
+  std::string extension = path.substr(path.find_last_of("./") + 1);
+  for (char& c : extension)
+  {
+    c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  }
+  if (extension != "EGRID" && extension != "FEGRID")
+  {
+    return false;
+  }
+  const std::string init = resmr::EclipseResults::FindInit(path);
+  bool unified = false;
+  std::vector<std::string> restarts = resmr::EclipseResults::FindRestarts(path, unified);
+  if (init.empty() && restarts.empty())
+  {
+    return false;
+  }
+  restarts.resize(std::min<std::size_t>(restarts.size(), 5));
+  std::vector<std::string> names = { path, init };
+  names.insert(names.end(), restarts.begin(), restarts.end());
+  if (!unified && !restarts.empty())
+  {
+    names.emplace_back(); // a fourth part at least: per-step files
+  }
+  set.clear();
+  for (std::size_t p = 0; p < names.size(); ++p)
+  {
+    std::string contents;
+    if (!names[p].empty() && !ReadWholeFile(names[p], contents))
+    {
+      return false;
+    }
+    set += (p ? std::string(SplitMarker) : std::string()) + contents;
+    if (set.size() > (std::size_t(1) << 20))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+int RunPath(const std::string& path, long& count)
+{
+  struct stat info;
+  if (stat(path.c_str(), &info) != 0)
+  {
+    std::fprintf(stderr, "FuzzEclipseOutputReplay: cannot stat %s\n", path.c_str());
+    return 1;
+  }
+  if (S_ISDIR(info.st_mode))
+  {
+    DIR* dir = opendir(path.c_str());
+    if (!dir)
+    {
+      std::fprintf(stderr, "FuzzEclipseOutputReplay: cannot open directory %s\n", path.c_str());
+      return 1;
+    }
+    int failures = 0;
+    while (const dirent* entry = readdir(dir))
+    {
+      const std::string name = entry->d_name;
+      if (name == "." || name == ".." || name[0] == '.')
+      {
+        continue;
+      }
+      failures += RunPath(path + "/" + name, count);
+    }
+    closedir(dir);
+    return failures;
+  }
+  std::string contents;
+  if (!ReadWholeFile(path, contents))
+  {
+    std::fprintf(stderr, "FuzzEclipseOutputReplay: cannot read %s\n", path.c_str());
+    return 1;
+  }
+  RunInput(path, contents, count);
+  // A grid with companions beside it is also replayed as a set, as run_fuzz.sh seeds it.
+  std::string set;
+  if (GridSet(path, set))
+  {
+    RunInput(path + " +companions", set, count);
+  }
+  return 0;
+}
+} // namespace
+
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer)
+#define RESMR_FUZZ_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define RESMR_FUZZ_SANITIZED 1
+#endif
+
+int main(int argc, char** argv)
+{
+  if (argc < 2)
+  {
+    std::fprintf(stderr, "usage: %s FILE_OR_DIRECTORY...\n", argv[0]);
+    return 2;
+  }
+#ifndef RESMR_FUZZ_SANITIZED
+  // What libFuzzer's -rss_limit_mb / malloc limit do when fuzzing: a runaway allocation
+  // fails (std::bad_alloc, printed as the input's outcome) instead of filling the machine.
+  // Not under ASan, which reserves terabytes of address space for its shadow memory.
+  const rlimit limit{ rlim_t(4) << 30, rlim_t(4) << 30 };
+  setrlimit(RLIMIT_AS, &limit);
+#endif
+  long count = 0;
+  int failures = 0;
+  for (int i = 1; i < argc; ++i)
+  {
+    failures += RunPath(argv[i], count);
+  }
+  std::printf("FuzzEclipseOutputReplay: ran %ld inputs, %d unreadable paths\n", count, failures);
+  return failures == 0 && count > 0 ? 0 : 1;
+}
+#endif
