@@ -36,6 +36,7 @@ struct SelectableArray
   std::string keyword;
   bool dynamic = false;
   resmr::EclipseResultArray info;
+  bool derivedOil = false; ///< SOIL = 1 - SWAT - SGAS, for restarts that do not hold SOIL
 };
 
 bool IsCommonArray(const std::string& name)
@@ -206,9 +207,19 @@ bool vtkEGRIDReader::OpenIfNeeded()
       [&](const resmr::EclipseResultArray& other) { return other.name == array.name; });
     internal.Arrays.push_back({ clash ? array.name + "_INIT" : array.name, array.name, false, array });
   }
+  bool hasWater = false, hasOil = false;
   for (const resmr::EclipseResultArray& array : dynamicArrays)
   {
     internal.Arrays.push_back({ array.name, array.name, true, array });
+    hasWater |= array.name == "SWAT";
+    hasOil |= array.name == "SOIL";
+  }
+  if (hasWater && !hasOil)
+  {
+    // OPM Flow and many ECLIPSE runs write SWAT and SGAS only; engineers expect SOIL.
+    SelectableArray oil{ "SOIL", "SOIL", true, { "SOIL", resmr::EclipseDataType::Real } };
+    oil.derivedOil = true;
+    internal.Arrays.push_back(oil);
   }
   const bool all = internal.Grid->deck.CellCount() <= DefaultAllArraysCellLimit;
   for (const SelectableArray& array : internal.Arrays)
@@ -286,6 +297,22 @@ namespace
 vtkSmartPointer<vtkDataArray> ReadCellArray(const resmr::EclipseResults& results,
   const SelectableArray& array, std::size_t step, const resmr_readers::CellOrder& order)
 {
+  if (array.derivedOil)
+  {
+    bool found = true;
+    auto oil = resmr_readers::MakeCellArray<vtkFloatArray>("SOIL", order, [&](float* out) {
+      const std::size_t cells = static_cast<std::size_t>(order.nx * order.ny * order.nz);
+      const float nan = std::numeric_limits<float>::quiet_NaN();
+      std::vector<float> gas(cells, 0.0f);
+      found = results.ReadDynamic(step, "SWAT", out, nan);
+      results.ReadDynamic(step, "SGAS", gas.data(), nan); // two-phase runs have no SGAS
+      for (std::size_t cell = 0; cell < cells; ++cell)
+      {
+        out[cell] = 1.0f - out[cell] - gas[cell];
+      }
+    });
+    return found ? oil : nullptr;
+  }
   bool found = true;
   const auto read = [&](auto* out, auto fill) {
     found = array.dynamic ? results.ReadDynamic(step, array.keyword, out, fill)

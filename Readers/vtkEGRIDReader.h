@@ -15,6 +15,7 @@
  *
  * LGRs and non-neighbour connections are not shown (a warning names them); dual-porosity
  * grids show the matrix grid. Field data: ReportStep, Days, Date of the step shown.
+ * Restarts without SOIL (OPM Flow writes SWAT and SGAS only) get SOIL = 1 - SWAT - SGAS.
  *
  * Work is forwarded to resmr::ReadEclipseGrid and resmr::EclipseResults (Core). Errors name
  * the file, keyword and byte offset and leave the output empty.

@@ -161,6 +161,14 @@ def check_model(name, relative_path):
             compare_cells(name, f"report {report} {array_name}", eclipse_order(grid, array_name, dims),
                           get(array_name), active)
             compared += 1
+        if "SOIL" not in restart_names and grid.GetCellData().GetArray("SOIL") is not None:
+            # Derived for restarts without SOIL: 1 - SWAT - SGAS (SGAS absent: two phases).
+            water = np.asarray(get("SWAT"), np.float32)
+            gas = np.asarray(get("SGAS"), np.float32) if "SGAS" in restart_names else 0.0
+            expected = np.float32(1.0) - water - gas
+            compare_cells(name, f"report {report} derived SOIL", eclipse_order(grid, "SOIL", dims),
+                          expected, active)
+            compared += 1
     if compared < len(steps):
         rt.fail(f"{name}: only {compared} restart arrays compared over {len(steps)} steps")
     print(f"{name}: {checked} INIT arrays and {compared} restart arrays over {len(steps)} report"
