@@ -115,16 +115,19 @@ CornerPointGeometry CornerPointGeometry::FromDeck(GrdeclDeck& deck, bool applyMa
   if (deck.HasCornerPointGeometry())
   {
     const int64_t nx = deck.dims[0], ny = deck.dims[1];
+    const std::size_t depths = deck.zcornSingle.empty() ? deck.zcorn.size() : deck.zcornSingle.size();
     if (static_cast<int64_t>(deck.coord.size()) != 6 * (nx + 1) * (ny + 1) ||
-      static_cast<int64_t>(deck.zcorn.size()) != 8 * deck.CellCount())
+      static_cast<int64_t>(depths) != 8 * deck.CellCount())
     {
       throw GrdeclError(deck.files.empty() ? std::string("deck") : deck.files.front(), 0, "ZCORN",
         "COORD/ZCORN sizes do not match the grid dimensions");
     }
     geometry.CoordValues = std::move(deck.coord);
     geometry.ZcornValues = std::move(deck.zcorn);
+    geometry.ZcornSingle = std::move(deck.zcornSingle);
     deck.coord.clear();
     deck.zcorn.clear();
+    deck.zcornSingle.clear();
   }
   else
   {

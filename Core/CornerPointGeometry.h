@@ -51,15 +51,17 @@ public:
   SharedCorners BuildSharedCorners() const;
 
   const std::vector<double>& Coord() const { return this->CoordValues; }
-  const std::vector<double>& Zcorn() const { return this->ZcornValues; }
+  /// True when corner depths are held in single precision (as EGRID stores them).
+  bool HasSinglePrecisionDepths() const { return !this->ZcornSingle.empty(); }
 
 private:
   double Z(int64_t i, int64_t j, int64_t k, int corner) const
   {
     const int64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
     const int64_t di = corner & 1, dj = (corner >> 1) & 1, dk = corner >> 2;
-    return this->ZcornValues[static_cast<std::size_t>(
-      ((2 * k + dk) * 2 * ny + 2 * j + dj) * 2 * nx + 2 * i + di)];
+    const auto index =
+      static_cast<std::size_t>(((2 * k + dk) * 2 * ny + 2 * j + dj) * 2 * nx + 2 * i + di);
+    return this->ZcornSingle.empty() ? this->ZcornValues[index] : this->ZcornSingle[index];
   }
   void DetectHandedness();
   void PillarPoint(int64_t pillar, double depth, double xyz[3]) const;
@@ -67,6 +69,7 @@ private:
   std::array<int64_t, 3> Dimensions{};
   std::vector<double> CoordValues;
   std::vector<double> ZcornValues;
+  std::vector<float> ZcornSingle; ///< used instead of ZcornValues when not empty
   /// Origin and unit axes from MAPAXES; false if an axis point coincides with the origin.
   static bool MapTransformOf(const MapAxes& axes, std::array<double, 6>& transform);
 

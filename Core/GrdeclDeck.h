@@ -55,6 +55,9 @@ struct GrdeclDeck
 
   std::vector<double> coord; ///< 6 (nx+1)(ny+1): pillar top xyz, bottom xyz
   std::vector<double> zcorn; ///< 8 nx ny nz depths, ECLIPSE order
+  /// The same in single precision, used instead of zcorn when the source stores float32
+  /// (EGRID): exact, and half the memory of the largest array of a model.
+  std::vector<float> zcornSingle;
   std::vector<double> dxv, dyv, dzv; ///< Cartesian alternatives (one value per column/layer)
 
   bool hasMapAxes = false;
@@ -76,7 +79,10 @@ struct GrdeclDeck
   int64_t CellCount() const { return this->dims[0] * this->dims[1] * this->dims[2]; }
   const CellArray* FindArray(const std::string& name) const;
   CellArray* FindArray(const std::string& name);
-  bool HasCornerPointGeometry() const { return !this->coord.empty() && !this->zcorn.empty(); }
+  bool HasCornerPointGeometry() const
+  {
+    return !this->coord.empty() && (!this->zcorn.empty() || !this->zcornSingle.empty());
+  }
 };
 
 /// Keywords that carry grid geometry rather than cell properties.

@@ -346,7 +346,7 @@ void TestGridAndResults()
   CHECK(grid.activeCells == 1 && !grid.dualPorosity);
   CHECK(grid.localGridNames == std::vector<std::string>({ "LOCAL1" }));
   CHECK(grid.units == "METRES");
-  CHECK(grid.deck.coord.size() == 36 && grid.deck.zcorn.size() == 16);
+  CHECK(grid.deck.coord.size() == 36 && grid.deck.zcornSingle.size() == 16 && grid.deck.zcorn.empty());
 
   const resmr::EclipseResults results(gridPath, grid);
   CHECK(results.UnifiedRestart());
@@ -391,6 +391,13 @@ void TestGridAndResults()
   grid3[actnum - 4 + 4 + 8 + 3] = 3; // ACTNUM count 3 for 2 cells
   ExpectError("ACTNUM count", [&] { resmr::ReadEclipseGrid(Write("BAD.EGRID", grid3)); },
     { "BAD.EGRID", "ACTNUM" });
+  std::string nanGrid = SmallGrid();
+  const std::size_t zcornData = nanGrid.find("ZCORN") - 4 + 24 + 4; // first depth
+  const float nan = std::nanf("");
+  const Element bits = Real(nan);
+  nanGrid.replace(zcornData + 4 * 5, 4, bits); // 6th depth
+  ExpectError("ZCORN NaN", [&] { resmr::ReadEclipseGrid(Write("NAN.EGRID", nanGrid)); },
+    { "NAN.EGRID", "ZCORN", "value 6 is not finite" });
   ExpectError("no GRIDHEAD", [&] { resmr::ReadEclipseGrid(Write("INIT.EGRID", Keyword("PORO", "REAL", {}))); },
     { "INIT.EGRID", "GRIDHEAD" });
 }

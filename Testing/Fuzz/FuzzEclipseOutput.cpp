@@ -318,10 +318,12 @@ void CheckGrid(const resmr::EclipseGrid& grid)
     BrokenInvariant("COORD has " + std::to_string(grid.deck.coord.size()) + " values for " +
       std::to_string(d[0]) + " x " + std::to_string(d[1]) + " x " + std::to_string(d[2]));
   }
-  if (grid.deck.zcorn.size() != 8 * n)
+  const std::size_t depths = grid.deck.zcorn.size() + grid.deck.zcornSingle.size();
+  if (depths != 8 * n || (!grid.deck.zcorn.empty() && !grid.deck.zcornSingle.empty()))
   {
-    BrokenInvariant("ZCORN has " + std::to_string(grid.deck.zcorn.size()) + " values for " +
-      std::to_string(n) + " cells");
+    BrokenInvariant("ZCORN has " + std::to_string(depths) + " values for " + std::to_string(n) +
+      " cells (double and single precision copies: " + std::to_string(grid.deck.zcorn.size()) +
+      ", " + std::to_string(grid.deck.zcornSingle.size()) + ")");
   }
   if (grid.actnum.size() != n)
   {
