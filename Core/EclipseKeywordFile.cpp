@@ -458,6 +458,24 @@ void EclipseKeywordFile::ReadRaw(int64_t offset, void* data, int64_t size, const
 
 void EclipseKeywordFile::IndexUnformatted()
 {
+  // Headers and markers are read through a 64 KiB window: files of many small records
+  // (restart headers, well data) are indexed with a few reads, not three per record.
+  std::vector<unsigned char> window;
+  int64_t windowStart = 0;
+  const auto peek = [&](int64_t offset, void* data, int64_t size, const EclipseRecord* record) {
+    if (offset < windowStart || offset + size > windowStart + static_cast<int64_t>(window.size()))
+    {
+      const int64_t want = std::min<int64_t>(std::max<int64_t>(size, 64 << 10), this->FileSize - offset);
+      window.resize(static_cast<std::size_t>(std::max<int64_t>(want, 0)));
+      windowStart = offset;
+      this->ReadRaw(offset, window.data(), static_cast<int64_t>(window.size()), record);
+      if (static_cast<int64_t>(window.size()) < size)
+      {
+        this->Fail(record, offset, "file truncated");
+      }
+    }
+    std::memcpy(data, window.data() + (offset - windowStart), static_cast<std::size_t>(size));
+  };
   int64_t position = 0;
   while (position < this->FileSize)
   {
@@ -468,7 +486,7 @@ void EclipseKeywordFile::IndexUnformatted()
       this->Fail(nullptr, position, "file truncated inside a keyword header");
     }
     unsigned char raw[HeaderBytes];
-    this->ReadRaw(position, raw, HeaderBytes, nullptr);
+    peek(position, raw, HeaderBytes, nullptr);
     if (BigEndian32(raw) != 16 || BigEndian32(raw + 20) != 16)
     {
       this->Fail(nullptr, position,
@@ -513,13 +531,13 @@ void EclipseKeywordFile::IndexUnformatted()
       const int64_t blocks = (record.count + perBlock - 1) / perBlock;
       const int64_t end = record.dataOffset + payload + 8 * blocks;
       unsigned char marker[4];
-      this->ReadRaw(record.dataOffset, marker, 4, &record);
+      peek(record.dataOffset, marker, 4, &record);
       bool standard = BigEndian32(marker) == std::min(record.count, perBlock) * record.elementSize &&
         end <= this->FileSize;
       if (standard && end < this->FileSize)
       {
         standard = this->FileSize - end >= 4 &&
-          (this->ReadRaw(end, marker, 4, &record), BigEndian32(marker) == 16);
+          (peek(end, marker, 4, &record), BigEndian32(marker) == 16);
       }
       record.endOffset = standard ? end : this->WalkBlocks(record);
     }
@@ -626,6 +644,44 @@ void EclipseKeywordFile::Read(const EclipseRecord& record, T* out) const
     ConvertBigEndian(record.type, data, n, out + first);
   });
 }
+
+template <typename T>
+void EclipseKeywordFile::ReadInPieces(
+  const EclipseRecord& record, const std::function<void(const T*, int64_t, int64_t)>& sink) const
+{
+  if (!record.IsNumeric())
+  {
+    this->Fail(&record, record.headerOffset, "expected numeric data, found type " + record.typeName);
+  }
+  constexpr int64_t Piece = 4096;
+  std::vector<T> values(static_cast<std::size_t>(std::min<int64_t>(Piece, record.count)));
+  if (this->Formatted)
+  {
+    // Formatted files are small; one pass over the whole record, handed on in pieces.
+    std::vector<T> all(static_cast<std::size_t>(record.count));
+    this->ReadFormatted(record, all.data());
+    for (int64_t first = 0; first < record.count; first += Piece)
+    {
+      sink(all.data() + first, first, std::min(Piece, record.count - first));
+    }
+    return;
+  }
+  this->ForEachBlock(record, [&](const unsigned char* data, int64_t first, int64_t n) {
+    for (int64_t done = 0; done < n; done += Piece)
+    {
+      const int64_t count = std::min(Piece, n - done);
+      ConvertBigEndian(record.type, data + done * record.elementSize, count, values.data());
+      sink(values.data(), first + done, count);
+    }
+  });
+}
+
+template void EclipseKeywordFile::ReadInPieces<int32_t>(
+  const EclipseRecord&, const std::function<void(const int32_t*, int64_t, int64_t)>&) const;
+template void EclipseKeywordFile::ReadInPieces<float>(
+  const EclipseRecord&, const std::function<void(const float*, int64_t, int64_t)>&) const;
+template void EclipseKeywordFile::ReadInPieces<double>(
+  const EclipseRecord&, const std::function<void(const double*, int64_t, int64_t)>&) const;
 
 template void EclipseKeywordFile::Read<int32_t>(const EclipseRecord&, int32_t*) const;
 template void EclipseKeywordFile::Read<float>(const EclipseRecord&, float*) const;

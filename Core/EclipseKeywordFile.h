@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,13 @@ public:
   /// to T. Defined for int32_t, float and double.
   template <typename T>
   void Read(const EclipseRecord& record, T* out) const;
+
+  /// Reads a numeric record piece by piece, with no buffer the size of the record:
+  /// `sink(values, first, count)` receives the converted values [first, first + count), in
+  /// order. Defined for int32_t, float and double.
+  template <typename T>
+  void ReadInPieces(
+    const EclipseRecord& record, const std::function<void(const T*, int64_t, int64_t)>& sink) const;
 
   /// Convenience: a numeric record as doubles.
   void ReadNumbers(const EclipseRecord& record, std::vector<double>& values) const;

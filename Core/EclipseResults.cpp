@@ -146,10 +146,21 @@ EclipseResults::EclipseResults(const std::string& gridPath, const EclipseGrid& g
   this->ActiveCount = grid.activeCells;
   this->DualPorosity = grid.dualPorosity;
   this->Expected = grid.activeCells + (grid.dualPorosity ? grid.fractureCells : 0);
-  this->Active.resize(static_cast<std::size_t>(this->CellCount));
   for (int64_t cell = 0; cell < this->CellCount; ++cell)
   {
-    this->Active[static_cast<std::size_t>(cell)] = grid.IsActive(cell);
+    if (!grid.IsActive(cell))
+    {
+      continue;
+    }
+    if (!this->ActiveRuns.empty() &&
+      this->ActiveRuns.back().first + this->ActiveRuns.back().second == cell)
+    {
+      ++this->ActiveRuns.back().second;
+    }
+    else
+    {
+      this->ActiveRuns.emplace_back(cell, 1);
+    }
   }
 
   this->Init = FindInit(gridPath);
@@ -392,20 +403,42 @@ void EclipseResults::Scatter(
     file.Read(record, cellValues); // one value per cell, in cell order: no copy
     return;
   }
-  std::vector<T> values;
-  ResizeLarge(values, static_cast<std::size_t>(record.count));
-  file.Read(record, values.data());
   if (!perActiveCell)
   {
     // Dual porosity, one value per cell and porosity: the matrix half comes first.
-    std::copy(values.begin(), values.begin() + this->CellCount, cellValues);
+    file.ReadInPieces<T>(record, [&](const T* values, int64_t first, int64_t count) {
+      if (first < this->CellCount)
+      {
+        std::copy(values, values + std::min(count, this->CellCount - first), cellValues + first);
+      }
+    });
     return;
   }
-  std::size_t next = 0; // matrix values come first, in cell order
-  for (int64_t cell = 0; cell < this->CellCount; ++cell)
-  {
-    cellValues[cell] = this->Active[static_cast<std::size_t>(cell)] ? values[next++] : fill;
-  }
+  // Active cells in order, matrix values first; the gaps between runs get `fill`.
+  std::size_t run = 0;
+  int64_t intoRun = 0, filledUpTo = 0;
+  file.ReadInPieces<T>(record, [&](const T* values, int64_t, int64_t count) {
+    while (count > 0 && run < this->ActiveRuns.size())
+    {
+      const auto& [start, length] = this->ActiveRuns[run];
+      if (intoRun == 0)
+      {
+        std::fill(cellValues + filledUpTo, cellValues + start, fill);
+      }
+      const int64_t take = std::min(count, length - intoRun);
+      std::copy(values, values + take, cellValues + start + intoRun);
+      values += take;
+      count -= take;
+      intoRun += take;
+      if (intoRun == length)
+      {
+        filledUpTo = start + length;
+        intoRun = 0;
+        ++run;
+      }
+    }
+  });
+  std::fill(cellValues + filledUpTo, cellValues + this->CellCount, fill);
 }
 
 template <typename T>
@@ -442,9 +475,15 @@ bool EclipseResults::ReadDynamic(std::size_t stepIndex, const std::string& name,
     this->Scatter(*this->UnifiedFile, this->UnifiedFile->Records()[recordIndex], cellValues, fill);
     return true;
   }
-  // Per-step files are reopened (their index is small) so hundreds of steps never hold
-  // hundreds of open files.
-  const EclipseKeywordFile file(this->Restarts[step.file]);
+  // Only the last step's file is kept open, so hundreds of steps never hold hundreds of
+  // open files, and a step's arrays share one open.
+  if (!this->StepFile || this->StepFileIndex != step.file)
+  {
+    this->StepFile.reset();
+    this->StepFile = std::make_unique<EclipseKeywordFile>(this->Restarts[step.file]);
+    this->StepFileIndex = step.file;
+  }
+  const EclipseKeywordFile& file = *this->StepFile;
   if (recordIndex >= file.Records().size() || file.Records()[recordIndex].name != name)
   {
     throw GrdeclError(file.Path(), 0, name, "file changed since it was opened; reload it");

@@ -10,6 +10,7 @@
 // - Arrays with one value per active cell are mapped to cells through the EGRID's ACTNUM
 //   (the deck's may differ); arrays with one value per cell are taken as they are. Dual
 //   porosity: the matrix values (the first part) are used. LGR sections are skipped.
+// - Not thread-safe: per-step restarts keep the last step's file open between calls.
 // - Arrays or steps that do not fit the grid (another active count) are left out with a
 //   warning naming the file and keyword; corrupt files throw GrdeclError.
 #pragma once
@@ -21,6 +22,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace resmr
@@ -83,7 +85,9 @@ private:
   template <typename T>
   void Scatter(const EclipseKeywordFile& file, const EclipseRecord& record, T* cellValues, T fill) const;
 
-  std::vector<bool> Active; ///< per cell: has a (matrix) value in active-cell arrays
+  /// Runs of consecutive active (matrix) cells: first cell, length. Values of active-cell
+  /// arrays go to these cells in order.
+  std::vector<std::pair<int64_t, int64_t>> ActiveRuns;
   int64_t CellCount = 0;
   int64_t ActiveCount = 0;
   bool DualPorosity = false;
@@ -97,7 +101,10 @@ private:
   std::vector<EclipseResultArray> Dynamic;
   std::vector<EclipseReportStep> ReportSteps;
   std::unique_ptr<EclipseKeywordFile> InitFile;
-  std::unique_ptr<EclipseKeywordFile> UnifiedFile; ///< kept open; per-step files are reopened
+  std::unique_ptr<EclipseKeywordFile> UnifiedFile; ///< kept open
+  /// The per-step file of the last step read, so a step's arrays share one open.
+  mutable std::unique_ptr<EclipseKeywordFile> StepFile;
+  mutable std::size_t StepFileIndex = 0;
   std::array<int, 3> StartDate{};
 };
 
