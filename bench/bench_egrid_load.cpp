@@ -25,6 +25,7 @@
 #include "EclipseGrid.h"
 #include "EclipseKeywordFile.h"
 #include "EclipseResults.h"
+#include "LargeArrays.h"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -314,12 +315,15 @@ int main(int argc, char** argv)
         values.name = array.name;
         if (array.IsInteger())
         {
+          // As the VTK reader allocates its arrays: malloc'd, huge pages advised.
           values.integer.reset(new int32_t[cells]);
+          resmr::AdviseHugePages(values.integer.get(), cells * sizeof(int32_t));
           loaded.results->ReadStatic(array.name, values.integer.get(), int32_t(0));
         }
         else
         {
           values.real.reset(new float[cells]);
+          resmr::AdviseHugePages(values.real.get(), cells * sizeof(float));
           loaded.results->ReadStatic(array.name, values.real.get(), 0.0f);
         }
         loaded.arrays.push_back(std::move(values));
