@@ -424,6 +424,18 @@ int vtkEGRIDReader::RequestData(
     this->UpdateStaticArrays();
     output->ShallowCopy(internal.Base);
     vtkCellData* cellData = output->GetCellData();
+    // What the grid holds but the output does not show, for scripts and the Information tab.
+    vtkNew<vtkIntArray> connections;
+    connections->SetName("NonNeighbourConnections");
+    connections->InsertNextValue(static_cast<int>(internal.Grid->nonNeighbourConnections));
+    output->GetFieldData()->AddArray(connections);
+    vtkNew<vtkStringArray> localGrids;
+    localGrids->SetName("LocalGridRefinements");
+    for (const std::string& name : internal.Grid->localGridNames)
+    {
+      localGrids->InsertNextValue(name);
+    }
+    output->GetFieldData()->AddArray(localGrids);
     if (!times.empty())
     {
       this->CurrentStep = static_cast<int>(step);

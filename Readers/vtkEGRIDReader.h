@@ -14,7 +14,8 @@
  * geometry and static arrays are built once and shared by every step's output.
  *
  * LGRs and non-neighbour connections are not shown (a warning names them); dual-porosity
- * grids show the matrix grid. Field data: ReportStep, Days, Date of the step shown.
+ * grids show the matrix grid. Field data: ReportStep, Days, Date of the step shown;
+ * NonNeighbourConnections (count) and LocalGridRefinements (names) not shown.
  * Restarts without SOIL (OPM Flow writes SWAT and SGAS only) get SOIL = 1 - SWAT - SGAS.
  *
  * Work is forwarded to resmr::ReadEclipseGrid and resmr::EclipseResults (Core). Errors name

@@ -131,6 +131,10 @@ def check_model(name, relative_path):
     if not np.array_equal(ghosts != 0, ~active):
         rt.fail(f"{name}: hidden cells are not exactly the inactive ones")
     compare_corners(name, grid, path, dims)
+    nnc_expected = sum(count for keyword, _, count in egrid.arrays if keyword == "NNC1")
+    nnc = grid.GetFieldData().GetArray("NonNeighbourConnections").GetValue(0)
+    if nnc != nnc_expected:
+        rt.fail(f"{name}: NonNeighbourConnections {nnc}, the EGRID has {nnc_expected}")
 
     init = EclFile(os.path.splitext(path)[0] + ".INIT")
     init_names = [array_name for array_name, _, _ in init.arrays]
