@@ -47,6 +47,26 @@ def points_and_cells(grid):
     return points, connectivity.reshape(-1, 8)
 
 
+def expect_read_error(reader, name, fragments):
+    """Updates `reader` on a bad file: its output must be empty and its LastError must hold
+    every fragment (file, keyword, what). Deletes the reader; returns the message."""
+    from paraview import servermanager, simple
+    reader.UpdatePipeline()
+    grid = servermanager.Fetch(reader, arg1=None, arg2=None, idx=0)
+    reader.UpdatePropertyInformation()
+    text = reader.GetPropertyValue("LastError")
+    # An empty vtkExplicitStructuredGrid reports 1 cell from its extent: count real ones.
+    cells = grid.GetCells().GetNumberOfCells() if grid.GetCells() else 0
+    if cells != 0 or grid.GetNumberOfPoints() != 0:
+        fail(f"{name}: output not empty ({cells} cells, {grid.GetNumberOfPoints()} points)")
+    missing = [f for f in fragments if f not in text]
+    if missing:
+        fail(f"{name}: error message lacks {missing}: {text!r}")
+    print(f"{name}: error reported: {text}")
+    simple.Delete(reader)
+    return text
+
+
 def place_camera(view, bounds, exaggeration, direction, zoom):
     """Looks at the centre of `bounds` (z scaled by `exaggeration`) from `direction`, z up,
     then dollies by `zoom`. Call after the first Render, which resets the camera."""
