@@ -5,6 +5,10 @@
 #include "GrdeclError.h"
 
 #include <algorithm>
+#include <atomic>
+#include <cstdlib>
+#include <exception>
+#include <thread>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -540,6 +544,7 @@ void EclipseKeywordFile::IndexUnformatted()
           (peek(end, marker, 4, &record), BigEndian32(marker) == 16);
       }
       record.endOffset = standard ? end : this->WalkBlocks(record);
+      record.standardBlocks = standard;
     }
     position = record.endOffset;
     this->Index.push_back(std::move(record));
@@ -578,11 +583,25 @@ int64_t EclipseKeywordFile::WalkBlocks(const EclipseRecord& record) const
 }
 
 template <typename Consumer>
-void EclipseKeywordFile::ForEachBlock(const EclipseRecord& record, Consumer&& consume) const
+void EclipseKeywordFile::ForEachBlock(
+  const EclipseRecord& record, Consumer&& consume, int64_t firstBlock, int64_t endBlock) const
 {
   if (record.count == 0 || record.elementSize == 0)
   {
     return;
+  }
+  // A range of blocks exists only for standard layouts, where block b starts at a known
+  // offset; the whole record otherwise.
+  const int64_t perBlock = ItemsPerBlock(record);
+  int64_t position = record.dataOffset;
+  int64_t remaining = record.count;
+  int64_t done = 0;
+  if (record.standardBlocks && (firstBlock > 0 || endBlock >= 0))
+  {
+    done = std::min(record.count, firstBlock * perBlock);
+    const int64_t end = endBlock < 0 ? record.count : std::min(record.count, endBlock * perBlock);
+    position += firstBlock * (perBlock * record.elementSize + 8);
+    remaining = end - done;
   }
   std::vector<unsigned char> buffer;
   int64_t bufferStart = 0;
@@ -602,9 +621,6 @@ void EclipseKeywordFile::ForEachBlock(const EclipseRecord& record, Consumer&& co
     }
     return buffer.data() + (offset - bufferStart);
   };
-  int64_t position = record.dataOffset;
-  int64_t remaining = record.count;
-  int64_t done = 0;
   while (remaining > 0)
   {
     const int64_t length = BigEndian32(ensure(position, 4));
@@ -628,6 +644,77 @@ void EclipseKeywordFile::ForEachBlock(const EclipseRecord& record, Consumer&& co
   }
 }
 
+namespace
+{
+std::atomic<int64_t> ParallelMinimum{ -1 };
+}
+
+int64_t EclipseKeywordFile::ParallelMinimumValues()
+{
+  int64_t value = ParallelMinimum.load();
+  if (value < 0)
+  {
+    value = int64_t(4) << 20;
+    if (const char* text = std::getenv("RESMR_PARALLEL_MIN_VALUES"))
+    {
+      int64_t parsed = 0;
+      if (ParseWhole(text, text + std::strlen(text), parsed) && parsed > 0)
+      {
+        value = parsed;
+      }
+    }
+    ParallelMinimum.store(value);
+  }
+  return value;
+}
+
+void EclipseKeywordFile::SetParallelMinimumValues(int64_t values)
+{
+  ParallelMinimum.store(std::max<int64_t>(1, values));
+}
+
+template <typename Consumer>
+void EclipseKeywordFile::ForEachBlockInParallel(const EclipseRecord& record, Consumer&& consume) const
+{
+  const int64_t perBlock = ItemsPerBlock(record);
+  const int64_t blocks = (record.count + perBlock - 1) / perBlock;
+  const int64_t cores = std::max(1u, std::thread::hardware_concurrency());
+  const int64_t workers = std::min<int64_t>({ cores, 8, blocks });
+  if (!record.standardBlocks || record.count < ParallelMinimumValues() || workers < 2)
+  {
+    this->ForEachBlock(record, consume);
+    return;
+  }
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(workers));
+  const auto work = [&](int64_t w) {
+    try
+    {
+      this->ForEachBlock(record, consume, blocks * w / workers, blocks * (w + 1) / workers);
+    }
+    catch (...)
+    {
+      errors[static_cast<std::size_t>(w)] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int64_t w = 1; w < workers; ++w)
+  {
+    threads.emplace_back(work, w);
+  }
+  work(0);
+  for (std::thread& thread : threads)
+  {
+    thread.join();
+  }
+  for (const std::exception_ptr& error : errors)
+  {
+    if (error)
+    {
+      std::rethrow_exception(error); // the first range's error: the earliest offset
+    }
+  }
+}
+
 template <typename T>
 void EclipseKeywordFile::Read(const EclipseRecord& record, T* out) const
 {
@@ -640,7 +727,7 @@ void EclipseKeywordFile::Read(const EclipseRecord& record, T* out) const
     this->ReadFormatted(record, out);
     return;
   }
-  this->ForEachBlock(record, [&](const unsigned char* data, int64_t first, int64_t n) {
+  this->ForEachBlockInParallel(record, [&](const unsigned char* data, int64_t first, int64_t n) {
     ConvertBigEndian(record.type, data, n, out + first);
   });
 }
@@ -654,7 +741,6 @@ void EclipseKeywordFile::ReadInPieces(
     this->Fail(&record, record.headerOffset, "expected numeric data, found type " + record.typeName);
   }
   constexpr int64_t Piece = 4096;
-  std::vector<T> values(static_cast<std::size_t>(std::min<int64_t>(Piece, record.count)));
   if (this->Formatted)
   {
     // Formatted files are small; one pass over the whole record, handed on in pieces.
@@ -666,12 +752,13 @@ void EclipseKeywordFile::ReadInPieces(
     }
     return;
   }
-  this->ForEachBlock(record, [&](const unsigned char* data, int64_t first, int64_t n) {
+  this->ForEachBlockInParallel(record, [&](const unsigned char* data, int64_t first, int64_t n) {
+    T values[Piece]; // per call, so each thread converts into its own
     for (int64_t done = 0; done < n; done += Piece)
     {
       const int64_t count = std::min(Piece, n - done);
-      ConvertBigEndian(record.type, data + done * record.elementSize, count, values.data());
-      sink(values.data(), first + done, count);
+      ConvertBigEndian(record.type, data + done * record.elementSize, count, values);
+      sink(values, first + done, count);
     }
   });
 }

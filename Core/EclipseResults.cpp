@@ -162,6 +162,12 @@ EclipseResults::EclipseResults(const std::string& gridPath, const EclipseGrid& g
       this->ActiveRuns.emplace_back(cell, 1);
     }
   }
+  int64_t before = 0;
+  for (const auto& run : this->ActiveRuns)
+  {
+    this->ValuesBeforeRun.push_back(before);
+    before += run.second;
+  }
 
   this->Init = FindInit(gridPath);
   if (this->Init.empty())
@@ -414,31 +420,38 @@ void EclipseResults::Scatter(
     });
     return;
   }
-  // Active cells in order, matrix values first; the gaps between runs get `fill`.
-  std::size_t run = 0;
-  int64_t intoRun = 0, filledUpTo = 0;
-  file.ReadInPieces<T>(record, [&](const T* values, int64_t, int64_t count) {
-    while (count > 0 && run < this->ActiveRuns.size())
+  // Active cells in order, matrix values first (fracture values, after them, are dropped).
+  // Pieces may arrive from several threads: each finds its run by the value index, and the
+  // gap before a run gets `fill` from whoever writes that run's first value.
+  const auto& runs = this->ActiveRuns;
+  const auto& before = this->ValuesBeforeRun;
+  file.ReadInPieces<T>(record, [&](const T* values, int64_t first, int64_t count) {
+    if (runs.empty() || first >= this->ActiveCount)
     {
-      const auto& [start, length] = this->ActiveRuns[run];
+      return;
+    }
+    count = std::min(count, this->ActiveCount - first);
+    std::size_t run = static_cast<std::size_t>(
+      std::upper_bound(before.begin(), before.end(), first) - before.begin() - 1);
+    int64_t intoRun = first - before[run];
+    while (count > 0)
+    {
+      const auto& [start, length] = runs[run];
       if (intoRun == 0)
       {
-        std::fill(cellValues + filledUpTo, cellValues + start, fill);
+        const int64_t gapStart = run > 0 ? runs[run - 1].first + runs[run - 1].second : 0;
+        std::fill(cellValues + gapStart, cellValues + start, fill);
       }
       const int64_t take = std::min(count, length - intoRun);
       std::copy(values, values + take, cellValues + start + intoRun);
       values += take;
       count -= take;
-      intoRun += take;
-      if (intoRun == length)
-      {
-        filledUpTo = start + length;
-        intoRun = 0;
-        ++run;
-      }
+      intoRun = 0;
+      ++run;
     }
   });
-  std::fill(cellValues + filledUpTo, cellValues + this->CellCount, fill);
+  const int64_t tail = runs.empty() ? 0 : runs.back().first + runs.back().second;
+  std::fill(cellValues + tail, cellValues + this->CellCount, fill);
 }
 
 template <typename T>

@@ -88,6 +88,7 @@ private:
   /// Runs of consecutive active (matrix) cells: first cell, length. Values of active-cell
   /// arrays go to these cells in order.
   std::vector<std::pair<int64_t, int64_t>> ActiveRuns;
+  std::vector<int64_t> ValuesBeforeRun; ///< active cells before each run (run lookup)
   int64_t CellCount = 0;
   int64_t ActiveCount = 0;
   bool DualPorosity = false;

@@ -401,6 +401,68 @@ void TestGridAndResults()
   ExpectError("no GRIDHEAD", [&] { resmr::ReadEclipseGrid(Write("INIT.EGRID", Keyword("PORO", "REAL", {}))); },
     { "INIT.EGRID", "GRIDHEAD" });
 }
+// Large records are split over threads by block ranges; with the threshold lowered, a grid
+// of 2400 cells (every 7th inactive) reads through the parallel paths and must equal the
+// file value for value.
+void TestParallelPieces()
+{
+  resmr::EclipseKeywordFile::SetParallelMinimumValues(1000);
+  const int nx = 60, ny = 40;
+  std::vector<int32_t> gridhead(100, 0);
+  gridhead[0] = 1;
+  gridhead[1] = nx;
+  gridhead[2] = ny;
+  gridhead[3] = 1;
+  std::vector<float> coord, zcorn(8 * nx * ny);
+  for (int j = 0; j <= ny; ++j)
+  {
+    for (int i = 0; i <= nx; ++i)
+    {
+      for (float z : { 1000.0f, 1010.0f })
+      {
+        coord.insert(coord.end(), { 10.0f * i, 10.0f * j, z });
+      }
+    }
+  }
+  for (std::size_t c = 0; c < zcorn.size(); ++c)
+  {
+    zcorn[c] = c < zcorn.size() / 2 ? 1000.0f + 0.001f * static_cast<float>(c) : 1010.0f;
+  }
+  std::vector<int32_t> actnum(nx * ny);
+  std::vector<float> poro;
+  std::vector<float> porv(nx * ny);
+  for (int cell = 0; cell < nx * ny; ++cell)
+  {
+    actnum[cell] = cell % 7 != 0;
+    porv[cell] = 0.5f * static_cast<float>(cell);
+    if (actnum[cell])
+    {
+      poro.push_back(static_cast<float>(cell) + 0.25f);
+    }
+  }
+  const std::string gridPath = Write("WIDE.EGRID",
+    Keyword("FILEHEAD", "INTE", Elements(std::vector<int32_t>(100, 0), Int)) +
+      Keyword("GRIDHEAD", "INTE", Elements(gridhead, Int)) + Keyword("COORD", "REAL", Elements(coord, Real)) +
+      Keyword("ZCORN", "REAL", Elements(zcorn, Real)) + Keyword("ACTNUM", "INTE", Elements(actnum, Int)) +
+      Keyword("ENDGRID", "INTE", {}));
+  Write("WIDE.INIT", Keyword("INTEHEAD", "INTE", Header(static_cast<int>(poro.size()), 1, 1, 2020)) +
+      Keyword("PORO", "REAL", Elements(poro, Real)) + Keyword("PORV", "REAL", Elements(porv, Real)));
+  const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath);
+  CHECK(grid.deck.zcornSingle == zcorn);
+  CHECK(grid.actnum == actnum);
+  const resmr::EclipseResults results(gridPath, grid);
+  std::vector<float> values(nx * ny);
+  CHECK(results.ReadStatic("PORO", values.data(), -1.0f));
+  bool same = true;
+  for (int cell = 0; cell < nx * ny; ++cell)
+  {
+    same &= values[cell] == (actnum[cell] ? static_cast<float>(cell) + 0.25f : -1.0f);
+  }
+  CHECK(same);
+  CHECK(results.ReadStatic("PORV", values.data(), -1.0f));
+  CHECK(values == porv);
+  resmr::EclipseKeywordFile::SetParallelMinimumValues(int64_t(4) << 20);
+}
 } // namespace
 
 int main()
@@ -412,6 +474,7 @@ int main()
   TestFormatted();
   TestBadUnformatted();
   TestGridAndResults();
+  TestParallelPieces();
   std::system(("rm -rf '" + Directory + "'").c_str());
   if (resmr_testing::Failures)
   {
