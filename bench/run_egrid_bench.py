@@ -194,8 +194,9 @@ def write_report(result, out_dir):
         f"- Measured: {result['version']} (commit `{result['commit']}`)",
         f"- Load average at start: {m['loadavg_at_start']}; at end: {c['loadavg_at_end']}. "
         f"Other CPU users at start: {', '.join(c['busy_at_start']) or 'none'}; at end: "
-        f"{', '.join(c['busy_at_end']) or 'none'}. Every tool is single-threaded; tools run "
-        "one after the other.",
+        f"{', '.join(c['busy_at_end']) or 'none'}. resmr reads records of 4 Mi values or more "
+        "with one thread per core (2 here), as a workstation would; the peers are "
+        "single-threaded; tools run one after the other.",
         "- Page cache: warm. Every file of a model was read once before its first tool, and RAM "
         "holds them all, so the numbers measure the readers, not the disk.",
         f"- Caps for every tool: {result['caps']['mem_limit_gb']:.0f} GB address space, "
