@@ -30,6 +30,9 @@ constexpr int64_t HeaderBytes = 24;             // marker, 8 + 4 + 4 bytes, mark
 constexpr int64_t ChunkBytes = 4 << 20;         // read granularity for record data
 constexpr int64_t NumbersPerBlock = 1000;       // ECLIPSE's Fortran record sizes
 constexpr int64_t StringsPerBlock = 105;
+// Headers are read through a window this big: small consecutive records share one read,
+// while a window past a big record wastes little copying.
+constexpr int64_t IndexWindowBytes = 8 << 10;
 constexpr std::size_t MaxNumberCharacters = 256; // formatted numbers are at most ~25 wide
 
 uint32_t BigEndian32(const unsigned char* p)
@@ -462,14 +465,14 @@ void EclipseKeywordFile::ReadRaw(int64_t offset, void* data, int64_t size, const
 
 void EclipseKeywordFile::IndexUnformatted()
 {
-  // Headers and markers are read through a 64 KiB window: files of many small records
+  // Headers and markers are read through a small window: files of many small records
   // (restart headers, well data) are indexed with a few reads, not three per record.
   std::vector<unsigned char> window;
   int64_t windowStart = 0;
   const auto peek = [&](int64_t offset, void* data, int64_t size, const EclipseRecord* record) {
     if (offset < windowStart || offset + size > windowStart + static_cast<int64_t>(window.size()))
     {
-      const int64_t want = std::min<int64_t>(std::max<int64_t>(size, 64 << 10), this->FileSize - offset);
+      const int64_t want = std::min<int64_t>(std::max<int64_t>(size, IndexWindowBytes), this->FileSize - offset);
       window.resize(static_cast<std::size_t>(std::max<int64_t>(want, 0)));
       windowStart = offset;
       this->ReadRaw(offset, window.data(), static_cast<int64_t>(window.size()), record);
@@ -676,11 +679,17 @@ void EclipseKeywordFile::SetParallelMinimumValues(int64_t values)
 template <typename Consumer>
 void EclipseKeywordFile::ForEachBlockInParallel(const EclipseRecord& record, Consumer&& consume) const
 {
+  if (!record.standardBlocks || record.count < ParallelMinimumValues())
+  {
+    this->ForEachBlock(record, consume);
+    return;
+  }
+  // hardware_concurrency() reads sysfs: asked once, and only for large records.
+  static const int64_t cores = std::max(1u, std::thread::hardware_concurrency());
   const int64_t perBlock = ItemsPerBlock(record);
   const int64_t blocks = (record.count + perBlock - 1) / perBlock;
-  const int64_t cores = std::max(1u, std::thread::hardware_concurrency());
   const int64_t workers = std::min<int64_t>({ cores, 8, blocks });
-  if (!record.standardBlocks || record.count < ParallelMinimumValues() || workers < 2)
+  if (workers < 2)
   {
     this->ForEachBlock(record, consume);
     return;
