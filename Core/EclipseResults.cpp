@@ -3,7 +3,6 @@
 #include "EclipseResults.h"
 
 #include "GrdeclError.h"
-#include "LargeArrays.h"
 
 #include <algorithm>
 #include <cctype>
