@@ -3,18 +3,22 @@
 // unified and per-step restarts, and bad input giving errors that name file and keyword.
 #include "EclipseGrid.h"
 #include "EclipseKeywordFile.h"
+#include "EclipseKeywordWriter.h"
 #include "EclipseResults.h"
 #include "CoreTesting.h"
 #include "GrdeclError.h"
 
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <algorithm>
 #include <functional>
 #include <string>
+#include <sys/resource.h>
 #include <unistd.h>
 #include <vector>
 
@@ -463,6 +467,114 @@ void TestParallelPieces()
   CHECK(values == porv);
   resmr::EclipseKeywordFile::SetParallelMinimumValues(int64_t(4) << 20);
 }
+// The streamed writer: every type, pieces of odd sizes crossing record boundaries, read
+// back by the reader value for value; errors leave no file under the final name.
+void TestWriter()
+{
+  const std::string path = Directory + "/WRITTEN.EGRID";
+  std::vector<int32_t> ints(2345);
+  std::vector<double> doubles(1001);
+  std::vector<std::string> names(230);
+  for (std::size_t i = 0; i < ints.size(); ++i)
+  {
+    ints[i] = static_cast<int32_t>(i * 37) - 5000;
+  }
+  for (std::size_t i = 0; i < doubles.size(); ++i)
+  {
+    doubles[i] = 1.0 / (1.0 + static_cast<double>(i));
+  }
+  for (std::size_t i = 0; i < names.size(); ++i)
+  {
+    names[i] = "W" + std::to_string(i);
+  }
+  {
+    resmr::EclipseKeywordWriter writer(path);
+    writer.Write("INTS", "INTE", ints);
+    writer.Begin("REALS", "REAL", 2345);
+    for (std::size_t first = 0; first < ints.size(); first += 333) // odd pieces
+    {
+      const std::size_t count = std::min<std::size_t>(333, ints.size() - first);
+      std::vector<float> piece(count);
+      for (std::size_t i = 0; i < count; ++i)
+      {
+        piece[i] = 0.5f * static_cast<float>(ints[first + i]);
+      }
+      writer.Append(piece.data(), static_cast<int64_t>(count));
+    }
+    writer.Write("DOUBS", "DOUB", doubles);
+    writer.Write("FLAGS", "LOGI", std::vector<int32_t>{ 1, 0, 1 });
+    writer.WriteStrings("NAMES", names);
+    writer.Begin("ENDSOL", "MESS", 0);
+    CHECK(access(path.c_str(), F_OK) != 0); // nothing under the final name before Commit
+    writer.Commit();
+  }
+  const resmr::EclipseKeywordFile file(path);
+  CHECK(file.Records().size() == 6);
+  std::vector<int32_t> intsBack(ints.size());
+  file.Read(*file.Find("INTS"), intsBack.data());
+  CHECK(intsBack == ints);
+  CHECK(file.Find("INTS")->standardBlocks && file.Find("REALS")->standardBlocks);
+  std::vector<float> realsBack(ints.size());
+  file.Read(*file.Find("REALS"), realsBack.data());
+  bool same = true;
+  for (std::size_t i = 0; i < ints.size(); ++i)
+  {
+    same &= realsBack[i] == 0.5f * static_cast<float>(ints[i]);
+  }
+  CHECK(same);
+  std::vector<double> doublesBack;
+  file.ReadNumbers(*file.Find("DOUBS"), doublesBack);
+  CHECK(doublesBack == doubles);
+  file.ReadNumbers(*file.Find("FLAGS"), doublesBack);
+  CHECK(doublesBack == std::vector<double>({ 1, 0, 1 }));
+  CHECK(file.ReadStrings(*file.Find("NAMES")) == names);
+
+  // Errors: the writer removes its temporary and never touches the final name.
+  const std::string failed = Directory + "/FAILED.EGRID";
+  ExpectError("short keyword", [&] {
+    resmr::EclipseKeywordWriter writer(failed);
+    writer.Begin("ZCORN", "REAL", 10);
+    writer.Append(std::vector<float>(4).data(), 4);
+    writer.Commit();
+  }, { "FAILED.EGRID", "6 values missing" });
+  ExpectError("too many", [&] {
+    resmr::EclipseKeywordWriter writer(failed);
+    writer.Begin("ZCORN", "REAL", 2);
+    writer.Append(std::vector<float>(3).data(), 3);
+  }, { "FAILED.EGRID", "ZCORN", "only 2 left" });
+  ExpectError("32-bit count", [&] {
+    resmr::EclipseKeywordWriter writer(failed);
+    writer.Begin("ZCORN", "REAL", int64_t(1) << 31);
+  }, { "FAILED.EGRID", "ZCORN", "32-bit count" });
+  ExpectError("unwritable folder", [&] { resmr::EclipseKeywordWriter(Directory + "/no/such/X.EGRID"); },
+    { "X.EGRID", "cannot create" });
+  // A full disk, simulated by a file-size limit: writes past 64 KiB fail (EFBIG).
+  struct rlimit saved;
+  getrlimit(RLIMIT_FSIZE, &saved);
+  struct rlimit small = saved;
+  small.rlim_cur = 64 << 10;
+  std::signal(SIGXFSZ, SIG_IGN);
+  setrlimit(RLIMIT_FSIZE, &small);
+  ExpectError("disk full", [&] {
+    resmr::EclipseKeywordWriter writer(failed);
+    std::vector<float> values(100000, 1.0f);
+    writer.Write("ZCORN", "REAL", values);
+    writer.Commit();
+  }, { "FAILED.EGRID", "write failed" });
+  setrlimit(RLIMIT_FSIZE, &saved);
+  CHECK(access(failed.c_str(), F_OK) != 0);
+  int leftovers = 0;
+  for (const char* pattern : { "/FAILED.EGRID.partial-*" })
+  {
+    const std::string command = "ls " + Directory + pattern + " 2>/dev/null | wc -l";
+    if (std::FILE* pipe = popen(command.c_str(), "r"))
+    {
+      leftovers = std::fgetc(pipe) - '0';
+      pclose(pipe);
+    }
+  }
+  CHECK(leftovers == 0);
+}
 } // namespace
 
 int main()
@@ -475,6 +587,7 @@ int main()
   TestBadUnformatted();
   TestGridAndResults();
   TestParallelPieces();
+  TestWriter();
   std::system(("rm -rf '" + Directory + "'").c_str());
   if (resmr_testing::Failures)
   {
