@@ -31,6 +31,7 @@
 #include "EclipseGrid.h"
 #include "EclipseKeywordFile.h"
 #include "EclipseResults.h"
+#include "FuzzReplay.h"
 #include "GrdeclError.h"
 
 #include <algorithm>
@@ -459,24 +460,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
 #ifdef RESMR_FUZZ_STANDALONE
 namespace
 {
-bool ReadWholeFile(const std::string& path, std::string& contents)
-{
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file)
-  {
-    return false;
-  }
-  contents.clear();
-  char buffer[1 << 16];
-  std::size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof(buffer), file)) > 0)
-  {
-    contents.append(buffer, got);
-  }
-  const bool ok = !std::ferror(file);
-  std::fclose(file);
-  return ok;
-}
+using resmr_fuzz::ReadWholeFile;
 
 void RunInput(const std::string& name, const std::string& contents, long& count)
 {
@@ -533,50 +517,6 @@ bool GridSet(const std::string& path, std::string& set)
   return true;
 }
 
-int RunPath(const std::string& path, long& count)
-{
-  struct stat info;
-  if (stat(path.c_str(), &info) != 0)
-  {
-    std::fprintf(stderr, "FuzzEclipseOutputReplay: cannot stat %s\n", path.c_str());
-    return 1;
-  }
-  if (S_ISDIR(info.st_mode))
-  {
-    DIR* dir = opendir(path.c_str());
-    if (!dir)
-    {
-      std::fprintf(stderr, "FuzzEclipseOutputReplay: cannot open directory %s\n", path.c_str());
-      return 1;
-    }
-    int failures = 0;
-    while (const dirent* entry = readdir(dir))
-    {
-      const std::string name = entry->d_name;
-      if (name == "." || name == ".." || name[0] == '.')
-      {
-        continue;
-      }
-      failures += RunPath(path + "/" + name, count);
-    }
-    closedir(dir);
-    return failures;
-  }
-  std::string contents;
-  if (!ReadWholeFile(path, contents))
-  {
-    std::fprintf(stderr, "FuzzEclipseOutputReplay: cannot read %s\n", path.c_str());
-    return 1;
-  }
-  RunInput(path, contents, count);
-  // A grid with companions beside it is also replayed as a set, as run_fuzz.sh seeds it.
-  std::string set;
-  if (GridSet(path, set))
-  {
-    RunInput(path + " +companions", set, count);
-  }
-  return 0;
-}
 } // namespace
 
 #if defined(__has_feature)
@@ -590,11 +530,6 @@ int RunPath(const std::string& path, long& count)
 
 int main(int argc, char** argv)
 {
-  if (argc < 2)
-  {
-    std::fprintf(stderr, "usage: %s FILE_OR_DIRECTORY...\n", argv[0]);
-    return 2;
-  }
 #ifndef RESMR_FUZZ_SANITIZED
   // What libFuzzer's -rss_limit_mb / malloc limit do when fuzzing: a runaway allocation
   // fails (std::bad_alloc, printed as the input's outcome) instead of filling the machine.
@@ -603,12 +538,15 @@ int main(int argc, char** argv)
   setrlimit(RLIMIT_AS, &limit);
 #endif
   long count = 0;
-  int failures = 0;
-  for (int i = 1; i < argc; ++i)
-  {
-    failures += RunPath(argv[i], count);
-  }
-  std::printf("FuzzEclipseOutputReplay: ran %ld inputs, %d unreadable paths\n", count, failures);
-  return failures == 0 && count > 0 ? 0 : 1;
+  return resmr_fuzz::ReplayMain("FuzzEclipseOutputReplay", argc, argv, count,
+    [&](const std::string& path, const std::string& contents) {
+      RunInput(path, contents, count);
+      // A grid with companions beside it is also replayed as a set, as run_fuzz.sh seeds it.
+      std::string set;
+      if (GridSet(path, set))
+      {
+        RunInput(path + " +companions", set, count);
+      }
+    });
 }
 #endif

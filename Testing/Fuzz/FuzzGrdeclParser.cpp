@@ -12,6 +12,7 @@
 #include "CornerPointGeometry.h"
 #include "GrdeclError.h"
 #include "GrdeclParser.h"
+#include "FuzzReplay.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -253,84 +254,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
 #ifdef RESMR_FUZZ_STANDALONE
 namespace
 {
-bool ReadWholeFile(const std::string& path, std::string& contents)
+void RunOne(const std::string& path, const std::string& contents, long& count)
 {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file)
-  {
-    return false;
-  }
-  contents.clear();
-  char buffer[1 << 16];
-  std::size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof(buffer), file)) > 0)
-  {
-    contents.append(buffer, got);
-  }
-  const bool ok = !std::ferror(file);
-  std::fclose(file);
-  return ok;
-}
-
-int RunPath(const std::string& path, long& count)
-{
-  struct stat info;
-  if (stat(path.c_str(), &info) != 0)
-  {
-    std::fprintf(stderr, "FuzzGrdeclParserReplay: cannot stat %s\n", path.c_str());
-    return 1;
-  }
-  if (S_ISDIR(info.st_mode))
-  {
-    DIR* dir = opendir(path.c_str());
-    if (!dir)
-    {
-      std::fprintf(stderr, "FuzzGrdeclParserReplay: cannot open directory %s\n", path.c_str());
-      return 1;
-    }
-    int failures = 0;
-    while (const dirent* entry = readdir(dir))
-    {
-      const std::string name = entry->d_name;
-      if (name == "." || name == ".." || name[0] == '.')
-      {
-        continue;
-      }
-      failures += RunPath(path + "/" + name, count);
-    }
-    closedir(dir);
-    return failures;
-  }
-  std::string contents;
-  if (!ReadWholeFile(path, contents))
-  {
-    std::fprintf(stderr, "FuzzGrdeclParserReplay: cannot read %s\n", path.c_str());
-    return 1;
-  }
   std::printf("%s (%zu bytes): ", path.c_str(), contents.size());
   std::fflush(stdout); // the name is out before a crash
   LastOutcome.clear();
   LLVMFuzzerTestOneInput(reinterpret_cast<const uint8_t*>(contents.data()), contents.size());
   std::printf("%s\n", LastOutcome.substr(0, 300).c_str());
   ++count;
-  return 0;
 }
 } // namespace
 
 int main(int argc, char** argv)
 {
-  if (argc < 2)
-  {
-    std::fprintf(stderr, "usage: %s FILE_OR_DIRECTORY...\n", argv[0]);
-    return 2;
-  }
   long count = 0;
-  int failures = 0;
-  for (int i = 1; i < argc; ++i)
-  {
-    failures += RunPath(argv[i], count);
-  }
-  std::printf("FuzzGrdeclParserReplay: ran %ld inputs, %d unreadable paths\n", count, failures);
-  return failures == 0 && count > 0 ? 0 : 1;
+  return resmr_fuzz::ReplayMain("FuzzGrdeclParserReplay", argc, argv, count,
+    [&](const std::string& path, const std::string& contents) { RunOne(path, contents, count); });
 }
 #endif

@@ -1,0 +1,94 @@
+// Replay driver shared by the fuzz targets' standalone builds (-DRESMR_FUZZ_STANDALONE):
+// runs a target over every file, or every file in every directory, named on the command
+// line, so ctest replays seeds and past findings without libFuzzer.
+#pragma once
+
+#include <cstdio>
+#include <dirent.h>
+#include <functional>
+#include <string>
+#include <sys/stat.h>
+
+namespace resmr_fuzz
+{
+
+inline bool ReadWholeFile(const std::string& path, std::string& contents)
+{
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file)
+  {
+    return false;
+  }
+  contents.clear();
+  char buffer[1 << 16];
+  std::size_t got = 0;
+  while ((got = std::fread(buffer, 1, sizeof(buffer), file)) > 0)
+  {
+    contents.append(buffer, got);
+  }
+  const bool ok = !std::ferror(file);
+  std::fclose(file);
+  return ok;
+}
+
+using InputRunner = std::function<void(const std::string& path, const std::string& contents)>;
+
+/// Calls `run` for every file at or under `path` (hidden names skipped); returns the number
+/// of paths that could not be read.
+inline int ForEachInput(const char* tool, const std::string& path, const InputRunner& run)
+{
+  struct stat info;
+  if (stat(path.c_str(), &info) != 0)
+  {
+    std::fprintf(stderr, "%s: cannot stat %s\n", tool, path.c_str());
+    return 1;
+  }
+  if (S_ISDIR(info.st_mode))
+  {
+    DIR* dir = opendir(path.c_str());
+    if (!dir)
+    {
+      std::fprintf(stderr, "%s: cannot open directory %s\n", tool, path.c_str());
+      return 1;
+    }
+    int failures = 0;
+    while (const dirent* entry = readdir(dir))
+    {
+      const std::string name = entry->d_name;
+      if (name[0] != '.')
+      {
+        failures += ForEachInput(tool, path + "/" + name, run);
+      }
+    }
+    closedir(dir);
+    return failures;
+  }
+  std::string contents;
+  if (!ReadWholeFile(path, contents))
+  {
+    std::fprintf(stderr, "%s: cannot read %s\n", tool, path.c_str());
+    return 1;
+  }
+  run(path, contents);
+  return 0;
+}
+
+/// The replay main: every argument through ForEachInput; `count` is incremented by the
+/// runner. Prints the tally ctest checks and fails when nothing ran or a path was unreadable.
+inline int ReplayMain(const char* tool, int argc, char** argv, long& count, const InputRunner& run)
+{
+  if (argc < 2)
+  {
+    std::fprintf(stderr, "usage: %s FILE_OR_DIRECTORY...\n", argv[0]);
+    return 2;
+  }
+  int failures = 0;
+  for (int i = 1; i < argc; ++i)
+  {
+    failures += ForEachInput(tool, argv[i], run);
+  }
+  std::printf("%s: ran %ld inputs, %d unreadable paths\n", tool, count, failures);
+  return failures == 0 && count > 0 ? 0 : 1;
+}
+
+} // namespace resmr_fuzz
