@@ -170,20 +170,9 @@ std::string PartName(std::size_t index, std::size_t count, bool formatted)
 
 [[noreturn]] void BrokenInvariant(const std::string& what)
 {
-  std::fprintf(stderr, "==FuzzEclipseOutput== broken invariant: %s\n", what.c_str());
-  std::fflush(stderr);
-  std::abort();
+  resmr_fuzz::BrokenInvariant("FuzzEclipseOutput", what);
 }
-
-/// RESMR_FUZZ_NO_INVARIANTS=1 skips CheckGrid, to see what a broken grid does downstream.
-bool InvariantsChecked()
-{
-  static const bool checked = [] {
-    const char* value = std::getenv("RESMR_FUZZ_NO_INVARIANTS");
-    return !(value && *value && std::strcmp(value, "0") != 0);
-  }();
-  return checked;
-}
+using resmr_fuzz::InvariantsChecked;
 
 /// Whitespace-separated tokens in text, and the length of the longest.
 int64_t CountTokens(std::string_view text, std::size_t& longest)

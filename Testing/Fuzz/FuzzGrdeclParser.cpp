@@ -101,24 +101,11 @@ bool NamesSpecialFiles(const uint8_t* data, std::size_t size)
   return false;
 }
 
-/// A finding that no sanitizer sees: the deck breaks a promise its consumers rely on (the
-/// reader indexes arrays, COORD, ZCORN and fault boxes by the grid dimensions).
 [[noreturn]] void BrokenInvariant(const std::string& what)
 {
-  std::fprintf(stderr, "==FuzzGrdeclParser== broken deck invariant: %s\n", what.c_str());
-  std::fflush(stderr);
-  std::abort();
+  resmr_fuzz::BrokenInvariant("FuzzGrdeclParser", what);
 }
-
-/// RESMR_FUZZ_NO_INVARIANTS=1 skips CheckDeck, to see what a broken deck does downstream.
-bool InvariantsChecked()
-{
-  static const bool checked = [] {
-    const char* value = std::getenv("RESMR_FUZZ_NO_INVARIANTS");
-    return !(value && *value && std::strcmp(value, "0") != 0);
-  }();
-  return checked;
-}
+using resmr_fuzz::InvariantsChecked;
 
 void CheckDeck(const resmr::GrdeclDeck& deck)
 {

@@ -1,9 +1,12 @@
-// Replay driver shared by the fuzz targets' standalone builds (-DRESMR_FUZZ_STANDALONE):
-// runs a target over every file, or every file in every directory, named on the command
-// line, so ctest replays seeds and past findings without libFuzzer.
+// Shared by the fuzz targets: invariant reporting, and the replay driver of their
+// standalone builds (-DRESMR_FUZZ_STANDALONE), which runs a target over every file, or
+// every file in every directory, named on the command line, so ctest replays seeds and
+// past findings without libFuzzer.
 #pragma once
 
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <dirent.h>
 #include <functional>
 #include <string>
@@ -11,6 +14,25 @@
 
 namespace resmr_fuzz
 {
+
+/// A finding no sanitizer sees: the parsed data breaks a promise its consumers rely on.
+[[noreturn]] inline void BrokenInvariant(const char* target, const std::string& what)
+{
+  std::fprintf(stderr, "==%s== broken invariant: %s\n", target, what.c_str());
+  std::fflush(stderr);
+  std::abort();
+}
+
+/// RESMR_FUZZ_NO_INVARIANTS=1 skips the invariant checks, to see what broken data does
+/// downstream.
+inline bool InvariantsChecked()
+{
+  static const bool checked = [] {
+    const char* value = std::getenv("RESMR_FUZZ_NO_INVARIANTS");
+    return !(value && *value && std::strcmp(value, "0") != 0);
+  }();
+  return checked;
+}
 
 inline bool ReadWholeFile(const std::string& path, std::string& contents)
 {
