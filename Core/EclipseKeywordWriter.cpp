@@ -7,9 +7,6 @@
 #include <cerrno>
 #include <cstring>
 #include <limits>
-#include <stdlib.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace resmr
 {
@@ -29,55 +26,23 @@ void PutBigEndian64(unsigned char* out, uint64_t value)
 } // namespace
 
 EclipseKeywordWriter::EclipseKeywordWriter(const std::string& path)
-  : FinalPath(path)
+  : Output(path)
 {
-  std::string pattern = path + ".partial-XXXXXX";
-  const int descriptor = mkstemp(&pattern[0]);
-  if (descriptor < 0)
-  {
-    throw GrdeclError(path, 0, "",
-      std::string("cannot create the output file beside it: ") + std::strerror(errno));
-  }
-  this->TemporaryPath = pattern;
-  this->File = fdopen(descriptor, "wb");
-  if (!this->File)
-  {
-    close(descriptor);
-    unlink(this->TemporaryPath.c_str());
-    throw GrdeclError(path, 0, "", std::string("cannot open the output file: ") + std::strerror(errno));
-  }
-  fchmod(descriptor, 0644); // mkstemp creates 0600; outputs are ordinary files
-  std::setvbuf(this->File, nullptr, _IOFBF, 1 << 20);
-}
-
-EclipseKeywordWriter::~EclipseKeywordWriter()
-{
-  this->Discard();
-}
-
-void EclipseKeywordWriter::Discard()
-{
-  if (this->File)
-  {
-    std::fclose(this->File);
-    this->File = nullptr;
-    unlink(this->TemporaryPath.c_str());
-  }
 }
 
 void EclipseKeywordWriter::Fail(const std::string& what)
 {
-  this->Discard();
-  throw GrdeclError(this->FinalPath, 0, this->Keyword, what);
+  this->Output.Discard();
+  throw GrdeclError(this->Output.Path(), 0, this->Keyword, what);
 }
 
 void EclipseKeywordWriter::PutBytes(const void* data, std::size_t size)
 {
-  if (!this->File)
+  if (!this->Output.IsOpen())
   {
-    throw GrdeclError(this->FinalPath, 0, this->Keyword, "writer already committed or failed");
+    throw GrdeclError(this->Output.Path(), 0, this->Keyword, "writer already committed or failed");
   }
-  if (std::fwrite(data, 1, size, this->File) != size)
+  if (!this->Output.Write(data, size))
   {
     this->Fail(std::string("write failed (disk full?): ") + std::strerror(errno));
   }
@@ -257,27 +222,7 @@ void EclipseKeywordWriter::Commit()
   {
     this->Fail(std::to_string(this->Remaining) + " values missing at the end of the file");
   }
-  if (!this->File)
-  {
-    throw GrdeclError(this->FinalPath, 0, "", "writer already committed or failed");
-  }
-  const bool flushed = std::fflush(this->File) == 0 && fsync(fileno(this->File)) == 0;
-  const int error = errno;
-  const bool closed = std::fclose(this->File) == 0;
-  this->File = nullptr;
-  if (!flushed || !closed)
-  {
-    unlink(this->TemporaryPath.c_str());
-    throw GrdeclError(this->FinalPath, 0, "",
-      std::string("write failed (disk full?): ") + std::strerror(flushed ? errno : error));
-  }
-  if (std::rename(this->TemporaryPath.c_str(), this->FinalPath.c_str()) != 0)
-  {
-    const int renameError = errno;
-    unlink(this->TemporaryPath.c_str());
-    throw GrdeclError(this->FinalPath, 0, "",
-      std::string("cannot move the finished file into place: ") + std::strerror(renameError));
-  }
+  this->Output.Commit();
 }
 
 } // namespace resmr

@@ -13,6 +13,7 @@
 //   under the final name. Errors throw GrdeclError naming the file and keyword.
 #pragma once
 
+#include "AtomicOutputFile.h"
 #include "EclipseKeywordFile.h"
 
 #include <cstdint>
@@ -28,7 +29,6 @@ class EclipseKeywordWriter
 public:
   /// Opens a temporary file beside `path`; throws GrdeclError if the folder is not writable.
   explicit EclipseKeywordWriter(const std::string& path);
-  ~EclipseKeywordWriter();
   EclipseKeywordWriter(const EclipseKeywordWriter&) = delete;
   EclipseKeywordWriter& operator=(const EclipseKeywordWriter&) = delete;
 
@@ -55,7 +55,7 @@ public:
   /// Flushes, checks the last keyword is complete and renames the file into place.
   void Commit();
 
-  const std::string& Path() const { return this->FinalPath; }
+  const std::string& Path() const { return this->Output.Path(); }
 
 private:
   template <typename T>
@@ -63,11 +63,8 @@ private:
   void PutBytes(const void* data, std::size_t size);
   void PutMarker(uint32_t value);
   [[noreturn]] void Fail(const std::string& what);
-  void Discard();
 
-  std::string FinalPath;
-  std::string TemporaryPath;
-  std::FILE* File = nullptr;
+  AtomicOutputFile Output;
   std::string Keyword;
   EclipseDataType Type = EclipseDataType::Message;
   int32_t ElementSize = 0;
