@@ -6,6 +6,10 @@
 //   resmr info GRID.EGRID
 //                       prints the grid's dimensions and active cells, its INIT arrays and
 //                       restart report steps as JSON
+//   resmr synth NX NY NZ -o FILE.EGRID|FILE.GRDECL [options]
+//                       writes a synthetic faulted reservoir (ResmrSynth.cpp)
+#include "ResmrCommands.h"
+
 #include "CornerPointGeometry.h"
 #include "EclipseGrid.h"
 #include "EclipseKeywordFile.h"
@@ -164,6 +168,10 @@ int Info(const char* path, bool skipMissingIncludes)
 
 int main(int argc, char** argv)
 {
+  if (argc >= 2 && std::strcmp(argv[1], "synth") == 0)
+  {
+    return SynthCommand(argc, argv);
+  }
   const bool lenient = argc == 4 && std::strcmp(argv[2], "--skip-missing-includes") == 0;
   if ((argc == 3 || lenient) && std::strcmp(argv[1], "info") == 0)
   {
@@ -179,6 +187,8 @@ int main(int argc, char** argv)
   }
   std::fprintf(stderr, "usage: resmr info [--skip-missing-includes] DECK|GRID.EGRID\n"
                        "  prints dimensions, active cells, arrays and faults of an Eclipse deck,\n"
-                       "  or of an EGRID with its INIT arrays and restart steps\n");
+                       "  or of an EGRID with its INIT arrays and restart steps\n"
+                       "usage: resmr synth NX NY NZ -o FILE.EGRID|FILE.GRDECL [options]\n"
+                       "  writes a synthetic faulted reservoir model (resmr synth --help)\n");
   return 2;
 }
