@@ -124,23 +124,7 @@ std::string Write(const std::string& name, const std::string& bytes)
 void ExpectError(const std::string& label, const std::function<void()>& action,
   const std::vector<std::string>& fragments)
 {
-  try
-  {
-    action();
-    std::fprintf(stderr, "%s: expected an error, none thrown\n", label.c_str());
-    ++resmr_testing::Failures;
-  }
-  catch (const resmr::GrdeclError& error)
-  {
-    for (const std::string& fragment : fragments)
-    {
-      if (std::string(error.what()).find(fragment) == std::string::npos)
-      {
-        std::fprintf(stderr, "%s: message lacks '%s': %s\n", label.c_str(), fragment.c_str(), error.what());
-        ++resmr_testing::Failures;
-      }
-    }
-  }
+  resmr_testing::ExpectError<resmr::GrdeclError>(label, action, fragments);
 }
 
 // ------------------------------------------------------------------ tests
