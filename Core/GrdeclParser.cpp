@@ -1,6 +1,8 @@
 // Eclipse grid deck parser (paper Sec. 3: the corner-point model and its cell properties).
 #include "GrdeclParser.h"
 
+#include "MemoryBudget.h"
+
 #include "EclipseKeywordFile.h"
 #include "GrdeclError.h"
 #include "GrdeclTokenizer.h"
@@ -67,8 +69,8 @@ int64_t CheckedCellCount(const std::array<int64_t, 3>& dims, int64_t maxCells,
   {
     throw GrdeclError(file, line, keyword,
       "grid of " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
-        std::to_string(dims[2]) + " cells is larger than this machine can hold (limit " +
-        std::to_string(maxCells) + " cells)");
+        std::to_string(dims[2]) + " cells is larger than this machine can hold in memory at full "
+        "resolution (limit " + std::to_string(maxCells) + " cells); " + MultiresolutionAdvice(file));
   }
   return count;
 }

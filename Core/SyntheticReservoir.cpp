@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
@@ -203,8 +204,9 @@ void SyntheticParameters::Validate() const
   auto inRange = [&](double value, double low, double high, const char* name) {
     if (!(value >= low && value <= high))
     {
-      fail(std::string(name) + " must be within [" + std::to_string(low) + ", " +
-        std::to_string(high) + "] (got " + std::to_string(value) + ")");
+      char text[160];
+      std::snprintf(text, sizeof(text), "%s must be within [%g, %g] (got %g)", name, low, high, value);
+      fail(text);
     }
   };
   inRange(this->maxThrow, 0, 2, "throw");

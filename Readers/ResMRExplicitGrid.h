@@ -1,4 +1,4 @@
-// Shared by the Eclipse readers: turns a Core corner-point grid into the plugin's
+// Shared by the Eclipse readers and the synthetic reservoir source: turns a Core corner-point grid into the plugin's
 // vtkExplicitStructuredGrid contract (paper Sec. 3): z up, corners shared where ECLIPSE
 // connects cells, I/J/K from 1, ACTNUM, HIDDENCELL for inactive cells, face connectivity
 // flags; and maps per-cell arrays from ECLIPSE cell order to VTK cell order.
@@ -9,7 +9,8 @@
 #include "vtkSmartPointer.h"
 #include "vtkType.h"
 
-#include "LargeArrays.h" // for resmr::AdviseHugePages
+#include "LargeArrays.h"         // for resmr::AdviseHugePages
+#include "ResMRReadersModule.h" // for export macro
 
 #include <cstdint>
 #include <vector>
@@ -25,7 +26,7 @@ namespace resmr_readers
 
 /// Modification time of a file in nanoseconds, -1 if it cannot be read: readers reopen a
 /// file when it changes.
-long long FileModificationTime(const char* path);
+RESMRREADERS_EXPORT long long FileModificationTime(const char* path);
 
 /// VTK cell id of an ECLIPSE cell index (i fastest, k down). Left-handed grids are stored
 /// with the structured k index running up so every hexahedron has a positive volume.
@@ -48,7 +49,7 @@ struct CellOrder
 /// Builds points, hexahedra, connectivity flags and the I, J, K and ACTNUM cell arrays.
 /// `actnum` holds ACTNUM as given (one per cell, ECLIPSE order), `active` which cells are
 /// shown; inactive cells get HIDDENCELL unless showInactive. Throws std::bad_alloc.
-CellOrder BuildExplicitGrid(const resmr::CornerPointGeometry& geometry,
+RESMRREADERS_EXPORT CellOrder BuildExplicitGrid(const resmr::CornerPointGeometry& geometry,
   const std::vector<int32_t>& actnum, const std::vector<bool>& active, bool showInactive,
   vtkExplicitStructuredGrid* grid);
 

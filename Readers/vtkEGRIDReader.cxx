@@ -15,6 +15,7 @@
 #include "vtkStringArray.h"
 
 #include "CornerPointGeometry.h"
+#include "MemoryBudget.h"
 #include "EclipseGrid.h"
 #include "EclipseKeywordFile.h"
 #include "EclipseResults.h"
@@ -145,6 +146,20 @@ int vtkEGRIDReader::GetNumberOfReportSteps()
   return static_cast<int>(this->Internal->Times.size());
 }
 
+void vtkEGRIDReader::SetMemoryLimitMB(int megabytes)
+{
+  megabytes = megabytes < 0 ? 0 : megabytes;
+  if (megabytes != this->MemoryLimitMB)
+  {
+    this->MemoryLimitMB = megabytes;
+    // Open again under the new limit: a refusal may no longer hold, or a grid may no
+    // longer fit.
+    this->Internal->Reset();
+    this->Internal->FailedFile.clear();
+    this->Modified();
+  }
+}
+
 void vtkEGRIDReader::ReportError(const std::string& message)
 {
   this->LastError = message;
@@ -175,7 +190,8 @@ bool vtkEGRIDReader::OpenIfNeeded()
   this->Warnings.clear();
   try
   {
-    internal.Grid = resmr::ReadEclipseGrid(this->FileName);
+    internal.Grid = resmr::ReadEclipseGrid(
+      this->FileName, resmr::MaxFullResolutionCells(int64_t(this->MemoryLimitMB) << 20));
     internal.Results = std::make_unique<resmr::EclipseResults>(this->FileName, *internal.Grid);
     internal.Geometry = resmr::CornerPointGeometry::FromDeck(internal.Grid->deck, this->ApplyMapAxes);
   }

@@ -19,6 +19,7 @@
 #include "vtkUnsignedCharArray.h"
 
 #include "CornerPointGeometry.h"
+#include "MemoryBudget.h"
 #include "ResMRExplicitGrid.h"
 #include "GrdeclError.h"
 #include "GrdeclParser.h"
@@ -127,6 +128,22 @@ void vtkGRDECLReader::SetFaultArrayStatus(const char* name, int status)
   }
 }
 
+void vtkGRDECLReader::SetMemoryLimitMB(int megabytes)
+{
+  megabytes = megabytes < 0 ? 0 : megabytes;
+  if (megabytes != this->MemoryLimitMB)
+  {
+    this->MemoryLimitMB = megabytes;
+    // Parse again under the new limit: a refusal may no longer hold, or a deck may no
+    // longer fit.
+    this->Internal->Geometry.reset();
+    this->Internal->Deck = resmr::GrdeclDeck();
+    this->Internal->ParsedFile.clear();
+    this->Internal->FailedFile.clear();
+    this->Modified();
+  }
+}
+
 void vtkGRDECLReader::ReportError(const std::string& message)
 {
   this->LastError = message;
@@ -166,7 +183,9 @@ bool vtkGRDECLReader::ParseIfNeeded()
   };
   try
   {
-    internal.Deck = resmr::ParseGrdeclFile(this->FileName);
+    resmr::GrdeclParseOptions options;
+    options.maxCells = resmr::MaxFullResolutionCells(int64_t(this->MemoryLimitMB) << 20);
+    internal.Deck = resmr::ParseGrdeclFile(this->FileName, options);
     internal.Geometry = resmr::CornerPointGeometry::FromDeck(internal.Deck, this->ApplyMapAxes);
   }
   catch (const std::bad_alloc&)

@@ -51,6 +51,14 @@ public:
   ///@}
 
   ///@{
+  /// Memory, in MiB, a full-resolution grid may take (about 300 bytes a cell); 0, the
+  /// default, means the memory available now. Bigger models are refused with a message
+  /// pointing to the multiresolution path.
+  void SetMemoryLimitMB(int megabytes);
+  vtkGetMacro(MemoryLimitMB, int);
+  ///@}
+
+  ///@{
   /// Place the grid in map coordinates given by MAPAXES. On by default.
   vtkSetMacro(ApplyMapAxes, bool);
   vtkGetMacro(ApplyMapAxes, bool);
@@ -101,6 +109,7 @@ private:
 
   char* FileName = nullptr;
   bool ShowInactiveCells = false;
+  int MemoryLimitMB = 0;
   bool ApplyMapAxes = true;
   bool LeftHanded = false;
   std::string LastError;
