@@ -818,9 +818,11 @@ bool SyntheticLayerStream::Next(SyntheticLayer& layer)
         : thickness < pinchThickness         ? SyntheticCellState::Pinched
         : centre > m.Contact                 ? SyntheticCellState::Water
                                              : SyntheticCellState::Active;
-      // Clean sands are porous, thick and permeable; shales are none of these.
-      const double poro = 0.03 + 0.27 * (0.6 * quality + 0.4 * noise);
-      const double ntg = Clamp(0.1 + 0.9 * (0.7 * quality + 0.3 * noise), 0.0, 1.0);
+      // Clean sands are porous, thick and permeable; shales are none of these. Within a
+      // layer, thicker parts are better sands (the layer noise, contrast stretched).
+      const double lateral = Clamp((noise - 0.5) * 2.5 + 0.5, 0.0, 1.0);
+      const double poro = 0.03 + 0.27 * (0.55 * quality + 0.45 * lateral);
+      const double ntg = Clamp(0.1 + 0.9 * (0.65 * quality + 0.35 * lateral), 0.0, 1.0);
       const double permx = 0.5 * DeterministicExp(27.0 * (poro - 0.03));
       layer.state[c] = state;
       layer.depth[c] = static_cast<float>(centre);
