@@ -45,13 +45,16 @@ build: configure
 	cmake --build $(BUILD_DIR)
 
 # The main job: open the demo model; with a display, in the ParaView GUI; without one,
-# screenshots in $(DEMO_OUTPUT)/.
+# screenshots in $(DEMO_OUTPUT)/ of the demo deck and of a generated 540k-cell model.
 demo: build
 	@if [ -n "$$DISPLAY" ]; then \
 	  echo "Opening $(DEMO_DECK) in ParaView (plugin from $(PLUGIN_DIR))"; \
 	  PV_PLUGIN_PATH=$(abspath $(PLUGIN_DIR)) paraview --data=$(DEMO_DECK); \
 	else \
-	  $(XVFB) pvpython --force-offscreen-rendering scripts/demo.py $(PLUGIN) $(DEMO_DECK) $(DEMO_OUTPUT); \
+	  $(XVFB) pvpython --force-offscreen-rendering scripts/demo.py $(PLUGIN) $(DEMO_DECK) $(DEMO_OUTPUT) && \
+	  mkdir -p $(DEMO_OUTPUT) && \
+	  $(BUILD_DIR)/bin/resmr synth 150 120 30 --steps 5 --quiet -o $(DEMO_OUTPUT)/SYNTHETIC.EGRID && \
+	  $(XVFB) pvpython --force-offscreen-rendering scripts/demo.py $(PLUGIN) $(DEMO_OUTPUT)/SYNTHETIC.EGRID $(DEMO_OUTPUT); \
 	fi
 
 test: build

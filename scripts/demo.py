@@ -1,8 +1,9 @@
-"""The main job: opens a model with the ReservoirMultiresolution plugin's GRDECLReader and
-writes screenshots (colored by PORO with cell edges, and the faults) to an output folder.
-Run by `make demo` under a virtual display when no display is available.
+"""The main job: opens a model with the ReservoirMultiresolution plugin's readers (a GRDECL
+deck, or an EGRID such as one `resmr synth` wrote) and writes screenshots (colored by PORO
+with cell edges; a deck's faults) to an output folder. Run by `make demo` under a virtual
+display when no display is available.
 
-usage: pvpython demo.py PLUGIN DECK OUTPUT_DIR
+usage: pvpython demo.py PLUGIN MODEL OUTPUT_DIR
 """
 import os
 import sys
@@ -13,7 +14,9 @@ plugin, deck, output = sys.argv[1:4]
 simple.LoadPlugin(plugin, remote=False, ns=vars(simple))
 os.makedirs(output, exist_ok=True)
 
-reader = simple.GRDECLReader(FileName=deck)
+is_deck = not deck.upper().endswith("EGRID")
+reader = simple.GRDECLReader(FileName=deck) if is_deck else simple.EGRIDReader(FileName=deck)
+prefix = os.path.splitext(os.path.basename(deck))[0]
 reader.UpdatePipeline()
 reader.UpdatePropertyInformation()
 error = reader.GetPropertyValue("LastError")
@@ -21,8 +24,8 @@ if error:
     sys.exit(f"demo: cannot read {deck}: {error}")
 grid = servermanager.Fetch(reader, arg1=None, arg2=None, idx=0)
 print(f"demo: {deck}: {grid.GetCells().GetNumberOfCells()} cells,"
-      f" {grid.GetNumberOfPoints()} points, properties {list(reader.CellArrays)},"
-      f" faults {list(reader.Faults)}")
+      f" {grid.GetNumberOfPoints()} points, properties {list(reader.CellArrays)}"
+      + (f", faults {list(reader.Faults)}" if is_deck else ""))
 
 view = simple.CreateView("RenderView")
 view.ViewSize = [1280, 800]
@@ -44,20 +47,21 @@ for name, direction in (("oblique", (-0.7, -1.0, 0.8)), ("top", (0.0, -0.05, 1.0
     camera.SetViewUp(0, 0, 1) if name != "top" else camera.SetViewUp(0, 1, 0)
     view.ResetCamera(False)
     simple.Render(view)
-    path = os.path.join(output, f"model_PORO_{name}.png")
+    path = os.path.join(output, f"{prefix}_PORO_{name}.png")
     simple.SaveScreenshot(path, view, ImageResolution=[1280, 800])
     print(f"demo: wrote {path}")
 
-faults = simple.Show(simple.OutputPort(reader, 1), view)
-faults.Scale = [1, 1, 8]
-simple.ColorBy(faults, ("CELLS", "FaultIndex"))
-display.Opacity = 0.35
-camera = view.GetActiveCamera()
-camera.SetFocalPoint(centre)
-camera.SetPosition([centre[0] - 0.7 * size, centre[1] - size, centre[2] + 0.8 * size])
-camera.SetViewUp(0, 0, 1)
-view.ResetCamera(False)
-simple.Render(view)
-path = os.path.join(output, "model_faults.png")
-simple.SaveScreenshot(path, view, ImageResolution=[1280, 800])
-print(f"demo: wrote {path}")
+if is_deck:
+    faults = simple.Show(simple.OutputPort(reader, 1), view)
+    faults.Scale = [1, 1, 8]
+    simple.ColorBy(faults, ("CELLS", "FaultIndex"))
+    display.Opacity = 0.35
+    camera = view.GetActiveCamera()
+    camera.SetFocalPoint(centre)
+    camera.SetPosition([centre[0] - 0.7 * size, centre[1] - size, centre[2] + 0.8 * size])
+    camera.SetViewUp(0, 0, 1)
+    view.ResetCamera(False)
+    simple.Render(view)
+    path = os.path.join(output, f"{prefix}_faults.png")
+    simple.SaveScreenshot(path, view, ImageResolution=[1280, 800])
+    print(f"demo: wrote {path}")
