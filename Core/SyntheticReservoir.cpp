@@ -484,34 +484,47 @@ void SyntheticReservoir::Calibrate()
       columns.push_back({ i, j });
     }
   }
-  // Noise at the four corner pillars of each sample column, per layer.
-  std::vector<double> noise(columns.size() * 4 * static_cast<std::size_t>(nz));
-  std::vector<double> centreNoise;
-  centreNoise.reserve(columns.size() * static_cast<std::size_t>(nz));
+  // Noise at the four corner pillars of a sample column, recomputed when needed: only every
+  // kStride-th layer is kept for the quantiles, so memory stays bounded (8 MB) for any nz.
+  const int64_t kStride = std::max<int64_t>(1, (static_cast<int64_t>(columns.size()) * nz + (1 << 20) - 1) >> 20);
+  auto cornerNoise = [&](std::size_t c, int64_t k, int corner) {
+    return this->Noise(ThicknessChannel, static_cast<double>(columns[c][0] + (corner & 1)),
+      static_cast<double>(columns[c][1] + (corner >> 1)), static_cast<double>(k));
+  };
+  std::vector<double> cornerNoiseMax;
+  cornerNoiseMax.reserve(columns.size() * static_cast<std::size_t>((nz + kStride - 1) / kStride));
   for (std::size_t c = 0; c < columns.size(); ++c)
   {
-    for (int64_t k = 0; k < nz; ++k)
+    for (int64_t k = 0; k < nz; k += kStride)
     {
-      double sum = 0;
+      // A cell has zero thickness where all four corners are under the pinch-out level.
+      double highest = 0;
       for (int corner = 0; corner < 4; ++corner)
       {
-        const double value = this->Noise(ThicknessChannel, static_cast<double>(columns[c][0] + (corner & 1)),
-          static_cast<double>(columns[c][1] + (corner >> 1)), static_cast<double>(k));
-        noise[(c * nz + k) * 4 + corner] = value;
-        sum += value;
+        highest = std::max(highest, cornerNoise(c, k, corner));
       }
-      centreNoise.push_back(0.25 * sum);
+      cornerNoiseMax.push_back(highest);
     }
   }
   this->PinchLevel = this->Params.pinchedFraction > 0
-    ? Clamp(Quantile(centreNoise, this->Params.pinchedFraction), 0.0, 0.95)
+    ? Clamp(Quantile(cornerNoiseMax, this->Params.pinchedFraction), 0.0, 0.95)
     : 0.0;
+  // Layers average their nominal thickness: the mean of max(0, noise - level) over the
+  // sampled corners.
   double mean = 0;
-  for (double value : centreNoise)
+  int64_t samples = 0;
+  for (std::size_t c = 0; c < columns.size(); ++c)
   {
-    mean += std::max(0.0, value - this->PinchLevel);
+    for (int64_t k = 0; k < nz; k += kStride)
+    {
+      for (int corner = 0; corner < 4; ++corner)
+      {
+        mean += std::max(0.0, cornerNoise(c, k, corner) - this->PinchLevel);
+        ++samples;
+      }
+    }
   }
-  mean /= static_cast<double>(centreNoise.size());
+  mean /= static_cast<double>(samples);
   this->ThicknessScale = mean > 0 ? 1.0 / mean : 1.0;
 
   this->Contact = std::numeric_limits<double>::infinity();
@@ -539,12 +552,12 @@ void SyntheticReservoir::Calibrate()
           double centre = 0, thickness = 0;
           for (int corner = 0; corner < 4; ++corner)
           {
-            const double t = this->LayerThickness[k] * this->ThicknessFactor(noise[(c * nz + k) * 4 + corner]);
+            const double t = this->LayerThickness[k] * this->ThicknessFactor(cornerNoise(c, k, corner));
             centre += top[corner] + 0.5 * t;
             thickness += t;
             top[corner] += t;
           }
-          if (0.25 * thickness >= 0.01 * this->LayerThickness[k])
+          if (k % kStride == 0 && 0.25 * thickness >= 0.01 * this->LayerThickness[k])
           {
             depths.push_back(0.25 * centre);
           }
