@@ -485,8 +485,9 @@ void SyntheticReservoir::Calibrate()
     }
   }
   // Noise at the four corner pillars of a sample column, recomputed when needed: only every
-  // kStride-th layer is kept for the quantiles, so memory stays bounded (8 MB) for any nz.
-  const int64_t kStride = std::max<int64_t>(1, (static_cast<int64_t>(columns.size()) * nz + (1 << 20) - 1) >> 20);
+  // kStride-th layer is kept for the quantiles (at most 2^18 values, 2 MB), so memory does
+  // not grow with nz.
+  const int64_t kStride = std::max<int64_t>(1, (static_cast<int64_t>(columns.size()) * nz + (1 << 18) - 1) >> 18);
   auto cornerNoise = [&](std::size_t c, int64_t k, int corner) {
     return this->Noise(ThicknessChannel, static_cast<double>(columns[c][0] + (corner & 1)),
       static_cast<double>(columns[c][1] + (corner >> 1)), static_cast<double>(k));
