@@ -2,6 +2,8 @@
 // shown).
 #include "EclipseResults.h"
 
+#include "CivilCalendar.h"
+
 #include "GrdeclError.h"
 
 #include <algorithm>
@@ -26,17 +28,6 @@ bool IsHeaderRecord(const std::string& name)
     "RSEG", "ILBS", "ILBR", "IUAD", "IUAP", "IGPH", "IUDQ", "DUDW", "DUDG", "DUDF", "ZUDN",
     "ZUDL", "IACT", "SACT", "ZACT", "ZLACT", "XHEAD", "ZFMFWE" };
   return names.count(name) > 0;
-}
-
-/// Days since 1 January 1970 of a proleptic Gregorian date (Howard Hinnant's algorithm).
-int64_t DaysFromCivil(int year, int month, int day)
-{
-  year -= month <= 2;
-  const int64_t era = (year >= 0 ? year : year - 399) / 400;
-  const int64_t yearOfEra = year - era * 400;
-  const int64_t dayOfYear = (153 * (month + (month > 2 ? -3 : 9)) + 2) / 5 + day - 1;
-  const int64_t dayOfEra = yearOfEra * 365 + yearOfEra / 4 - yearOfEra / 100 + dayOfYear;
-  return era * 146097 + dayOfEra - 719468;
 }
 
 bool ValidDate(const std::array<int, 3>& date)

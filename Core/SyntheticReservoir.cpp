@@ -2,6 +2,8 @@
 // Compiled with -ffp-contract=off: the same bits on every machine (see the header).
 #include "SyntheticReservoir.h"
 
+#include "CivilCalendar.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -155,28 +157,6 @@ private:
   uint64_t State;
 };
 
-int64_t DaysFromCivil(int64_t y, int64_t m, int64_t d)
-{
-  y -= m <= 2;
-  const int64_t era = (y >= 0 ? y : y - 399) / 400;
-  const int64_t yoe = y - era * 400;
-  const int64_t doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
-  const int64_t doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-  return era * 146097 + doe - 719468;
-}
-
-SyntheticDate CivilFromDays(int64_t z)
-{
-  z += 719468;
-  const int64_t era = (z >= 0 ? z : z - 146096) / 146097;
-  const int64_t doe = z - era * 146097;
-  const int64_t yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
-  const int64_t doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-  const int64_t mp = (5 * doy + 2) / 153;
-  const int64_t d = doy - (153 * mp + 2) / 5 + 1;
-  const int64_t m = mp + (mp < 10 ? 3 : -9);
-  return { static_cast<int>(yoe + era * 400 + (m <= 2)), static_cast<int>(m), static_cast<int>(d) };
-}
 } // namespace
 
 void SyntheticParameters::Validate() const
@@ -695,7 +675,8 @@ int SyntheticReservoir::StepDays(int step) const
 SyntheticDate SyntheticReservoir::StepDate(int step) const
 {
   const SyntheticDate start = StartDate();
-  return CivilFromDays(DaysFromCivil(start.year, start.month, start.day) + this->StepDays(step));
+  const std::array<int, 3> date = CivilFromDays(DaysFromCivil(start.year, start.month, start.day) + this->StepDays(step));
+  return { date[0], date[1], date[2] };
 }
 
 void SyntheticReservoir::FillStep(int step, const SyntheticLayer& layer, float* pressure, float* swat) const
