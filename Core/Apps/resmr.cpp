@@ -8,6 +8,8 @@
 //                       restart report steps as JSON
 //   resmr synth NX NY NZ -o FILE.EGRID|FILE.GRDECL [options]
 //                       writes a synthetic faulted reservoir (ResmrSynth.cpp)
+//   resmr simplify MODEL [options]
+//                       simplifies a model by column collapses, prints quality (ResmrSimplify.cpp)
 #include "ResmrCommands.h"
 
 #include "CornerPointGeometry.h"
@@ -172,6 +174,10 @@ int main(int argc, char** argv)
   {
     return SynthCommand(argc, argv);
   }
+  if (argc >= 2 && std::strcmp(argv[1], "simplify") == 0)
+  {
+    return SimplifyCommand(argc, argv);
+  }
   const bool lenient = argc == 4 && std::strcmp(argv[2], "--skip-missing-includes") == 0;
   if ((argc == 3 || lenient) && std::strcmp(argv[1], "info") == 0)
   {
@@ -189,6 +195,8 @@ int main(int argc, char** argv)
                        "  prints dimensions, active cells, arrays and faults of an Eclipse deck,\n"
                        "  or of an EGRID with its INIT arrays and restart steps\n"
                        "usage: resmr synth NX NY NZ -o FILE.EGRID|FILE.GRDECL [options]\n"
-                       "  writes a synthetic faulted reservoir model (resmr synth --help)\n");
+                       "  writes a synthetic faulted reservoir model (resmr synth --help)\n"
+                       "usage: resmr simplify MODEL [--fraction F | --columns N | --uniform B]\n"
+                       "  column-collapse simplification and its quality (resmr simplify --help)\n");
   return 2;
 }

@@ -1,0 +1,680 @@
+// Column-collapse simplification (paper Sec. 4.1, Figs. 5-7).
+#include "ColumnCollapse.h"
+
+#include "MeshQuality.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace resmr
+{
+namespace
+{
+uint64_t Mix(uint64_t x)
+{
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ull;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebull;
+  x ^= x >> 31;
+  return x;
+}
+
+int IndexOf(const std::array<int32_t, 4>& q, int32_t node)
+{
+  for (int i = 0; i < 4; ++i)
+  {
+    if (q[i] == node)
+    {
+      return i;
+    }
+  }
+  return -1;
+}
+} // namespace
+
+ColumnCollapse::ColumnCollapse(ColumnMesh& mesh, uint64_t seed)
+  : Mesh(mesh)
+  , RandomState(Mix(seed + 0x9e3779b97f4a7c15ull))
+{
+  this->AliveIndex.assign(static_cast<std::size_t>(mesh.ColumnSlots()), -1);
+  for (int32_t c = 0; c < mesh.ColumnSlots(); ++c)
+  {
+    if (mesh.IsColumnAlive(c) && !mesh.IsLocked(c))
+    {
+      this->AliveIndex[c] = static_cast<int32_t>(this->AliveList.size());
+      this->AliveList.push_back(c);
+    }
+  }
+}
+
+double ColumnCollapse::RandomUnit()
+{
+  this->RandomState += 0x9e3779b97f4a7c15ull;
+  return static_cast<double>(Mix(this->RandomState) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+void ColumnCollapse::Smooth(int32_t node)
+{
+  // Laplacian smoothing in each layer (x, y and the topological coordinate), then the z of
+  // least quadric error at that (x, y) (Sec. 4.1).
+  ColumnMesh& m = this->Mesh;
+  std::vector<int32_t> neighbours;
+  std::vector<uint8_t> boundary;
+  m.Neighbours(node, neighbours, boundary);
+  if (neighbours.empty())
+  {
+    return;
+  }
+  const double weight = 1.0 / static_cast<double>(neighbours.size());
+  std::array<double, 2> topology = { 0, 0 };
+  for (int32_t other : neighbours)
+  {
+    topology[0] += m.Topology[other][0] * weight;
+    topology[1] += m.Topology[other][1] * weight;
+  }
+  m.Topology[node] = topology;
+  double above = -std::numeric_limits<double>::infinity();
+  for (int32_t k = 0; k <= m.LayerCount; ++k)
+  {
+    glm::dvec3 average(0.0);
+    double low = std::numeric_limits<double>::infinity(), high = -low;
+    for (int32_t other : neighbours)
+    {
+      const glm::dvec3 p = m.Position(other, k);
+      average += p * weight;
+      low = std::min(low, p.z);
+      high = std::max(high, p.z);
+    }
+    average.z = this->PlaceDepth(node, k, average, low, high, above);
+    above = average.z;
+    m.SetPosition(node, k, average);
+  }
+}
+
+double ColumnCollapse::PlaceDepth(int32_t node, int32_t k, const glm::dvec3& xy, double low, double high, double above) const
+{
+  // The z of least quadric error (Sec. 4.1), kept within the depths around it (a nearly
+  // vertical side plane alone would throw it far) and below the interface above (layers
+  // never cross).
+  const double z = std::clamp(this->Mesh.NodeQuadric(node, k).OptimalZ(xy.x, xy.y, xy.z), low, high);
+  return std::max(z, above);
+}
+
+bool ColumnCollapse::Manifold(int32_t node) const
+{
+  // Each edge at the node in at most two columns, and the columns around it one fan.
+  const ColumnMesh& m = this->Mesh;
+  const std::vector<int32_t>& columns = m.ColumnsOfNode[node];
+  const std::size_t n = columns.size();
+  if (n == 0)
+  {
+    return true;
+  }
+  std::vector<int32_t> ends;   // the two neighbours of the node in each column
+  ends.reserve(2 * n);
+  for (int32_t column : columns)
+  {
+    const auto& q = m.Corners[column];
+    const int at = IndexOf(q, node);
+    ends.push_back(q[(at + 1) % 4]);
+    ends.push_back(q[(at + 3) % 4]);
+  }
+  int boundaryEdges = 0;
+  std::vector<int> component(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    component[i] = static_cast<int>(i);
+  }
+  for (std::size_t e = 0; e < ends.size(); ++e)
+  {
+    int count = 0;
+    for (std::size_t f = 0; f < ends.size(); ++f)
+    {
+      if (ends[f] == ends[e])
+      {
+        ++count;
+        if (f / 2 != e / 2)
+        {
+          // Columns sharing this edge belong to one fan.
+          const int a = component[e / 2], b = component[f / 2];
+          if (a != b)
+          {
+            for (int& c : component)
+            {
+              c = c == b ? a : c;
+            }
+          }
+        }
+      }
+    }
+    if (count > 2)
+    {
+      return false;
+    }
+    boundaryEdges += count == 1 ? 1 : 0;
+  }
+  if (boundaryEdges != 0 && boundaryEdges != 2)
+  {
+    return false;
+  }
+  return std::all_of(component.begin(), component.end(), [&](int c) { return c == component[0]; });
+}
+
+bool ColumnCollapse::InvertsCells(int32_t column) const
+{
+  // Every hexahedron of the column must keep non-negative corner Jacobians: faces that stay
+  // convex seen from above can still invert a cell whose vertical edges lean too far.
+  const ColumnMesh& m = this->Mesh;
+  const auto& q = m.Corners[column];
+  glm::dvec3 corners[8];
+  for (int i = 0; i < 4; ++i)
+  {
+    corners[i + 4] = m.Position(q[i], 0);
+  }
+  for (int32_t k = 0; k < m.LayerCount; ++k)
+  {
+    for (int i = 0; i < 4; ++i)
+    {
+      corners[i] = corners[i + 4];
+      corners[i + 4] = m.Position(q[i], k + 1);
+    }
+    bool degenerate = false;
+    if (HexScaledJacobian(corners, m.OrientationSign, degenerate) < 0 && !degenerate)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+bool ColumnCollapse::FoldsOver(int32_t column) const
+{
+  // Top and bottom faces seen from above: every corner must still turn the mesh's way.
+  const ColumnMesh& m = this->Mesh;
+  const auto& q = m.Corners[column];
+  const double sign = m.OrientationSign;
+  for (int32_t k = 0; k <= m.LayerCount; ++k)
+  {
+    glm::dvec3 p[4];
+    for (int i = 0; i < 4; ++i)
+    {
+      p[i] = m.Position(q[i], k);
+    }
+    for (int i = 0; i < 4; ++i)
+    {
+      const glm::dvec3& a = p[(i + 3) % 4];
+      const glm::dvec3& b = p[i];
+      const glm::dvec3& c = p[(i + 1) % 4];
+      const double turn = (b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x);
+      if (!(turn * sign > 0))
+      {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+bool ColumnCollapse::Apply(const Plan& plan, double& cost)
+{
+  ColumnMesh& m = this->Mesh;
+  const int32_t c = plan.column;
+  const int32_t interfaces = m.LayerCount + 1;
+  const auto corners = m.Corners[c];
+  this->SavedNodes.clear();
+  this->SavedCorners.clear();
+  for (int32_t node : corners)
+  {
+    NodeState state;
+    state.node = node;
+    state.alive = m.NodeAlive[node];
+    state.topology = m.Topology[node];
+    const std::size_t first = static_cast<std::size_t>(node) * interfaces;
+    state.positions.assign(m.Positions.begin() + first * 3, m.Positions.begin() + (first + interfaces) * 3);
+    state.quadrics.assign(m.Quadrics.begin() + first, m.Quadrics.begin() + first + interfaces);
+    state.columns = m.ColumnsOfNode[node];
+    this->SavedNodes.push_back(std::move(state));
+  }
+  this->RemovedColumn = c;
+
+  // The column goes; the merged nodes become the survivor.
+  const int32_t survivor = plan.placeAt >= 0 ? plan.placeAt : plan.merged[0];
+  m.ColumnAlive[c] = 0;
+  --m.AliveColumnCount;
+  for (int32_t node : corners)
+  {
+    auto& list = m.ColumnsOfNode[node];
+    list.erase(std::remove(list.begin(), list.end(), c), list.end());
+  }
+  for (int i = 0; i < plan.mergedCount; ++i)
+  {
+    const int32_t node = plan.merged[i];
+    if (node == survivor)
+    {
+      continue;
+    }
+    for (int32_t k = 0; k < interfaces; ++k)
+    {
+      m.NodeQuadric(survivor, k) += m.NodeQuadric(node, k);
+    }
+    for (int32_t column : m.ColumnsOfNode[node])
+    {
+      this->SavedCorners.push_back({ column, m.Corners[column] });
+      std::replace(m.Corners[column].begin(), m.Corners[column].end(), node, survivor);
+      auto& list = m.ColumnsOfNode[survivor];
+      if (std::find(list.begin(), list.end(), column) == list.end())
+      {
+        list.push_back(column);
+      }
+    }
+    m.ColumnsOfNode[node].clear();
+    m.NodeAlive[node] = 0;
+  }
+
+  // Topology first: no column may repeat a node, and nodes must stay manifold.
+  bool valid = true;
+  for (int32_t column : m.ColumnsOfNode[survivor])
+  {
+    auto q = m.Corners[column];
+    std::sort(q.begin(), q.end());
+    valid = valid && std::adjacent_find(q.begin(), q.end()) == q.end();
+  }
+  valid = valid && this->Manifold(survivor);
+  for (int i = 0; i < plan.keptCount && valid; ++i)
+  {
+    valid = this->Manifold(plan.kept[i]);
+  }
+  if (!valid)
+  {
+    ++this->Stats.rejectedTopology;
+    return false;
+  }
+
+  // Geometry: place or smooth, then reject fold-overs.
+  if (plan.placeAt < 0 && !plan.gentle)
+  {
+    this->Smooth(survivor);
+  }
+  else if (plan.placeAt < 0)
+  {
+    // Midpoint of the merged nodes (as they were), z at the quadric minimum.
+    const double weight = 1.0 / plan.mergedCount;
+    std::array<double, 2> topology = { 0, 0 };
+    double above = -std::numeric_limits<double>::infinity();
+    for (int32_t k = 0; k < interfaces; ++k)
+    {
+      glm::dvec3 average(0.0);
+      double low = std::numeric_limits<double>::infinity(), high = -low;
+      for (const NodeState& state : this->SavedNodes)
+      {
+        if (std::find(plan.merged, plan.merged + plan.mergedCount, state.node) != plan.merged + plan.mergedCount)
+        {
+          const glm::dvec3 p(state.positions[k * 3], state.positions[k * 3 + 1], state.positions[k * 3 + 2]);
+          average += p * weight;
+          low = std::min(low, p.z);
+          high = std::max(high, p.z);
+          if (k == 0)
+          {
+            topology[0] += state.topology[0] * weight;
+            topology[1] += state.topology[1] * weight;
+          }
+        }
+      }
+      average.z = this->PlaceDepth(survivor, k, average, low, high, above);
+      above = average.z;
+      m.SetPosition(survivor, k, average);
+    }
+    m.Topology[survivor] = topology;
+  }
+  this->Scratch.assign(1, survivor);
+  for (int i = 0; i < plan.keptCount; ++i)
+  {
+    if (!plan.gentle && !m.IsBoundaryNode(plan.kept[i]))
+    {
+      this->Smooth(plan.kept[i]);
+      this->Scratch.push_back(plan.kept[i]);
+    }
+  }
+  cost = 0;
+  for (int32_t node : this->Scratch)
+  {
+    for (int32_t column : m.ColumnsOfNode[node])
+    {
+      if (this->FoldsOver(column) || this->InvertsCells(column))
+      {
+        ++this->Stats.rejectedFoldOver;
+        return false;
+      }
+    }
+    for (int32_t k = 0; k < interfaces; ++k)
+    {
+      cost = std::max(cost, m.NodeQuadric(node, k).Error(m.Position(node, k)));
+    }
+  }
+  return true;
+}
+
+void ColumnCollapse::Undo()
+{
+  ColumnMesh& m = this->Mesh;
+  const int32_t interfaces = m.LayerCount + 1;
+  for (auto it = this->SavedCorners.rbegin(); it != this->SavedCorners.rend(); ++it)
+  {
+    m.Corners[it->first] = it->second;
+  }
+  for (NodeState& state : this->SavedNodes)
+  {
+    const std::size_t first = static_cast<std::size_t>(state.node) * interfaces;
+    m.NodeAlive[state.node] = state.alive;
+    m.Topology[state.node] = state.topology;
+    std::copy(state.positions.begin(), state.positions.end(), m.Positions.begin() + first * 3);
+    std::copy(state.quadrics.begin(), state.quadrics.end(), m.Quadrics.begin() + first);
+    m.ColumnsOfNode[state.node] = std::move(state.columns);
+  }
+  m.ColumnAlive[this->RemovedColumn] = 1;
+  ++m.AliveColumnCount;
+  this->SavedNodes.clear();
+  this->SavedCorners.clear();
+  this->RemovedColumn = -1;
+}
+
+void ColumnCollapse::Commit()
+{
+  const int32_t c = this->RemovedColumn;
+  if (c >= 0 && this->AliveIndex[c] >= 0)
+  {
+    const int32_t at = this->AliveIndex[c];
+    const int32_t last = this->AliveList.back();
+    this->AliveList[at] = last;
+    this->AliveIndex[last] = at;
+    this->AliveList.pop_back();
+    this->AliveIndex[c] = -1;
+  }
+  this->SavedNodes.clear();
+  this->SavedCorners.clear();
+  this->RemovedColumn = -1;
+}
+
+void ColumnCollapse::TryOption(const Plan& option, Plan& best, bool& found)
+{
+  double cost = 0;
+  const int64_t folds = this->Stats.rejectedFoldOver;
+  bool valid = this->Apply(option, cost);
+  this->Undo();
+  Plan chosen = option;
+  if (!valid && this->Stats.rejectedFoldOver > folds && !option.gentle)
+  {
+    // The paper's smoothing folded a face: try without it, the survivor at the merged
+    // nodes' midpoint, then at each of them.
+    chosen.gentle = true;
+    valid = this->Apply(chosen, cost);
+    this->Undo();
+    for (int i = 0; i < option.mergedCount && !valid && option.placeAt < 0; ++i)
+    {
+      chosen.placeAt = option.merged[i];
+      valid = this->Apply(chosen, cost);
+      this->Undo();
+    }
+  }
+  if (valid && (!found || cost < best.cost))
+  {
+    best = chosen;
+    best.cost = cost;
+    found = true;
+  }
+}
+
+bool ColumnCollapse::PlanColumn(int32_t column, Plan& best)
+{
+  const ColumnMesh& m = this->Mesh;
+  if (column < 0 || column >= m.ColumnSlots() || !m.IsColumnAlive(column) || m.IsLocked(column))
+  {
+    return false;
+  }
+  const auto q = m.Corners[column];
+  bool edge[4], onBoundary[4];
+  int edges = 0, boundaryNodes = 0;
+  for (int i = 0; i < 4; ++i)
+  {
+    edge[i] = m.IsBoundaryEdge(column, i); // between corners i and i+1
+    onBoundary[i] = m.IsBoundaryNode(q[i]);
+    edges += edge[i];
+    boundaryNodes += onBoundary[i];
+  }
+  bool found = false;
+  Plan option;
+  option.column = column;
+  auto diagonal = [&](int first, Operator op) {
+    // Merge corners first and first+2, keep the other two.
+    const int a = first, b = first + 2;
+    if (onBoundary[a] && onBoundary[b])
+    {
+      return; // would join two boundary stretches
+    }
+    option.op = op;
+    option.mergedCount = 2;
+    option.merged[0] = q[a];
+    option.merged[1] = q[b];
+    option.placeAt = onBoundary[a] ? q[a] : (onBoundary[b] ? q[b] : -1);
+    option.keptCount = 2;
+    option.kept[0] = q[(a + 1) % 4];
+    option.kept[1] = q[(a + 3) % 4];
+    this->TryOption(option, best, found);
+  };
+  auto threeIntoOne = [&](int keep, Operator op) {
+    // Corners keep+1..keep+3 become one, at whichever of their positions costs least.
+    option.op = op;
+    option.mergedCount = 3;
+    for (int i = 0; i < 3; ++i)
+    {
+      option.merged[i] = q[(keep + 1 + i) % 4];
+    }
+    option.keptCount = 1;
+    option.kept[0] = q[keep];
+    for (int i = 0; i < 3; ++i)
+    {
+      option.placeAt = option.merged[i];
+      this->TryOption(option, best, found);
+    }
+  };
+
+  if (edges == 0 && boundaryNodes == 0)
+  {
+    // Operator 1: one direction, by lateral valence (the diagonal holding the lowest valence;
+    // on a tie the smaller new valence; then at random).
+    int valence[4];
+    for (int i = 0; i < 4; ++i)
+    {
+      valence[i] = m.LateralValence(q[i]);
+    }
+    const int low0 = std::min(valence[0], valence[2]), low1 = std::min(valence[1], valence[3]);
+    int first;
+    if (low0 != low1)
+    {
+      first = low0 < low1 ? 0 : 1;
+    }
+    else
+    {
+      const int new0 = valence[0] + valence[2] - 2, new1 = valence[1] + valence[3] - 2;
+      first = new0 != new1 ? (new0 < new1 ? 0 : 1) : (this->RandomUnit() < 0.5 ? 0 : 1);
+    }
+    diagonal(first, Internal);
+  }
+  else if (edges <= 1)
+  {
+    // Operator 2: one or two nodes on the boundary; both directions, the cheaper wins.
+    diagonal(0, Boundary);
+    diagonal(1, Boundary);
+  }
+  else if (edges == 2)
+  {
+    // Operator 3: two consecutive boundary edges (a corner column).
+    for (int i = 0; i < 4; ++i)
+    {
+      if (edge[i] && edge[(i + 1) % 4])
+      {
+        const int keep = (i + 3) % 4; // the corner opposite the boundary corner i+1
+        if (!onBoundary[keep])
+        {
+          threeIntoOne(keep, Corner);
+        }
+      }
+    }
+  }
+  else if (edges == 3)
+  {
+    // Operator 4: one internal edge; either of its nodes stays.
+    for (int i = 0; i < 4; ++i)
+    {
+      if (!edge[i])
+      {
+        threeIntoOne(i, FourBoundary);
+        threeIntoOne((i + 1) % 4, FourBoundary);
+      }
+    }
+  }
+  return found;
+}
+
+void ColumnCollapse::Perform(const Plan& plan)
+{
+  double cost = 0;
+  if (!this->Apply(plan, cost))
+  {
+    this->Undo();
+    return;
+  }
+  this->Commit();
+  ++this->Stats.collapses;
+  ++this->Stats.operatorCounts[plan.op];
+  this->Stats.maxError = std::max(this->Stats.maxError, cost);
+  const int32_t survivor = plan.placeAt >= 0 ? plan.placeAt : plan.merged[0];
+  std::vector<int32_t> worklist = { survivor };
+  for (int i = 0; i < plan.keptCount; ++i)
+  {
+    worklist.push_back(plan.kept[i]);
+  }
+  std::vector<int32_t> neighbours;
+  std::vector<uint8_t> boundary;
+  for (std::size_t i = 0, n = worklist.size(); i < n; ++i)
+  {
+    this->Mesh.Neighbours(worklist[i], neighbours, boundary);
+    worklist.insert(worklist.end(), neighbours.begin(), neighbours.end());
+  }
+  this->RemoveDoublets(std::move(worklist));
+}
+
+void ColumnCollapse::RemoveDoublets(std::vector<int32_t> worklist)
+{
+  // A non-boundary node of lateral valence 2 sits between two columns sharing two
+  // consecutive edges (Fig. 7): it moves onto the opposite corner of one of them, which
+  // may form new doublets around it.
+  ColumnMesh& m = this->Mesh;
+  std::vector<int32_t> neighbours;
+  std::vector<uint8_t> boundary;
+  while (!worklist.empty())
+  {
+    const int32_t node = worklist.back();
+    worklist.pop_back();
+    if (!m.IsNodeAlive(node) || m.ColumnsOfNode[node].size() != 2 || m.LateralValence(node) != 2 ||
+      m.IsBoundaryNode(node))
+    {
+      continue;
+    }
+    Plan best;
+    bool found = false;
+    for (int32_t column : m.ColumnsOfNode[node])
+    {
+      if (m.IsLocked(column))
+      {
+        continue;
+      }
+      const auto& q = m.Corners[column];
+      Plan option;
+      option.column = column;
+      option.op = Doublet;
+      option.mergedCount = 2;
+      option.merged[0] = node;
+      option.merged[1] = q[(IndexOf(q, node) + 2) % 4];
+      option.placeAt = option.merged[1];
+      option.keptCount = 0;
+      this->TryOption(option, best, found);
+    }
+    if (!found)
+    {
+      continue;
+    }
+    const auto q = m.Corners[best.column];
+    double cost = 0;
+    if (!this->Apply(best, cost))
+    {
+      this->Undo();
+      continue;
+    }
+    this->Commit();
+    ++this->Stats.doublets;
+    ++this->Stats.operatorCounts[Doublet];
+    this->Stats.maxError = std::max(this->Stats.maxError, cost);
+    for (int32_t corner : q)
+    {
+      if (m.IsNodeAlive(corner))
+      {
+        worklist.push_back(corner);
+        m.Neighbours(corner, neighbours, boundary);
+        worklist.insert(worklist.end(), neighbours.begin(), neighbours.end());
+      }
+    }
+  }
+}
+
+SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::function<void(double)>& progress)
+{
+  ColumnMesh& m = this->Mesh;
+  this->Stats.columnsBefore = m.AliveColumns();
+  const int64_t toRemove = std::max<int64_t>(1, m.AliveColumns() - targetColumns);
+  int64_t failures = 0;
+  int64_t sinceProgress = 0;
+  while (m.AliveColumns() > targetColumns && !this->AliveList.empty())
+  {
+    Plan best;
+    bool found = false;
+    for (int candidate = 0; candidate < 8; ++candidate)
+    {
+      const auto pick = static_cast<std::size_t>(this->RandomUnit() * static_cast<double>(this->AliveList.size()));
+      Plan plan;
+      if (this->PlanColumn(this->AliveList[std::min(pick, this->AliveList.size() - 1)], plan) &&
+        (!found || plan.cost < best.cost))
+      {
+        best = plan;
+        found = true;
+      }
+    }
+    if (!found)
+    {
+      // Nothing valid among these candidates; give up once every column has had many chances.
+      if (++failures > 64 + 4 * static_cast<int64_t>(this->AliveList.size()))
+      {
+        break;
+      }
+      continue;
+    }
+    failures = 0;
+    this->Perform(best);
+    if (progress && ++sinceProgress >= 256)
+    {
+      sinceProgress = 0;
+      progress(std::min(1.0, static_cast<double>(this->Stats.columnsBefore - m.AliveColumns()) / static_cast<double>(toRemove)));
+    }
+  }
+  this->Stats.columnsAfter = m.AliveColumns();
+  this->Stats.reachedTarget = m.AliveColumns() <= targetColumns;
+  if (progress)
+  {
+    progress(1.0);
+  }
+  return this->Stats;
+}
+
+} // namespace resmr

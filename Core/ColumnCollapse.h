@@ -1,0 +1,119 @@
+// Column-collapse simplification of a reservoir hexahedral mesh (paper Sec. 4.1): the five
+// operators (internal, boundary, corner, four-boundary-vertex, doublet), local Laplacian
+// smoothing per layer with z at the quadric minimum, fold-over rejection, and Wu-Kobbelt
+// multiple-choice selection (8 random candidates, the cheapest performed).
+//
+// Contract:
+// - Works in place on a ColumnMesh; every collapse removes one column of nk hexahedra and
+//   keeps every other column a hexahedral column (layers are never merged).
+// - A collapse is rejected if it would fold a top or bottom face over (seen from above, any
+//   corner triangle turning against the mesh orientation), leave a column with a repeated
+//   node, or make a node non-manifold (an edge of three columns, or a pinched fan).
+// - Quadrics of merged vertices add; a collapse costs the largest error of the vertices it
+//   creates or moves. Locked columns are never removed.
+// - Deterministic for a seed.
+#pragma once
+
+#include "ColumnMesh.h"
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace resmr
+{
+
+struct SimplifyReport
+{
+  int64_t columnsBefore = 0, columnsAfter = 0;
+  int64_t collapses = 0;           ///< operators 1-4 performed
+  int64_t doublets = 0;            ///< doublet collapses performed
+  int64_t operatorCounts[5] = {};  ///< by operator: 0 internal, 1 boundary, 2 corner, 3 four-boundary, 4 doublet
+  int64_t rejectedFoldOver = 0;    ///< candidate options rejected by the fold-over test
+  int64_t rejectedTopology = 0;    ///< candidate options rejected as non-manifold or degenerate
+  double maxError = 0;             ///< largest cost of a performed collapse
+  bool reachedTarget = false;      ///< false: no valid collapse was left
+};
+
+class ColumnCollapse
+{
+public:
+  /// Operators, as the paper numbers them (Figs. 5, 6, 7).
+  enum Operator
+  {
+    Internal = 0,
+    Boundary = 1,
+    Corner = 2,
+    FourBoundary = 3,
+    Doublet = 4
+  };
+
+  /// One way of collapsing a column: `merged` nodes become one, placed at node `placeAt`
+  /// (one of them) or, if -1, smoothed; `kept` nodes stay and are smoothed if not on the
+  /// boundary.
+  struct Plan
+  {
+    int32_t column = -1;
+    Operator op = Internal;
+    int32_t merged[3] = { -1, -1, -1 };
+    int mergedCount = 0;
+    int32_t placeAt = -1;
+    int32_t kept[2] = { -1, -1 };
+    int keptCount = 0;
+    /// The fallback when the paper's smoothing folds a face: no smoothing of kept nodes, and
+    /// a smoothed survivor placed at the merged nodes' midpoint instead.
+    bool gentle = false;
+    double cost = 0;
+  };
+
+  ColumnCollapse(ColumnMesh& mesh, uint64_t seed);
+
+  /// Collapses until at most `targetColumns` columns are left or no collapse is valid.
+  /// `progress` (optional) gets the fraction done.
+  SimplifyReport Simplify(int64_t targetColumns, const std::function<void(double)>& progress = {});
+
+  /// The cheapest valid plan for one column by the operator its topology calls for; false if
+  /// none is valid (or the column is locked or dead).
+  bool PlanColumn(int32_t column, Plan& best);
+  /// Performs a plan found by PlanColumn, then removes the doublets it forms.
+  void Perform(const Plan& plan);
+
+  const SimplifyReport& Report() const { return this->Stats; }
+
+private:
+  bool Apply(const Plan& plan, double& cost);
+  void Undo();
+  void Commit();
+  void RemoveDoublets(std::vector<int32_t> worklist);
+  void Smooth(int32_t node);
+  double PlaceDepth(int32_t node, int32_t k, const glm::dvec3& xy, double low, double high, double above) const;
+  bool Manifold(int32_t node) const;
+  bool FoldsOver(int32_t column) const;
+  bool InvertsCells(int32_t column) const;
+  void TryOption(const Plan& option, Plan& best, bool& found);
+  double RandomUnit();
+
+  ColumnMesh& Mesh;
+  uint64_t RandomState;
+  SimplifyReport Stats;
+  std::vector<int32_t> AliveList;     ///< unlocked alive columns, for random picks
+  std::vector<int32_t> AliveIndex;    ///< position of a column in AliveList, -1 if absent
+
+  // Undo log of the last Apply.
+  struct NodeState
+  {
+    int32_t node;
+    uint8_t alive;
+    std::array<double, 2> topology;
+    std::vector<double> positions;
+    std::vector<Quadric> quadrics;
+    std::vector<int32_t> columns;
+  };
+  std::vector<NodeState> SavedNodes;
+  std::vector<std::pair<int32_t, std::array<int32_t, 4>>> SavedCorners;
+  int32_t RemovedColumn = -1;
+  std::vector<int32_t> Scratch;
+  std::vector<uint8_t> ScratchFlags;
+};
+
+} // namespace resmr

@@ -1,0 +1,419 @@
+// Column-structured hexahedral mesh of a reservoir region (paper Sec. 4.1, Figs. 3 and 4).
+#include "ColumnMesh.h"
+
+#include "CornerPointGeometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace resmr
+{
+namespace
+{
+/// Corner q of our columns ((i,j), (i+1,j), (i+1,j+1), (i,j+1)) as an ECLIPSE corner index.
+constexpr int EclipseCorner[4] = { 0, 1, 3, 2 };
+
+int Find(std::array<int, 4>& parent, int x)
+{
+  while (parent[x] != x)
+  {
+    x = parent[x] = parent[parent[x]];
+  }
+  return x;
+}
+} // namespace
+
+ColumnMesh ColumnMesh::FromCornerPoints(const CornerPointGeometry& geometry, const std::vector<bool>& active)
+{
+  return FromCornerPoints(geometry, active, 0, geometry.Dims()[0], 0, geometry.Dims()[1]);
+}
+
+ColumnMesh ColumnMesh::FromCornerPoints(const CornerPointGeometry& geometry, const std::vector<bool>& active,
+  int64_t i0, int64_t i1, int64_t j0, int64_t j1)
+{
+  const int64_t nx = geometry.Dims()[0], ny = geometry.Dims()[1], nz = geometry.Dims()[2];
+  if (i0 < 0 || j0 < 0 || i1 > nx || j1 > ny || i0 >= i1 || j0 >= j1 || nz < 1)
+  {
+    throw std::invalid_argument("column mesh: empty or out-of-grid box [" + std::to_string(i0) + ", " +
+      std::to_string(i1) + ") x [" + std::to_string(j0) + ", " + std::to_string(j1) + ") of a " +
+      std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) + " grid");
+  }
+  if (static_cast<int64_t>(active.size()) != nx * ny * nz)
+  {
+    throw std::invalid_argument("column mesh: " + std::to_string(active.size()) + " active flags for " +
+      std::to_string(nx * ny * nz) + " cells");
+  }
+  const int64_t width = i1 - i0, height = j1 - j0;
+  ColumnMesh mesh;
+  mesh.LayerCount = static_cast<int32_t>(nz);
+  const int64_t interfaces = nz + 1;
+
+  // Columns with at least one active cell (Fig. 3).
+  std::vector<int32_t> columnOf(static_cast<std::size_t>(width * height), -1);
+  for (int64_t j = j0; j < j1; ++j)
+  {
+    for (int64_t i = i0; i < i1; ++i)
+    {
+      bool any = false;
+      for (int64_t k = 0; k < nz && !any; ++k)
+      {
+        any = active[static_cast<std::size_t>((k * ny + j) * nx + i)];
+      }
+      if (any)
+      {
+        columnOf[(j - j0) * width + (i - i0)] = static_cast<int32_t>(mesh.Corners.size());
+        mesh.Corners.push_back({ -1, -1, -1, -1 });
+        mesh.Origin.push_back({ static_cast<int32_t>(i), static_cast<int32_t>(j) });
+        for (int64_t k = 0; k < nz; ++k)
+        {
+          mesh.ActiveCells.push_back(active[static_cast<std::size_t>((k * ny + j) * nx + i)] ? 1 : 0);
+        }
+      }
+    }
+  }
+  if (mesh.Corners.empty())
+  {
+    throw std::invalid_argument("column mesh: no active cell in the box");
+  }
+
+  // Corner stacks of two rows of columns at a time: [row][i][corner][interface][xyz].
+  const std::size_t stackSize = static_cast<std::size_t>(4 * interfaces * 3);
+  std::vector<double> rows[2];
+  rows[0].assign(static_cast<std::size_t>(width) * stackSize, 0.0);
+  rows[1].assign(static_cast<std::size_t>(width) * stackSize, 0.0);
+  auto fillRow = [&](std::vector<double>& row, int64_t j) {
+    double corners[8][3];
+    for (int64_t i = i0; i < i1; ++i)
+    {
+      if (columnOf[(j - j0) * width + (i - i0)] < 0)
+      {
+        continue;
+      }
+      double* stack = &row[static_cast<std::size_t>(i - i0) * stackSize];
+      for (int64_t k = 0; k < nz; ++k)
+      {
+        geometry.CellCorners(i, j, k, corners);
+        for (int q = 0; q < 4; ++q)
+        {
+          for (int d = 0; d < 3; ++d)
+          {
+            if (!std::isfinite(corners[EclipseCorner[q]][d]) || !std::isfinite(corners[EclipseCorner[q] + 4][d]))
+            {
+              throw std::invalid_argument("column mesh: cell (" + std::to_string(i + 1) + ", " +
+                std::to_string(j + 1) + ", " + std::to_string(k + 1) + ") has a non-finite corner");
+            }
+            stack[(q * interfaces + k) * 3 + d] = corners[EclipseCorner[q]][d];
+            if (k == nz - 1)
+            {
+              stack[(q * interfaces + nz) * 3 + d] = corners[EclipseCorner[q] + 4][d];
+            }
+          }
+        }
+      }
+    }
+  };
+  auto stackOf = [&](int64_t i, int64_t j, int q) -> const double* {
+    const std::vector<double>& row = rows[(j - j0) & 1];
+    return &row[static_cast<std::size_t>(i - i0) * stackSize + static_cast<std::size_t>(q * interfaces * 3)];
+  };
+  auto sameStack = [&](const double* a, const double* b) {
+    return std::equal(a, a + interfaces * 3, b);
+  };
+
+  // Nodes, pillar by pillar: the (up to) four columns around a pillar share a node where
+  // edge-adjacent columns agree at every interface.
+  for (int64_t pj = j0; pj <= j1; ++pj)
+  {
+    if (pj < j1)
+    {
+      fillRow(rows[(pj - j0) & 1], pj);
+    }
+    for (int64_t pi = i0; pi <= i1; ++pi)
+    {
+      // Around the pillar: 0 (pi-1, pj-1), 1 (pi, pj-1), 2 (pi-1, pj), 3 (pi, pj); the corner
+      // each touches the pillar with.
+      const int64_t ci[4] = { pi - 1, pi, pi - 1, pi };
+      const int64_t cj[4] = { pj - 1, pj - 1, pj, pj };
+      const int cq[4] = { 2, 3, 1, 0 };
+      int32_t column[4];
+      for (int a = 0; a < 4; ++a)
+      {
+        const bool inside = ci[a] >= i0 && ci[a] < i1 && cj[a] >= j0 && cj[a] < j1;
+        column[a] = inside ? columnOf[(cj[a] - j0) * width + (ci[a] - i0)] : -1;
+      }
+      std::array<int, 4> parent = { 0, 1, 2, 3 };
+      const int pairs[4][2] = { { 0, 1 }, { 2, 3 }, { 0, 2 }, { 1, 3 } };
+      for (const auto& pair : pairs)
+      {
+        const int a = pair[0], b = pair[1];
+        if (column[a] >= 0 && column[b] >= 0 &&
+          sameStack(stackOf(ci[a], cj[a], cq[a]), stackOf(ci[b], cj[b], cq[b])))
+        {
+          parent[Find(parent, a)] = Find(parent, b);
+        }
+      }
+      int32_t nodeOfRoot[4] = { -1, -1, -1, -1 };
+      for (int a = 0; a < 4; ++a)
+      {
+        if (column[a] < 0)
+        {
+          continue;
+        }
+        const int root = Find(parent, a);
+        if (nodeOfRoot[root] < 0)
+        {
+          nodeOfRoot[root] = static_cast<int32_t>(mesh.Topology.size());
+          mesh.Topology.push_back({ static_cast<double>(pi), static_cast<double>(pj) });
+          const double* stack = stackOf(ci[a], cj[a], cq[a]);
+          mesh.Positions.insert(mesh.Positions.end(), stack, stack + interfaces * 3);
+        }
+        mesh.Corners[column[a]][cq[a]] = nodeOfRoot[root];
+      }
+    }
+  }
+  mesh.BuildAdjacencyAndQuadrics();
+  return mesh;
+}
+
+ColumnMesh ColumnMesh::FromParts(int32_t layers, std::vector<double> positions,
+  std::vector<std::array<double, 2>> topology, std::vector<std::array<int32_t, 4>> corners,
+  std::vector<uint8_t> activeCells)
+{
+  if (layers < 1 || positions.size() != topology.size() * static_cast<std::size_t>(layers + 1) * 3 ||
+    activeCells.size() != corners.size() * static_cast<std::size_t>(layers))
+  {
+    throw std::invalid_argument("column mesh: inconsistent parts");
+  }
+  ColumnMesh mesh;
+  mesh.LayerCount = layers;
+  mesh.Positions = std::move(positions);
+  mesh.Topology = std::move(topology);
+  mesh.Corners = std::move(corners);
+  mesh.ActiveCells = std::move(activeCells);
+  mesh.Origin.assign(mesh.Corners.size(), { -1, -1 });
+  for (const auto& quad : mesh.Corners)
+  {
+    for (int32_t node : quad)
+    {
+      if (node < 0 || node >= static_cast<int32_t>(mesh.Topology.size()))
+      {
+        throw std::invalid_argument("column mesh: corner refers to a missing node");
+      }
+    }
+  }
+  mesh.BuildAdjacencyAndQuadrics();
+  return mesh;
+}
+
+void ColumnMesh::BuildAdjacencyAndQuadrics()
+{
+  const std::size_t nodes = this->Topology.size();
+  const int32_t interfaces = this->LayerCount + 1;
+  this->NodeAlive.assign(nodes, 1);
+  this->ColumnAlive.assign(this->Corners.size(), 1);
+  this->Locked.assign(this->Corners.size(), 0);
+  this->AliveColumnCount = static_cast<int64_t>(this->Corners.size());
+  this->ColumnsOfNode.assign(nodes, {});
+  for (std::size_t c = 0; c < this->Corners.size(); ++c)
+  {
+    for (int32_t node : this->Corners[c])
+    {
+      this->ColumnsOfNode[node].push_back(static_cast<int32_t>(c));
+    }
+  }
+  this->Quadrics.assign(nodes * static_cast<std::size_t>(interfaces), Quadric());
+  glm::dvec3 normal;
+  double d;
+  for (int32_t c = 0; c < static_cast<int32_t>(this->Corners.size()); ++c)
+  {
+    const auto& q = this->Corners[c];
+    for (int32_t k = 0; k < this->LayerCount; ++k)
+    {
+      if (!this->IsCellActive(c, k))
+      {
+        continue;
+      }
+      // Type 1: top and bottom faces.
+      for (int32_t level : { k, k + 1 })
+      {
+        if (Quadric::PlaneOfQuad(this->Position(q[0], level), this->Position(q[1], level),
+              this->Position(q[2], level), this->Position(q[3], level), normal, d))
+        {
+          const Quadric plane = Quadric::FromPlane(normal, d, 1.0);
+          for (int32_t node : q)
+          {
+            this->NodeQuadric(node, level) += plane;
+          }
+        }
+      }
+      // Types 2, 3, 4: external side faces, heavily weighted.
+      for (int e = 0; e < 4; ++e)
+      {
+        const int32_t a = q[e], b = q[(e + 1) % 4];
+        int32_t across = -1;
+        for (int32_t other : this->ColumnsOfNode[a])
+        {
+          if (other == c)
+          {
+            continue;
+          }
+          const auto& o = this->Corners[other];
+          for (int f = 0; f < 4; ++f)
+          {
+            if (o[f] == b && o[(f + 1) % 4] == a)
+            {
+              across = other;
+            }
+          }
+        }
+        if (across >= 0 && this->IsCellActive(across, k))
+        {
+          continue; // internal face
+        }
+        if (Quadric::PlaneOfQuad(this->Position(a, k), this->Position(b, k), this->Position(b, k + 1),
+              this->Position(a, k + 1), normal, d))
+        {
+          const Quadric plane = Quadric::FromPlane(normal, d, SideWeight);
+          this->NodeQuadric(a, k) += plane;
+          this->NodeQuadric(b, k) += plane;
+          this->NodeQuadric(a, k + 1) += plane;
+          this->NodeQuadric(b, k + 1) += plane;
+        }
+      }
+    }
+  }
+  (void)interfaces;
+  this->ComputeOrientation();
+}
+
+void ColumnMesh::ComputeOrientation()
+{
+  double area = 0;
+  for (std::size_t c = 0; c < this->Corners.size(); ++c)
+  {
+    const auto& q = this->Corners[c];
+    for (int e = 0; e < 4; ++e)
+    {
+      const glm::dvec3 a = this->Position(q[e], 0), b = this->Position(q[(e + 1) % 4], 0);
+      area += a.x * b.y - b.x * a.y;
+    }
+  }
+  this->OrientationSign = area >= 0 ? 1 : -1;
+}
+
+void ColumnMesh::Neighbours(int32_t node, std::vector<int32_t>& nodes, std::vector<uint8_t>& boundary) const
+{
+  nodes.clear();
+  boundary.clear();
+  for (int32_t column : this->ColumnsOfNode[node])
+  {
+    const auto& q = this->Corners[column];
+    const int at = static_cast<int>(std::find(q.begin(), q.end(), node) - q.begin());
+    for (int32_t other : { q[(at + 1) % 4], q[(at + 3) % 4] })
+    {
+      const auto found = std::find(nodes.begin(), nodes.end(), other);
+      if (found == nodes.end())
+      {
+        nodes.push_back(other);
+        boundary.push_back(1);
+      }
+      else
+      {
+        boundary[found - nodes.begin()] = 0; // a second column on this edge
+      }
+    }
+  }
+}
+
+int ColumnMesh::LateralValence(int32_t node) const
+{
+  std::vector<int32_t> nodes;
+  std::vector<uint8_t> boundary;
+  this->Neighbours(node, nodes, boundary);
+  return static_cast<int>(nodes.size());
+}
+
+bool ColumnMesh::IsBoundaryNode(int32_t node) const
+{
+  std::vector<int32_t> nodes;
+  std::vector<uint8_t> boundary;
+  this->Neighbours(node, nodes, boundary);
+  return std::find(boundary.begin(), boundary.end(), 1) != boundary.end();
+}
+
+bool ColumnMesh::IsBoundaryEdge(int32_t column, int corner) const
+{
+  const auto& q = this->Corners[column];
+  const int32_t a = q[corner], b = q[(corner + 1) % 4];
+  for (int32_t other : this->ColumnsOfNode[a])
+  {
+    if (other == column)
+    {
+      continue;
+    }
+    const auto& o = this->Corners[other];
+    for (int f = 0; f < 4; ++f)
+    {
+      if (o[f] == b && o[(f + 1) % 4] == a)
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+} // namespace resmr
+
+namespace resmr
+{
+
+HexMesh ToHexMesh(const ColumnMesh& mesh)
+{
+  HexMesh out;
+  const int32_t layers = mesh.Layers();
+  const int32_t interfaces = layers + 1;
+  out.layers = layers;
+  std::vector<int64_t> firstPoint(static_cast<std::size_t>(mesh.NodeCount()), -1);
+  int64_t points = 0;
+  for (int32_t node = 0; node < mesh.NodeCount(); ++node)
+  {
+    if (mesh.IsNodeAlive(node) && !mesh.NodeColumns(node).empty())
+    {
+      firstPoint[node] = points;
+      points += interfaces;
+      for (int32_t k = 0; k < interfaces; ++k)
+      {
+        const glm::dvec3 p = mesh.Position(node, k);
+        out.points.insert(out.points.end(), { p.x, p.y, p.z });
+        const auto& t = mesh.TopologicalCoordinate(node);
+        out.topology.insert(out.topology.end(), { t[0], t[1], static_cast<double>(k) });
+      }
+    }
+  }
+  for (int32_t c = 0; c < mesh.ColumnSlots(); ++c)
+  {
+    if (!mesh.IsColumnAlive(c))
+    {
+      continue;
+    }
+    const auto& q = mesh.ColumnCorners(c);
+    for (int32_t k = 0; k < layers; ++k)
+    {
+      std::array<int64_t, 8> cell;
+      for (int i = 0; i < 4; ++i)
+      {
+        cell[i] = firstPoint[q[i]] + k;
+        cell[i + 4] = firstPoint[q[i]] + k + 1;
+      }
+      out.cells.push_back(cell);
+      out.active.push_back(mesh.IsCellActive(c, k) ? 1 : 0);
+    }
+  }
+  return out;
+}
+
+} // namespace resmr
