@@ -181,7 +181,7 @@ bool ColumnCollapse::InvertsCells(int32_t column) const
       corners[i + 4] = m.Position(q[i], k + 1);
     }
     bool degenerate = false;
-    if (HexScaledJacobian(corners, m.OrientationSign, degenerate) < 0 && !degenerate)
+    if (HexScaledJacobian(corners, m.OrientationSign, degenerate) < -1e-9 && !degenerate)
     {
       return true;
     }
@@ -191,7 +191,7 @@ bool ColumnCollapse::InvertsCells(int32_t column) const
 
 bool ColumnCollapse::FoldsOver(int32_t column) const
 {
-  // Top and bottom faces seen from above: every corner must still turn the mesh's way.
+  // Top and bottom faces seen from above: no corner may turn against the mesh.
   const ColumnMesh& m = this->Mesh;
   const auto& q = m.Corners[column];
   const double sign = m.OrientationSign;
@@ -207,8 +207,11 @@ bool ColumnCollapse::FoldsOver(int32_t column) const
       const glm::dvec3& a = p[(i + 3) % 4];
       const glm::dvec3& b = p[i];
       const glm::dvec3& c = p[(i + 1) % 4];
+      // Straight corners are allowed (a boundary collapse along a straight outline makes
+      // them); a corner turning the wrong way is a fold.
       const double turn = (b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x);
-      if (!(turn * sign > 0))
+      const double scale = std::hypot(b.x - a.x, b.y - a.y) * std::hypot(c.x - b.x, c.y - b.y);
+      if (!(turn * sign >= -1e-9 * scale))
       {
         return true;
       }
@@ -585,7 +588,8 @@ void ColumnCollapse::RemoveDoublets(std::vector<int32_t> worklist)
     }
     Plan best;
     bool found = false;
-    for (int32_t column : m.ColumnsOfNode[node])
+    const std::vector<int32_t> columns = m.ColumnsOfNode[node]; // TryOption rewrites the list
+    for (int32_t column : columns)
     {
       if (m.IsLocked(column))
       {

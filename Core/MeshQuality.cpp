@@ -198,6 +198,8 @@ public:
     }
   }
 
+  const std::vector<Triangle>& All() const { return this->Triangles; }
+
   /// Distance from p to the nearest triangle.
   double Distance(const glm::dvec3& p) const
   {
@@ -255,18 +257,20 @@ private:
   std::vector<int64_t> Items;
 };
 
-double LargestDistance(const std::vector<std::array<glm::dvec3, 4>>& quads, const TriangleGrid& target, int perFace,
+double LargestDistance(const std::vector<Triangle>& triangles, const TriangleGrid& target, int perTriangle,
   int64_t& samples)
 {
-  static const double params[8][2] = { { 0.25, 0.25 }, { 0.75, 0.25 }, { 0.75, 0.75 }, { 0.25, 0.75 }, { 0, 0 },
-    { 1, 0 }, { 1, 1 }, { 0, 1 } };
+  // Samples on the triangles themselves (so a surface is at distance 0 from itself): the
+  // centroid, then points towards each corner.
+  static const double weights[6][3] = { { 4.0 / 6, 1.0 / 6, 1.0 / 6 }, { 1.0 / 6, 4.0 / 6, 1.0 / 6 },
+    { 1.0 / 6, 1.0 / 6, 4.0 / 6 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
   double largest = 0;
-  for (const auto& q : quads)
+  for (const Triangle& t : triangles)
   {
-    for (int s = -1; s < perFace; ++s)
+    for (int s = -1; s < perTriangle; ++s)
     {
-      const double u = s < 0 ? 0.5 : params[s % 8][0], v = s < 0 ? 0.5 : params[s % 8][1];
-      const glm::dvec3 p = (1 - u) * (1 - v) * q[0] + u * (1 - v) * q[1] + u * v * q[2] + (1 - u) * v * q[3];
+      const glm::dvec3 p = s < 0 ? (t.a + t.b + t.c) / 3.0
+                                 : weights[s % 6][0] * t.a + weights[s % 6][1] * t.b + weights[s % 6][2] * t.c;
       largest = std::max(largest, target.Distance(p));
       ++samples;
     }
@@ -334,7 +338,7 @@ HexQuality MeasureHexahedra(const HexMesh& mesh, int orientation)
       ++quality.degenerate;
       continue;
     }
-    quality.inverted += worst < 0 ? 1 : 0;
+    quality.inverted += worst < -1e-9 ? 1 : 0; // straight corners (0) are not inverted
     quality.minScaledJacobian = std::min(quality.minScaledJacobian, worst);
     sum += worst;
     ++measured;
@@ -353,8 +357,8 @@ BoundaryDistance MeasureBoundaryDistance(const HexMesh& a, const HexMesh& b, int
   std::vector<std::array<glm::dvec3, 4>> quadsA, quadsB;
   const TriangleGrid gridA(BoundaryTriangles(a, quadsA));
   const TriangleGrid gridB(BoundaryTriangles(b, quadsB));
-  result.forward = LargestDistance(quadsA, gridB, perFace, result.samples);
-  result.backward = LargestDistance(quadsB, gridA, perFace, result.samples);
+  result.forward = LargestDistance(gridA.All(), gridB, perFace, result.samples);
+  result.backward = LargestDistance(gridB.All(), gridA, perFace, result.samples);
   result.hausdorff = std::max(result.forward, result.backward);
   glm::dvec3 low(std::numeric_limits<double>::max()), high(-std::numeric_limits<double>::max());
   for (const auto& q : quadsA)

@@ -43,8 +43,9 @@ struct BoundaryDistance
 };
 
 /// Two-sided Hausdorff distance between the external boundaries (faces of active cells not
-/// shared with another active cell: top, bottom, faults, active limits) of two meshes,
-/// sampled at face centres and `perFace` more points a face. Deterministic.
-BoundaryDistance MeasureBoundaryDistance(const HexMesh& a, const HexMesh& b, int perFace = 4);
+/// shared with another active cell: top, bottom, faults, active limits) of two meshes, each
+/// face split in two triangles, sampled at triangle centroids and `perTriangle` more points
+/// a triangle. Deterministic.
+BoundaryDistance MeasureBoundaryDistance(const HexMesh& a, const HexMesh& b, int perTriangle = 3);
 
 } // namespace resmr

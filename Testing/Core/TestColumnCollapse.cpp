@@ -1,0 +1,357 @@
+// Unit tests of the column-collapse simplification (paper Sec. 4.1): quadrics; each operator
+// on small hand-built meshes (resulting topology, quadrics, topological coordinates); faults
+// splitting nodes; invariants after random simplification of a real model (hexahedral
+// columns of nk cells, no inverted cell, no doublet, coordinates inside the original ranges);
+// determinism for a seed; bad input.
+#include "ColumnCollapse.h"
+#include "ColumnMesh.h"
+#include "CoreTesting.h"
+#include "CornerPointGeometry.h"
+#include "EclipseGrid.h"
+#include "MeshQuality.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace
+{
+std::string DataDirectory;
+
+/// An n x m grid of columns, `layers` flat layers of thickness 1 (depth k), unit cells in
+/// x and y; every cell active.
+resmr::ColumnMesh Grid(int n, int m, int layers)
+{
+  std::vector<double> positions;
+  std::vector<std::array<double, 2>> topology;
+  for (int j = 0; j <= m; ++j)
+  {
+    for (int i = 0; i <= n; ++i)
+    {
+      topology.push_back({ double(i), double(j) });
+      for (int k = 0; k <= layers; ++k)
+      {
+        positions.insert(positions.end(), { double(i), double(j), double(k) });
+      }
+    }
+  }
+  std::vector<std::array<int32_t, 4>> corners;
+  for (int j = 0; j < m; ++j)
+  {
+    for (int i = 0; i < n; ++i)
+    {
+      const int32_t p = j * (n + 1) + i;
+      corners.push_back({ p, p + 1, p + n + 2, p + n + 1 });
+    }
+  }
+  return resmr::ColumnMesh::FromParts(layers, positions, topology, corners,
+    std::vector<uint8_t>(corners.size() * layers, 1));
+}
+
+void TestQuadric()
+{
+  // The plane z = 5 (normal (0,0,1), d = -5) weighted 3: error 3 d^2; optimal z 5.
+  const resmr::Quadric q = resmr::Quadric::FromPlane({ 0, 0, 1 }, -5, 3);
+  CHECK(std::fabs(q.Error({ 1, 2, 7 }) - 12) < 1e-12);
+  CHECK(std::fabs(q.OptimalZ(4, -3, 0) - 5) < 1e-12);
+  resmr::Quadric sum = q;
+  sum += resmr::Quadric::FromPlane({ 0, 0, 1 }, -7, 1);
+  CHECK(std::fabs(sum.OptimalZ(0, 0, 0) - 5.5) < 1e-12); // weighted mean of 5 (x3) and 7
+  // No plane constrains z: the fallback.
+  CHECK(resmr::Quadric::FromPlane({ 1, 0, 0 }, 0, 1).OptimalZ(0, 0, 42) == 42);
+  glm::dvec3 normal;
+  double d;
+  CHECK(!resmr::Quadric::PlaneOfQuad({ 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 }, normal, d));
+}
+
+void TestQuadricsOfFaces()
+{
+  // One flat layer: a corner node of the 2x2 grid lies on the top plane (weight 1), the two
+  // grid-limit side planes (type 4, weight 10,000): its quadric is 0 at its own position and
+  // grows 10,000 x d^2 moving sideways, 1 x d^2 (per top face) moving up.
+  resmr::ColumnMesh mesh = Grid(2, 2, 1);
+  const resmr::Quadric& corner = mesh.NodeQuadric(0, 0);
+  CHECK(corner.Error({ 0, 0, 0 }) < 1e-9);
+  CHECK(std::fabs(corner.Error({ -1, 0, 0 }) - 10000) < 1e-6);
+  CHECK(std::fabs(corner.Error({ 0, 0, -1 }) - 1) < 1e-9);
+  // The centre node touches four top faces and no side face.
+  const resmr::Quadric& centre = mesh.NodeQuadric(4, 0);
+  CHECK(std::fabs(centre.Error({ 1, 1, -1 }) - 4) < 1e-9);
+  CHECK(centre.Error({ 5, 5, 0 }) < 1e-9);
+  // An inactive cell beside an active one makes their shared side face external (type 2):
+  // in a 2 x 1 row whose right cell is inactive, the middle nodes get the side plane x = 1.
+  resmr::ColumnMesh row = resmr::ColumnMesh::FromParts(1,
+    { 0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 0, 1, 2, 0, 0, 2, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 0, 1, 1, 1, 2, 1, 0, 2, 1, 1 },
+    { { 0, 0 }, { 1, 0 }, { 2, 0 }, { 0, 1 }, { 1, 1 }, { 2, 1 } }, { { 0, 1, 4, 3 }, { 1, 2, 5, 4 } }, { 1, 0 });
+  CHECK(std::fabs(row.NodeQuadric(1, 0).Error({ 1.5, 0, 0 }) - 0.25 * 10000) < 1e-6);
+  CHECK(row.NodeQuadric(2, 0).Error({ 5, 5, 5 }) == 0); // touches only the inactive cell
+  CHECK(mesh.IsBoundaryNode(0) && !mesh.IsBoundaryNode(4));
+  CHECK(mesh.LateralValence(4) == 4 && mesh.LateralValence(0) == 2 && mesh.LateralValence(1) == 3);
+}
+
+void TestInternalCollapse()
+{
+  // 3x3 columns, 2 layers: the centre column is internal. Its diagonal with the lowest
+  // valence (all 4 here, tie; new valences tie too) is merged; the two other corners stay
+  // and lose one edge each.
+  resmr::ColumnMesh mesh = Grid(3, 3, 2);
+  resmr::ColumnCollapse collapse(mesh, 7);
+  resmr::ColumnCollapse::Plan plan;
+  CHECK(collapse.PlanColumn(4, plan));
+  CHECK(plan.op == resmr::ColumnCollapse::Internal);
+  CHECK(plan.mergedCount == 2 && plan.keptCount == 2);
+  const int32_t a = plan.merged[0], b = plan.merged[1];
+  const resmr::Quadric qa = mesh.NodeQuadric(a, 1), qb = mesh.NodeQuadric(b, 1);
+  const int valenceKept = mesh.LateralValence(plan.kept[0]);
+  collapse.Perform(plan);
+  CHECK(mesh.AliveColumns() == 8);
+  CHECK(!mesh.IsColumnAlive(4));
+  const int32_t survivor = mesh.IsNodeAlive(a) ? a : b;
+  CHECK(mesh.IsNodeAlive(a) != mesh.IsNodeAlive(b));
+  CHECK(mesh.LateralValence(plan.kept[0]) == valenceKept - 1);
+  CHECK(mesh.LateralValence(survivor) == 4 + 4 - 2);
+  // Quadrics add.
+  resmr::Quadric sum = qa;
+  sum += qb;
+  for (int i = 0; i < 10; ++i)
+  {
+    CHECK(std::fabs(mesh.NodeQuadric(survivor, 1).q[i] - sum.q[i]) < 1e-9);
+  }
+  // Smoothed to the centre of its neighbours, on the flat layers, with the matching
+  // topological coordinate.
+  const glm::dvec3 p = mesh.Position(survivor, 1);
+  CHECK(std::fabs(p.x - 1.5) < 1e-9 && std::fabs(p.y - 1.5) < 1e-9 && std::fabs(p.z - 1) < 1e-9);
+  const auto& t = mesh.TopologicalCoordinate(survivor);
+  CHECK(std::fabs(t[0] - 1.5) < 1e-9 && std::fabs(t[1] - 1.5) < 1e-9);
+  CHECK(collapse.Report().operatorCounts[resmr::ColumnCollapse::Internal] == 1);
+}
+
+void TestBoundaryCornerAndFourBoundary()
+{
+  // Boundary collapse: the middle column of the bottom row has one boundary edge; the
+  // survivor sits on the boundary node, so the outline does not move.
+  {
+    resmr::ColumnMesh mesh = Grid(3, 3, 1);
+    resmr::ColumnCollapse collapse(mesh, 1);
+    resmr::ColumnCollapse::Plan plan;
+    CHECK(collapse.PlanColumn(1, plan));
+    CHECK(plan.op == resmr::ColumnCollapse::Boundary);
+    CHECK(plan.placeAt >= 0 && mesh.IsBoundaryNode(plan.placeAt));
+    const glm::dvec3 before = mesh.Position(plan.placeAt, 0);
+    collapse.Perform(plan);
+    CHECK(mesh.AliveColumns() == 8);
+    CHECK(glm::length(mesh.Position(plan.placeAt, 0) - before) == 0);
+    CHECK(mesh.IsBoundaryNode(plan.placeAt));
+  }
+  // Corner collapse: the three nodes on the two boundary edges become one, at the position
+  // of least error among them; the inner node stays.
+  {
+    resmr::ColumnMesh mesh = Grid(3, 3, 1);
+    resmr::ColumnCollapse collapse(mesh, 1);
+    resmr::ColumnCollapse::Plan plan;
+    CHECK(collapse.PlanColumn(0, plan));
+    CHECK(plan.op == resmr::ColumnCollapse::Corner);
+    CHECK(plan.mergedCount == 3 && plan.keptCount == 1 && plan.kept[0] == 5);
+    collapse.Perform(plan);
+    CHECK(mesh.AliveColumns() == 8);
+    int alive = 0;
+    for (int i = 0; i < 3; ++i)
+    {
+      alive += mesh.IsNodeAlive(plan.merged[i]);
+    }
+    CHECK(alive == 1);
+  }
+  // Four boundary nodes, one internal edge: the end column of a 3 x 1 row.
+  {
+    resmr::ColumnMesh mesh = Grid(3, 1, 2);
+    resmr::ColumnCollapse collapse(mesh, 1);
+    resmr::ColumnCollapse::Plan plan;
+    CHECK(collapse.PlanColumn(0, plan));
+    CHECK(plan.op == resmr::ColumnCollapse::FourBoundary);
+    CHECK(plan.mergedCount == 3 && plan.keptCount == 1);
+    CHECK(plan.kept[0] == 1 || plan.kept[0] == 5); // a node of the internal edge stays
+    collapse.Perform(plan);
+    CHECK(mesh.AliveColumns() == 2);
+    // The middle column of the row has two opposite boundary edges: no operator applies.
+    resmr::ColumnMesh row = Grid(3, 1, 1);
+    resmr::ColumnCollapse rowCollapse(row, 1);
+    CHECK(!rowCollapse.PlanColumn(1, plan));
+  }
+  // A single column cannot collapse; simplification leaves it unchanged.
+  {
+    resmr::ColumnMesh mesh = Grid(1, 1, 3);
+    resmr::ColumnCollapse collapse(mesh, 1);
+    const resmr::SimplifyReport report = collapse.Simplify(0);
+    CHECK(mesh.AliveColumns() == 1 && !report.reachedTarget && report.collapses == 0);
+  }
+}
+
+void TestRandomSimplificationInvariants()
+{
+  // A 12 x 10 grid with 3 layers, simplified to a quarter: counts, no doublet left, every
+  // column four distinct nodes, valid cells, coordinates in range.
+  resmr::ColumnMesh mesh = Grid(12, 10, 3);
+  resmr::ColumnCollapse collapse(mesh, 3);
+  const resmr::SimplifyReport report = collapse.Simplify(30);
+  CHECK(report.reachedTarget);
+  CHECK(mesh.AliveColumns() <= 30);
+  CHECK(report.collapses + report.doublets == 120 - mesh.AliveColumns());
+  for (int32_t node = 0; node < mesh.NodeCount(); ++node)
+  {
+    if (mesh.IsNodeAlive(node) && !mesh.NodeColumns(node).empty() && !mesh.IsBoundaryNode(node))
+    {
+      CHECK(mesh.LateralValence(node) >= 3);
+    }
+  }
+  const resmr::HexMesh hex = resmr::ToHexMesh(mesh);
+  CHECK(hex.CellCount() == mesh.AliveColumns() * 3);
+  CHECK(resmr::MeasureHexahedra(hex, mesh.Orientation()).inverted == 0);
+  for (std::size_t p = 0; p < hex.topology.size(); p += 3)
+  {
+    CHECK(hex.topology[p] >= 0 && hex.topology[p] <= 12 && hex.topology[p + 1] >= 0 && hex.topology[p + 1] <= 10);
+  }
+}
+
+resmr::ColumnMesh Reek(std::vector<bool>& active, resmr::CornerPointGeometry*& geometryOut)
+{
+  static resmr::EclipseGrid grid =
+    resmr::ReadEclipseGrid(DataDirectory + "/reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID");
+  static resmr::CornerPointGeometry geometry = resmr::CornerPointGeometry::FromDeck(grid.deck, false);
+  active.resize(static_cast<std::size_t>(geometry.CellCount()));
+  for (int64_t c = 0; c < geometry.CellCount(); ++c)
+  {
+    active[c] = grid.IsActive(c);
+  }
+  geometryOut = &geometry;
+  return resmr::ColumnMesh::FromCornerPoints(geometry, active);
+}
+
+void TestRealModel()
+{
+  std::vector<bool> active;
+  resmr::CornerPointGeometry* geometry = nullptr;
+  resmr::ColumnMesh mesh = Reek(active, geometry);
+  const int64_t nx = geometry->Dims()[0], ny = geometry->Dims()[1], nz = geometry->Dims()[2];
+  // Columns with an active cell, completed (Fig. 3).
+  int64_t expected = 0;
+  for (int64_t j = 0; j < ny; ++j)
+  {
+    for (int64_t i = 0; i < nx; ++i)
+    {
+      bool any = false;
+      for (int64_t k = 0; k < nz; ++k)
+      {
+        any = any || active[(k * ny + j) * nx + i];
+      }
+      expected += any;
+    }
+  }
+  CHECK(mesh.AliveColumns() == expected);
+  CHECK(mesh.Layers() == nz);
+  // Faults split nodes: more nodes than pillars touched, and boundary edges inside the grid.
+  CHECK(mesh.NodeCount() > (nx + 1) * (ny + 1) / 2);
+  const resmr::HexMesh original = resmr::ToHexMesh(mesh);
+  CHECK(resmr::MeasureHexahedra(original, mesh.Orientation()).inverted == 0);
+
+  const int64_t before = mesh.AliveColumns();
+  resmr::ColumnCollapse collapse(mesh, 11);
+  const resmr::SimplifyReport report = collapse.Simplify(before / 2);
+  std::printf("Reek: %lld -> %lld columns, %lld collapses, %lld doublets, ops %lld/%lld/%lld/%lld, %lld fold-overs rejected\n",
+    static_cast<long long>(before), static_cast<long long>(mesh.AliveColumns()), static_cast<long long>(report.collapses),
+    static_cast<long long>(report.doublets), static_cast<long long>(report.operatorCounts[0]),
+    static_cast<long long>(report.operatorCounts[1]), static_cast<long long>(report.operatorCounts[2]),
+    static_cast<long long>(report.operatorCounts[3]), static_cast<long long>(report.rejectedFoldOver));
+  CHECK(report.reachedTarget);
+  const resmr::HexMesh simplified = resmr::ToHexMesh(mesh);
+  const resmr::HexQuality quality = resmr::MeasureHexahedra(simplified, mesh.Orientation());
+  CHECK(quality.inverted == 0);
+  CHECK(simplified.CellCount() == mesh.AliveColumns() * nz);
+  // Coordinates inside the original ranges; tk is the interface.
+  for (int64_t p = 0; p < simplified.PointCount(); ++p)
+  {
+    const double* t = &simplified.topology[p * 3];
+    CHECK(t[0] >= 0 && t[0] <= nx && t[1] >= 0 && t[1] <= ny && t[2] >= 0 && t[2] <= nz);
+  }
+  for (const auto& cell : simplified.cells)
+  {
+    for (int i = 0; i < 4; ++i)
+    {
+      CHECK(simplified.topology[cell[i + 4] * 3 + 2] == simplified.topology[cell[i] * 3 + 2] + 1);
+    }
+  }
+  const resmr::BoundaryDistance distance = resmr::MeasureBoundaryDistance(original, simplified);
+  std::printf("Reek at 50%%: min scaled Jacobian %.3f, boundary Hausdorff %.1f m (%.4f of the diagonal)\n",
+    quality.minScaledJacobian, distance.hausdorff, distance.relative);
+  CHECK(distance.relative < 0.05);
+  CHECK(resmr::MeasureBoundaryDistance(original, original).hausdorff < 1e-6);
+
+  // Deterministic for a seed; another seed, another mesh.
+  auto run = [&](uint64_t seed) {
+    std::vector<bool> flags;
+    resmr::CornerPointGeometry* g = nullptr;
+    resmr::ColumnMesh again = Reek(flags, g);
+    resmr::ColumnCollapse c(again, seed);
+    c.Simplify(before / 2);
+    return resmr::ToHexMesh(again).points;
+  };
+  CHECK(run(11) == simplified.points);
+  CHECK(run(12) != simplified.points);
+}
+
+void TestBadInput()
+{
+  using resmr_testing::ExpectError;
+  std::vector<bool> active;
+  resmr::CornerPointGeometry* geometry = nullptr;
+  Reek(active, geometry);
+  ExpectError<std::invalid_argument>("empty box",
+    [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, active, 5, 5, 0, 10); }, { "empty or out-of-grid box" });
+  ExpectError<std::invalid_argument>("box outside",
+    [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, active, 0, 1000, 0, 10); }, { "out-of-grid box" });
+  const std::vector<bool> none(active.size(), false);
+  ExpectError<std::invalid_argument>("all inactive", [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, none); },
+    { "no active cell" });
+  ExpectError<std::invalid_argument>("wrong flags",
+    [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, std::vector<bool>(3, true)); }, { "3 active flags" });
+  ExpectError<std::invalid_argument>("bad parts", [&] {
+    resmr::ColumnMesh::FromParts(1, { 0, 0, 0 }, { { 0, 0 } }, { { 0, 0, 0, 9 } }, { 1 });
+  }, { "inconsistent parts" });
+  // Zero-thickness layers: degenerate cells are not measured, and simplification keeps them.
+  resmr::ColumnMesh flat = Grid(6, 6, 2);
+  for (int32_t node = 0; node < flat.NodeCount(); ++node)
+  {
+    flat.SetPosition(node, 1, flat.Position(node, 0));
+  }
+  resmr::ColumnCollapse collapse(flat, 1);
+  collapse.Simplify(18);
+  const resmr::HexQuality quality = resmr::MeasureHexahedra(resmr::ToHexMesh(flat), flat.Orientation());
+  CHECK(quality.inverted == 0 && quality.degenerate == flat.AliveColumns());
+}
+} // namespace
+
+int main(int argc, char** argv)
+{
+  if (argc < 2)
+  {
+    std::fprintf(stderr, "usage: TestColumnCollapse DATA_DIR\n");
+    return 2;
+  }
+  DataDirectory = argv[1];
+  TestQuadric();
+  TestQuadricsOfFaces();
+  TestInternalCollapse();
+  TestBoundaryCornerAndFourBoundary();
+  TestRandomSimplificationInvariants();
+  TestRealModel();
+  TestBadInput();
+  if (resmr_testing::Failures)
+  {
+    std::fprintf(stderr, "%d check(s) failed\n", resmr_testing::Failures);
+    return 1;
+  }
+  std::printf("all column collapse checks passed\n");
+  return 0;
+}
