@@ -644,7 +644,7 @@ SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::functi
   {
     Plan best;
     bool found = false;
-    for (int candidate = 0; candidate < 8; ++candidate)
+    for (int candidate = 0; candidate < this->Candidates; ++candidate)
     {
       const auto pick = static_cast<std::size_t>(this->RandomUnit() * static_cast<double>(this->AliveList.size()));
       Plan plan;

@@ -80,6 +80,9 @@ public:
 
   const SimplifyReport& Report() const { return this->Stats; }
 
+  /// Random candidates weighed before each collapse (Wu-Kobbelt; the paper uses 8).
+  void SetCandidates(int candidates) { this->Candidates = candidates < 1 ? 1 : candidates; }
+
 private:
   bool Apply(const Plan& plan, double& cost);
   void Undo();
@@ -95,6 +98,7 @@ private:
 
   ColumnMesh& Mesh;
   uint64_t RandomState;
+  int Candidates = 8;
   SimplifyReport Stats;
   std::vector<int32_t> AliveList;     ///< unlocked alive columns, for random picks
   std::vector<int32_t> AliveIndex;    ///< position of a column in AliveList, -1 if absent

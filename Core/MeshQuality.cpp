@@ -258,7 +258,7 @@ private:
 };
 
 double LargestDistance(const std::vector<Triangle>& triangles, const TriangleGrid& target, int perTriangle,
-  int64_t& samples)
+  int64_t& samples, std::array<double, 3>& worst)
 {
   // Samples on the triangles themselves (so a surface is at distance 0 from itself): the
   // centroid, then points towards each corner.
@@ -271,7 +271,12 @@ double LargestDistance(const std::vector<Triangle>& triangles, const TriangleGri
     {
       const glm::dvec3 p = s < 0 ? (t.a + t.b + t.c) / 3.0
                                  : weights[s % 6][0] * t.a + weights[s % 6][1] * t.b + weights[s % 6][2] * t.c;
-      largest = std::max(largest, target.Distance(p));
+      const double distance = target.Distance(p);
+      if (distance > largest)
+      {
+        largest = distance;
+        worst = { p.x, p.y, p.z };
+      }
       ++samples;
     }
   }
@@ -357,8 +362,8 @@ BoundaryDistance MeasureBoundaryDistance(const HexMesh& a, const HexMesh& b, int
   std::vector<std::array<glm::dvec3, 4>> quadsA, quadsB;
   const TriangleGrid gridA(BoundaryTriangles(a, quadsA));
   const TriangleGrid gridB(BoundaryTriangles(b, quadsB));
-  result.forward = LargestDistance(gridA.All(), gridB, perFace, result.samples);
-  result.backward = LargestDistance(gridB.All(), gridA, perFace, result.samples);
+  result.forward = LargestDistance(gridA.All(), gridB, perFace, result.samples, result.worstForward);
+  result.backward = LargestDistance(gridB.All(), gridA, perFace, result.samples, result.worstBackward);
   result.hausdorff = std::max(result.forward, result.backward);
   glm::dvec3 low(std::numeric_limits<double>::max()), high(-std::numeric_limits<double>::max());
   for (const auto& q : quadsA)

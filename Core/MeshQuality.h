@@ -7,6 +7,7 @@
 
 #include <glm/glm.hpp>
 
+#include <array>
 #include <cstdint>
 
 namespace resmr
@@ -40,6 +41,7 @@ struct BoundaryDistance
   double diagonal = 0; ///< bounding-box diagonal of `a`
   double relative = 0; ///< hausdorff / diagonal
   int64_t samples = 0;
+  std::array<double, 3> worstForward{}, worstBackward{}; ///< where each largest distance was met
 };
 
 /// Two-sided Hausdorff distance between the external boundaries (faces of active cells not

@@ -27,6 +27,7 @@ const char* SimplifyUsage =
   "  MODEL: an EGRID, a GRDECL/DATA deck, or synth:NXxNYxNZ[:SEED] (generated in memory)\n"
   "  --fraction F   keep this fraction of the columns (default 0.1)\n"
   "  --columns N    keep N columns\n"
+  "  --candidates N random candidates weighed per collapse (default 8, as the paper)\n"
   "  --uniform B    also coarsen uniformly by B x B column blocks and simplify to the same\n"
   "                 column count, reporting both\n"
   "  Prints JSON: counts, operators used, quality (scaled Jacobian, inverted cells, lateral\n"
@@ -107,11 +108,12 @@ std::string QualityJson(const resmr::HexQuality& q)
 
 std::string DistanceJson(const resmr::BoundaryDistance& d)
 {
-  char text[256];
+  char text[512];
   std::snprintf(text, sizeof(text),
     "{\"hausdorff\": %.6g, \"relative\": %.6g, \"forward\": %.6g, \"backward\": %.6g, \"diagonal\": %.6g, "
-    "\"samples\": %lld}",
-    d.hausdorff, d.relative, d.forward, d.backward, d.diagonal, static_cast<long long>(d.samples));
+    "\"samples\": %lld, \"worst_forward\": [%.2f, %.2f, %.2f], \"worst_backward\": [%.2f, %.2f, %.2f]}",
+    d.hausdorff, d.relative, d.forward, d.backward, d.diagonal, static_cast<long long>(d.samples), d.worstForward[0],
+    d.worstForward[1], d.worstForward[2], d.worstBackward[0], d.worstBackward[1], d.worstBackward[2]);
   return text;
 }
 
@@ -136,6 +138,7 @@ int SimplifyCommand(int argc, char** argv)
   long long columns = -1, uniform = 0;
   unsigned long long seed = 1;
   bool hausdorff = true;
+  int candidates = 8;
   try
   {
     for (int a = 2; a < argc; ++a)
@@ -156,6 +159,8 @@ int SimplifyCommand(int argc, char** argv)
         uniform = std::atoll(value());
       else if (option == "--seed")
         seed = std::strtoull(value(), nullptr, 10);
+      else if (option == "--candidates")
+        candidates = std::atoi(value());
       else if (option == "--no-hausdorff")
         hausdorff = false;
       else if (option == "-h" || option == "--help")
@@ -193,6 +198,7 @@ int SimplifyCommand(int argc, char** argv)
     }
     const auto simplifyStart = std::chrono::steady_clock::now();
     resmr::ColumnCollapse collapse(mesh, seed);
+    collapse.SetCandidates(candidates);
     const resmr::SimplifyReport report = collapse.Simplify(target);
     const auto done = std::chrono::steady_clock::now();
     const resmr::HexMesh simplified = resmr::ToHexMesh(mesh);
