@@ -180,8 +180,7 @@ bool ColumnCollapse::InvertsCells(int32_t column) const
       corners[i] = corners[i + 4];
       corners[i + 4] = m.Position(q[i], k + 1);
     }
-    bool degenerate = false;
-    if (HexScaledJacobian(corners, m.OrientationSign, degenerate) < -1e-9 && !degenerate)
+    if (HexInverted(corners, m.OrientationSign))
     {
       return true;
     }
@@ -210,8 +209,13 @@ bool ColumnCollapse::FoldsOver(int32_t column) const
       // Straight corners are allowed (a boundary collapse along a straight outline makes
       // them); a corner turning the wrong way is a fold.
       const double turn = (b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x);
-      const double scale = std::hypot(b.x - a.x, b.y - a.y) * std::hypot(c.x - b.x, c.y - b.y);
-      if (!(turn * sign >= -1e-9 * scale))
+      if (turn * sign >= 0)
+      {
+        continue;
+      }
+      const double scale2 = ((b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y)) *
+        ((c.x - b.x) * (c.x - b.x) + (c.y - b.y) * (c.y - b.y));
+      if (!(turn * turn <= 1e-18 * scale2))
       {
         return true;
       }

@@ -323,6 +323,34 @@ double HexScaledJacobian(const glm::dvec3 corners[8], int orientation, bool& deg
   return worst;
 }
 
+bool HexInverted(const glm::dvec3 corners[8], int orientation)
+{
+  static const int next[8][3] = { { 1, 3, 4 }, { 2, 0, 5 }, { 3, 1, 6 }, { 0, 2, 7 }, { 7, 5, 0 }, { 4, 6, 1 },
+    { 5, 7, 2 }, { 6, 4, 3 } };
+  static const int forward[8] = { 4, 5, 6, 7, 0, 1, 2, 3 };
+  static const int backward[8] = { 4, 7, 6, 5, 0, 3, 2, 1 };
+  const int* order = orientation > 0 ? forward : backward;
+  glm::dvec3 p[8];
+  for (int i = 0; i < 8; ++i)
+  {
+    p[i] = corners[order[i]];
+    p[i].z = -p[i].z;
+  }
+  for (int i = 0; i < 8; ++i)
+  {
+    const glm::dvec3 e1 = p[next[i][0]] - p[i], e2 = p[next[i][1]] - p[i], e3 = p[next[i][2]] - p[i];
+    const double det = glm::dot(e1, glm::cross(e2, e3));
+    if (det >= 0)
+    {
+      continue;
+    }
+    // Rare path: as HexScaledJacobian decides it.
+    bool degenerate = false;
+    return HexScaledJacobian(corners, orientation, degenerate) < -1e-9 && !degenerate;
+  }
+  return false;
+}
+
 HexQuality MeasureHexahedra(const HexMesh& mesh, int orientation)
 {
   HexQuality quality;

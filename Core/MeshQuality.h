@@ -19,6 +19,10 @@ namespace resmr
 /// (and 0 returned) when an edge has no length (a pinched-out cell).
 double HexScaledJacobian(const glm::dvec3 corners[8], int orientation, bool& degenerate);
 
+/// The same test as HexScaledJacobian(...) < -1e-9 on a non-degenerate cell, without the
+/// normalisation on the usual path (every corner Jacobian positive): for tight loops.
+bool HexInverted(const glm::dvec3 corners[8], int orientation);
+
 struct HexQuality
 {
   int64_t cells = 0;
