@@ -34,7 +34,15 @@ ColumnMesh ColumnMesh::FromCornerPoints(const CornerPointGeometry& geometry, con
 ColumnMesh ColumnMesh::FromCornerPoints(const CornerPointGeometry& geometry, const std::vector<bool>& active,
   int64_t i0, int64_t i1, int64_t j0, int64_t j1)
 {
-  const int64_t nx = geometry.Dims()[0], ny = geometry.Dims()[1], nz = geometry.Dims()[2];
+  return FromCells(geometry.Dims(),
+    [&](int64_t i, int64_t j, int64_t k, double corners[8][3]) { geometry.CellCorners(i, j, k, corners); }, active,
+    i0, i1, j0, j1);
+}
+
+ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims, const CellCornersFunction& cellCorners,
+  const std::vector<bool>& active, int64_t i0, int64_t i1, int64_t j0, int64_t j1)
+{
+  const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
   if (i0 < 0 || j0 < 0 || i1 > nx || j1 > ny || i0 >= i1 || j0 >= j1 || nz < 1)
   {
     throw std::invalid_argument("column mesh: empty or out-of-grid box [" + std::to_string(i0) + ", " +
@@ -95,7 +103,7 @@ ColumnMesh ColumnMesh::FromCornerPoints(const CornerPointGeometry& geometry, con
       double* stack = &row[static_cast<std::size_t>(i - i0) * stackSize];
       for (int64_t k = 0; k < nz; ++k)
       {
-        geometry.CellCorners(i, j, k, corners);
+        cellCorners(i, j, k, corners);
         for (int q = 0; q < 4; ++q)
         {
           for (int d = 0; d < 3; ++d)

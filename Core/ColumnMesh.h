@@ -24,6 +24,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace resmr
@@ -43,6 +44,12 @@ public:
     int64_t i0, int64_t i1, int64_t j0, int64_t j1);
   /// The whole grid.
   static ColumnMesh FromCornerPoints(const CornerPointGeometry& geometry, const std::vector<bool>& active);
+
+  /// The same from any source of cell corners: `corners(i, j, k, out)` gives the 8 corners
+  /// (x, y, depth) of cell (i, j, k) in ECLIPSE order (di + 2 dj + 4 dk, dk = 1 deeper).
+  using CellCornersFunction = std::function<void(int64_t, int64_t, int64_t, double[8][3])>;
+  static ColumnMesh FromCells(const std::array<int64_t, 3>& dims, const CellCornersFunction& corners,
+    const std::vector<bool>& active, int64_t i0, int64_t i1, int64_t j0, int64_t j1);
 
   /// A mesh from explicit data, for tests and other sources: `positions` holds
   /// (layers + 1) * 3 values a node, `corners` four nodes a column (counter-clockwise in

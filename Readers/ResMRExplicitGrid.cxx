@@ -18,12 +18,6 @@
 
 namespace resmr_readers
 {
-namespace
-{
-// ECLIPSE corner c = di + 2 dj + 4 dk for each VTK hexahedron point (k down, right-handed).
-constexpr int EclipseCornerOfVTKPoint[8] = { 0, 1, 3, 2, 4, 5, 7, 6 };
-} // namespace
-
 long long FileModificationTime(const char* path)
 {
   struct stat info;

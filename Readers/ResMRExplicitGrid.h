@@ -24,6 +24,10 @@ class CornerPointGeometry;
 namespace resmr_readers
 {
 
+/// ECLIPSE corner (di + 2 dj + 4 dk) of each point of the grid's VTK hexahedra; mirrored
+/// (left-handed) grids swap top and bottom: corner ^ 4.
+constexpr int EclipseCornerOfVTKPoint[8] = { 0, 1, 3, 2, 4, 5, 7, 6 };
+
 /// Modification time of a file in nanoseconds, -1 if it cannot be read: readers reopen a
 /// file when it changes.
 RESMRREADERS_EXPORT long long FileModificationTime(const char* path);
