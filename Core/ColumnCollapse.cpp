@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <queue>
 
 namespace resmr
 {
@@ -670,6 +671,102 @@ SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::functi
     }
     failures = 0;
     this->Perform(best);
+    if (progress && ++sinceProgress >= 256)
+    {
+      sinceProgress = 0;
+      progress(std::min(1.0, static_cast<double>(this->Stats.columnsBefore - m.AliveColumns()) / static_cast<double>(toRemove)));
+    }
+  }
+  this->Stats.columnsAfter = m.AliveColumns();
+  this->Stats.reachedTarget = m.AliveColumns() <= targetColumns;
+  if (progress)
+  {
+    progress(1.0);
+  }
+  return this->Stats;
+}
+
+SimplifyReport ColumnCollapse::SimplifyGreedy(int64_t targetColumns, const std::function<void(double)>& progress)
+{
+  ColumnMesh& m = this->Mesh;
+  this->Stats.columnsBefore = m.AliveColumns();
+  const int64_t toRemove = std::max<int64_t>(1, m.AliveColumns() - targetColumns);
+  struct Entry
+  {
+    double cost;
+    int32_t column;
+    uint32_t stamp;
+    bool operator<(const Entry& other) const
+    {
+      // std::priority_queue keeps the largest on top: invert for the cheapest, ties by column.
+      return this->cost != other.cost ? this->cost > other.cost : this->column > other.column;
+    }
+  };
+  std::priority_queue<Entry> queue;
+  std::vector<uint32_t> stamps(static_cast<std::size_t>(m.ColumnSlots()), 0);
+  auto plan = [&](int32_t column) {
+    Plan found;
+    ++stamps[column];
+    if (this->PlanColumn(column, found))
+    {
+      queue.push({ found.cost, column, stamps[column] });
+    }
+  };
+  for (int32_t column : this->AliveList)
+  {
+    plan(column);
+  }
+  std::vector<int32_t> neighbours, touched;
+  std::vector<uint8_t> boundary;
+  int64_t sinceProgress = 0;
+  while (m.AliveColumns() > targetColumns && !queue.empty())
+  {
+    const Entry top = queue.top();
+    queue.pop();
+    if (top.stamp != stamps[top.column] || !m.IsColumnAlive(top.column))
+    {
+      continue; // superseded
+    }
+    Plan fresh;
+    ++stamps[top.column];
+    if (!this->PlanColumn(top.column, fresh))
+    {
+      continue; // planned again when a neighbour changes
+    }
+    if (!queue.empty() && fresh.cost > queue.top().cost)
+    {
+      queue.push({ fresh.cost, top.column, stamps[top.column] });
+      continue;
+    }
+    // Columns whose plans may change: those within two edges of the nodes this collapse
+    // merges or smooths (a plan smooths its kept nodes over their neighbours).
+    touched.clear();
+    std::vector<int32_t> ring(m.Corners[top.column].begin(), m.Corners[top.column].end());
+    for (int step = 0; step < 2; ++step)
+    {
+      const std::size_t count = ring.size();
+      for (std::size_t i = 0; i < count; ++i)
+      {
+        m.Neighbours(ring[i], neighbours, boundary);
+        ring.insert(ring.end(), neighbours.begin(), neighbours.end());
+      }
+      std::sort(ring.begin(), ring.end());
+      ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+    }
+    for (int32_t node : ring)
+    {
+      touched.insert(touched.end(), m.ColumnsOfNode[node].begin(), m.ColumnsOfNode[node].end());
+    }
+    this->Perform(fresh);
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    for (int32_t column : touched)
+    {
+      if (m.IsColumnAlive(column) && !m.IsLocked(column))
+      {
+        plan(column);
+      }
+    }
     if (progress && ++sinceProgress >= 256)
     {
       sinceProgress = 0;

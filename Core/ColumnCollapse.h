@@ -83,6 +83,11 @@ public:
   /// Random candidates weighed before each collapse (Wu-Kobbelt; the paper uses 8).
   void SetCandidates(int candidates) { this->Candidates = candidates < 1 ? 1 : candidates; }
 
+  /// Instead of random candidates, always perform the cheapest collapse of the whole mesh: a
+  /// lazily updated priority queue in which only the columns a collapse touches are planned
+  /// again.
+  SimplifyReport SimplifyGreedy(int64_t targetColumns, const std::function<void(double)>& progress = {});
+
 private:
   bool Apply(const Plan& plan, double& cost);
   void Undo();

@@ -28,6 +28,7 @@ const char* SimplifyUsage =
   "  --fraction F   keep this fraction of the columns (default 0.1)\n"
   "  --columns N    keep N columns\n"
   "  --candidates N random candidates weighed per collapse (default 8, as the paper)\n"
+  "  --greedy       always the cheapest collapse of the whole mesh (a priority queue)\n"
   "  --uniform B    also coarsen uniformly by B x B column blocks and simplify to the same\n"
   "                 column count, reporting both\n"
   "  Prints JSON: counts, operators used, quality (scaled Jacobian, inverted cells, lateral\n"
@@ -139,6 +140,7 @@ int SimplifyCommand(int argc, char** argv)
   unsigned long long seed = 1;
   bool hausdorff = true;
   int candidates = 8;
+  bool greedy = false;
   try
   {
     for (int a = 2; a < argc; ++a)
@@ -161,6 +163,8 @@ int SimplifyCommand(int argc, char** argv)
         seed = std::strtoull(value(), nullptr, 10);
       else if (option == "--candidates")
         candidates = std::atoi(value());
+      else if (option == "--greedy")
+        greedy = true;
       else if (option == "--no-hausdorff")
         hausdorff = false;
       else if (option == "-h" || option == "--help")
@@ -199,7 +203,7 @@ int SimplifyCommand(int argc, char** argv)
     const auto simplifyStart = std::chrono::steady_clock::now();
     resmr::ColumnCollapse collapse(mesh, seed);
     collapse.SetCandidates(candidates);
-    const resmr::SimplifyReport report = collapse.Simplify(target);
+    const resmr::SimplifyReport report = greedy ? collapse.SimplifyGreedy(target) : collapse.Simplify(target);
     const auto done = std::chrono::steady_clock::now();
     const resmr::HexMesh simplified = resmr::ToHexMesh(mesh);
     const double buildSeconds = std::chrono::duration<double>(built - start).count();
