@@ -38,6 +38,7 @@ int IndexOf(const std::array<int32_t, 4>& q, int32_t node)
 ColumnCollapse::ColumnCollapse(ColumnMesh& mesh, uint64_t seed)
   : Mesh(mesh)
   , RandomState(Mix(seed + 0x9e3779b97f4a7c15ull))
+  , Seed(seed)
 {
   this->AliveIndex.assign(static_cast<std::size_t>(mesh.ColumnSlots()), -1);
   for (int32_t c = 0; c < mesh.ColumnSlots(); ++c)
@@ -506,7 +507,10 @@ bool ColumnCollapse::PlanColumn(int32_t column, Plan& best)
     else
     {
       const int new0 = valence[0] + valence[2] - 2, new1 = valence[1] + valence[3] - 2;
-      first = new0 != new1 ? (new0 < new1 ? 0 : 1) : (this->RandomUnit() < 0.5 ? 0 : 1);
+      // A persisting tie goes one way at random, but the same way each time this column is
+      // planned with the same corners (plans are compared again and again).
+      const uint64_t coin = Mix(this->Seed ^ Mix(static_cast<uint64_t>(q[0]) * 0x9e3779b97f4a7c15ull + static_cast<uint64_t>(q[2])));
+      first = new0 != new1 ? (new0 < new1 ? 0 : 1) : static_cast<int>(coin & 1);
     }
     diagonal(first, Internal);
   }

@@ -103,6 +103,7 @@ private:
 
   ColumnMesh& Mesh;
   uint64_t RandomState;
+  uint64_t Seed;
   int Candidates = 8;
   SimplifyReport Stats;
   std::vector<int32_t> AliveList;     ///< unlocked alive columns, for random picks
