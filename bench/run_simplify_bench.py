@@ -1,0 +1,128 @@
+"""Column-collapse simplification benchmark (issue 5, paper Sec. 4.1): for each model, the
+simplification to 50%, 10% and 1% of its columns, and the comparison with uniform B x B
+coarsening (B = 2, 3) at the same column count, for the paper's selection (8 random
+candidates) and the greedy queue. Records counts, inverted cells, scaled Jacobians, boundary
+Hausdorff distance, input cells per second and peak memory in bench/results/simplify.{md,json}
+and a plot of boundary error against cell count (simplify.png).
+
+usage: python3 bench/run_simplify_bench.py [--big] [--seeds N]
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DATA = os.environ.get("RESMR_DATA_DIR", os.path.join(os.path.dirname(ROOT), "shared", "data"))
+MODELS = [
+    ("Reek", os.path.join(DATA, "reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID")),
+    ("Brugge", os.path.join(DATA, "brugge/Real0/BRUGGE_0000.EGRID")),
+    ("Emerald", os.path.join(DATA, "emerald/eme_small_w_hole_grid_params.grdecl")),
+    ("synthetic 1M", "synth:100x100x100:1"),
+]
+BIG = [("synthetic 10M", "synth:500x200x100:1")]
+MODES = [("8 candidates", ["--candidates", "8"]), ("greedy", ["--greedy"])]
+
+
+def simplify(resmr, model, *options):
+    started = time.time()
+    run = subprocess.run([resmr, "simplify", model, *options], capture_output=True, text=True)
+    if run.returncode != 0:
+        return {"error": run.stderr.strip()[-500:], "wall": time.time() - started}
+    result = json.loads(run.stdout)
+    result["wall"] = time.time() - started
+    return result
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--resmr", default=os.path.join(ROOT, "build", "bin", "resmr"))
+    parser.add_argument("--big", action="store_true", help="also the 10M-cell synthetic model")
+    parser.add_argument("--seeds", type=int, default=1)
+    args = parser.parse_args()
+    models = MODELS + (BIG if args.big else [])
+    rows = []
+    for name, model in models:
+        for mode, options in MODES:
+            for seed in range(1, args.seeds + 1):
+                for fraction in (0.5, 0.1, 0.01):
+                    r = simplify(args.resmr, model, "--fraction", str(fraction), "--seed", str(seed), *options)
+                    rows.append({"model": name, "mode": mode, "seed": seed, "kind": "fraction", "fraction": fraction, **r})
+                    print(json.dumps({k: rows[-1].get(k) for k in ("model", "mode", "fraction", "columns_after",
+                                                                   "target_columns", "wall")}), flush=True)
+                for block in (2, 3):
+                    r = simplify(args.resmr, model, "--uniform", str(block), "--seed", str(seed), *options)
+                    rows.append({"model": name, "mode": mode, "seed": seed, "kind": "uniform", "block": block, **r})
+                    print(json.dumps({k: rows[-1].get(k) for k in ("model", "mode", "block", "columns_after",
+                                                                   "target_columns", "wall")}), flush=True)
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+    cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
+    results = os.path.join(ROOT, "bench", "results")
+    with open(os.path.join(results, "simplify.json"), "w") as handle:
+        json.dump({"commit": commit, "cpu": cpu, "cores": os.cpu_count(), "rows": rows}, handle, indent=1)
+
+    def quality(r):
+        q = r.get("quality_after", {})
+        return f"{q.get('inverted', '?')} / {q.get('min_scaled_jacobian', 0):.3f}"
+
+    lines = ["# Column-collapse simplification (issue 5, paper Sec. 4.1)", "",
+             f"`bench/run_simplify_bench.py` at commit {commit}, {cpu}, {os.cpu_count()} cores, one thread.",
+             "Boundary error: two-sided Hausdorff distance between the external boundaries (top, bottom,",
+             "faults, active limits) of the simplified and the original mesh, metres. Input cells/s counts",
+             "the completed columns' cells over build + simplification time.", "",
+             "## Simplification to a fraction of the columns", "",
+             "| model | selection | seed | target | columns before -> after | reached | inverted / min scaled Jacobian | boundary error m | input cells/s | peak RSS MB |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if r["kind"] != "fraction":
+            continue
+        if "error" in r:
+            lines.append(f"| {r['model']} | {r['mode']} | {r['seed']} | {r['fraction']:.0%} | error: {r['error'][:80]} | | | | | |")
+            continue
+        lines.append(f"| {r['model']} | {r['mode']} | {r['seed']} | {r['fraction']:.0%} | {r['columns_before']} -> "
+                     f"{r['columns_after']} | {'yes' if r['reached_target'] else 'no'} | {quality(r)} | "
+                     f"{r['boundary_distance']['hausdorff']:.1f} | {r['input_cells_per_second']:,.0f} | {r['peak_rss_mb']:.0f} |")
+    lines += ["", "## Against uniform B x B coarsening at the same column count", "",
+              "| model | selection | seed | B | columns | ours: boundary error m | uniform: boundary error m | lower than uniform | ours inverted | uniform inverted |",
+              "|---|---|---|---|---|---|---|---|---|---|"]
+    beaten = []
+    for r in rows:
+        if r["kind"] != "uniform" or "error" in r:
+            continue
+        ours, theirs = r["boundary_distance"]["hausdorff"], r["uniform"]["boundary_distance"]["hausdorff"]
+        better = ours < theirs and r["reached_target"]
+        beaten.append(better)
+        lines.append(f"| {r['model']} | {r['mode']} | {r['seed']} | {r['block']} | {r['columns_after']} (target "
+                     f"{r['target_columns']}) | {ours:.1f} | {theirs:.1f} | {'yes' if better else '**no**'} | "
+                     f"{r['quality_after']['inverted']} | {r['uniform']['quality']['inverted']} |")
+    lines += ["", f"Lower than uniform in {sum(beaten)} of {len(beaten)} comparisons.", ""]
+    with open(os.path.join(results, "simplify.md"), "w") as handle:
+        handle.write("\n".join(lines))
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        figure, axes = plt.subplots(1, len(models), figsize=(4 * len(models), 3.5))
+        for axis, (name, _) in zip(axes, models):
+            for mode, _ in MODES:
+                points = sorted((r["cells_after"], r["boundary_distance"]["hausdorff"]) for r in rows
+                                if r["model"] == name and r["mode"] == mode and "error" not in r)
+                axis.plot([p[0] for p in points], [p[1] for p in points], "o-", label=mode)
+            uniform = sorted((r["uniform"]["columns"] * r["layers"], r["uniform"]["boundary_distance"]["hausdorff"])
+                             for r in rows if r["model"] == name and r["kind"] == "uniform" and "error" not in r)
+            axis.plot([p[0] for p in uniform], [p[1] for p in uniform], "s--", label="uniform")
+            axis.set_title(name)
+            axis.set_xlabel("cells")
+            axis.set_ylabel("boundary error (m)")
+        axes[0].legend()
+        figure.tight_layout()
+        figure.savefig(os.path.join(results, "simplify.png"), dpi=90)
+    except ImportError:
+        print("matplotlib missing: no plot", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
