@@ -284,21 +284,32 @@ double LargestDistance(const std::vector<Triangle>& triangles, const TriangleGri
 }
 } // namespace
 
-double HexScaledJacobian(const glm::dvec3 corners[8], int orientation, bool& degenerate)
+namespace
 {
-  // Corner neighbours of a VTK-ordered hexahedron, in right-handed order.
-  static const int next[8][3] = { { 1, 3, 4 }, { 2, 0, 5 }, { 3, 1, 6 }, { 0, 2, 7 }, { 7, 5, 0 }, { 4, 6, 1 },
-    { 5, 7, 2 }, { 6, 4, 3 } };
-  // Bottom face (the deeper interface) first, counter-clockwise seen from above, z up.
+// Corner neighbours of a VTK-ordered hexahedron, in right-handed order.
+constexpr int CornerNeighbours[8][3] = { { 1, 3, 4 }, { 2, 0, 5 }, { 3, 1, 6 }, { 0, 2, 7 }, { 7, 5, 0 },
+  { 4, 6, 1 }, { 5, 7, 2 }, { 6, 4, 3 } };
+
+/// A HexMesh cell's corners in VTK order in a z-up frame: the bottom face (the deeper
+/// interface) first, counter-clockwise seen from above.
+void ZUpVTKCorners(const glm::dvec3 corners[8], int orientation, glm::dvec3 p[8])
+{
   static const int forward[8] = { 4, 5, 6, 7, 0, 1, 2, 3 };
   static const int backward[8] = { 4, 7, 6, 5, 0, 3, 2, 1 };
   const int* order = orientation > 0 ? forward : backward;
-  glm::dvec3 p[8];
   for (int i = 0; i < 8; ++i)
   {
     p[i] = corners[order[i]];
     p[i].z = -p[i].z;
   }
+}
+} // namespace
+
+double HexScaledJacobian(const glm::dvec3 corners[8], int orientation, bool& degenerate)
+{
+  const auto& next = CornerNeighbours;
+  glm::dvec3 p[8];
+  ZUpVTKCorners(corners, orientation, p);
   double longest = 0, shortest = std::numeric_limits<double>::infinity();
   for (int i = 0; i < 8; ++i)
   {
@@ -325,17 +336,9 @@ double HexScaledJacobian(const glm::dvec3 corners[8], int orientation, bool& deg
 
 bool HexInverted(const glm::dvec3 corners[8], int orientation)
 {
-  static const int next[8][3] = { { 1, 3, 4 }, { 2, 0, 5 }, { 3, 1, 6 }, { 0, 2, 7 }, { 7, 5, 0 }, { 4, 6, 1 },
-    { 5, 7, 2 }, { 6, 4, 3 } };
-  static const int forward[8] = { 4, 5, 6, 7, 0, 1, 2, 3 };
-  static const int backward[8] = { 4, 7, 6, 5, 0, 3, 2, 1 };
-  const int* order = orientation > 0 ? forward : backward;
+  const auto& next = CornerNeighbours;
   glm::dvec3 p[8];
-  for (int i = 0; i < 8; ++i)
-  {
-    p[i] = corners[order[i]];
-    p[i].z = -p[i].z;
-  }
+  ZUpVTKCorners(corners, orientation, p);
   for (int i = 0; i < 8; ++i)
   {
     const glm::dvec3 e1 = p[next[i][0]] - p[i], e2 = p[next[i][1]] - p[i], e3 = p[next[i][2]] - p[i];
