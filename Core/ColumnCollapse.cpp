@@ -1,6 +1,8 @@
 // Column-collapse simplification (paper Sec. 4.1, Figs. 5-7).
 #include "ColumnCollapse.h"
 
+#include "HashMix.h"
+
 #include "MeshQuality.h"
 
 #include <algorithm>
@@ -14,12 +16,7 @@ namespace
 {
 uint64_t Mix(uint64_t x)
 {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ull;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebull;
-  x ^= x >> 31;
-  return x;
+  return HashMix(x);
 }
 
 int IndexOf(const std::array<int32_t, 4>& q, int32_t node)
@@ -642,6 +639,17 @@ void ColumnCollapse::RemoveDoublets(std::vector<int32_t> worklist)
   }
 }
 
+SimplifyReport ColumnCollapse::Finish(int64_t targetColumns, const std::function<void(double)>& progress)
+{
+  this->Stats.columnsAfter = this->Mesh.AliveColumns();
+  this->Stats.reachedTarget = this->Mesh.AliveColumns() <= targetColumns;
+  if (progress)
+  {
+    progress(1.0);
+  }
+  return this->Stats;
+}
+
 SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::function<void(double)>& progress)
 {
   ColumnMesh& m = this->Mesh;
@@ -681,13 +689,7 @@ SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::functi
       progress(std::min(1.0, static_cast<double>(this->Stats.columnsBefore - m.AliveColumns()) / static_cast<double>(toRemove)));
     }
   }
-  this->Stats.columnsAfter = m.AliveColumns();
-  this->Stats.reachedTarget = m.AliveColumns() <= targetColumns;
-  if (progress)
-  {
-    progress(1.0);
-  }
-  return this->Stats;
+  return this->Finish(targetColumns, progress);
 }
 
 SimplifyReport ColumnCollapse::SimplifyGreedy(int64_t targetColumns, const std::function<void(double)>& progress)
@@ -777,13 +779,7 @@ SimplifyReport ColumnCollapse::SimplifyGreedy(int64_t targetColumns, const std::
       progress(std::min(1.0, static_cast<double>(this->Stats.columnsBefore - m.AliveColumns()) / static_cast<double>(toRemove)));
     }
   }
-  this->Stats.columnsAfter = m.AliveColumns();
-  this->Stats.reachedTarget = m.AliveColumns() <= targetColumns;
-  if (progress)
-  {
-    progress(1.0);
-  }
-  return this->Stats;
+  return this->Finish(targetColumns, progress);
 }
 
 } // namespace resmr

@@ -90,6 +90,7 @@ public:
 
 private:
   bool Apply(const Plan& plan, double& cost);
+  SimplifyReport Finish(int64_t targetColumns, const std::function<void(double)>& progress);
   void Undo();
   void Commit();
   void RemoveDoublets(std::vector<int32_t> worklist);

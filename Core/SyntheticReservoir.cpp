@@ -2,6 +2,8 @@
 // Compiled with -ffp-contract=off: the same bits on every machine (see the header).
 #include "SyntheticReservoir.h"
 
+#include "HashMix.h"
+
 #include "CivilCalendar.h"
 
 #include <algorithm>
@@ -32,12 +34,7 @@ constexpr double Pi = 3.14159265358979323846;
 
 uint64_t Mix(uint64_t x)
 {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ull;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebull;
-  x ^= x >> 31;
-  return x;
+  return HashMix(x);
 }
 
 /// Uniform in [0, 1) from a lattice point of a channel.

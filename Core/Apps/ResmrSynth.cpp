@@ -90,13 +90,7 @@ int SynthCommand(int argc, char** argv)
     for (int a = 2; a < argc; ++a)
     {
       const std::string option = argv[a];
-      auto value = [&]() -> const char* {
-        if (a + 1 >= argc)
-        {
-          throw std::invalid_argument(option + " needs a value");
-        }
-        return argv[++a];
-      };
+      auto value = [&]() { return OptionValue(a, argc, argv); };
       if (option == "-o" || option == "--output")
         output = value();
       else if (option == "--seed")
