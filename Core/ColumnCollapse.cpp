@@ -74,31 +74,31 @@ void ColumnCollapse::Smooth(int32_t node)
     topology[1] += m.Topology[other][1] * weight;
   }
   m.Topology[node] = topology;
-  double above = -std::numeric_limits<double>::infinity();
+  double above = 0;
   for (int32_t k = 0; k <= m.LayerCount; ++k)
   {
     glm::dvec3 average(0.0);
-    double low = std::numeric_limits<double>::infinity(), high = -low;
+    DepthBounds bounds;
     for (int32_t other : neighbours)
     {
       const glm::dvec3 p = m.Position(other, k);
       average += p * weight;
-      low = std::min(low, p.z);
-      high = std::max(high, p.z);
+      bounds.Add(p.z, k > 0 ? m.Position(other, k - 1).z : p.z);
     }
-    average.z = this->PlaceDepth(node, k, average, low, high, above);
+    average.z = this->PlaceDepth(node, k, average, bounds, above);
     above = average.z;
     m.SetPosition(node, k, average);
   }
 }
 
-double ColumnCollapse::PlaceDepth(int32_t node, int32_t k, const glm::dvec3& xy, double low, double high, double above) const
+double ColumnCollapse::PlaceDepth(int32_t node, int32_t k, const glm::dvec3& xy, const DepthBounds& bounds, double above) const
 {
   // The z of least quadric error (Sec. 4.1), kept within the depths around it (a nearly
-  // vertical side plane alone would throw it far) and below the interface above (layers
-  // never cross).
-  const double z = std::clamp(this->Mesh.NodeQuadric(node, k).OptimalZ(xy.x, xy.y, xy.z), low, high);
-  return std::max(z, above);
+  // vertical side plane alone would throw it far), then below the interface above by a
+  // thickness within those of the same layer around it: interfaces placed one by one would
+  // otherwise cross or pinch thin layers, and a thin cell pinched at one corner inverts.
+  const double z = std::clamp(this->Mesh.NodeQuadric(node, k).OptimalZ(xy.x, xy.y, xy.z), bounds.low, bounds.high);
+  return k == 0 ? z : std::clamp(z, above + bounds.thinnest, above + bounds.thickest);
 }
 
 bool ColumnCollapse::Manifold(int32_t node) const
@@ -308,19 +308,18 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
     // Midpoint of the merged nodes (as they were), z at the quadric minimum.
     const double weight = 1.0 / plan.mergedCount;
     std::array<double, 2> topology = { 0, 0 };
-    double above = -std::numeric_limits<double>::infinity();
+    double above = 0;
     for (int32_t k = 0; k < interfaces; ++k)
     {
       glm::dvec3 average(0.0);
-      double low = std::numeric_limits<double>::infinity(), high = -low;
+      DepthBounds bounds;
       for (const NodeState& state : this->SavedNodes)
       {
         if (std::find(plan.merged, plan.merged + plan.mergedCount, state.node) != plan.merged + plan.mergedCount)
         {
           const glm::dvec3 p(state.positions[k * 3], state.positions[k * 3 + 1], state.positions[k * 3 + 2]);
           average += p * weight;
-          low = std::min(low, p.z);
-          high = std::max(high, p.z);
+          bounds.Add(p.z, k > 0 ? state.positions[(k - 1) * 3 + 2] : p.z);
           if (k == 0)
           {
             topology[0] += state.topology[0] * weight;
@@ -328,7 +327,7 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
           }
         }
       }
-      average.z = this->PlaceDepth(survivor, k, average, low, high, above);
+      average.z = this->PlaceDepth(survivor, k, average, bounds, above);
       above = average.z;
       m.SetPosition(survivor, k, average);
     }
@@ -346,19 +345,96 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
   cost = 0;
   for (int32_t node : this->Scratch)
   {
+    cost = std::max(cost, this->NodeError(node));
+  }
+  for (int i = 0; i < plan.keptCount && !plan.gentle; ++i)
+  {
+    if (m.IsBoundaryNode(plan.kept[i]) && this->SlideAlongBoundary(plan.kept[i], cost))
+    {
+      this->Scratch.push_back(plan.kept[i]);
+    }
+  }
+  for (int32_t node : this->Scratch)
+  {
     for (int32_t column : m.ColumnsOfNode[node])
     {
-      if (this->FoldsOver(column) || this->InvertsCells(column))
+      if (this->FoldsOver(column))
       {
         ++this->Stats.rejectedFoldOver;
         return false;
       }
-    }
-    for (int32_t k = 0; k < interfaces; ++k)
-    {
-      cost = std::max(cost, m.NodeQuadric(node, k).Error(m.Position(node, k)));
+      if (this->InvertsCells(column))
+      {
+        ++this->Stats.rejectedInverted;
+        return false;
+      }
     }
   }
+  return true;
+}
+
+double ColumnCollapse::NodeError(int32_t node) const
+{
+  double error = 0;
+  for (int32_t k = 0; k <= this->Mesh.LayerCount; ++k)
+  {
+    error = std::max(error, this->Mesh.NodeQuadric(node, k).Error(this->Mesh.Position(node, k)));
+  }
+  return error;
+}
+
+bool ColumnCollapse::SlideAlongBoundary(int32_t node, double allowed)
+{
+  // A kept boundary node slides to the midpoint of its two boundary neighbours, which evens
+  // out the slivers boundary collapses leave, but only where that costs no more than the
+  // collapse already does (the heavy side planes keep corners and bends where they are).
+  ColumnMesh& m = this->Mesh;
+  std::vector<int32_t> neighbours;
+  std::vector<uint8_t> boundary;
+  m.Neighbours(node, neighbours, boundary);
+  int32_t ends[2];
+  int count = 0;
+  for (std::size_t i = 0; i < neighbours.size(); ++i)
+  {
+    if (boundary[i])
+    {
+      if (count == 2)
+      {
+        return false;
+      }
+      ends[count++] = neighbours[i];
+    }
+  }
+  if (count != 2)
+  {
+    return false;
+  }
+  const double before = this->NodeError(node);
+  const int32_t interfaces = m.LayerCount + 1;
+  std::vector<double>& saved = this->SlideSaved;
+  const std::size_t first = static_cast<std::size_t>(node) * interfaces * 3;
+  saved.assign(m.Positions.begin() + first, m.Positions.begin() + first + interfaces * 3);
+  const std::array<double, 2> topology = m.Topology[node];
+  double above = 0;
+  for (int32_t k = 0; k < interfaces; ++k)
+  {
+    const glm::dvec3 a = m.Position(ends[0], k), b = m.Position(ends[1], k);
+    glm::dvec3 middle = 0.5 * (a + b);
+    DepthBounds bounds;
+    bounds.Add(a.z, k > 0 ? m.Position(ends[0], k - 1).z : a.z);
+    bounds.Add(b.z, k > 0 ? m.Position(ends[1], k - 1).z : b.z);
+    middle.z = this->PlaceDepth(node, k, middle, bounds, above);
+    above = middle.z;
+    m.SetPosition(node, k, middle);
+  }
+  if (this->NodeError(node) > std::max(allowed, before))
+  {
+    std::copy(saved.begin(), saved.end(), m.Positions.begin() + first);
+    return false;
+  }
+  m.Topology[node] = { 0.5 * (m.Topology[ends[0]][0] + m.Topology[ends[1]][0]),
+    0.5 * (m.Topology[ends[0]][1] + m.Topology[ends[1]][1]) };
+  (void)topology;
   return true;
 }
 
@@ -406,11 +482,11 @@ void ColumnCollapse::Commit()
 void ColumnCollapse::TryOption(const Plan& option, Plan& best, bool& found)
 {
   double cost = 0;
-  const int64_t folds = this->Stats.rejectedFoldOver;
+  const int64_t folds = this->Stats.rejectedFoldOver + this->Stats.rejectedInverted;
   bool valid = this->Apply(option, cost);
   this->Undo();
   Plan chosen = option;
-  if (!valid && this->Stats.rejectedFoldOver > folds && !option.gentle)
+  if (!valid && this->Stats.rejectedFoldOver + this->Stats.rejectedInverted > folds && !option.gentle)
   {
     // The paper's smoothing folded a face: try without it, the survivor at the merged
     // nodes' midpoint, then at each of them.

@@ -17,7 +17,9 @@
 #include "ColumnMesh.h"
 
 #include <cstdint>
+#include <algorithm>
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace resmr
@@ -30,6 +32,7 @@ struct SimplifyReport
   int64_t doublets = 0;            ///< doublet collapses performed
   int64_t operatorCounts[5] = {};  ///< by operator: 0 internal, 1 boundary, 2 corner, 3 four-boundary, 4 doublet
   int64_t rejectedFoldOver = 0;    ///< candidate options rejected by the fold-over test
+  int64_t rejectedInverted = 0;    ///< candidate options rejected for inverting a hexahedron
   int64_t rejectedTopology = 0;    ///< candidate options rejected as non-manifold or degenerate
   double maxError = 0;             ///< largest cost of a performed collapse
   bool reachedTarget = false;      ///< false: no valid collapse was left
@@ -95,7 +98,23 @@ private:
   void Commit();
   void RemoveDoublets(std::vector<int32_t> worklist);
   void Smooth(int32_t node);
-  double PlaceDepth(int32_t node, int32_t k, const glm::dvec3& xy, double low, double high, double above) const;
+  bool SlideAlongBoundary(int32_t node, double allowed);
+  double NodeError(int32_t node) const;
+  /// Depths of an interface around a node being placed, and the thicknesses of the layer
+  /// above it there.
+  struct DepthBounds
+  {
+    double low = std::numeric_limits<double>::infinity(), high = -std::numeric_limits<double>::infinity();
+    double thinnest = std::numeric_limits<double>::infinity(), thickest = -std::numeric_limits<double>::infinity();
+    void Add(double z, double zAbove)
+    {
+      low = std::min(low, z);
+      high = std::max(high, z);
+      thinnest = std::min(thinnest, z - zAbove);
+      thickest = std::max(thickest, z - zAbove);
+    }
+  };
+  double PlaceDepth(int32_t node, int32_t k, const glm::dvec3& xy, const DepthBounds& bounds, double above) const;
   bool Manifold(int32_t node) const;
   bool FoldsOver(int32_t column) const;
   bool InvertsCells(int32_t column) const;
@@ -125,6 +144,7 @@ private:
   int32_t RemovedColumn = -1;
   std::vector<int32_t> Scratch;
   std::vector<uint8_t> ScratchFlags;
+  std::vector<double> SlideSaved;
 };
 
 } // namespace resmr

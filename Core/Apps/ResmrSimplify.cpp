@@ -31,6 +31,7 @@ const char* SimplifyUsage =
   "  --greedy       always the cheapest collapse of the whole mesh (a priority queue)\n"
   "  --uniform B    also coarsen uniformly by B x B column blocks and simplify to the same\n"
   "                 column count, reporting both\n"
+  "  --top-obj F    also write the simplified top surface (z up) as a Wavefront OBJ\n"
   "  Prints JSON: counts, operators used, quality (scaled Jacobian, inverted cells, lateral\n"
   "  valence, quadric error, boundary Hausdorff distance to the original), time.\n";
 
@@ -130,6 +131,39 @@ int MaxValence(const resmr::ColumnMesh& mesh)
   }
   return largest;
 }
+/// The top interface of every column as a quad, z up, for a look at the mesh from above.
+void WriteTopSurface(const resmr::ColumnMesh& mesh, const std::string& path)
+{
+  std::FILE* out = std::fopen(path.c_str(), "w");
+  if (!out)
+  {
+    throw std::runtime_error(path + ": cannot write");
+  }
+  std::vector<int32_t> index(static_cast<std::size_t>(mesh.NodeCount()), -1);
+  int32_t next = 1;
+  for (int32_t column = 0; column < mesh.ColumnSlots(); ++column)
+  {
+    if (!mesh.IsColumnAlive(column))
+    {
+      continue;
+    }
+    for (int32_t node : mesh.ColumnCorners(column))
+    {
+      if (index[node] < 0)
+      {
+        index[node] = next++;
+        const glm::dvec3 p = mesh.Position(node, 0);
+        std::fprintf(out, "v %.3f %.3f %.3f\n", p.x, p.y, -p.z);
+      }
+    }
+    const auto& q = mesh.ColumnCorners(column);
+    std::fprintf(out, "f %d %d %d %d\n", index[q[0]], index[q[1]], index[q[2]], index[q[3]]);
+  }
+  if (std::fclose(out) != 0)
+  {
+    throw std::runtime_error(path + ": write failed");
+  }
+}
 } // namespace
 
 int SimplifyCommand(int argc, char** argv)
@@ -141,6 +175,7 @@ int SimplifyCommand(int argc, char** argv)
   bool hausdorff = true;
   int candidates = 8;
   bool greedy = false;
+  std::string topObj;
   try
   {
     for (int a = 2; a < argc; ++a)
@@ -159,6 +194,8 @@ int SimplifyCommand(int argc, char** argv)
         candidates = std::atoi(value());
       else if (option == "--greedy")
         greedy = true;
+      else if (option == "--top-obj")
+        topObj = value();
       else if (option == "--no-hausdorff")
         hausdorff = false;
       else if (option == "-h" || option == "--help")
@@ -200,6 +237,10 @@ int SimplifyCommand(int argc, char** argv)
     const resmr::SimplifyReport report = greedy ? collapse.SimplifyGreedy(target) : collapse.Simplify(target);
     const auto done = std::chrono::steady_clock::now();
     const resmr::HexMesh simplified = resmr::ToHexMesh(mesh);
+    if (!topObj.empty())
+    {
+      WriteTopSurface(mesh, topObj);
+    }
     const double buildSeconds = std::chrono::duration<double>(built - start).count();
     const double simplifySeconds = std::chrono::duration<double>(done - simplifyStart).count();
     const int64_t inputCells = before * mesh.Layers();
@@ -208,7 +249,7 @@ int SimplifyCommand(int argc, char** argv)
                 "\"cells_before\": %lld, \"target_columns\": %lld, \"columns_after\": %lld, \"cells_after\": %lld, "
                 "\"reached_target\": %s, \"collapses\": %lld, \"doublets\": %lld, "
                 "\"operators\": {\"internal\": %lld, \"boundary\": %lld, \"corner\": %lld, \"four_boundary\": %lld, "
-                "\"doublet\": %lld}, \"rejected_foldover\": %lld, \"rejected_topology\": %lld, "
+                "\"doublet\": %lld}, \"rejected_foldover\": %lld, \"rejected_inverted\": %lld, \"rejected_topology\": %lld, "
                 "\"max_quadric_error\": %.6g, \"max_lateral_valence\": %d, \"seconds_build\": %.3f, "
                 "\"seconds_simplify\": %.3f, \"input_cells_per_second\": %.0f",
       source.c_str(), static_cast<long long>(model.deck.dims[0]), static_cast<long long>(model.deck.dims[1]),
@@ -219,7 +260,7 @@ int SimplifyCommand(int argc, char** argv)
       static_cast<long long>(report.operatorCounts[0]), static_cast<long long>(report.operatorCounts[1]),
       static_cast<long long>(report.operatorCounts[2]), static_cast<long long>(report.operatorCounts[3]),
       static_cast<long long>(report.operatorCounts[4]), static_cast<long long>(report.rejectedFoldOver),
-      static_cast<long long>(report.rejectedTopology), report.maxError, MaxValence(mesh), buildSeconds,
+      static_cast<long long>(report.rejectedInverted), static_cast<long long>(report.rejectedTopology), report.maxError, MaxValence(mesh), buildSeconds,
       simplifySeconds, static_cast<double>(inputCells) / std::max(1e-9, buildSeconds + simplifySeconds));
     std::printf(", \"quality_before\": %s, \"quality_after\": %s",
       QualityJson(resmr::MeasureHexahedra(original, mesh.Orientation())).c_str(),
