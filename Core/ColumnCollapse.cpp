@@ -245,7 +245,8 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
   }
   this->RemovedColumn = c;
 
-  // The column goes; the merged nodes become the survivor.
+  // The column goes; the merged nodes become the survivor (and for a strip collapse, the
+  // second pair becomes a second survivor).
   const int32_t survivor = plan.placeAt >= 0 ? plan.placeAt : plan.merged[0];
   m.ColumnAlive[c] = 0;
   --m.AliveColumnCount;
@@ -254,40 +255,50 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
     auto& list = m.ColumnsOfNode[node];
     list.erase(std::remove(list.begin(), list.end(), c), list.end());
   }
-  for (int i = 0; i < plan.mergedCount; ++i)
-  {
-    const int32_t node = plan.merged[i];
-    if (node == survivor)
+  auto mergeInto = [&](const int32_t* nodes, int count, int32_t into) {
+    for (int i = 0; i < count; ++i)
     {
-      continue;
-    }
-    for (int32_t k = 0; k < interfaces; ++k)
-    {
-      m.NodeQuadric(survivor, k) += m.NodeQuadric(node, k);
-    }
-    for (int32_t column : m.ColumnsOfNode[node])
-    {
-      this->SavedCorners.push_back({ column, m.Corners[column] });
-      std::replace(m.Corners[column].begin(), m.Corners[column].end(), node, survivor);
-      auto& list = m.ColumnsOfNode[survivor];
-      if (std::find(list.begin(), list.end(), column) == list.end())
+      const int32_t node = nodes[i];
+      if (node == into)
       {
-        list.push_back(column);
+        continue;
       }
+      for (int32_t k = 0; k < interfaces; ++k)
+      {
+        m.NodeQuadric(into, k) += m.NodeQuadric(node, k);
+      }
+      for (int32_t column : m.ColumnsOfNode[node])
+      {
+        this->SavedCorners.push_back({ column, m.Corners[column] });
+        std::replace(m.Corners[column].begin(), m.Corners[column].end(), node, into);
+        auto& list = m.ColumnsOfNode[into];
+        if (std::find(list.begin(), list.end(), column) == list.end())
+        {
+          list.push_back(column);
+        }
+      }
+      m.ColumnsOfNode[node].clear();
+      m.NodeAlive[node] = 0;
     }
-    m.ColumnsOfNode[node].clear();
-    m.NodeAlive[node] = 0;
+  };
+  mergeInto(plan.merged, plan.mergedCount, survivor);
+  if (plan.op == Strip)
+  {
+    mergeInto(plan.mergedSecond, 2, plan.placeSecondAt);
   }
 
   // Topology first: no column may repeat a node, and nodes must stay manifold.
   bool valid = true;
-  for (int32_t column : m.ColumnsOfNode[survivor])
+  for (int32_t node : { survivor, plan.op == Strip ? plan.placeSecondAt : survivor })
   {
-    auto q = m.Corners[column];
-    std::sort(q.begin(), q.end());
-    valid = valid && std::adjacent_find(q.begin(), q.end()) == q.end();
+    for (int32_t column : m.ColumnsOfNode[node])
+    {
+      auto q = m.Corners[column];
+      std::sort(q.begin(), q.end());
+      valid = valid && std::adjacent_find(q.begin(), q.end()) == q.end();
+    }
+    valid = valid && this->Manifold(node);
   }
-  valid = valid && this->Manifold(survivor);
   for (int i = 0; i < plan.keptCount && valid; ++i)
   {
     valid = this->Manifold(plan.kept[i]);
@@ -334,6 +345,10 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
     m.Topology[survivor] = topology;
   }
   this->Scratch.assign(1, survivor);
+  if (plan.op == Strip)
+  {
+    this->Scratch.push_back(plan.placeSecondAt);
+  }
   for (int i = 0; i < plan.keptCount; ++i)
   {
     if (!plan.gentle && !m.IsBoundaryNode(plan.kept[i]))
@@ -593,6 +608,31 @@ bool ColumnCollapse::PlanColumn(int32_t column, Plan& best)
     diagonal(0, Boundary);
     diagonal(1, Boundary);
   }
+  else if (edges == 2 && edge[0] == edge[2])
+  {
+    // Two opposite boundary edges: a column of a strip one column wide, which none of the
+    // paper's operators removes (rings and thin arms of a model stall on them). Each
+    // boundary edge collapses to one of its nodes, which keeps the strip's outline; the
+    // columns on either side become neighbours.
+    const int first = edge[0] ? 0 : 1;
+    option.op = Strip;
+    option.gentle = true;
+    option.mergedCount = 2;
+    option.merged[0] = q[first];
+    option.merged[1] = q[first + 1];
+    option.mergedSecond[0] = q[first + 2];
+    option.mergedSecond[1] = q[(first + 3) % 4];
+    option.keptCount = 0;
+    for (int a = 0; a < 2; ++a)
+    {
+      for (int b = 0; b < 2; ++b)
+      {
+        option.placeAt = option.merged[a];
+        option.placeSecondAt = option.mergedSecond[b];
+        this->TryOption(option, best, found);
+      }
+    }
+  }
   else if (edges == 2)
   {
     // Operator 3: two consecutive boundary edges (a corner column).
@@ -637,6 +677,10 @@ void ColumnCollapse::Perform(const Plan& plan)
   this->Stats.maxError = std::max(this->Stats.maxError, cost);
   const int32_t survivor = plan.placeAt >= 0 ? plan.placeAt : plan.merged[0];
   std::vector<int32_t> worklist = { survivor };
+  if (plan.op == Strip)
+  {
+    worklist.push_back(plan.placeSecondAt);
+  }
   for (int i = 0; i < plan.keptCount; ++i)
   {
     worklist.push_back(plan.kept[i]);
@@ -682,10 +726,16 @@ void ColumnCollapse::RemoveDoublets(std::vector<int32_t> worklist)
       option.column = column;
       option.op = Doublet;
       option.mergedCount = 2;
+      const int at = IndexOf(q, node);
       option.merged[0] = node;
-      option.merged[1] = q[(IndexOf(q, node) + 2) % 4];
+      option.merged[1] = q[(at + 2) % 4];
       option.placeAt = option.merged[1];
-      option.keptCount = 0;
+      // The doublet node's two neighbours are smoothed (the paper's rule for nodes that
+      // remain): they often sit at the bend that made the doublet, and the one column left
+      // would fold over them. TryOption falls back to leaving them if smoothing folds.
+      option.keptCount = 2;
+      option.kept[0] = q[(at + 1) % 4];
+      option.kept[1] = q[(at + 3) % 4];
       this->TryOption(option, best, found);
     }
     if (!found)

@@ -1,5 +1,6 @@
 // Column-collapse simplification of a reservoir hexahedral mesh (paper Sec. 4.1): the five
-// operators (internal, boundary, corner, four-boundary-vertex, doublet), local Laplacian
+// operators (internal, boundary, corner, four-boundary-vertex, doublet) plus a strip collapse
+// for columns between two opposite boundary edges, local Laplacian
 // smoothing per layer with z at the quadric minimum, fold-over rejection, and Wu-Kobbelt
 // multiple-choice selection (8 random candidates, the cheapest performed).
 //
@@ -28,9 +29,9 @@ namespace resmr
 struct SimplifyReport
 {
   int64_t columnsBefore = 0, columnsAfter = 0;
-  int64_t collapses = 0;           ///< operators 1-4 performed
+  int64_t collapses = 0;           ///< operators 1-4 and strip collapses performed
   int64_t doublets = 0;            ///< doublet collapses performed
-  int64_t operatorCounts[5] = {};  ///< by operator: 0 internal, 1 boundary, 2 corner, 3 four-boundary, 4 doublet
+  int64_t operatorCounts[6] = {};  ///< by operator: 0 internal, 1 boundary, 2 corner, 3 four-boundary, 4 doublet, 5 strip
   int64_t rejectedFoldOver = 0;    ///< candidate options rejected by the fold-over test
   int64_t rejectedInverted = 0;    ///< candidate options rejected for inverting a hexahedron
   int64_t rejectedTopology = 0;    ///< candidate options rejected as non-manifold or degenerate
@@ -48,7 +49,10 @@ public:
     Boundary = 1,
     Corner = 2,
     FourBoundary = 3,
-    Doublet = 4
+    Doublet = 4,
+    /// Ours, not the paper's: a column with two opposite boundary edges (a strip one column
+    /// wide) loses both internal edges, each boundary edge becoming one node.
+    Strip = 5
   };
 
   /// One way of collapsing a column: `merged` nodes become one, placed at node `placeAt`
@@ -63,6 +67,9 @@ public:
     int32_t placeAt = -1;
     int32_t kept[2] = { -1, -1 };
     int keptCount = 0;
+    /// Strip collapses only: the second boundary edge's nodes, merged at `placeSecondAt`.
+    int32_t mergedSecond[2] = { -1, -1 };
+    int32_t placeSecondAt = -1;
     /// The fallback when the paper's smoothing folds a face: no smoothing of kept nodes, and
     /// a smoothed survivor placed at the merged nodes' midpoint instead.
     bool gentle = false;

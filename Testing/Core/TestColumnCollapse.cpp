@@ -10,6 +10,7 @@
 #include "EclipseGrid.h"
 #include "MeshQuality.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -175,10 +176,20 @@ void TestBoundaryCornerAndFourBoundary()
     CHECK(plan.kept[0] == 1 || plan.kept[0] == 5); // a node of the internal edge stays
     collapse.Perform(plan);
     CHECK(mesh.AliveColumns() == 2);
-    // The middle column of the row has two opposite boundary edges: no operator applies.
+    // The middle column of the row has two opposite boundary edges, which none of the
+    // paper's operators removes: the strip collapse turns each boundary edge into one of its
+    // nodes, left where it was, and the end columns become neighbours.
     resmr::ColumnMesh row = Grid(3, 1, 1);
     resmr::ColumnCollapse rowCollapse(row, 1);
-    CHECK(!rowCollapse.PlanColumn(1, plan));
+    CHECK(rowCollapse.PlanColumn(1, plan));
+    CHECK(plan.op == resmr::ColumnCollapse::Strip && plan.keptCount == 0);
+    const glm::dvec3 first = row.Position(plan.placeAt, 1), second = row.Position(plan.placeSecondAt, 1);
+    rowCollapse.Perform(plan);
+    CHECK(row.AliveColumns() == 2 && !row.IsColumnAlive(1));
+    CHECK(row.Position(plan.placeAt, 1) == first && row.Position(plan.placeSecondAt, 1) == second);
+    CHECK(!row.IsBoundaryEdge(0, 1) && !row.IsBoundaryEdge(2, 3)); // the ends now share an edge
+    CHECK(rowCollapse.Report().operatorCounts[resmr::ColumnCollapse::Strip] == 1);
+    CHECK(resmr::MeasureHexahedra(resmr::ToHexMesh(row), row.Orientation()).inverted == 0);
   }
   // A single column cannot collapse; simplification leaves it unchanged.
   {
@@ -213,6 +224,179 @@ void TestRandomSimplificationInvariants()
   {
     CHECK(hex.topology[p] >= 0 && hex.topology[p] <= 12 && hex.topology[p + 1] >= 0 && hex.topology[p + 1] <= 10);
   }
+}
+
+/// Sum of the quadrics of the live nodes at an interface: collapses only add quadrics
+/// together, so it never changes.
+resmr::Quadric TotalQuadric(const resmr::ColumnMesh& mesh, int32_t interface)
+{
+  resmr::Quadric sum;
+  for (int32_t node = 0; node < mesh.NodeCount(); ++node)
+  {
+    if (mesh.IsNodeAlive(node) && !mesh.NodeColumns(node).empty())
+    {
+      sum += mesh.NodeQuadric(node, interface);
+    }
+  }
+  return sum;
+}
+
+bool SameQuadric(const resmr::Quadric& a, const resmr::Quadric& b)
+{
+  for (int i = 0; i < 10; ++i)
+  {
+    if (std::fabs(a.q[i] - b.q[i]) > 1e-9 * (1 + std::fabs(a.q[i])))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+void TestDoubletCascade()
+{
+  // A 6 x 6 grid (node (i, j) = 7j + i, column (i, j) = 6j + i). Three internal collapses,
+  // each keeping node A = (2, 2), bring it and its neighbour B = (3, 2) down to lateral
+  // valence 2 and 3; the third leaves A between two columns sharing two consecutive edges
+  // (Fig. 7). Its removal takes one valence from B, a second doublet, removed in turn.
+  resmr::ColumnMesh mesh = Grid(6, 6, 2);
+  const resmr::Quadric total0 = TotalQuadric(mesh, 0), total2 = TotalQuadric(mesh, 2);
+  resmr::ColumnCollapse collapse(mesh, 1);
+  auto node = [](int i, int j) { return 7 * j + i; };
+  auto internal = [&](int column, int32_t a, int32_t b, int32_t keepA, int32_t keepB) {
+    resmr::ColumnCollapse::Plan plan;
+    plan.column = column;
+    plan.op = resmr::ColumnCollapse::Internal;
+    plan.mergedCount = 2;
+    plan.merged[0] = a;
+    plan.merged[1] = b;
+    plan.keptCount = 2;
+    plan.kept[0] = keepA;
+    plan.kept[1] = keepB;
+    const int64_t before = mesh.AliveColumns();
+    collapse.Perform(plan);
+    CHECK(mesh.AliveColumns() < before);
+  };
+  const int32_t A = node(2, 2), B = node(3, 2);
+  internal(6 * 1 + 3, node(3, 1), node(4, 2), B, node(4, 1)); // B: valence 3
+  CHECK(mesh.LateralValence(B) == 3 && collapse.Report().doublets == 0);
+  internal(6 * 1 + 1, node(2, 1), node(1, 2), A, node(1, 1)); // A: valence 3
+  CHECK(mesh.LateralValence(A) == 3 && collapse.Report().doublets == 0);
+  internal(6 * 2 + 1, node(2, 1), node(2, 3), A, node(1, 3)); // A: a doublet, then B
+  const resmr::SimplifyReport& report = collapse.Report();
+  CHECK(report.collapses == 3);
+  std::printf("doublet test: %lld doublets, %lld fold-over, %lld inverted, %lld topology rejections\n", (long long)report.doublets, (long long)report.rejectedFoldOver, (long long)report.rejectedInverted, (long long)report.rejectedTopology);
+  CHECK(report.doublets >= 2);
+  CHECK(report.operatorCounts[resmr::ColumnCollapse::Doublet] == report.doublets);
+  CHECK(mesh.AliveColumns() == 36 - 3 - report.doublets);
+  CHECK(!mesh.IsNodeAlive(A) || mesh.NodeColumns(A).empty());
+  CHECK(!mesh.IsNodeAlive(B) || mesh.NodeColumns(B).empty());
+  // No doublet is left, every column still has four distinct nodes, and no quadric was lost
+  // (a doublet's node adds its quadric to the one it moves onto).
+  for (int32_t n = 0; n < mesh.NodeCount(); ++n)
+  {
+    if (mesh.IsNodeAlive(n) && !mesh.NodeColumns(n).empty() && !mesh.IsBoundaryNode(n))
+    {
+      CHECK(mesh.LateralValence(n) >= 3);
+    }
+  }
+  for (int32_t c = 0; c < mesh.ColumnSlots(); ++c)
+  {
+    if (mesh.IsColumnAlive(c))
+    {
+      auto q = mesh.ColumnCorners(c);
+      std::sort(q.begin(), q.end());
+      CHECK(std::adjacent_find(q.begin(), q.end()) == q.end());
+    }
+  }
+  CHECK(SameQuadric(TotalQuadric(mesh, 0), total0) && SameQuadric(TotalQuadric(mesh, 2), total2));
+  // Topological coordinates of the live nodes stay inside the grid.
+  for (int32_t n = 0; n < mesh.NodeCount(); ++n)
+  {
+    if (mesh.IsNodeAlive(n) && !mesh.NodeColumns(n).empty())
+    {
+      const auto& t = mesh.TopologicalCoordinate(n);
+      CHECK(t[0] >= 0 && t[0] <= 6 && t[1] >= 0 && t[1] <= 6);
+    }
+  }
+  CHECK(resmr::MeasureHexahedra(resmr::ToHexMesh(mesh), mesh.Orientation()).inverted == 0);
+}
+
+void TestFault()
+{
+  // A 4 x 3 x 2 grid of 10 m cells whose columns i >= 2 are thrown down 5 m: the pillars at
+  // i = 2 carry two nodes each (one a side), the fault edges are boundaries of both sides,
+  // and fault nodes get the side planes (type 3) with the weight 10,000.
+  const std::array<int64_t, 3> dims = { 4, 3, 2 };
+  auto corners = [](int64_t i, int64_t j, int64_t k, double out[8][3]) {
+    const double throwDown = i >= 2 ? 5.0 : 0.0;
+    for (int c = 0; c < 8; ++c)
+    {
+      out[c][0] = 10.0 * static_cast<double>(i + (c & 1));
+      out[c][1] = 10.0 * static_cast<double>(j + ((c >> 1) & 1));
+      out[c][2] = 1000.0 + throwDown + static_cast<double>(k + (c >> 2));
+    }
+  };
+  resmr::ColumnMesh mesh = resmr::ColumnMesh::FromCells(dims, corners, std::vector<bool>(24, true), 0, 4, 0, 3);
+  CHECK(mesh.AliveColumns() == 12);
+  CHECK(mesh.NodeCount() == 5 * 4 + 4); // the four fault pillars split
+  // Column (1, 1) = 5 has the fault on its edge from corner 1 to corner 2; column (2, 1) = 6
+  // across it shares no node with it.
+  const auto& left = mesh.ColumnCorners(5);
+  const auto& right = mesh.ColumnCorners(6);
+  for (int32_t a : left)
+  {
+    CHECK(std::find(right.begin(), right.end(), a) == right.end());
+  }
+  CHECK(mesh.IsBoundaryEdge(5, 1) && mesh.IsBoundaryEdge(6, 3) && !mesh.IsBoundaryEdge(5, 0));
+  CHECK(mesh.IsBoundaryNode(left[1]) && mesh.IsBoundaryNode(left[2]) && !mesh.IsBoundaryNode(left[0]));
+  // The fault plane x = 20 is in the fault node's quadric, heavily weighted: 1 m off it
+  // costs at least 10,000; 1 m up along it, a top face's weight.
+  const glm::dvec3 onFault = mesh.Position(left[2], 1);
+  CHECK(std::fabs(onFault.x - 20) < 1e-12 && std::fabs(onFault.z - 1001) < 1e-12);
+  CHECK(mesh.NodeQuadric(left[2], 1).Error(onFault) < 1e-9);
+  CHECK(mesh.NodeQuadric(left[2], 1).Error(onFault + glm::dvec3(1, 0, 0)) >= 10000 - 1e-6);
+  CHECK(mesh.NodeQuadric(left[2], 1).Error(onFault + glm::dvec3(0, 0, 1)) < 10);
+  // The collapse of column (1, 1) is a boundary collapse against the fault: the survivor is
+  // a fault node, which stays where it was, and the other side is untouched.
+  std::vector<glm::dvec3> rightSide;
+  for (int32_t a : right)
+  {
+    rightSide.push_back(mesh.Position(a, 1));
+  }
+  resmr::ColumnCollapse collapse(mesh, 5);
+  resmr::ColumnCollapse::Plan plan;
+  CHECK(collapse.PlanColumn(5, plan));
+  CHECK(plan.op == resmr::ColumnCollapse::Boundary);
+  CHECK(plan.placeAt == left[1] || plan.placeAt == left[2]);
+  const glm::dvec3 kept = mesh.Position(plan.placeAt, 2);
+  collapse.Perform(plan);
+  CHECK(mesh.AliveColumns() == 11 && !mesh.IsColumnAlive(5));
+  CHECK(glm::length(mesh.Position(plan.placeAt, 2) - kept) == 0);
+  CHECK(mesh.IsBoundaryNode(plan.placeAt));
+  for (int i = 0; i < 4; ++i)
+  {
+    CHECK(mesh.Position(right[i], 1) == rightSide[i]);
+  }
+  // Simplified to 4 columns: still no node shared across the fault (x < 20 on one side,
+  // >= 20 on the other, depths 5 m apart), and no inverted cell.
+  collapse.Simplify(4);
+  for (int32_t c = 0; c < mesh.ColumnSlots(); ++c)
+  {
+    if (!mesh.IsColumnAlive(c))
+    {
+      continue;
+    }
+    bool west = false, east = false;
+    for (int32_t a : mesh.ColumnCorners(c))
+    {
+      const glm::dvec3 p = mesh.Position(a, 0);
+      west = west || p.x < 20 - 1e-9;
+      east = east || p.x > 20 + 1e-9;
+    }
+    CHECK(!(west && east));
+  }
+  CHECK(resmr::MeasureHexahedra(resmr::ToHexMesh(mesh), mesh.Orientation()).inverted == 0);
 }
 
 resmr::ColumnMesh Reek(std::vector<bool>& active, resmr::CornerPointGeometry*& geometryOut)
@@ -345,6 +529,8 @@ int main(int argc, char** argv)
   TestInternalCollapse();
   TestBoundaryCornerAndFourBoundary();
   TestRandomSimplificationInvariants();
+  TestDoubletCascade();
+  TestFault();
   TestRealModel();
   TestBadInput();
   if (resmr_testing::Failures)
