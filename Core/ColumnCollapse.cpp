@@ -429,7 +429,6 @@ bool ColumnCollapse::SlideAlongBoundary(int32_t node, double allowed)
   std::vector<double>& saved = this->SlideSaved;
   const std::size_t first = static_cast<std::size_t>(node) * interfaces * 3;
   saved.assign(m.Positions.begin() + first, m.Positions.begin() + first + interfaces * 3);
-  const std::array<double, 2> topology = m.Topology[node];
   double above = 0;
   for (int32_t k = 0; k < interfaces; ++k)
   {
@@ -449,7 +448,6 @@ bool ColumnCollapse::SlideAlongBoundary(int32_t node, double allowed)
   }
   m.Topology[node] = { 0.5 * (m.Topology[ends[0]][0] + m.Topology[ends[1]][0]),
     0.5 * (m.Topology[ends[0]][1] + m.Topology[ends[1]][1]) };
-  (void)topology;
   return true;
 }
 

@@ -2,6 +2,8 @@
 // measures, optionally side by side with uniform b x b coarsening at the same column count.
 #include "ResmrCommands.h"
 
+#include "AtomicOutputFile.h"
+
 #include "ColumnCollapse.h"
 #include "ColumnMesh.h"
 #include "CornerPointGeometry.h"
@@ -131,38 +133,39 @@ int MaxValence(const resmr::ColumnMesh& mesh)
   }
   return largest;
 }
-/// The top interface of every column as a quad, z up, for a look at the mesh from above.
+/// The top interface of every column as a quad, z up, for a look at the mesh from above;
+/// written to a temporary and renamed, so a failed write leaves nothing half-written.
 void WriteTopSurface(const resmr::ColumnMesh& mesh, const std::string& path)
 {
-  std::FILE* out = std::fopen(path.c_str(), "w");
-  if (!out)
-  {
-    throw std::runtime_error(path + ": cannot write");
-  }
+  resmr::AtomicOutputFile out(path);
   std::vector<int32_t> index(static_cast<std::size_t>(mesh.NodeCount()), -1);
   int32_t next = 1;
+  char line[160];
+  auto put = [&](int length) {
+    if (!out.Write(line, static_cast<std::size_t>(length)))
+    {
+      throw std::runtime_error(path + ": write failed");
+    }
+  };
   for (int32_t column = 0; column < mesh.ColumnSlots(); ++column)
   {
     if (!mesh.IsColumnAlive(column))
     {
       continue;
     }
-    for (int32_t node : mesh.ColumnCorners(column))
+    const auto& q = mesh.ColumnCorners(column);
+    for (int32_t node : q)
     {
       if (index[node] < 0)
       {
         index[node] = next++;
         const glm::dvec3 p = mesh.Position(node, 0);
-        std::fprintf(out, "v %.3f %.3f %.3f\n", p.x, p.y, -p.z);
+        put(std::snprintf(line, sizeof(line), "v %.3f %.3f %.3f\n", p.x, p.y, -p.z));
       }
     }
-    const auto& q = mesh.ColumnCorners(column);
-    std::fprintf(out, "f %d %d %d %d\n", index[q[0]], index[q[1]], index[q[2]], index[q[3]]);
+    put(std::snprintf(line, sizeof(line), "f %d %d %d %d\n", index[q[0]], index[q[1]], index[q[2]], index[q[3]]));
   }
-  if (std::fclose(out) != 0)
-  {
-    throw std::runtime_error(path + ": write failed");
-  }
+  out.Commit();
 }
 } // namespace
 
