@@ -231,6 +231,7 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
   const auto corners = m.Corners[c];
   this->SavedNodes.clear();
   this->SavedCorners.clear();
+  this->SavedMoves.clear();
   for (int32_t node : corners)
   {
     NodeState state;
@@ -357,6 +358,10 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
       this->Scratch.push_back(plan.kept[i]);
     }
   }
+  if (plan.ring)
+  {
+    this->SmoothRing(plan.placeAt < 0);
+  }
   cost = 0;
   for (int32_t node : this->Scratch)
   {
@@ -451,10 +456,256 @@ bool ColumnCollapse::SlideAlongBoundary(int32_t node, double allowed)
   return true;
 }
 
+namespace
+{
+/// Worst corner of a quadrilateral seen from above at one interface: the smallest sine of its
+/// corner angles, negative where a corner turns against the mesh.
+double CornerQuality(const ColumnMesh& m, const std::array<int32_t, 4>& q, int32_t k)
+{
+  double worst = 1;
+  for (int i = 0; i < 4; ++i)
+  {
+    const glm::dvec3 a = m.Position(q[(i + 3) % 4], k), b = m.Position(q[i], k), c = m.Position(q[(i + 1) % 4], k);
+    const double ux = b.x - a.x, uy = b.y - a.y, vx = c.x - b.x, vy = c.y - b.y;
+    const double length = std::sqrt((ux * ux + uy * uy) * (vx * vx + vy * vy));
+    worst = std::min(worst, length > 0 ? m.Orientation() * (ux * vy - uy * vx) / length : -1.0);
+  }
+  return worst;
+}
+} // namespace
+
+bool ColumnCollapse::RotateEdge(int32_t column, int corner)
+{
+  ColumnMesh& m = this->Mesh;
+  const auto a = m.Corners[column];
+  const int32_t h = a[corner], x = a[(corner + 1) % 4];
+  int32_t other = -1;
+  int at = -1;
+  for (int32_t candidate : m.ColumnsOfNode[h])
+  {
+    const auto& o = m.Corners[candidate];
+    for (int f = 0; candidate != column && f < 4; ++f)
+    {
+      if (o[f] == x && o[(f + 1) % 4] == h)
+      {
+        other = candidate;
+        at = f;
+      }
+    }
+  }
+  if (other < 0 || m.IsLocked(column) || m.IsLocked(other))
+  {
+    return false;
+  }
+  for (int32_t k = 0; k < m.LayerCount; ++k)
+  {
+    if (m.IsCellActive(column, k) != m.IsCellActive(other, k))
+    {
+      return false; // the active region would change shape
+    }
+  }
+  const auto b = m.Corners[other];
+  // The hexagon of the two columns, in their orientation: h, b2, b3, x, a2, a3.
+  const int32_t hexagon[6] = { h, b[(at + 2) % 4], b[(at + 3) % 4], x, a[(corner + 2) % 4], a[(corner + 3) % 4] };
+  for (int i = 0; i < 6; ++i)
+  {
+    for (int j = i + 1; j < 6; ++j)
+    {
+      if (hexagon[i] == hexagon[j])
+      {
+        return false;
+      }
+    }
+  }
+  auto quality = [&](const std::array<int32_t, 4>& q) {
+    return std::min(CornerQuality(m, q, 0), CornerQuality(m, q, m.LayerCount));
+  };
+  const double before = std::min(quality(a), quality(b));
+  std::vector<int32_t> neighbours;
+  std::vector<uint8_t> boundary;
+  double bestQuality = before;
+  int bestShift = -1;
+  for (int shift = 1; shift <= 2; ++shift)
+  {
+    // New diagonal from hexagon[shift] to hexagon[shift + 3]; it must not be an edge already.
+    const int32_t from = hexagon[shift], to = hexagon[shift + 3];
+    m.Neighbours(from, neighbours, boundary);
+    if (std::find(neighbours.begin(), neighbours.end(), to) != neighbours.end())
+    {
+      continue;
+    }
+    const std::array<int32_t, 4> first = { hexagon[shift], hexagon[shift + 1], hexagon[shift + 2], hexagon[(shift + 3) % 6] };
+    const std::array<int32_t, 4> second = { hexagon[(shift + 3) % 6], hexagon[(shift + 4) % 6], hexagon[(shift + 5) % 6], hexagon[shift] };
+    const double after = std::min(quality(first), quality(second));
+    if (after > bestQuality)
+    {
+      bestQuality = after;
+      bestShift = shift;
+    }
+  }
+  if (bestShift < 0)
+  {
+    return false;
+  }
+  const int shift = bestShift;
+  auto rewire = [&](const std::array<int32_t, 4>& first, const std::array<int32_t, 4>& second) {
+    for (int32_t node : hexagon)
+    {
+      auto& list = m.ColumnsOfNode[node];
+      list.erase(std::remove_if(list.begin(), list.end(), [&](int32_t c) { return c == column || c == other; }), list.end());
+    }
+    m.Corners[column] = first;
+    m.Corners[other] = second;
+    for (int32_t c : { column, other })
+    {
+      for (int32_t node : m.Corners[c])
+      {
+        m.ColumnsOfNode[node].push_back(c);
+      }
+    }
+  };
+  rewire({ hexagon[shift], hexagon[shift + 1], hexagon[shift + 2], hexagon[(shift + 3) % 6] },
+    { hexagon[(shift + 3) % 6], hexagon[(shift + 4) % 6], hexagon[(shift + 5) % 6], hexagon[shift] });
+  bool valid = !this->FoldsOver(column) && !this->FoldsOver(other) && !this->InvertsCells(column) &&
+    !this->InvertsCells(other);
+  for (int i = 0; i < 6 && valid; ++i)
+  {
+    valid = this->Manifold(hexagon[i]);
+  }
+  if (!valid)
+  {
+    rewire(a, b);
+    return false;
+  }
+  return true;
+}
+
+int64_t ColumnCollapse::RotateEdges()
+{
+  int64_t rotations = 0;
+  for (int32_t column = 0; column < this->Mesh.ColumnSlots(); ++column)
+  {
+    for (int corner = 0; corner < 4 && this->Mesh.IsColumnAlive(column); ++corner)
+    {
+      if (this->RotateEdge(column, corner))
+      {
+        ++rotations;
+      }
+    }
+  }
+  this->Stats.rotations += rotations;
+  return rotations;
+}
+
+bool ColumnCollapse::Pinned(int32_t node) const
+{
+  const auto& columns = this->Mesh.ColumnsOfNode[node];
+  return std::any_of(columns.begin(), columns.end(), [this](int32_t c) { return this->Mesh.IsLocked(c); });
+}
+
+int64_t ColumnCollapse::Relax(double allowed)
+{
+  // Collapses leave fans of slivers around the nodes they merged into, and a sliver's own
+  // collapse folds its neighbours: the simplification stalls far above small targets.
+  // Evening the mesh out, within the error already spent, frees them.
+  ColumnMesh& m = this->Mesh;
+  const int32_t interfaces = m.LayerCount + 1;
+  int64_t moved = 0;
+  std::vector<double> saved;
+  for (int32_t node = 0; node < m.NodeCount(); ++node)
+  {
+    if (!m.IsNodeAlive(node) || m.ColumnsOfNode[node].empty() || this->Pinned(node))
+    {
+      continue;
+    }
+    const std::size_t first = static_cast<std::size_t>(node) * interfaces * 3;
+    saved.assign(m.Positions.begin() + first, m.Positions.begin() + first + interfaces * 3);
+    const std::array<double, 2> topology = m.Topology[node];
+    bool keep;
+    if (m.IsBoundaryNode(node))
+    {
+      keep = this->SlideAlongBoundary(node, allowed);
+    }
+    else
+    {
+      const double before = this->NodeError(node);
+      this->Smooth(node);
+      keep = this->NodeError(node) <= std::max(allowed, before);
+    }
+    for (std::size_t i = 0; keep && i < m.ColumnsOfNode[node].size(); ++i)
+    {
+      const int32_t column = m.ColumnsOfNode[node][i];
+      keep = !this->FoldsOver(column) && !this->InvertsCells(column);
+    }
+    if (!keep)
+    {
+      std::copy(saved.begin(), saved.end(), m.Positions.begin() + first);
+      m.Topology[node] = topology;
+      continue;
+    }
+    ++moved;
+  }
+  return moved;
+}
+
+void ColumnCollapse::SmoothRing(bool smoothSurvivor)
+{
+  // The interior neighbours of the nodes moved so far (this->Scratch, the survivor first)
+  // are smoothed with them a few times: a Gauss-Seidel sweep that spreads the collapse over
+  // the fan around it.
+  ColumnMesh& m = this->Mesh;
+  const int32_t interfaces = m.LayerCount + 1;
+  const std::size_t centres = this->Scratch.size();
+  std::vector<int32_t> neighbours;
+  std::vector<uint8_t> boundary;
+  std::vector<int32_t> ring;
+  for (std::size_t i = 0; i < centres; ++i)
+  {
+    m.Neighbours(this->Scratch[i], neighbours, boundary);
+    for (int32_t node : neighbours)
+    {
+      const bool corner = std::any_of(this->SavedNodes.begin(), this->SavedNodes.end(),
+        [node](const NodeState& state) { return state.node == node; });
+      if (!corner && std::find(ring.begin(), ring.end(), node) == ring.end() && !m.IsBoundaryNode(node) &&
+        !this->Pinned(node))
+      {
+        ring.push_back(node);
+      }
+    }
+  }
+  for (int32_t node : ring)
+  {
+    const std::size_t first = static_cast<std::size_t>(node) * interfaces * 3;
+    this->SavedMoves.push_back(
+      { node, m.Topology[node], std::vector<double>(m.Positions.begin() + first, m.Positions.begin() + first + interfaces * 3) });
+  }
+  for (int sweep = 0; sweep < 3; ++sweep)
+  {
+    for (int32_t node : ring)
+    {
+      this->Smooth(node);
+    }
+    for (std::size_t i = smoothSurvivor ? 0 : 1; i < centres; ++i)
+    {
+      if (!m.IsBoundaryNode(this->Scratch[i]))
+      {
+        this->Smooth(this->Scratch[i]);
+      }
+    }
+  }
+  this->Scratch.insert(this->Scratch.end(), ring.begin(), ring.end());
+}
+
 void ColumnCollapse::Undo()
 {
   ColumnMesh& m = this->Mesh;
   const int32_t interfaces = m.LayerCount + 1;
+  for (const MovedNode& moved : this->SavedMoves)
+  {
+    m.Topology[moved.node] = moved.topology;
+    std::copy(moved.positions.begin(), moved.positions.end(), m.Positions.begin() + static_cast<std::size_t>(moved.node) * interfaces * 3);
+  }
+  this->SavedMoves.clear();
   for (auto it = this->SavedCorners.rbegin(); it != this->SavedCorners.rend(); ++it)
   {
     m.Corners[it->first] = it->second;
@@ -487,6 +738,7 @@ void ColumnCollapse::Commit()
     this->AliveList.pop_back();
     this->AliveIndex[c] = -1;
   }
+  this->SavedMoves.clear();
   this->SavedNodes.clear();
   this->SavedCorners.clear();
   this->RemovedColumn = -1;
@@ -512,6 +764,14 @@ void ColumnCollapse::TryOption(const Plan& option, Plan& best, bool& found)
       valid = this->Apply(chosen, cost);
       this->Undo();
     }
+  }
+  if (!valid && this->Stalled && this->Stats.rejectedFoldOver + this->Stats.rejectedInverted > folds)
+  {
+    chosen = option;
+    chosen.gentle = false;
+    chosen.ring = true;
+    valid = this->Apply(chosen, cost);
+    this->Undo();
   }
   if (valid && (!found || cost < best.cost))
   {
@@ -781,6 +1041,7 @@ SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::functi
   const int64_t toRemove = std::max<int64_t>(1, m.AliveColumns() - targetColumns);
   int64_t failures = 0;
   int64_t sinceProgress = 0;
+  int64_t relaxedAt = -1;
   while (m.AliveColumns() > targetColumns && !this->AliveList.empty())
   {
     Plan best;
@@ -798,10 +1059,23 @@ SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::functi
     }
     if (!found)
     {
-      // Nothing valid among these candidates; give up once every column has had many chances.
+      // Nothing valid among these candidates. Once every column has had many chances, even
+      // the mesh out and go on; give up when that freed nothing since the last time.
       if (++failures > 64 + 4 * static_cast<int64_t>(this->AliveList.size()))
       {
-        break;
+        if (m.AliveColumns() == relaxedAt)
+        {
+          break;
+        }
+        relaxedAt = m.AliveColumns();
+        ++this->Stats.relaxations;
+        this->Stalled = true;
+        this->RotateEdges();
+        for (int pass = 0; pass < 3; ++pass)
+        {
+          this->Relax(this->Stats.maxError);
+        }
+        failures = 0;
       }
       continue;
     }

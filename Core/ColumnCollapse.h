@@ -35,6 +35,8 @@ struct SimplifyReport
   int64_t rejectedFoldOver = 0;    ///< candidate options rejected by the fold-over test
   int64_t rejectedInverted = 0;    ///< candidate options rejected for inverting a hexahedron
   int64_t rejectedTopology = 0;    ///< candidate options rejected as non-manifold or degenerate
+  int64_t relaxations = 0;         ///< times the whole mesh was smoothed to unblock collapses
+  int64_t rotations = 0;           ///< edge rotations made to unblock collapses
   double maxError = 0;             ///< largest cost of a performed collapse
   bool reachedTarget = false;      ///< false: no valid collapse was left
 };
@@ -73,6 +75,9 @@ public:
     /// The fallback when the paper's smoothing folds a face: no smoothing of kept nodes, and
     /// a smoothed survivor placed at the merged nodes' midpoint instead.
     bool gentle = false;
+    /// The fallback once the simplification stalls: the whole 1-ring of the moved nodes is
+    /// smoothed as well, a few times over.
+    bool ring = false;
     double cost = 0;
   };
 
@@ -106,6 +111,20 @@ private:
   void RemoveDoublets(std::vector<int32_t> worklist);
   void Smooth(int32_t node);
   bool SlideAlongBoundary(int32_t node, double allowed);
+  /// Smooths every movable node once (Laplacian and quadric z inside, sliding along the
+  /// boundary), each move kept only if it folds and inverts nothing and costs at most
+  /// `allowed`. Returns the number of moves kept.
+  int64_t Relax(double allowed);
+  /// Edge rotation (Tarini et al. 2010; ours, not the paper's): the edge two columns share
+  /// turns to another diagonal of their hexagon, moving no node, when that rounds out the
+  /// thinner of them without folding or inverting anything. Returns the rotations made.
+  int64_t RotateEdges();
+  bool RotateEdge(int32_t column, int corner);
+  /// A node of a locked column: it never moves or merges into another node.
+  bool Pinned(int32_t node) const;
+  /// Smooths the interior 1-ring of the nodes in Scratch with them (ring plans), logging the
+  /// ring for Undo and adding it to Scratch.
+  void SmoothRing(bool smoothSurvivor);
   double NodeError(int32_t node) const;
   /// Depths of an interface around a node being placed, and the thicknesses of the layer
   /// above it there.
@@ -148,6 +167,14 @@ private:
   };
   std::vector<NodeState> SavedNodes;
   std::vector<std::pair<int32_t, std::array<int32_t, 4>>> SavedCorners;
+  struct MovedNode
+  {
+    int32_t node;
+    std::array<double, 2> topology;
+    std::vector<double> positions;
+  };
+  std::vector<MovedNode> SavedMoves;  ///< ring nodes a ring plan smoothed
+  bool Stalled = false;               ///< ring plans are tried (set once collapses run out)
   int32_t RemovedColumn = -1;
   std::vector<int32_t> Scratch;
   std::vector<uint8_t> ScratchFlags;
