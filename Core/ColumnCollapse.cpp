@@ -59,8 +59,8 @@ void ColumnCollapse::Smooth(int32_t node)
   // Laplacian smoothing in each layer (x, y and the topological coordinate), then the z of
   // least quadric error at that (x, y) (Sec. 4.1).
   ColumnMesh& m = this->Mesh;
-  std::vector<int32_t> neighbours;
-  std::vector<uint8_t> boundary;
+  std::vector<int32_t>& neighbours = this->SmoothNeighbours;
+  std::vector<uint8_t>& boundary = this->SmoothBoundary;
   m.Neighbours(node, neighbours, boundary);
   if (neighbours.empty())
   {
@@ -111,8 +111,8 @@ bool ColumnCollapse::Manifold(int32_t node) const
   {
     return true;
   }
-  std::vector<int32_t> ends;   // the two neighbours of the node in each column
-  ends.reserve(2 * n);
+  std::vector<int32_t>& ends = this->ManifoldEnds; // the two neighbours of the node in each column
+  ends.clear();
   for (int32_t column : columns)
   {
     const auto& q = m.Corners[column];
@@ -121,7 +121,8 @@ bool ColumnCollapse::Manifold(int32_t node) const
     ends.push_back(q[(at + 3) % 4]);
   }
   int boundaryEdges = 0;
-  std::vector<int> component(n);
+  std::vector<int>& component = this->ManifoldComponents;
+  component.resize(n);
   for (std::size_t i = 0; i < n; ++i)
   {
     component[i] = static_cast<int>(i);
@@ -229,20 +230,22 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
   const int32_t c = plan.column;
   const int32_t interfaces = m.LayerCount + 1;
   const auto corners = m.Corners[c];
-  this->SavedNodes.clear();
   this->SavedCorners.clear();
   this->SavedMoves.clear();
-  for (int32_t node : corners)
+  // The four saved states keep their buffers from one plan to the next: planning tries
+  // several options for each of many candidates, and allocation dominated it.
+  this->SavedNodes.resize(4);
+  for (int i = 0; i < 4; ++i)
   {
-    NodeState state;
+    NodeState& state = this->SavedNodes[i];
+    const int32_t node = corners[i];
     state.node = node;
     state.alive = m.NodeAlive[node];
     state.topology = m.Topology[node];
     const std::size_t first = static_cast<std::size_t>(node) * interfaces;
     state.positions.assign(m.Positions.begin() + first * 3, m.Positions.begin() + (first + interfaces) * 3);
     state.quadrics.assign(m.Quadrics.begin() + first, m.Quadrics.begin() + first + interfaces);
-    state.columns = m.ColumnsOfNode[node];
-    this->SavedNodes.push_back(std::move(state));
+    state.columns.assign(m.ColumnsOfNode[node].begin(), m.ColumnsOfNode[node].end());
   }
   this->RemovedColumn = c;
 
@@ -374,20 +377,30 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
       this->Scratch.push_back(plan.kept[i]);
     }
   }
+  // Each column around the moved nodes once: the fold test for all of them first (cheap,
+  // and where most rejections happen), then the inversion test.
+  std::vector<int32_t>& around = this->Around;
+  around.clear();
   for (int32_t node : this->Scratch)
   {
-    for (int32_t column : m.ColumnsOfNode[node])
+    around.insert(around.end(), m.ColumnsOfNode[node].begin(), m.ColumnsOfNode[node].end());
+  }
+  std::sort(around.begin(), around.end());
+  around.erase(std::unique(around.begin(), around.end()), around.end());
+  for (int32_t column : around)
+  {
+    if (this->FoldsOver(column))
     {
-      if (this->FoldsOver(column))
-      {
-        ++this->Stats.rejectedFoldOver;
-        return false;
-      }
-      if (this->InvertsCells(column))
-      {
-        ++this->Stats.rejectedInverted;
-        return false;
-      }
+      ++this->Stats.rejectedFoldOver;
+      return false;
+    }
+  }
+  for (int32_t column : around)
+  {
+    if (this->InvertsCells(column))
+    {
+      ++this->Stats.rejectedInverted;
+      return false;
     }
   }
   return true;
@@ -409,8 +422,8 @@ bool ColumnCollapse::SlideAlongBoundary(int32_t node, double allowed)
   // out the slivers boundary collapses leave, but only where that costs no more than the
   // collapse already does (the heavy side planes keep corners and bends where they are).
   ColumnMesh& m = this->Mesh;
-  std::vector<int32_t> neighbours;
-  std::vector<uint8_t> boundary;
+  std::vector<int32_t>& neighbours = this->SlideNeighbours;
+  std::vector<uint8_t>& boundary = this->SlideBoundary;
   m.Neighbours(node, neighbours, boundary);
   int32_t ends[2];
   int count = 0;
@@ -458,19 +471,20 @@ bool ColumnCollapse::SlideAlongBoundary(int32_t node, double allowed)
 
 namespace
 {
-/// Worst corner of a quadrilateral seen from above at one interface: the smallest sine of its
-/// corner angles, negative where a corner turns against the mesh.
-double CornerQuality(const ColumnMesh& m, const std::array<int32_t, 4>& q, int32_t k)
+/// Shape of a quadrilateral seen from above at one interface: its smallest corner area over
+/// the mean squared edge length (1 for a square, near 0 for a sliver or a straight corner,
+/// negative where a corner turns against the mesh).
+double ShapeQuality(const ColumnMesh& m, const std::array<int32_t, 4>& q, int32_t k)
 {
-  double worst = 1;
+  double smallest = std::numeric_limits<double>::infinity(), squares = 0;
   for (int i = 0; i < 4; ++i)
   {
     const glm::dvec3 a = m.Position(q[(i + 3) % 4], k), b = m.Position(q[i], k), c = m.Position(q[(i + 1) % 4], k);
     const double ux = b.x - a.x, uy = b.y - a.y, vx = c.x - b.x, vy = c.y - b.y;
-    const double length = std::sqrt((ux * ux + uy * uy) * (vx * vx + vy * vy));
-    worst = std::min(worst, length > 0 ? m.Orientation() * (ux * vy - uy * vx) / length : -1.0);
+    smallest = std::min(smallest, m.Orientation() * (ux * vy - uy * vx));
+    squares += vx * vx + vy * vy;
   }
-  return worst;
+  return squares > 0 ? 4 * smallest / squares : -1.0;
 }
 } // namespace
 
@@ -518,7 +532,7 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
     }
   }
   auto quality = [&](const std::array<int32_t, 4>& q) {
-    return std::min(CornerQuality(m, q, 0), CornerQuality(m, q, m.LayerCount));
+    return std::min(ShapeQuality(m, q, 0), ShapeQuality(m, q, m.LayerCount));
   };
   const double before = std::min(quality(a), quality(b));
   std::vector<int32_t> neighbours;
@@ -717,11 +731,10 @@ void ColumnCollapse::Undo()
     m.Topology[state.node] = state.topology;
     std::copy(state.positions.begin(), state.positions.end(), m.Positions.begin() + first * 3);
     std::copy(state.quadrics.begin(), state.quadrics.end(), m.Quadrics.begin() + first);
-    m.ColumnsOfNode[state.node] = std::move(state.columns);
+    m.ColumnsOfNode[state.node].swap(state.columns);
   }
   m.ColumnAlive[this->RemovedColumn] = 1;
   ++m.AliveColumnCount;
-  this->SavedNodes.clear();
   this->SavedCorners.clear();
   this->RemovedColumn = -1;
 }
@@ -739,7 +752,6 @@ void ColumnCollapse::Commit()
     this->AliveIndex[c] = -1;
   }
   this->SavedMoves.clear();
-  this->SavedNodes.clear();
   this->SavedCorners.clear();
   this->RemovedColumn = -1;
 }
@@ -1061,7 +1073,8 @@ SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::functi
     {
       // Nothing valid among these candidates. Once every column has had many chances, even
       // the mesh out and go on; give up when that freed nothing since the last time.
-      if (++failures > 64 + 4 * static_cast<int64_t>(this->AliveList.size()))
+      // (Each column is then among the candidates eight times on average.)
+      if (++failures > 16 + static_cast<int64_t>(this->AliveList.size()))
       {
         if (m.AliveColumns() == relaxedAt)
         {

@@ -177,6 +177,12 @@ private:
   bool Stalled = false;               ///< ring plans are tried (set once collapses run out)
   int32_t RemovedColumn = -1;
   std::vector<int32_t> Scratch;
+  std::vector<int32_t> Around;
+  // Buffers reused by the hot helpers (planning calls them for every option tried).
+  std::vector<int32_t> SmoothNeighbours, SlideNeighbours;
+  std::vector<uint8_t> SmoothBoundary, SlideBoundary;
+  mutable std::vector<int32_t> ManifoldEnds;
+  mutable std::vector<int> ManifoldComponents;
   std::vector<uint8_t> ScratchFlags;
   std::vector<double> SlideSaved;
 };

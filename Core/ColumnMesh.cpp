@@ -338,18 +338,51 @@ void ColumnMesh::Neighbours(int32_t node, std::vector<int32_t>& nodes, std::vect
 
 int ColumnMesh::LateralValence(int32_t node) const
 {
-  std::vector<int32_t> nodes;
-  std::vector<uint8_t> boundary;
-  this->Neighbours(node, nodes, boundary);
-  return static_cast<int>(nodes.size());
+  // Distinct neighbours, counted without building lists (a node has few columns).
+  const auto& columns = this->ColumnsOfNode[node];
+  int valence = 0;
+  for (std::size_t c = 0; c < columns.size(); ++c)
+  {
+    const auto& q = this->Corners[columns[c]];
+    const int at = static_cast<int>(std::find(q.begin(), q.end(), node) - q.begin());
+    for (int32_t other : { q[(at + 1) % 4], q[(at + 3) % 4] })
+    {
+      bool seen = false;
+      for (std::size_t d = 0; d < c && !seen; ++d)
+      {
+        const auto& o = this->Corners[columns[d]];
+        seen = std::find(o.begin(), o.end(), other) != o.end();
+      }
+      valence += seen ? 0 : 1;
+    }
+  }
+  return valence;
 }
 
 bool ColumnMesh::IsBoundaryNode(int32_t node) const
 {
-  std::vector<int32_t> nodes;
-  std::vector<uint8_t> boundary;
-  this->Neighbours(node, nodes, boundary);
-  return std::find(boundary.begin(), boundary.end(), 1) != boundary.end();
+  // A node is on the boundary when some edge at it lies in one column only. Its columns
+  // are few: count each edge's columns in place rather than build the neighbour lists.
+  const auto& columns = this->ColumnsOfNode[node];
+  for (int32_t column : columns)
+  {
+    const auto& q = this->Corners[column];
+    const int at = static_cast<int>(std::find(q.begin(), q.end(), node) - q.begin());
+    for (int32_t other : { q[(at + 1) % 4], q[(at + 3) % 4] })
+    {
+      int shared = 0;
+      for (int32_t second : columns)
+      {
+        const auto& o = this->Corners[second];
+        shared += std::find(o.begin(), o.end(), other) != o.end() ? 1 : 0;
+      }
+      if (shared == 1)
+      {
+        return true;
+      }
+    }
+  }
+  return false;
 }
 
 bool ColumnMesh::IsBoundaryEdge(int32_t column, int corner) const
