@@ -259,6 +259,24 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
     auto& list = m.ColumnsOfNode[node];
     list.erase(std::remove(list.begin(), list.end(), c), list.end());
   }
+  // Nodes of locked columns stay where they are: they may only be the survivor, placed at
+  // itself (the hierarchy relies on locked columns matching their neighbours exactly).
+  for (int i = 0; i < plan.mergedCount; ++i)
+  {
+    if ((plan.merged[i] != plan.placeAt || plan.placeAt < 0) && this->Pinned(plan.merged[i]))
+    {
+      ++this->Stats.rejectedTopology;
+      return false;
+    }
+  }
+  for (int i = 0; i < 2 && plan.op == Strip; ++i)
+  {
+    if (plan.mergedSecond[i] != plan.placeSecondAt && this->Pinned(plan.mergedSecond[i]))
+    {
+      ++this->Stats.rejectedTopology;
+      return false;
+    }
+  }
   auto mergeInto = [&](const int32_t* nodes, int count, int32_t into) {
     for (int i = 0; i < count; ++i)
     {
@@ -355,7 +373,7 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
   }
   for (int i = 0; i < plan.keptCount; ++i)
   {
-    if (!plan.gentle && !m.IsBoundaryNode(plan.kept[i]))
+    if (!plan.gentle && !m.IsBoundaryNode(plan.kept[i]) && !this->Pinned(plan.kept[i]))
     {
       this->Smooth(plan.kept[i]);
       this->Scratch.push_back(plan.kept[i]);
@@ -372,7 +390,7 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
   }
   for (int i = 0; i < plan.keptCount && !plan.gentle; ++i)
   {
-    if (m.IsBoundaryNode(plan.kept[i]) && this->SlideAlongBoundary(plan.kept[i], cost))
+    if (m.IsBoundaryNode(plan.kept[i]) && !this->Pinned(plan.kept[i]) && this->SlideAlongBoundary(plan.kept[i], cost))
     {
       this->Scratch.push_back(plan.kept[i]);
     }
@@ -511,13 +529,6 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
   {
     return false;
   }
-  for (int32_t k = 0; k < m.LayerCount; ++k)
-  {
-    if (m.IsCellActive(column, k) != m.IsCellActive(other, k))
-    {
-      return false; // the active region would change shape
-    }
-  }
   const auto b = m.Corners[other];
   // The hexagon of the two columns, in their orientation: h, b2, b3, x, a2, a3.
   const int32_t hexagon[6] = { h, b[(at + 2) % 4], b[(at + 3) % 4], x, a[(corner + 2) % 4], a[(corner + 3) % 4] };
@@ -590,6 +601,14 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
   {
     rewire(a, b);
     return false;
+  }
+  // Each new column covers parts of both old ones: a layer is active in it where it was in
+  // either (a rotation never opens a hole in the active volume).
+  for (int32_t k = 0; k < m.LayerCount; ++k)
+  {
+    uint8_t& first = m.ActiveCells[static_cast<std::size_t>(column) * m.LayerCount + k];
+    uint8_t& second = m.ActiveCells[static_cast<std::size_t>(other) * m.LayerCount + k];
+    first = second = (first || second) ? 1 : 0;
   }
   return true;
 }
@@ -871,6 +890,11 @@ bool ColumnCollapse::PlanColumn(int32_t column, Plan& best)
       first = new0 != new1 ? (new0 < new1 ? 0 : 1) : static_cast<int>(coin & 1);
     }
     diagonal(first, Internal);
+    if (!found && this->Stalled)
+    {
+      // Stalled: the direction the valence rule turned down, if it is the only one valid.
+      diagonal(1 - first, Internal);
+    }
   }
   else if (edges <= 1)
   {

@@ -2,7 +2,10 @@
 // operators (internal, boundary, corner, four-boundary-vertex, doublet) plus a strip collapse
 // for columns between two opposite boundary edges, local Laplacian
 // smoothing per layer with z at the quadric minimum, fold-over rejection, and Wu-Kobbelt
-// multiple-choice selection (8 random candidates, the cheapest performed).
+// multiple-choice selection (8 random candidates, the cheapest performed). When no candidate
+// is valid any more (slivers fanned around heavy boundary nodes fold whatever collapses next
+// to them), edges are rotated, the mesh is smoothed within the error already spent, and
+// rejected collapses may smooth their whole 1-ring; it gives up only when that frees nothing.
 //
 // Contract:
 // - Works in place on a ColumnMesh; every collapse removes one column of nk hexahedra and
@@ -103,7 +106,15 @@ public:
   /// again.
   SimplifyReport SimplifyGreedy(int64_t targetColumns, const std::function<void(double)>& progress = {});
 
+  /// Edge rotation (Tarini et al. 2010; ours, not the paper's), which Simplify runs when
+  /// collapses run out: the edge two unlocked columns share turns to another diagonal of
+  /// their hexagon, moving no node, where that rounds out the thinner of them without folding
+  /// or inverting anything. A layer of either new column is active where it was in either
+  /// old one. Returns the rotations made.
+  int64_t RotateEdges();
+
 private:
+  bool RotateEdge(int32_t column, int corner);
   bool Apply(const Plan& plan, double& cost);
   SimplifyReport Finish(int64_t targetColumns, const std::function<void(double)>& progress);
   void Undo();
@@ -115,11 +126,6 @@ private:
   /// boundary), each move kept only if it folds and inverts nothing and costs at most
   /// `allowed`. Returns the number of moves kept.
   int64_t Relax(double allowed);
-  /// Edge rotation (Tarini et al. 2010; ours, not the paper's): the edge two columns share
-  /// turns to another diagonal of their hexagon, moving no node, when that rounds out the
-  /// thinner of them without folding or inverting anything. Returns the rotations made.
-  int64_t RotateEdges();
-  bool RotateEdge(int32_t column, int corner);
   /// A node of a locked column: it never moves or merges into another node.
   bool Pinned(int32_t node) const;
   /// Smooths the interior 1-ring of the nodes in Scratch with them (ring plans), logging the
