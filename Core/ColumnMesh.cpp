@@ -385,6 +385,50 @@ bool ColumnMesh::IsBoundaryNode(int32_t node) const
   return false;
 }
 
+int64_t ColumnMesh::ConnectedParts() const
+{
+  std::vector<int32_t> parent(this->Corners.size());
+  for (std::size_t c = 0; c < parent.size(); ++c)
+  {
+    parent[c] = static_cast<int32_t>(c);
+  }
+  auto root = [&](int32_t c) {
+    while (parent[c] != c)
+    {
+      c = parent[c] = parent[parent[c]];
+    }
+    return c;
+  };
+  for (std::size_t node = 0; node < this->ColumnsOfNode.size(); ++node)
+  {
+    const auto& columns = this->ColumnsOfNode[node];
+    for (std::size_t a = 0; a < columns.size(); ++a)
+    {
+      for (std::size_t b = a + 1; b < columns.size(); ++b)
+      {
+        // Joined if they share an edge (two nodes), not where they only touch at a corner.
+        const auto& qa = this->Corners[columns[a]];
+        const auto& qb = this->Corners[columns[b]];
+        int shared = 0;
+        for (int32_t n : qa)
+        {
+          shared += std::find(qb.begin(), qb.end(), n) != qb.end() ? 1 : 0;
+        }
+        if (shared >= 2)
+        {
+          parent[root(columns[a])] = root(columns[b]);
+        }
+      }
+    }
+  }
+  int64_t parts = 0;
+  for (std::size_t c = 0; c < parent.size(); ++c)
+  {
+    parts += this->ColumnAlive[c] && root(static_cast<int32_t>(c)) == static_cast<int32_t>(c) ? 1 : 0;
+  }
+  return parts;
+}
+
 bool ColumnMesh::IsBoundaryEdge(int32_t column, int corner) const
 {
   const auto& q = this->Corners[column];

@@ -105,6 +105,10 @@ public:
   /// Whether the edge between corners c and c+1 of a column has a column on its other side.
   bool IsBoundaryEdge(int32_t column, int corner) const;
 
+  /// Pieces of the mesh joined by no shared edge (fault blocks cut off all round, isolated
+  /// columns): collapses never join two, so no simplification leaves fewer columns.
+  int64_t ConnectedParts() const;
+
   /// +1 if columns run counter-clockwise in (x, y) seen from above (depth down), -1 if
   /// clockwise: fold-over checks compare with it.
   int Orientation() const { return this->OrientationSign; }

@@ -227,6 +227,7 @@ int SimplifyCommand(int argc, char** argv)
     const auto built = std::chrono::steady_clock::now();
     const resmr::HexMesh original = resmr::ToHexMesh(mesh);
     const int64_t before = mesh.AliveColumns();
+    const int64_t parts = mesh.ConnectedParts();
     resmr::HexMesh coarse;
     int64_t target = columns >= 0 ? columns : static_cast<int64_t>(std::llround(fraction * static_cast<double>(before)));
     if (uniform > 0)
@@ -249,7 +250,7 @@ int SimplifyCommand(int argc, char** argv)
     const int64_t inputCells = before * mesh.Layers();
 
     std::printf("{\"input\": \"%s\", \"dims\": [%lld, %lld, %lld], \"layers\": %d, \"columns_before\": %lld, "
-                "\"cells_before\": %lld, \"target_columns\": %lld, \"columns_after\": %lld, \"cells_after\": %lld, "
+                "\"cells_before\": %lld, \"connected_parts\": %lld, \"target_columns\": %lld, \"columns_after\": %lld, \"cells_after\": %lld, "
                 "\"reached_target\": %s, \"collapses\": %lld, \"doublets\": %lld, "
                 "\"operators\": {\"internal\": %lld, \"boundary\": %lld, \"corner\": %lld, \"four_boundary\": %lld, "
                 "\"doublet\": %lld, \"strip\": %lld}, \"rejected_foldover\": %lld, \"rejected_inverted\": %lld, \"rejected_topology\": %lld, "
@@ -257,7 +258,7 @@ int SimplifyCommand(int argc, char** argv)
                 "\"seconds_simplify\": %.3f, \"input_cells_per_second\": %.0f",
       source.c_str(), static_cast<long long>(model.deck.dims[0]), static_cast<long long>(model.deck.dims[1]),
       static_cast<long long>(model.deck.dims[2]), mesh.Layers(), static_cast<long long>(before),
-      static_cast<long long>(inputCells), static_cast<long long>(target), static_cast<long long>(mesh.AliveColumns()),
+      static_cast<long long>(inputCells), static_cast<long long>(parts), static_cast<long long>(target), static_cast<long long>(mesh.AliveColumns()),
       static_cast<long long>(mesh.CellCount()), report.reachedTarget ? "true" : "false",
       static_cast<long long>(report.collapses), static_cast<long long>(report.doublets),
       static_cast<long long>(report.operatorCounts[0]), static_cast<long long>(report.operatorCounts[1]),

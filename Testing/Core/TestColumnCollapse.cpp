@@ -583,6 +583,24 @@ void TestEdgeRotation()
   CHECK(after.inverted == 0 && std::fabs(after.minScaledJacobian - 0.8575) < 1e-3);
 }
 
+void TestConnectedParts()
+{
+  CHECK(Grid(4, 3, 1).ConnectedParts() == 1);
+  // Two unit columns touching at one corner only, and a third far away: three parts.
+  std::vector<double> positions;
+  std::vector<std::array<double, 2>> topology;
+  const double xy[11][2] = { { 0, 0 }, { 1, 0 }, { 1, 1 }, { 0, 1 }, { 2, 1 }, { 2, 2 }, { 1, 2 }, { 5, 5 }, { 6, 5 },
+    { 6, 6 }, { 5, 6 } };
+  for (const auto& p : xy)
+  {
+    topology.push_back({ p[0], p[1] });
+    positions.insert(positions.end(), { p[0], p[1], 0.0, p[0], p[1], 1.0 });
+  }
+  const resmr::ColumnMesh mesh = resmr::ColumnMesh::FromParts(1, positions, topology,
+    { { 0, 1, 2, 3 }, { 2, 4, 5, 6 }, { 7, 8, 9, 10 } }, { 1, 1, 1 });
+  CHECK(mesh.ConnectedParts() == 3);
+}
+
 void TestBadInput()
 {
   using resmr_testing::ExpectError;
@@ -632,6 +650,7 @@ int main(int argc, char** argv)
   TestRealModel();
   TestLockedColumns();
   TestEdgeRotation();
+  TestConnectedParts();
   TestBadInput();
   if (resmr_testing::Failures)
   {
