@@ -1070,6 +1070,23 @@ SimplifyReport ColumnCollapse::Finish(int64_t targetColumns, const std::function
   return this->Stats;
 }
 
+bool ColumnCollapse::Unblock(int64_t& relaxedAt)
+{
+  if (this->Mesh.AliveColumns() == relaxedAt)
+  {
+    return false; // the last round freed nothing
+  }
+  relaxedAt = this->Mesh.AliveColumns();
+  ++this->Stats.relaxations;
+  this->Stalled = true;
+  this->RotateEdges();
+  for (int pass = 0; pass < 3; ++pass)
+  {
+    this->Relax(this->Stats.maxError);
+  }
+  return true;
+}
+
 SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::function<void(double)>& progress)
 {
   ColumnMesh& m = this->Mesh;
@@ -1100,17 +1117,9 @@ SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::functi
       // (Each column is then among the candidates eight times on average.)
       if (++failures > 16 + static_cast<int64_t>(this->AliveList.size()))
       {
-        if (m.AliveColumns() == relaxedAt)
+        if (!this->Unblock(relaxedAt))
         {
           break;
-        }
-        relaxedAt = m.AliveColumns();
-        ++this->Stats.relaxations;
-        this->Stalled = true;
-        this->RotateEdges();
-        for (int pass = 0; pass < 3; ++pass)
-        {
-          this->Relax(this->Stats.maxError);
         }
         failures = 0;
       }
@@ -1160,58 +1169,71 @@ SimplifyReport ColumnCollapse::SimplifyGreedy(int64_t targetColumns, const std::
   std::vector<int32_t> neighbours, touched;
   std::vector<uint8_t> boundary;
   int64_t sinceProgress = 0;
-  while (m.AliveColumns() > targetColumns && !queue.empty())
+  int64_t relaxedAt = -1;
+  for (;;)
   {
-    const Entry top = queue.top();
-    queue.pop();
-    if (top.stamp != stamps[top.column] || !m.IsColumnAlive(top.column))
+    while (m.AliveColumns() > targetColumns && !queue.empty())
     {
-      continue; // superseded
-    }
-    Plan fresh;
-    ++stamps[top.column];
-    if (!this->PlanColumn(top.column, fresh))
-    {
-      continue; // planned again when a neighbour changes
-    }
-    if (!queue.empty() && fresh.cost > queue.top().cost)
-    {
-      queue.push({ fresh.cost, top.column, stamps[top.column] });
-      continue;
-    }
-    // Columns whose plans may change: those within two edges of the nodes this collapse
-    // merges or smooths (a plan smooths its kept nodes over their neighbours).
-    touched.clear();
-    std::vector<int32_t> ring(m.Corners[top.column].begin(), m.Corners[top.column].end());
-    for (int step = 0; step < 2; ++step)
-    {
-      const std::size_t count = ring.size();
-      for (std::size_t i = 0; i < count; ++i)
+      const Entry top = queue.top();
+      queue.pop();
+      if (top.stamp != stamps[top.column] || !m.IsColumnAlive(top.column))
       {
-        m.Neighbours(ring[i], neighbours, boundary);
-        ring.insert(ring.end(), neighbours.begin(), neighbours.end());
+        continue; // superseded
       }
-      std::sort(ring.begin(), ring.end());
-      ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
-    }
-    for (int32_t node : ring)
-    {
-      touched.insert(touched.end(), m.ColumnsOfNode[node].begin(), m.ColumnsOfNode[node].end());
-    }
-    this->Perform(fresh);
-    std::sort(touched.begin(), touched.end());
-    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-    for (int32_t column : touched)
-    {
-      if (m.IsColumnAlive(column) && !m.IsLocked(column))
+      Plan fresh;
+      ++stamps[top.column];
+      if (!this->PlanColumn(top.column, fresh))
       {
-        plan(column);
+        continue; // planned again when a neighbour changes
+      }
+      if (!queue.empty() && fresh.cost > queue.top().cost)
+      {
+        queue.push({ fresh.cost, top.column, stamps[top.column] });
+        continue;
+      }
+      // Columns whose plans may change: those within two edges of the nodes this collapse
+      // merges or smooths (a plan smooths its kept nodes over their neighbours).
+      touched.clear();
+      std::vector<int32_t> ring(m.Corners[top.column].begin(), m.Corners[top.column].end());
+      for (int step = 0; step < 2; ++step)
+      {
+        const std::size_t count = ring.size();
+        for (std::size_t i = 0; i < count; ++i)
+        {
+          m.Neighbours(ring[i], neighbours, boundary);
+          ring.insert(ring.end(), neighbours.begin(), neighbours.end());
+        }
+        std::sort(ring.begin(), ring.end());
+        ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+      }
+      for (int32_t node : ring)
+      {
+        touched.insert(touched.end(), m.ColumnsOfNode[node].begin(), m.ColumnsOfNode[node].end());
+      }
+      this->Perform(fresh);
+      std::sort(touched.begin(), touched.end());
+      touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+      for (int32_t column : touched)
+      {
+        if (m.IsColumnAlive(column) && !m.IsLocked(column))
+        {
+          plan(column);
+        }
+      }
+      if (progress && ++sinceProgress >= 256)
+      {
+        sinceProgress = 0;
+        progress(std::min(1.0, static_cast<double>(this->Stats.columnsBefore - m.AliveColumns()) / static_cast<double>(toRemove)));
       }
     }
-    if (progress && ++sinceProgress >= 256)
+    // Nothing valid is left in the queue: unblock as Simplify does, and plan every column again.
+    if (m.AliveColumns() <= targetColumns || !this->Unblock(relaxedAt))
     {
-      sinceProgress = 0;
-      progress(std::min(1.0, static_cast<double>(this->Stats.columnsBefore - m.AliveColumns()) / static_cast<double>(toRemove)));
+      break;
+    }
+    for (int32_t column : this->AliveList)
+    {
+      plan(column);
     }
   }
   return this->Finish(targetColumns, progress);

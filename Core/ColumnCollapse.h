@@ -126,6 +126,9 @@ private:
   /// boundary), each move kept only if it folds and inverts nothing and costs at most
   /// `allowed`. Returns the number of moves kept.
   int64_t Relax(double allowed);
+  /// When collapses ran out: rotations, then three relaxations; false (nothing done) if the
+  /// last time freed no column (`relaxedAt`, the column count then).
+  bool Unblock(int64_t& relaxedAt);
   /// A node of a locked column: it never moves or merges into another node.
   bool Pinned(int32_t node) const;
   /// Smooths the interior 1-ring of the nodes in Scratch with them (ring plans), logging the

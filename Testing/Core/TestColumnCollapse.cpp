@@ -495,6 +495,11 @@ void TestRealModel()
     static_cast<long long>(smallReport.rotations), static_cast<long long>(smallReport.relaxations));
   CHECK(smallReport.reachedTarget);
   CHECK(resmr::MeasureHexahedra(resmr::ToHexMesh(small), small.Orientation()).inverted == 0);
+  // The greedy selection unblocks the same way.
+  resmr::ColumnMesh greedyMesh = Reek(flags, g);
+  resmr::ColumnCollapse greedy(greedyMesh, 1);
+  CHECK(greedy.SimplifyGreedy(before / 100).reachedTarget);
+  CHECK(resmr::MeasureHexahedra(resmr::ToHexMesh(greedyMesh), greedyMesh.Orientation()).inverted == 0);
 }
 
 void TestLockedColumns()
