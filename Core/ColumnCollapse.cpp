@@ -545,6 +545,11 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
   auto quality = [&](const std::array<int32_t, 4>& q) {
     return std::min(ShapeQuality(m, q, 0), ShapeQuality(m, q, m.LayerCount));
   };
+  // The two columns the diagonal from hexagon[shift] to hexagon[shift + 3] makes.
+  auto split = [&](int shift) {
+    return std::make_pair(std::array<int32_t, 4>{ hexagon[shift], hexagon[shift + 1], hexagon[shift + 2], hexagon[shift + 3] },
+      std::array<int32_t, 4>{ hexagon[shift + 3], hexagon[(shift + 4) % 6], hexagon[(shift + 5) % 6], hexagon[shift] });
+  };
   const double before = std::min(quality(a), quality(b));
   std::vector<int32_t> neighbours;
   std::vector<uint8_t> boundary;
@@ -559,9 +564,8 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
     {
       continue;
     }
-    const std::array<int32_t, 4> first = { hexagon[shift], hexagon[shift + 1], hexagon[shift + 2], hexagon[(shift + 3) % 6] };
-    const std::array<int32_t, 4> second = { hexagon[(shift + 3) % 6], hexagon[(shift + 4) % 6], hexagon[(shift + 5) % 6], hexagon[shift] };
-    const double after = std::min(quality(first), quality(second));
+    const auto columns = split(shift);
+    const double after = std::min(quality(columns.first), quality(columns.second));
     if (after > bestQuality)
     {
       bestQuality = after;
@@ -572,7 +576,6 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
   {
     return false;
   }
-  const int shift = bestShift;
   auto rewire = [&](const std::array<int32_t, 4>& first, const std::array<int32_t, 4>& second) {
     for (int32_t node : hexagon)
     {
@@ -589,10 +592,9 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
       }
     }
   };
-  rewire({ hexagon[shift], hexagon[shift + 1], hexagon[shift + 2], hexagon[(shift + 3) % 6] },
-    { hexagon[(shift + 3) % 6], hexagon[(shift + 4) % 6], hexagon[(shift + 5) % 6], hexagon[shift] });
-  bool valid = !this->FoldsOver(column) && !this->FoldsOver(other) && !this->InvertsCells(column) &&
-    !this->InvertsCells(other);
+  const auto chosen = split(bestShift);
+  rewire(chosen.first, chosen.second);
+  bool valid = this->KeepsShape(column) && this->KeepsShape(other);
   for (int i = 0; i < 6 && valid; ++i)
   {
     valid = this->Manifold(hexagon[i]);
@@ -630,6 +632,26 @@ int64_t ColumnCollapse::RotateEdges()
   return rotations;
 }
 
+ColumnCollapse::MovedNode ColumnCollapse::SaveNode(int32_t node) const
+{
+  const std::size_t first = static_cast<std::size_t>(node) * (this->Mesh.LayerCount + 1) * 3;
+  const auto& positions = this->Mesh.Positions;
+  return { node, this->Mesh.Topology[node],
+    std::vector<double>(positions.begin() + first, positions.begin() + first + (this->Mesh.LayerCount + 1) * 3) };
+}
+
+void ColumnCollapse::RestoreNode(const MovedNode& saved)
+{
+  this->Mesh.Topology[saved.node] = saved.topology;
+  std::copy(saved.positions.begin(), saved.positions.end(),
+    this->Mesh.Positions.begin() + static_cast<std::size_t>(saved.node) * (this->Mesh.LayerCount + 1) * 3);
+}
+
+bool ColumnCollapse::KeepsShape(int32_t column) const
+{
+  return !this->FoldsOver(column) && !this->InvertsCells(column);
+}
+
 bool ColumnCollapse::Pinned(int32_t node) const
 {
   const auto& columns = this->Mesh.ColumnsOfNode[node];
@@ -642,18 +664,14 @@ int64_t ColumnCollapse::Relax(double allowed)
   // collapse folds its neighbours: the simplification stalls far above small targets.
   // Evening the mesh out, within the error already spent, frees them.
   ColumnMesh& m = this->Mesh;
-  const int32_t interfaces = m.LayerCount + 1;
   int64_t moved = 0;
-  std::vector<double> saved;
   for (int32_t node = 0; node < m.NodeCount(); ++node)
   {
     if (!m.IsNodeAlive(node) || m.ColumnsOfNode[node].empty() || this->Pinned(node))
     {
       continue;
     }
-    const std::size_t first = static_cast<std::size_t>(node) * interfaces * 3;
-    saved.assign(m.Positions.begin() + first, m.Positions.begin() + first + interfaces * 3);
-    const std::array<double, 2> topology = m.Topology[node];
+    const MovedNode saved = this->SaveNode(node);
     bool keep;
     if (m.IsBoundaryNode(node))
     {
@@ -667,13 +685,11 @@ int64_t ColumnCollapse::Relax(double allowed)
     }
     for (std::size_t i = 0; keep && i < m.ColumnsOfNode[node].size(); ++i)
     {
-      const int32_t column = m.ColumnsOfNode[node][i];
-      keep = !this->FoldsOver(column) && !this->InvertsCells(column);
+      keep = this->KeepsShape(m.ColumnsOfNode[node][i]);
     }
     if (!keep)
     {
-      std::copy(saved.begin(), saved.end(), m.Positions.begin() + first);
-      m.Topology[node] = topology;
+      this->RestoreNode(saved);
       continue;
     }
     ++moved;
@@ -687,7 +703,6 @@ void ColumnCollapse::SmoothRing(bool smoothSurvivor)
   // are smoothed with them a few times: a Gauss-Seidel sweep that spreads the collapse over
   // the fan around it.
   ColumnMesh& m = this->Mesh;
-  const int32_t interfaces = m.LayerCount + 1;
   const std::size_t centres = this->Scratch.size();
   std::vector<int32_t> neighbours;
   std::vector<uint8_t> boundary;
@@ -708,9 +723,7 @@ void ColumnCollapse::SmoothRing(bool smoothSurvivor)
   }
   for (int32_t node : ring)
   {
-    const std::size_t first = static_cast<std::size_t>(node) * interfaces * 3;
-    this->SavedMoves.push_back(
-      { node, m.Topology[node], std::vector<double>(m.Positions.begin() + first, m.Positions.begin() + first + interfaces * 3) });
+    this->SavedMoves.push_back(this->SaveNode(node));
   }
   for (int sweep = 0; sweep < 3; ++sweep)
   {
@@ -735,8 +748,7 @@ void ColumnCollapse::Undo()
   const int32_t interfaces = m.LayerCount + 1;
   for (const MovedNode& moved : this->SavedMoves)
   {
-    m.Topology[moved.node] = moved.topology;
-    std::copy(moved.positions.begin(), moved.positions.end(), m.Positions.begin() + static_cast<std::size_t>(moved.node) * interfaces * 3);
+    this->RestoreNode(moved);
   }
   this->SavedMoves.clear();
   for (auto it = this->SavedCorners.rbegin(); it != this->SavedCorners.rend(); ++it)

@@ -129,6 +129,8 @@ private:
   /// When collapses ran out: rotations, then three relaxations; false (nothing done) if the
   /// last time freed no column (`relaxedAt`, the column count then).
   bool Unblock(int64_t& relaxedAt);
+  /// Neither folds a face over nor inverts a cell of the column.
+  bool KeepsShape(int32_t column) const;
   /// A node of a locked column: it never moves or merges into another node.
   bool Pinned(int32_t node) const;
   /// Smooths the interior 1-ring of the nodes in Scratch with them (ring plans), logging the
@@ -183,6 +185,8 @@ private:
     std::vector<double> positions;
   };
   std::vector<MovedNode> SavedMoves;  ///< ring nodes a ring plan smoothed
+  MovedNode SaveNode(int32_t node) const;
+  void RestoreNode(const MovedNode& saved);
   bool Stalled = false;               ///< ring plans are tried (set once collapses run out)
   int32_t RemovedColumn = -1;
   std::vector<int32_t> Scratch;
