@@ -224,30 +224,133 @@ bool ColumnCollapse::FoldsOver(int32_t column) const
   return false;
 }
 
+void ColumnCollapse::SaveNodeState(NodeState& state, int32_t node) const
+{
+  const ColumnMesh& m = this->Mesh;
+  const std::size_t interfaces = static_cast<std::size_t>(m.LayerCount) + 1;
+  const std::size_t first = static_cast<std::size_t>(node) * interfaces;
+  state.node = node;
+  state.alive = m.NodeAlive[node];
+  state.topology = m.Topology[node];
+  state.positions.assign(m.Positions.begin() + first * 3, m.Positions.begin() + (first + interfaces) * 3);
+  state.quadrics.assign(m.Quadrics.begin() + first, m.Quadrics.begin() + first + interfaces);
+  state.columns.assign(m.ColumnsOfNode[node].begin(), m.ColumnsOfNode[node].end());
+}
+
+void ColumnCollapse::MergeNode(int32_t node, int32_t into)
+{
+  ColumnMesh& m = this->Mesh;
+  if (node == into)
+  {
+    return;
+  }
+  for (int32_t k = 0; k <= m.LayerCount; ++k)
+  {
+    m.NodeQuadric(into, k) += m.NodeQuadric(node, k);
+  }
+  for (int32_t column : m.ColumnsOfNode[node])
+  {
+    this->SavedCorners.push_back({ column, m.Corners[column] });
+    std::replace(m.Corners[column].begin(), m.Corners[column].end(), node, into);
+    auto& list = m.ColumnsOfNode[into];
+    if (std::find(list.begin(), list.end(), column) == list.end())
+    {
+      list.push_back(column);
+    }
+  }
+  m.ColumnsOfNode[node].clear();
+  m.NodeAlive[node] = 0;
+}
+
+void ColumnCollapse::PlaceAtAverage(int32_t node, const NodeState* const* states, int count)
+{
+  ColumnMesh& m = this->Mesh;
+  const double weight = 1.0 / count;
+  std::array<double, 2> topology = { 0, 0 };
+  for (int i = 0; i < count; ++i)
+  {
+    topology[0] += states[i]->topology[0] * weight;
+    topology[1] += states[i]->topology[1] * weight;
+  }
+  double above = 0;
+  for (int32_t k = 0; k <= m.LayerCount; ++k)
+  {
+    glm::dvec3 average(0.0);
+    DepthBounds bounds;
+    for (int i = 0; i < count; ++i)
+    {
+      const std::vector<double>& p = states[i]->positions;
+      const glm::dvec3 at(p[k * 3], p[k * 3 + 1], p[k * 3 + 2]);
+      average += at * weight;
+      bounds.Add(at.z, k > 0 ? p[(k - 1) * 3 + 2] : at.z);
+    }
+    average.z = this->PlaceDepth(node, k, average, bounds, above);
+    above = average.z;
+    m.SetPosition(node, k, average);
+  }
+  m.Topology[node] = topology;
+}
+
+bool ColumnCollapse::TopologyValidAt(int32_t node) const
+{
+  for (int32_t column : this->Mesh.ColumnsOfNode[node])
+  {
+    auto q = this->Mesh.Corners[column];
+    std::sort(q.begin(), q.end());
+    if (std::adjacent_find(q.begin(), q.end()) != q.end())
+    {
+      return false;
+    }
+  }
+  return this->Manifold(node);
+}
+
+bool ColumnCollapse::ShapeKeptAround(const std::vector<int32_t>& nodes)
+{
+  const ColumnMesh& m = this->Mesh;
+  std::vector<int32_t>& around = this->Around;
+  around.clear();
+  for (int32_t node : nodes)
+  {
+    around.insert(around.end(), m.ColumnsOfNode[node].begin(), m.ColumnsOfNode[node].end());
+  }
+  std::sort(around.begin(), around.end());
+  around.erase(std::unique(around.begin(), around.end()), around.end());
+  for (int32_t column : around)
+  {
+    if (this->FoldsOver(column))
+    {
+      ++this->Stats.rejectedFoldOver;
+      return false;
+    }
+  }
+  for (int32_t column : around)
+  {
+    if (this->InvertsCells(column))
+    {
+      ++this->Stats.rejectedInverted;
+      return false;
+    }
+  }
+  return true;
+}
+
 bool ColumnCollapse::Apply(const Plan& plan, double& cost)
 {
   ColumnMesh& m = this->Mesh;
   const int32_t c = plan.column;
-  const int32_t interfaces = m.LayerCount + 1;
   const auto corners = m.Corners[c];
   this->SavedCorners.clear();
   this->SavedMoves.clear();
+  this->Pending = true;
   // The four saved states keep their buffers from one plan to the next: planning tries
   // several options for each of many candidates, and allocation dominated it.
   this->SavedNodes.resize(4);
   for (int i = 0; i < 4; ++i)
   {
-    NodeState& state = this->SavedNodes[i];
-    const int32_t node = corners[i];
-    state.node = node;
-    state.alive = m.NodeAlive[node];
-    state.topology = m.Topology[node];
-    const std::size_t first = static_cast<std::size_t>(node) * interfaces;
-    state.positions.assign(m.Positions.begin() + first * 3, m.Positions.begin() + (first + interfaces) * 3);
-    state.quadrics.assign(m.Quadrics.begin() + first, m.Quadrics.begin() + first + interfaces);
-    state.columns.assign(m.ColumnsOfNode[node].begin(), m.ColumnsOfNode[node].end());
+    this->SaveNodeState(this->SavedNodes[i], corners[i]);
   }
-  this->RemovedColumn = c;
+  this->RemovedColumns.assign(1, c);
 
   // The column goes; the merged nodes become the survivor (and for a strip collapse, the
   // second pair becomes a second survivor).
@@ -277,50 +380,17 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
       return false;
     }
   }
-  auto mergeInto = [&](const int32_t* nodes, int count, int32_t into) {
-    for (int i = 0; i < count; ++i)
-    {
-      const int32_t node = nodes[i];
-      if (node == into)
-      {
-        continue;
-      }
-      for (int32_t k = 0; k < interfaces; ++k)
-      {
-        m.NodeQuadric(into, k) += m.NodeQuadric(node, k);
-      }
-      for (int32_t column : m.ColumnsOfNode[node])
-      {
-        this->SavedCorners.push_back({ column, m.Corners[column] });
-        std::replace(m.Corners[column].begin(), m.Corners[column].end(), node, into);
-        auto& list = m.ColumnsOfNode[into];
-        if (std::find(list.begin(), list.end(), column) == list.end())
-        {
-          list.push_back(column);
-        }
-      }
-      m.ColumnsOfNode[node].clear();
-      m.NodeAlive[node] = 0;
-    }
-  };
-  mergeInto(plan.merged, plan.mergedCount, survivor);
-  if (plan.op == Strip)
+  for (int i = 0; i < plan.mergedCount; ++i)
   {
-    mergeInto(plan.mergedSecond, 2, plan.placeSecondAt);
+    this->MergeNode(plan.merged[i], survivor);
+  }
+  for (int i = 0; i < 2 && plan.op == Strip; ++i)
+  {
+    this->MergeNode(plan.mergedSecond[i], plan.placeSecondAt);
   }
 
   // Topology first: no column may repeat a node, and nodes must stay manifold.
-  bool valid = true;
-  for (int32_t node : { survivor, plan.op == Strip ? plan.placeSecondAt : survivor })
-  {
-    for (int32_t column : m.ColumnsOfNode[node])
-    {
-      auto q = m.Corners[column];
-      std::sort(q.begin(), q.end());
-      valid = valid && std::adjacent_find(q.begin(), q.end()) == q.end();
-    }
-    valid = valid && this->Manifold(node);
-  }
+  bool valid = this->TopologyValidAt(survivor) && (plan.op != Strip || this->TopologyValidAt(plan.placeSecondAt));
   for (int i = 0; i < plan.keptCount && valid; ++i)
   {
     valid = this->Manifold(plan.kept[i]);
@@ -339,32 +409,16 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
   else if (plan.placeAt < 0)
   {
     // Midpoint of the merged nodes (as they were), z at the quadric minimum.
-    const double weight = 1.0 / plan.mergedCount;
-    std::array<double, 2> topology = { 0, 0 };
-    double above = 0;
-    for (int32_t k = 0; k < interfaces; ++k)
+    const NodeState* merged[3];
+    int count = 0;
+    for (const NodeState& state : this->SavedNodes)
     {
-      glm::dvec3 average(0.0);
-      DepthBounds bounds;
-      for (const NodeState& state : this->SavedNodes)
+      if (std::find(plan.merged, plan.merged + plan.mergedCount, state.node) != plan.merged + plan.mergedCount)
       {
-        if (std::find(plan.merged, plan.merged + plan.mergedCount, state.node) != plan.merged + plan.mergedCount)
-        {
-          const glm::dvec3 p(state.positions[k * 3], state.positions[k * 3 + 1], state.positions[k * 3 + 2]);
-          average += p * weight;
-          bounds.Add(p.z, k > 0 ? state.positions[(k - 1) * 3 + 2] : p.z);
-          if (k == 0)
-          {
-            topology[0] += state.topology[0] * weight;
-            topology[1] += state.topology[1] * weight;
-          }
-        }
+        merged[count++] = &state;
       }
-      average.z = this->PlaceDepth(survivor, k, average, bounds, above);
-      above = average.z;
-      m.SetPosition(survivor, k, average);
     }
-    m.Topology[survivor] = topology;
+    this->PlaceAtAverage(survivor, merged, count);
   }
   this->Scratch.assign(1, survivor);
   if (plan.op == Strip)
@@ -395,33 +449,7 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
       this->Scratch.push_back(plan.kept[i]);
     }
   }
-  // Each column around the moved nodes once: the fold test for all of them first (cheap,
-  // and where most rejections happen), then the inversion test.
-  std::vector<int32_t>& around = this->Around;
-  around.clear();
-  for (int32_t node : this->Scratch)
-  {
-    around.insert(around.end(), m.ColumnsOfNode[node].begin(), m.ColumnsOfNode[node].end());
-  }
-  std::sort(around.begin(), around.end());
-  around.erase(std::unique(around.begin(), around.end()), around.end());
-  for (int32_t column : around)
-  {
-    if (this->FoldsOver(column))
-    {
-      ++this->Stats.rejectedFoldOver;
-      return false;
-    }
-  }
-  for (int32_t column : around)
-  {
-    if (this->InvertsCells(column))
-    {
-      ++this->Stats.rejectedInverted;
-      return false;
-    }
-  }
-  return true;
+  return this->ShapeKeptAround(this->Scratch);
 }
 
 double ColumnCollapse::NodeError(int32_t node) const
@@ -506,12 +534,12 @@ double ShapeQuality(const ColumnMesh& m, const std::array<int32_t, 4>& q, int32_
 }
 } // namespace
 
-bool ColumnCollapse::RotateEdge(int32_t column, int corner)
+bool ColumnCollapse::EdgeHexagon(int32_t column, int corner, int32_t& other, int32_t hexagon[6]) const
 {
-  ColumnMesh& m = this->Mesh;
-  const auto a = m.Corners[column];
+  const ColumnMesh& m = this->Mesh;
+  const auto& a = m.Corners[column];
   const int32_t h = a[corner], x = a[(corner + 1) % 4];
-  int32_t other = -1;
+  other = -1;
   int at = -1;
   for (int32_t candidate : m.ColumnsOfNode[h])
   {
@@ -529,26 +557,63 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
   {
     return false;
   }
-  const auto b = m.Corners[other];
+  const auto& b = m.Corners[other];
   // The hexagon of the two columns, in their orientation: h, b2, b3, x, a2, a3.
-  const int32_t hexagon[6] = { h, b[(at + 2) % 4], b[(at + 3) % 4], x, a[(corner + 2) % 4], a[(corner + 3) % 4] };
+  const int32_t nodes[6] = { h, b[(at + 2) % 4], b[(at + 3) % 4], x, a[(corner + 2) % 4], a[(corner + 3) % 4] };
   for (int i = 0; i < 6; ++i)
   {
-    for (int j = i + 1; j < 6; ++j)
+    hexagon[i] = nodes[i];
+    for (int j = 0; j < i; ++j)
     {
-      if (hexagon[i] == hexagon[j])
+      if (nodes[i] == nodes[j])
       {
         return false;
       }
     }
   }
+  return true;
+}
+
+std::pair<std::array<int32_t, 4>, std::array<int32_t, 4>> ColumnCollapse::SplitHexagon(const int32_t hexagon[6], int shift)
+{
+  // The two columns the diagonal from hexagon[shift] to hexagon[shift + 3] makes.
+  return { { hexagon[shift], hexagon[shift + 1], hexagon[shift + 2], hexagon[shift + 3] },
+    { hexagon[shift + 3], hexagon[(shift + 4) % 6], hexagon[(shift + 5) % 6], hexagon[shift] } };
+}
+
+void ColumnCollapse::Rewire(int32_t column, int32_t other, const int32_t hexagon[6], const std::array<int32_t, 4>& first,
+  const std::array<int32_t, 4>& second)
+{
+  ColumnMesh& m = this->Mesh;
+  for (int i = 0; i < 6; ++i)
+  {
+    auto& list = m.ColumnsOfNode[hexagon[i]];
+    list.erase(std::remove_if(list.begin(), list.end(), [&](int32_t c) { return c == column || c == other; }), list.end());
+  }
+  m.Corners[column] = first;
+  m.Corners[other] = second;
+  for (int32_t c : { column, other })
+  {
+    for (int32_t node : m.Corners[c])
+    {
+      m.ColumnsOfNode[node].push_back(c);
+    }
+  }
+}
+
+bool ColumnCollapse::RotateEdge(int32_t column, int corner)
+{
+  ColumnMesh& m = this->Mesh;
+  int32_t other = -1;
+  int32_t hexagon[6];
+  if (!this->EdgeHexagon(column, corner, other, hexagon))
+  {
+    return false;
+  }
+  const auto a = m.Corners[column];
+  const auto b = m.Corners[other];
   auto quality = [&](const std::array<int32_t, 4>& q) {
     return std::min(ShapeQuality(m, q, 0), ShapeQuality(m, q, m.LayerCount));
-  };
-  // The two columns the diagonal from hexagon[shift] to hexagon[shift + 3] makes.
-  auto split = [&](int shift) {
-    return std::make_pair(std::array<int32_t, 4>{ hexagon[shift], hexagon[shift + 1], hexagon[shift + 2], hexagon[shift + 3] },
-      std::array<int32_t, 4>{ hexagon[shift + 3], hexagon[(shift + 4) % 6], hexagon[(shift + 5) % 6], hexagon[shift] });
   };
   const double before = std::min(quality(a), quality(b));
   std::vector<int32_t> neighbours;
@@ -564,7 +629,7 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
     {
       continue;
     }
-    const auto columns = split(shift);
+    const auto columns = SplitHexagon(hexagon, shift);
     const double after = std::min(quality(columns.first), quality(columns.second));
     if (after > bestQuality)
     {
@@ -576,24 +641,8 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
   {
     return false;
   }
-  auto rewire = [&](const std::array<int32_t, 4>& first, const std::array<int32_t, 4>& second) {
-    for (int32_t node : hexagon)
-    {
-      auto& list = m.ColumnsOfNode[node];
-      list.erase(std::remove_if(list.begin(), list.end(), [&](int32_t c) { return c == column || c == other; }), list.end());
-    }
-    m.Corners[column] = first;
-    m.Corners[other] = second;
-    for (int32_t c : { column, other })
-    {
-      for (int32_t node : m.Corners[c])
-      {
-        m.ColumnsOfNode[node].push_back(c);
-      }
-    }
-  };
-  const auto chosen = split(bestShift);
-  rewire(chosen.first, chosen.second);
+  const auto chosen = SplitHexagon(hexagon, bestShift);
+  this->Rewire(column, other, hexagon, chosen.first, chosen.second);
   bool valid = this->KeepsShape(column) && this->KeepsShape(other);
   for (int i = 0; i < 6 && valid; ++i)
   {
@@ -601,7 +650,7 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
   }
   if (!valid)
   {
-    rewire(a, b);
+    this->Rewire(column, other, hexagon, a, b);
     return false;
   }
   // Each new column covers parts of both old ones: a layer is active in it where it was in
@@ -613,6 +662,74 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
     first = second = (first || second) ? 1 : 0;
   }
   return true;
+}
+
+bool ColumnCollapse::MergeAlongBoundary(int32_t column, int corner)
+{
+  // The pair becomes one column and a column of three boundary nodes in a row (a straight
+  // corner), which the corner operator removes: the boundary loses two nodes.
+  ColumnMesh& m = this->Mesh;
+  int32_t other = -1;
+  int32_t hexagon[6];
+  if (!this->EdgeHexagon(column, corner, other, hexagon) || !m.IsBoundaryNode(hexagon[0]))
+  {
+    return false;
+  }
+  const auto a = m.Corners[column];
+  const auto b = m.Corners[other];
+  std::vector<uint8_t> activeA(m.ActiveCells.begin() + static_cast<std::ptrdiff_t>(column) * m.LayerCount,
+    m.ActiveCells.begin() + static_cast<std::ptrdiff_t>(column + 1) * m.LayerCount);
+  std::vector<int32_t> neighbours;
+  std::vector<uint8_t> boundary;
+  for (int shift = 1; shift <= 2; ++shift)
+  {
+    const int32_t from = hexagon[shift], to = hexagon[shift + 3];
+    m.Neighbours(from, neighbours, boundary);
+    if (std::find(neighbours.begin(), neighbours.end(), to) != neighbours.end())
+    {
+      continue;
+    }
+    const auto columns = SplitHexagon(hexagon, shift);
+    this->Rewire(column, other, hexagon, columns.first, columns.second);
+    bool valid = true;
+    for (int i = 0; i < 6 && valid; ++i)
+    {
+      valid = this->Manifold(hexagon[i]);
+    }
+    // The new column holding h and both its boundary neighbours goes by the corner operator
+    // (its straight corner at h would not pass a shape test on its own; the corner
+    // collapse's own tests judge the result, which includes the other column).
+    for (int32_t corners : { column, other })
+    {
+      Plan plan;
+      if (valid && IndexOf(m.Corners[corners], hexagon[0]) >= 0 && this->PlanColumn(corners, plan) && plan.op == Corner)
+      {
+        const int32_t kept = corners == column ? other : column;
+        for (int32_t k = 0; k < m.LayerCount; ++k)
+        {
+          uint8_t& flag = m.ActiveCells[static_cast<std::size_t>(kept) * m.LayerCount + k];
+          flag = (flag || activeA[k] || m.ActiveCells[static_cast<std::size_t>(other) * m.LayerCount + k]) ? 1 : 0;
+        }
+        this->Perform(plan);
+        return true;
+      }
+    }
+    this->Rewire(column, other, hexagon, a, b);
+  }
+  return false;
+}
+
+int64_t ColumnCollapse::MergeAlongBoundaries(int64_t targetColumns)
+{
+  const int64_t before = this->Mesh.AliveColumns();
+  for (int32_t column = 0; column < this->Mesh.ColumnSlots() && this->Mesh.AliveColumns() > targetColumns; ++column)
+  {
+    for (int corner = 0; corner < 4 && this->Mesh.IsColumnAlive(column) && this->Mesh.AliveColumns() > targetColumns; ++corner)
+    {
+      this->MergeAlongBoundary(column, corner);
+    }
+  }
+  return before - this->Mesh.AliveColumns();
 }
 
 int64_t ColumnCollapse::RotateEdges()
@@ -744,6 +861,11 @@ void ColumnCollapse::SmoothRing(bool smoothSurvivor)
 
 void ColumnCollapse::Undo()
 {
+  if (!this->Pending)
+  {
+    return; // undone or committed already
+  }
+  this->Pending = false;
   ColumnMesh& m = this->Mesh;
   const int32_t interfaces = m.LayerCount + 1;
   for (const MovedNode& moved : this->SavedMoves)
@@ -764,27 +886,33 @@ void ColumnCollapse::Undo()
     std::copy(state.quadrics.begin(), state.quadrics.end(), m.Quadrics.begin() + first);
     m.ColumnsOfNode[state.node].swap(state.columns);
   }
-  m.ColumnAlive[this->RemovedColumn] = 1;
-  ++m.AliveColumnCount;
+  for (int32_t column : this->RemovedColumns)
+  {
+    m.ColumnAlive[column] = 1;
+    ++m.AliveColumnCount;
+  }
   this->SavedCorners.clear();
-  this->RemovedColumn = -1;
+  this->RemovedColumns.clear();
 }
 
 void ColumnCollapse::Commit()
 {
-  const int32_t c = this->RemovedColumn;
-  if (c >= 0 && this->AliveIndex[c] >= 0)
+  this->Pending = false;
+  for (int32_t c : this->RemovedColumns)
   {
-    const int32_t at = this->AliveIndex[c];
-    const int32_t last = this->AliveList.back();
-    this->AliveList[at] = last;
-    this->AliveIndex[last] = at;
-    this->AliveList.pop_back();
-    this->AliveIndex[c] = -1;
+    if (this->AliveIndex[c] >= 0)
+    {
+      const int32_t at = this->AliveIndex[c];
+      const int32_t last = this->AliveList.back();
+      this->AliveList[at] = last;
+      this->AliveIndex[last] = at;
+      this->AliveList.pop_back();
+      this->AliveIndex[c] = -1;
+    }
   }
   this->SavedMoves.clear();
   this->SavedCorners.clear();
-  this->RemovedColumn = -1;
+  this->RemovedColumns.clear();
 }
 
 void ColumnCollapse::TryOption(const Plan& option, Plan& best, bool& found)
@@ -1071,6 +1199,355 @@ void ColumnCollapse::RemoveDoublets(std::vector<int32_t> worklist)
   }
 }
 
+bool ColumnCollapse::TraceChord(int32_t column, int axis, ChordPath& chord, std::vector<uint8_t>* visited) const
+{
+  const ColumnMesh& m = this->Mesh;
+  chord.columns.clear();
+  chord.edges.clear();
+  chord.closed = false;
+  // The column across edge `e` of column `c` and the index of that edge in it, or -1.
+  auto across = [&m](int32_t c, int e, int& entry) {
+    const auto& q = m.Corners[c];
+    const int32_t u = q[e], v = q[(e + 1) % 4];
+    for (int32_t other : m.ColumnsOfNode[u])
+    {
+      const auto& o = m.Corners[other];
+      for (int f = 0; other != c && f < 4; ++f)
+      {
+        if (o[f] == v && o[(f + 1) % 4] == u)
+        {
+          entry = f;
+          return other;
+        }
+      }
+    }
+    return -1;
+  };
+  // Back to one end (a boundary edge), or round to the column again along the same axis.
+  int32_t start = column;
+  int in = axis;
+  const int64_t limit = 2 * static_cast<int64_t>(m.ColumnSlots()) + 2;
+  for (int64_t step = 0;; ++step)
+  {
+    int entry = -1;
+    const int32_t previous = across(start, in, entry);
+    if (previous < 0)
+    {
+      break;
+    }
+    if (step > limit)
+    {
+      return false;
+    }
+    if (previous == column && entry % 2 == axis % 2)
+    {
+      chord.closed = true;
+      start = column;
+      in = axis;
+      break;
+    }
+    start = previous;
+    in = (entry + 2) % 4;
+  }
+  // Forward from there, each column entered through edge `in` and left through `in + 2`.
+  int32_t c = start;
+  const int startAxis = in % 2;
+  const auto& first = m.Corners[c];
+  chord.edges.push_back({ first[in], first[(in + 1) % 4] });
+  for (;;)
+  {
+    if (std::find(chord.columns.begin(), chord.columns.end(), c) != chord.columns.end() || m.IsLocked(c) ||
+      (m.IsBoundaryEdge(c, (in + 1) % 4) && m.IsBoundaryEdge(c, (in + 3) % 4)))
+    {
+      // Crosses itself or a locked column, or runs through a column with no neighbour on
+      // either side, which would vanish with nothing to take its place (a strip of a model
+      // one column wide, or a whole fault block).
+      return false;
+    }
+    chord.columns.push_back(c);
+    if (visited)
+    {
+      (*visited)[static_cast<std::size_t>(c) * 2 + in % 2] = 1;
+    }
+    const auto& q = m.Corners[c];
+    const int out = (in + 2) % 4;
+    int entry = -1;
+    const int32_t next = across(c, out, entry);
+    if (next == start && chord.closed && entry % 2 == startAxis)
+    {
+      break; // the loop closes on the first edge
+    }
+    chord.edges.push_back({ q[out], q[(out + 1) % 4] });
+    if (next < 0)
+    {
+      break;
+    }
+    c = next;
+    in = entry;
+  }
+  std::vector<int32_t> nodes;
+  for (const auto& edge : chord.edges)
+  {
+    nodes.push_back(edge[0]);
+    nodes.push_back(edge[1]);
+  }
+  std::sort(nodes.begin(), nodes.end());
+  return std::adjacent_find(nodes.begin(), nodes.end()) == nodes.end();
+}
+
+bool ColumnCollapse::ApplyChord(const ChordPath& chord, bool ring, double& cost)
+{
+  ColumnMesh& m = this->Mesh;
+  this->SavedCorners.clear();
+  this->SavedMoves.clear();
+  this->Pending = true;
+  const std::size_t edgeCount = chord.edges.size();
+  this->SavedNodes.resize(2 * edgeCount);
+  // How each crossed edge becomes one node, decided on the mesh as it is: the survivor is
+  // a pinned node (placed at itself), else a boundary node (an end of an open chord, a
+  // boundary edge, chooses between its nodes and their midpoint), else the midpoint,
+  // smoothed.
+  enum Placement
+  {
+    AtSurvivor,
+    AlongBoundary,
+    Smoothed
+  };
+  struct Collapse
+  {
+    int32_t survivor, other;
+    Placement placement;
+  };
+  std::vector<Collapse> collapses;
+  this->RemovedColumns.clear();
+  for (std::size_t e = 0; e < edgeCount; ++e)
+  {
+    const int32_t a = chord.edges[e][0], b = chord.edges[e][1];
+    this->SaveNodeState(this->SavedNodes[2 * e], a);
+    this->SaveNodeState(this->SavedNodes[2 * e + 1], b);
+    const bool pinnedA = this->Pinned(a), pinnedB = this->Pinned(b);
+    const bool boundaryA = m.IsBoundaryNode(a), boundaryB = m.IsBoundaryNode(b);
+    const bool end = !chord.closed && (e == 0 || e + 1 == edgeCount);
+    if ((pinnedA && pinnedB) || (pinnedA && boundaryB && !boundaryA) || (pinnedB && boundaryA && !boundaryB) ||
+      (boundaryA && boundaryB && !end))
+    {
+      // Two pinned nodes cannot merge, a boundary node must not be pulled inside, and an
+      // inner edge between two boundary nodes would join two stretches of the boundary.
+      ++this->Stats.rejectedTopology;
+      this->SavedNodes.resize(2 * e + 2);
+      return false;
+    }
+    if (pinnedA || pinnedB)
+    {
+      collapses.push_back({ pinnedA ? a : b, pinnedA ? b : a, AtSurvivor });
+    }
+    else if (boundaryA && boundaryB)
+    {
+      collapses.push_back({ a, b, AlongBoundary });
+    }
+    else if (boundaryA || boundaryB)
+    {
+      collapses.push_back({ boundaryA ? a : b, boundaryA ? b : a, AtSurvivor });
+    }
+    else
+    {
+      collapses.push_back({ a, b, Smoothed });
+    }
+  }
+  this->RemovedColumns.assign(chord.columns.begin(), chord.columns.end());
+  for (int32_t c : chord.columns)
+  {
+    m.ColumnAlive[c] = 0;
+    --m.AliveColumnCount;
+    for (int32_t node : m.Corners[c])
+    {
+      auto& list = m.ColumnsOfNode[node];
+      list.erase(std::remove(list.begin(), list.end(), c), list.end());
+    }
+  }
+  for (const Collapse& collapse : collapses)
+  {
+    this->MergeNode(collapse.other, collapse.survivor);
+  }
+  for (const Collapse& collapse : collapses)
+  {
+    if (m.ColumnsOfNode[collapse.survivor].empty() || !this->TopologyValidAt(collapse.survivor))
+    {
+      ++this->Stats.rejectedTopology;
+      return false;
+    }
+  }
+  // Placement: the midpoints first, then the boundary ends at whichever of their midpoint
+  // and nodes costs least, then the interior survivors smoothed together a few times.
+  this->Scratch.clear();
+  for (std::size_t e = 0; e < edgeCount; ++e)
+  {
+    const Collapse& collapse = collapses[e];
+    if (collapse.placement == AtSurvivor)
+    {
+      continue;
+    }
+    const NodeState* pair[2] = { &this->SavedNodes[2 * e], &this->SavedNodes[2 * e + 1] };
+    this->PlaceAtAverage(collapse.survivor, pair, 2);
+    this->Scratch.push_back(collapse.survivor);
+    if (collapse.placement == AlongBoundary)
+    {
+      const MovedNode middle = this->SaveNode(collapse.survivor);
+      double best = this->NodeError(collapse.survivor);
+      const NodeState* bestAt = nullptr;
+      for (const NodeState* at : pair)
+      {
+        std::copy(at->positions.begin(), at->positions.end(),
+          m.Positions.begin() + static_cast<std::size_t>(collapse.survivor) * (m.LayerCount + 1) * 3);
+        const double error = this->NodeError(collapse.survivor);
+        if (error < best)
+        {
+          best = error;
+          bestAt = at;
+        }
+      }
+      this->RestoreNode(middle);
+      if (bestAt)
+      {
+        std::copy(bestAt->positions.begin(), bestAt->positions.end(),
+          m.Positions.begin() + static_cast<std::size_t>(collapse.survivor) * (m.LayerCount + 1) * 3);
+        m.Topology[collapse.survivor] = bestAt->topology;
+      }
+    }
+  }
+  for (int sweep = 0; sweep < 3; ++sweep)
+  {
+    for (const Collapse& collapse : collapses)
+    {
+      if (collapse.placement == Smoothed)
+      {
+        this->Smooth(collapse.survivor);
+      }
+    }
+  }
+  if (ring)
+  {
+    this->SmoothRing(true);
+  }
+  cost = 0;
+  for (int32_t node : this->Scratch)
+  {
+    cost = std::max(cost, this->NodeError(node));
+  }
+  for (const Collapse& collapse : collapses)
+  {
+    if (collapse.placement == AtSurvivor)
+    {
+      cost = std::max(cost, this->NodeError(collapse.survivor));
+      this->Scratch.push_back(collapse.survivor);
+    }
+  }
+  return this->ShapeKeptAround(this->Scratch);
+}
+
+int64_t ColumnCollapse::PerformChord(const ChordPath& chord)
+{
+  double cost = 0, ringCost = 0;
+  const bool plain = this->ApplyChord(chord, false, cost);
+  this->Undo();
+  const bool ringed = this->ApplyChord(chord, true, ringCost);
+  this->Undo();
+  if (!plain && !ringed)
+  {
+    return 0;
+  }
+  if (!this->ApplyChord(chord, ringed && (!plain || ringCost < cost), cost))
+  {
+    this->Undo(); // not reached: the same chord was valid a moment ago
+    return 0;
+  }
+  const std::vector<int32_t> survivors = this->Scratch;
+  const int64_t removed = static_cast<int64_t>(this->RemovedColumns.size());
+  this->Commit();
+  ++this->Stats.collapses;
+  ++this->Stats.operatorCounts[Chord];
+  this->Stats.maxError = std::max(this->Stats.maxError, cost);
+  std::vector<int32_t> worklist = survivors;
+  std::vector<int32_t> neighbours;
+  std::vector<uint8_t> boundary;
+  for (int32_t node : survivors)
+  {
+    this->Mesh.Neighbours(node, neighbours, boundary);
+    worklist.insert(worklist.end(), neighbours.begin(), neighbours.end());
+  }
+  this->RemoveDoublets(std::move(worklist));
+  return removed;
+}
+
+int64_t ColumnCollapse::CollapseChord(int32_t column, int axis)
+{
+  ChordPath chord;
+  if (column < 0 || column >= this->Mesh.ColumnSlots() || !this->Mesh.IsColumnAlive(column) ||
+    !this->TraceChord(column, axis & 1, chord, nullptr))
+  {
+    return 0;
+  }
+  return this->PerformChord(chord);
+}
+
+int64_t ColumnCollapse::CollapseChords(int64_t targetColumns)
+{
+  // Every chord once (the visited flags), weighed by the cheaper of its two ways.
+  ColumnMesh& m = this->Mesh;
+  struct Candidate
+  {
+    double cost;
+    int32_t column;
+    int axis;
+    bool operator<(const Candidate& other) const
+    {
+      return this->cost != other.cost ? this->cost < other.cost : this->column < other.column;
+    }
+  };
+  std::vector<Candidate> candidates;
+  std::vector<uint8_t> visited(static_cast<std::size_t>(m.ColumnSlots()) * 2, 0);
+  ChordPath chord;
+  for (int32_t column : this->AliveList)
+  {
+    for (int axis = 0; axis < 2; ++axis)
+    {
+      if (visited[static_cast<std::size_t>(column) * 2 + axis] || !this->TraceChord(column, axis, chord, &visited))
+      {
+        continue;
+      }
+      double cost = 0, ringCost = 0;
+      const bool plain = this->ApplyChord(chord, false, cost);
+      this->Undo();
+      const bool ringed = this->ApplyChord(chord, true, ringCost);
+      this->Undo();
+      if (plain || ringed)
+      {
+        candidates.push_back({ plain && ringed ? std::min(cost, ringCost) : (plain ? cost : ringCost), column, axis });
+      }
+    }
+  }
+  std::sort(candidates.begin(), candidates.end());
+  // Chords cost more than column collapses do: a few go, then collapses resume around them.
+  const int64_t budget = std::max<int64_t>(1, (m.AliveColumns() - targetColumns) / 4);
+  int64_t removed = 0;
+  for (const Candidate& candidate : candidates)
+  {
+    if (m.AliveColumns() <= targetColumns || removed >= budget)
+    {
+      break;
+    }
+    // Earlier chords changed the mesh: trace again; one longer than what is left to remove
+    // goes only if nothing else did.
+    if (!m.IsColumnAlive(candidate.column) || !this->TraceChord(candidate.column, candidate.axis, chord, nullptr) ||
+      (removed > 0 && static_cast<int64_t>(chord.columns.size()) > m.AliveColumns() - targetColumns))
+    {
+      continue;
+    }
+    removed += this->PerformChord(chord);
+  }
+  return removed;
+}
+
 SimplifyReport ColumnCollapse::Finish(int64_t targetColumns, const std::function<void(double)>& progress)
 {
   this->Stats.columnsAfter = this->Mesh.AliveColumns();
@@ -1082,11 +1559,13 @@ SimplifyReport ColumnCollapse::Finish(int64_t targetColumns, const std::function
   return this->Stats;
 }
 
-bool ColumnCollapse::Unblock(int64_t& relaxedAt)
+bool ColumnCollapse::Unblock(int64_t& relaxedAt, int64_t targetColumns)
 {
   if (this->Mesh.AliveColumns() == relaxedAt)
   {
-    return false; // the last round freed nothing
+    // Rotations and smoothing freed nothing last time: boundary slivers in pairs, chords.
+    const int64_t merged = this->MergeAlongBoundaries(targetColumns);
+    return merged + (this->Mesh.AliveColumns() > targetColumns ? this->CollapseChords(targetColumns) : 0) > 0;
   }
   relaxedAt = this->Mesh.AliveColumns();
   ++this->Stats.relaxations;
@@ -1097,6 +1576,35 @@ bool ColumnCollapse::Unblock(int64_t& relaxedAt)
     this->Relax(this->Stats.maxError);
   }
   return true;
+}
+
+int64_t ColumnCollapse::SweepCollapses(int64_t targetColumns)
+{
+  std::vector<std::pair<double, int32_t>> valid;
+  for (int32_t column : this->AliveList)
+  {
+    Plan plan;
+    if (this->PlanColumn(column, plan))
+    {
+      valid.emplace_back(plan.cost, column);
+    }
+  }
+  std::sort(valid.begin(), valid.end());
+  int64_t performed = 0;
+  for (const auto& entry : valid)
+  {
+    Plan plan;
+    if (this->Mesh.AliveColumns() <= targetColumns)
+    {
+      break;
+    }
+    if (this->PlanColumn(entry.second, plan)) // again: the collapses before changed the mesh
+    {
+      this->Perform(plan);
+      ++performed;
+    }
+  }
+  return performed;
 }
 
 SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::function<void(double)>& progress)
@@ -1124,16 +1632,17 @@ SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::functi
     }
     if (!found)
     {
-      // Nothing valid among these candidates. Once every column has had many chances, even
-      // the mesh out and go on; give up when that freed nothing since the last time.
-      // (Each column is then among the candidates eight times on average.)
-      if (++failures > 16 + static_cast<int64_t>(this->AliveList.size()))
+      // Nothing valid among these candidates. Sixteen times in a row: valid collapses have
+      // become rare, and drawing at random until every column has had its chances would
+      // cost eight plans a column. Plan each column once instead and perform what is valid;
+      // when nothing is, unblock, and give up when that frees nothing.
+      if (++failures >= 16)
       {
-        if (!this->Unblock(relaxedAt))
+        failures = 0;
+        if (this->SweepCollapses(targetColumns) == 0 && !this->Unblock(relaxedAt, targetColumns))
         {
           break;
         }
-        failures = 0;
       }
       continue;
     }
@@ -1239,7 +1748,7 @@ SimplifyReport ColumnCollapse::SimplifyGreedy(int64_t targetColumns, const std::
       }
     }
     // Nothing valid is left in the queue: unblock as Simplify does, and plan every column again.
-    if (m.AliveColumns() <= targetColumns || !this->Unblock(relaxedAt))
+    if (m.AliveColumns() <= targetColumns || !this->Unblock(relaxedAt, targetColumns))
     {
       break;
     }

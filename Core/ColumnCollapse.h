@@ -1,11 +1,12 @@
 // Column-collapse simplification of a reservoir hexahedral mesh (paper Sec. 4.1): the five
 // operators (internal, boundary, corner, four-boundary-vertex, doublet) plus a strip collapse
-// for columns between two opposite boundary edges, local Laplacian
+// for columns between two opposite boundary edges and a chord collapse, local Laplacian
 // smoothing per layer with z at the quadric minimum, fold-over rejection, and Wu-Kobbelt
 // multiple-choice selection (8 random candidates, the cheapest performed). When no candidate
 // is valid any more (slivers fanned around heavy boundary nodes fold whatever collapses next
 // to them), edges are rotated, the mesh is smoothed within the error already spent, and
-// rejected collapses may smooth their whole 1-ring; it gives up only when that frees nothing.
+// rejected collapses may smooth their whole 1-ring; when that frees nothing either, whole
+// chords of columns collapse; it gives up only when no chord can.
 //
 // Contract:
 // - Works in place on a ColumnMesh; every collapse removes one column of nk hexahedra and
@@ -32,9 +33,9 @@ namespace resmr
 struct SimplifyReport
 {
   int64_t columnsBefore = 0, columnsAfter = 0;
-  int64_t collapses = 0;           ///< operators 1-4 and strip collapses performed
+  int64_t collapses = 0;           ///< operators 1-4, strip and chord collapses performed
   int64_t doublets = 0;            ///< doublet collapses performed
-  int64_t operatorCounts[6] = {};  ///< by operator: 0 internal, 1 boundary, 2 corner, 3 four-boundary, 4 doublet, 5 strip
+  int64_t operatorCounts[7] = {};  ///< by operator: 0 internal, 1 boundary, 2 corner, 3 four-boundary, 4 doublet, 5 strip, 6 chord
   int64_t rejectedFoldOver = 0;    ///< candidate options rejected by the fold-over test
   int64_t rejectedInverted = 0;    ///< candidate options rejected for inverting a hexahedron
   int64_t rejectedTopology = 0;    ///< candidate options rejected as non-manifold or degenerate
@@ -57,7 +58,14 @@ public:
     Doublet = 4,
     /// Ours, not the paper's: a column with two opposite boundary edges (a strip one column
     /// wide) loses both internal edges, each boundary edge becoming one node.
-    Strip = 5
+    Strip = 5,
+    /// Ours, not the paper's (poly-chord collapse, Daniels et al. 2008): a chord of columns,
+    /// each entered and left through opposite edges, from boundary to boundary (or round a
+    /// loop); every edge it crosses becomes one node, and the columns on its two sides become
+    /// neighbours. Used only once nothing else is valid: a straight fault otherwise keeps
+    /// its nodes at the original spacing, for no single collapse merges two of them without
+    /// folding the slivers that stand on it.
+    Chord = 6
   };
 
   /// One way of collapsing a column: `merged` nodes become one, placed at node `placeAt`
@@ -113,8 +121,70 @@ public:
   /// old one. Returns the rotations made.
   int64_t RotateEdges();
 
+  /// Collapses the chord through `column` across its edges `axis` and `axis + 2` (0 or 1)
+  /// if that is valid (the same rules as the other operators, with the crossed edges'
+  /// interior nodes smoothed), then removes the doublets it forms. Returns the columns
+  /// removed (0: not valid, or the chord crosses itself or a locked column).
+  int64_t CollapseChord(int32_t column, int axis);
+
+  /// Ours, not the paper's, which Simplify runs once nothing else is valid: slivers fanned
+  /// on a straight stretch of boundary (faults collapse last, their side planes weighing
+  /// 10,000) have one boundary edge each, and no operator merges two of their boundary
+  /// nodes. Two such columns sharing an edge from a boundary node h are split the other way
+  /// (an edge rotation), which leaves h and its two boundary neighbours in one column; the
+  /// corner operator removes that column, judged by its own tests. Stops at
+  /// `targetColumns`; returns the columns removed.
+  int64_t MergeAlongBoundaries(int64_t targetColumns);
+
 private:
+  // Undo log of the last Apply or ApplyChord: the merged nodes as they were.
+  struct NodeState
+  {
+    int32_t node;
+    uint8_t alive;
+    std::array<double, 2> topology;
+    std::vector<double> positions;
+    std::vector<Quadric> quadrics;
+    std::vector<int32_t> columns;
+  };
+  /// A chord: its columns in order and the L + 1 edges they cross (L for a loop).
+  struct ChordPath
+  {
+    std::vector<int32_t> columns;
+    std::vector<std::array<int32_t, 2>> edges;
+    bool closed = false;
+  };
+  /// The chord through a column; false if it crosses itself. `visited` (optional, two flags
+  /// a column slot, one per axis) is marked along it.
+  bool TraceChord(int32_t column, int axis, ChordPath& chord, std::vector<uint8_t>* visited) const;
+  /// Like Apply, for a chord; `ring` also smooths the 1-ring of the moved nodes.
+  bool ApplyChord(const ChordPath& chord, bool ring, double& cost);
+  /// Applies and commits the cheaper valid way of collapsing a chord; the columns removed.
+  int64_t PerformChord(const ChordPath& chord);
+  /// Chord collapses, cheapest first, until a quarter of the columns still to go are gone;
+  /// the columns removed.
+  int64_t CollapseChords(int64_t targetColumns);
+  void SaveNodeState(NodeState& state, int32_t node) const;
+  /// No column at the node repeats a node, and the node is manifold.
+  bool TopologyValidAt(int32_t node) const;
+  /// Neither a fold nor an inverted cell in any column around the nodes (folds tested first,
+  /// for all of them: cheap, and where most rejections happen); counts the rejection.
+  bool ShapeKeptAround(const std::vector<int32_t>& nodes);
+  /// Node `node` merges into `into`: quadrics add, columns are rewired (logged for Undo).
+  void MergeNode(int32_t node, int32_t into);
+  /// Places a node at the average of saved nodes (positions and topology), z at the
+  /// quadric minimum within their depths.
+  void PlaceAtAverage(int32_t node, const NodeState* const* states, int count);
   bool RotateEdge(int32_t column, int corner);
+  /// The other column at edge `corner` of a column and their hexagon (see RotateEdge);
+  /// false if there is none, either is locked, or the hexagon repeats a node.
+  bool EdgeHexagon(int32_t column, int corner, int32_t& other, int32_t hexagon[6]) const;
+  static std::pair<std::array<int32_t, 4>, std::array<int32_t, 4>> SplitHexagon(const int32_t hexagon[6], int shift);
+  void Rewire(int32_t column, int32_t other, const int32_t hexagon[6], const std::array<int32_t, 4>& first,
+    const std::array<int32_t, 4>& second);
+  /// Two columns sharing an edge from a boundary node become one (see
+  /// MergeAlongBoundaries); kept only if valid.
+  bool MergeAlongBoundary(int32_t column, int corner);
   bool Apply(const Plan& plan, double& cost);
   SimplifyReport Finish(int64_t targetColumns, const std::function<void(double)>& progress);
   void Undo();
@@ -126,9 +196,14 @@ private:
   /// boundary), each move kept only if it folds and inverts nothing and costs at most
   /// `allowed`. Returns the number of moves kept.
   int64_t Relax(double allowed);
+  /// Plans every column once and performs the valid plans, cheapest first, each planned
+  /// again before it goes; the collapses performed.
+  int64_t SweepCollapses(int64_t targetColumns);
   /// When collapses ran out: rotations, then three relaxations; false (nothing done) if the
   /// last time freed no column (`relaxedAt`, the column count then).
-  bool Unblock(int64_t& relaxedAt);
+  /// When that freed nothing either: chord collapses (CollapseChords); false if none is
+  /// valid.
+  bool Unblock(int64_t& relaxedAt, int64_t targetColumns);
   /// Neither folds a face over nor inverts a cell of the column.
   bool KeepsShape(int32_t column) const;
   /// A node of a locked column: it never moves or merges into another node.
@@ -166,16 +241,6 @@ private:
   std::vector<int32_t> AliveList;     ///< unlocked alive columns, for random picks
   std::vector<int32_t> AliveIndex;    ///< position of a column in AliveList, -1 if absent
 
-  // Undo log of the last Apply.
-  struct NodeState
-  {
-    int32_t node;
-    uint8_t alive;
-    std::array<double, 2> topology;
-    std::vector<double> positions;
-    std::vector<Quadric> quadrics;
-    std::vector<int32_t> columns;
-  };
   std::vector<NodeState> SavedNodes;
   std::vector<std::pair<int32_t, std::array<int32_t, 4>>> SavedCorners;
   struct MovedNode
@@ -188,7 +253,8 @@ private:
   MovedNode SaveNode(int32_t node) const;
   void RestoreNode(const MovedNode& saved);
   bool Stalled = false;               ///< ring plans are tried (set once collapses run out)
-  int32_t RemovedColumn = -1;
+  std::vector<int32_t> RemovedColumns;  ///< by the last Apply or ApplyChord
+  bool Pending = false;                 ///< an Apply or ApplyChord awaits Undo or Commit
   std::vector<int32_t> Scratch;
   std::vector<int32_t> Around;
   // Buffers reused by the hot helpers (planning calls them for every option tried).

@@ -250,20 +250,21 @@ int SimplifyCommand(int argc, char** argv)
     const int64_t inputCells = before * mesh.Layers();
 
     std::printf("{\"input\": \"%s\", \"dims\": [%lld, %lld, %lld], \"layers\": %d, \"columns_before\": %lld, "
-                "\"cells_before\": %lld, \"connected_parts\": %lld, \"target_columns\": %lld, \"columns_after\": %lld, \"cells_after\": %lld, "
+                "\"cells_before\": %lld, \"connected_parts\": %lld, \"target_columns\": %lld, \"columns_after\": %lld, \"connected_parts_after\": %lld, \"cells_after\": %lld, "
                 "\"reached_target\": %s, \"collapses\": %lld, \"doublets\": %lld, "
                 "\"operators\": {\"internal\": %lld, \"boundary\": %lld, \"corner\": %lld, \"four_boundary\": %lld, "
-                "\"doublet\": %lld, \"strip\": %lld}, \"rejected_foldover\": %lld, \"rejected_inverted\": %lld, \"rejected_topology\": %lld, "
+                "\"doublet\": %lld, \"strip\": %lld, \"chord\": %lld}, \"rejected_foldover\": %lld, \"rejected_inverted\": %lld, \"rejected_topology\": %lld, "
                 "\"relaxations\": %lld, \"rotations\": %lld, \"max_quadric_error\": %.6g, \"max_lateral_valence\": %d, \"seconds_build\": %.3f, "
                 "\"seconds_simplify\": %.3f, \"input_cells_per_second\": %.0f",
       source.c_str(), static_cast<long long>(model.deck.dims[0]), static_cast<long long>(model.deck.dims[1]),
       static_cast<long long>(model.deck.dims[2]), mesh.Layers(), static_cast<long long>(before),
       static_cast<long long>(inputCells), static_cast<long long>(parts), static_cast<long long>(target), static_cast<long long>(mesh.AliveColumns()),
-      static_cast<long long>(mesh.CellCount()), report.reachedTarget ? "true" : "false",
+      static_cast<long long>(mesh.ConnectedParts()), static_cast<long long>(mesh.CellCount()), report.reachedTarget ? "true" : "false",
       static_cast<long long>(report.collapses), static_cast<long long>(report.doublets),
       static_cast<long long>(report.operatorCounts[0]), static_cast<long long>(report.operatorCounts[1]),
       static_cast<long long>(report.operatorCounts[2]), static_cast<long long>(report.operatorCounts[3]),
-      static_cast<long long>(report.operatorCounts[4]), static_cast<long long>(report.operatorCounts[5]), static_cast<long long>(report.rejectedFoldOver),
+      static_cast<long long>(report.operatorCounts[4]), static_cast<long long>(report.operatorCounts[5]),
+      static_cast<long long>(report.operatorCounts[6]), static_cast<long long>(report.rejectedFoldOver),
       static_cast<long long>(report.rejectedInverted), static_cast<long long>(report.rejectedTopology),
       static_cast<long long>(report.relaxations), static_cast<long long>(report.rotations), report.maxError, MaxValence(mesh), buildSeconds,
       simplifySeconds, static_cast<double>(inputCells) / std::max(1e-9, buildSeconds + simplifySeconds));

@@ -588,6 +588,104 @@ void TestEdgeRotation()
   CHECK(after.inverted == 0 && std::fabs(after.minScaledJacobian - 0.8575) < 1e-3);
 }
 
+/// Alive nodes (with columns) at y = `y` in interface 0.
+int NodesAtY(const resmr::ColumnMesh& mesh, double y)
+{
+  int count = 0;
+  for (int32_t node = 0; node < mesh.NodeCount(); ++node)
+  {
+    count += mesh.IsNodeAlive(node) && !mesh.NodeColumns(node).empty() && mesh.Position(node, 0).y == y ? 1 : 0;
+  }
+  return count;
+}
+
+bool AllColumnsValid(const resmr::ColumnMesh& mesh)
+{
+  for (int32_t c = 0; c < mesh.ColumnSlots(); ++c)
+  {
+    if (!mesh.IsColumnAlive(c))
+    {
+      continue;
+    }
+    auto q = mesh.ColumnCorners(c);
+    for (int32_t node : q)
+    {
+      const auto& columns = mesh.NodeColumns(node);
+      if (!mesh.IsNodeAlive(node) || std::find(columns.begin(), columns.end(), c) == columns.end())
+      {
+        return false;
+      }
+    }
+    std::sort(q.begin(), q.end());
+    if (std::adjacent_find(q.begin(), q.end()) != q.end())
+    {
+      return false;
+    }
+  }
+  return resmr::MeasureHexahedra(resmr::ToHexMesh(mesh), mesh.Orientation()).inverted == 0;
+}
+
+void TestChordCollapse()
+{
+  // 4 x 3 columns: the chord through column (1, 1) across its bottom and top edges is the
+  // column of cells i = 1, from the boundary at y = 0 to the boundary at y = 3.
+  resmr::ColumnMesh mesh = Grid(4, 3, 1);
+  const resmr::Quadric bottomLeft = mesh.NodeQuadric(1, 0), bottomRight = mesh.NodeQuadric(2, 0);
+  resmr::ColumnCollapse collapse(mesh, 1);
+  CHECK(collapse.CollapseChord(5, 0) == 3);
+  CHECK(mesh.AliveColumns() == 9);
+  CHECK(!mesh.IsColumnAlive(1) && !mesh.IsColumnAlive(5) && !mesh.IsColumnAlive(9));
+  CHECK(collapse.Report().operatorCounts[resmr::ColumnCollapse::Chord] == 1);
+  CHECK(mesh.ConnectedParts() == 1);
+  CHECK(AllColumnsValid(mesh));
+  // Each crossed edge is one node now: 4 of the 20 nodes are gone, 5 - 1 left on each row.
+  CHECK(NodesAtY(mesh, 0) == 4 && NodesAtY(mesh, 3) == 4);
+  // The boundary ends stay on the boundary, halfway (every position costs nothing there and
+  // the midpoint keeps the cells even), with the merged quadric and the mean topological
+  // coordinate; columns (0, 0) and (2, 0) are neighbours now.
+  const int32_t end = mesh.IsNodeAlive(1) ? 1 : 2;
+  CHECK(!mesh.IsNodeAlive(end == 1 ? 2 : 1));
+  CHECK(mesh.Position(end, 0) == glm::dvec3(1.5, 0, 0));
+  CHECK(mesh.TopologicalCoordinate(end)[0] == 1.5 && mesh.TopologicalCoordinate(end)[1] == 0);
+  resmr::Quadric sum = bottomLeft;
+  sum += bottomRight;
+  CHECK(SameQuadric(mesh.NodeQuadric(end, 0), sum));
+  const auto& left = mesh.ColumnCorners(0);
+  const auto& right = mesh.ColumnCorners(2);
+  CHECK(std::count_if(left.begin(), left.end(), [&](int32_t n) { return std::find(right.begin(), right.end(), n) != right.end(); }) == 2);
+
+  // Refused: a chord along a strip one column wide (it would vanish), and one through a
+  // locked column. Across the strip, the chord is one column (as a strip collapse).
+  resmr::ColumnMesh strip = Grid(1, 3, 1);
+  resmr::ColumnCollapse stripCollapse(strip, 1);
+  CHECK(stripCollapse.CollapseChord(1, 0) == 0 && strip.AliveColumns() == 3);
+  CHECK(stripCollapse.CollapseChord(1, 1) == 1 && strip.AliveColumns() == 2 && strip.ConnectedParts() == 1);
+  CHECK(AllColumnsValid(strip));
+  resmr::ColumnMesh locked = Grid(4, 3, 1);
+  locked.SetLocked(9, true);
+  resmr::ColumnCollapse lockedCollapse(locked, 1);
+  CHECK(lockedCollapse.CollapseChord(5, 0) == 0 && locked.AliveColumns() == 12);
+  CHECK(lockedCollapse.CollapseChord(6, 1) == 4 && locked.AliveColumns() == 8 && AllColumnsValid(locked));
+}
+
+void TestMergeAlongBoundary()
+{
+  // 4 x 2 columns: the bottom row stands on the straight boundary y = 0 with 5 nodes. One
+  // merge turns two of its columns into one and takes two nodes off that boundary.
+  resmr::ColumnMesh mesh = Grid(4, 2, 1);
+  resmr::ColumnCollapse collapse(mesh, 1);
+  CHECK(collapse.MergeAlongBoundaries(7) == 1);
+  CHECK(mesh.AliveColumns() == 7);
+  CHECK(NodesAtY(mesh, 0) == 3 && NodesAtY(mesh, 1) == 5 && NodesAtY(mesh, 2) == 5);
+  CHECK(collapse.Report().operatorCounts[resmr::ColumnCollapse::Corner] == 1);
+  CHECK(AllColumnsValid(mesh));
+  CHECK(mesh.ConnectedParts() == 1);
+  // Nothing is left to merge once no boundary stretch holds three nodes in a row.
+  resmr::ColumnMesh square = Grid(1, 1, 1);
+  resmr::ColumnCollapse squareCollapse(square, 1);
+  CHECK(squareCollapse.MergeAlongBoundaries(0) == 0);
+}
+
 void TestConnectedParts()
 {
   CHECK(Grid(4, 3, 1).ConnectedParts() == 1);
@@ -655,6 +753,8 @@ int main(int argc, char** argv)
   TestRealModel();
   TestLockedColumns();
   TestEdgeRotation();
+  TestChordCollapse();
+  TestMergeAlongBoundary();
   TestConnectedParts();
   TestBadInput();
   if (resmr_testing::Failures)
