@@ -1575,6 +1575,7 @@ bool ColumnCollapse::Unblock(int64_t& relaxedAt, int64_t targetColumns)
   {
     this->Relax(this->Stats.maxError);
   }
+  this->MergeAlongBoundaries(targetColumns);
   return true;
 }
 

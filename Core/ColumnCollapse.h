@@ -199,10 +199,9 @@ private:
   /// Plans every column once and performs the valid plans, cheapest first, each planned
   /// again before it goes; the collapses performed.
   int64_t SweepCollapses(int64_t targetColumns);
-  /// When collapses ran out: rotations, then three relaxations; false (nothing done) if the
-  /// last time freed no column (`relaxedAt`, the column count then).
-  /// When that freed nothing either: chord collapses (CollapseChords); false if none is
-  /// valid.
+  /// When collapses ran out: rotations, three relaxations, boundary slivers merged in pairs.
+  /// If the last time freed no column (`relaxedAt`, the column count then): only pairs and
+  /// chord collapses, false if neither removed anything.
   bool Unblock(int64_t& relaxedAt, int64_t targetColumns);
   /// Neither folds a face over nor inverts a cell of the column.
   bool KeepsShape(int32_t column) const;
