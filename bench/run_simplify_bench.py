@@ -92,12 +92,12 @@ def main():
              "the completed columns' cells over build + simplification time. Inverted cells: scaled",
              "Jacobian below zero; Brugge and Emerald have such cells as delivered (ParaView's Mesh Quality",
              "counts 97 and 285 in the whole grids); a collapse never creates one, and a column holding one",
-             "can still be removed. Rotations / relaxations: edge rotations and whole-mesh smoothing passes",
-             "made when collapses ran out (8-candidate mode only). Parts: pieces joined by no shared edge",
+             "can still be removed. Rotations / relaxations / chords: edge rotations, whole-mesh smoothing",
+             "passes and chord collapses made when collapses ran out. Parts (before / after): pieces joined by no shared edge",
              "(fault blocks cut off all round, isolated columns); no collapse joins two, so a target below",
              "that count cannot be reached by any column-collapse method.", "",
              "## Simplification to a fraction of the columns", "",
-             "| model | selection | seed | target | columns before -> after | parts | reached | rotations / relaxations | inverted before -> after / min scaled Jacobian | boundary error m | input cells/s | peak RSS MB |",
+             "| model | selection | seed | target | columns before -> after | parts | reached | rotations / relaxations / chords | inverted before -> after / min scaled Jacobian | boundary error m | input cells/s | peak RSS MB |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         if r["kind"] != "fraction":
@@ -106,8 +106,8 @@ def main():
             lines.append(f"| {r['model']} | {r['mode']} | {r['seed']} | {r['fraction']:.0%} | error: {r['error'][:80]} | | | | | | | |")
             continue
         lines.append(f"| {r['model']} | {r['mode']} | {r['seed']} | {r['fraction']:.0%} | {r['columns_before']} -> "
-                     f"{r['columns_after']} | {r.get('connected_parts', '?')} | {'yes' if r['reached_target'] else '**no**'} | "
-                     f"{r.get('rotations', '?')} / {r.get('relaxations', '?')} | {quality(r)} | "
+                     f"{r['columns_after']} | {r.get('connected_parts', '?')} / {r.get('connected_parts_after', '?')} | {'yes' if r['reached_target'] else '**no**'} | "
+                     f"{r.get('rotations', '?')} / {r.get('relaxations', '?')} / {r['operators'].get('chord', '?')} | {quality(r)} | "
                      f"{r['boundary_distance']['hausdorff']:.1f} | {r['input_cells_per_second']:,.0f} | {r['peak_rss_mb']:.0f} |")
     lines += ["", "## Against uniform B x B coarsening at the same column count", "",
               "| model | selection | seed | B | columns | ours: boundary error m | uniform: boundary error m | lower than uniform | ours inverted | uniform inverted |",
