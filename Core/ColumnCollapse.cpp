@@ -601,6 +601,22 @@ void ColumnCollapse::Rewire(int32_t column, int32_t other, const int32_t hexagon
   }
 }
 
+bool ColumnCollapse::DiagonalIsEdge(const int32_t hexagon[6], int shift) const
+{
+  const std::vector<int32_t>& columns = this->Mesh.ColumnsOfNode[hexagon[shift]];
+  const int32_t to = hexagon[shift + 3];
+  return std::any_of(columns.begin(), columns.end(), [&](int32_t c) {
+    const auto& q = this->Mesh.Corners[c];
+    const int at = IndexOf(q, hexagon[shift]);
+    return q[(at + 1) % 4] == to || q[(at + 3) % 4] == to;
+  });
+}
+
+bool ColumnCollapse::HexagonManifold(const int32_t hexagon[6]) const
+{
+  return std::all_of(hexagon, hexagon + 6, [this](int32_t node) { return this->Manifold(node); });
+}
+
 bool ColumnCollapse::RotateEdge(int32_t column, int corner)
 {
   ColumnMesh& m = this->Mesh;
@@ -616,16 +632,11 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
     return std::min(ShapeQuality(m, q, 0), ShapeQuality(m, q, m.LayerCount));
   };
   const double before = std::min(quality(a), quality(b));
-  std::vector<int32_t> neighbours;
-  std::vector<uint8_t> boundary;
   double bestQuality = before;
   int bestShift = -1;
   for (int shift = 1; shift <= 2; ++shift)
   {
-    // New diagonal from hexagon[shift] to hexagon[shift + 3]; it must not be an edge already.
-    const int32_t from = hexagon[shift], to = hexagon[shift + 3];
-    m.Neighbours(from, neighbours, boundary);
-    if (std::find(neighbours.begin(), neighbours.end(), to) != neighbours.end())
+    if (this->DiagonalIsEdge(hexagon, shift))
     {
       continue;
     }
@@ -643,12 +654,7 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
   }
   const auto chosen = SplitHexagon(hexagon, bestShift);
   this->Rewire(column, other, hexagon, chosen.first, chosen.second);
-  bool valid = this->KeepsShape(column) && this->KeepsShape(other);
-  for (int i = 0; i < 6 && valid; ++i)
-  {
-    valid = this->Manifold(hexagon[i]);
-  }
-  if (!valid)
+  if (!this->KeepsShape(column) || !this->KeepsShape(other) || !this->HexagonManifold(hexagon))
   {
     this->Rewire(column, other, hexagon, a, b);
     return false;
@@ -679,23 +685,15 @@ bool ColumnCollapse::MergeAlongBoundary(int32_t column, int corner)
   const auto b = m.Corners[other];
   std::vector<uint8_t> activeA(m.ActiveCells.begin() + static_cast<std::ptrdiff_t>(column) * m.LayerCount,
     m.ActiveCells.begin() + static_cast<std::ptrdiff_t>(column + 1) * m.LayerCount);
-  std::vector<int32_t> neighbours;
-  std::vector<uint8_t> boundary;
   for (int shift = 1; shift <= 2; ++shift)
   {
-    const int32_t from = hexagon[shift], to = hexagon[shift + 3];
-    m.Neighbours(from, neighbours, boundary);
-    if (std::find(neighbours.begin(), neighbours.end(), to) != neighbours.end())
+    if (this->DiagonalIsEdge(hexagon, shift))
     {
       continue;
     }
     const auto columns = SplitHexagon(hexagon, shift);
     this->Rewire(column, other, hexagon, columns.first, columns.second);
-    bool valid = true;
-    for (int i = 0; i < 6 && valid; ++i)
-    {
-      valid = this->Manifold(hexagon[i]);
-    }
+    const bool valid = this->HexagonManifold(hexagon);
     // The new column holding h and both its boundary neighbours goes by the corner operator
     // (its straight corner at h would not pass a shape test on its own; the corner
     // collapse's own tests judge the result, which includes the other column).

@@ -179,6 +179,9 @@ private:
   /// The other column at edge `corner` of a column and their hexagon (see RotateEdge);
   /// false if there is none, either is locked, or the hexagon repeats a node.
   bool EdgeHexagon(int32_t column, int corner, int32_t& other, int32_t hexagon[6]) const;
+  /// Whether the diagonal from hexagon[shift] to hexagon[shift + 3] is an edge already.
+  bool DiagonalIsEdge(const int32_t hexagon[6], int shift) const;
+  bool HexagonManifold(const int32_t hexagon[6]) const;
   static std::pair<std::array<int32_t, 4>, std::array<int32_t, 4>> SplitHexagon(const int32_t hexagon[6], int shift);
   void Rewire(int32_t column, int32_t other, const int32_t hexagon[6], const std::array<int32_t, 4>& first,
     const std::array<int32_t, 4>& second);
