@@ -48,47 +48,44 @@ struct Triangle
   glm::dvec3 a, b, c;
 };
 
-/// External faces of active cells, split into triangles.
+/// Calls `visit(face, key)` for each face of each active cell, `key` its sorted node ids.
+template <typename Visit>
+void ForEachActiveFace(const HexMesh& mesh, Visit visit)
+{
+  for (std::size_t c = 0; c < mesh.cells.size(); ++c)
+  {
+    if (!mesh.active[c])
+    {
+      continue;
+    }
+    for (const auto& face : Faces(mesh.cells[c]))
+    {
+      FaceKey key{ face };
+      std::sort(key.ids.begin(), key.ids.end());
+      visit(face, key);
+    }
+  }
+}
+
+/// External faces of active cells (those only one active cell has), split into triangles.
 std::vector<Triangle> BoundaryTriangles(const HexMesh& mesh, std::vector<std::array<glm::dvec3, 4>>& quads)
 {
   std::unordered_map<FaceKey, int, FaceHash> count;
   count.reserve(mesh.cells.size() * 3);
-  for (std::size_t c = 0; c < mesh.cells.size(); ++c)
-  {
-    if (!mesh.active[c])
-    {
-      continue;
-    }
-    for (const auto& face : Faces(mesh.cells[c]))
-    {
-      FaceKey key{ face };
-      std::sort(key.ids.begin(), key.ids.end());
-      ++count[key];
-    }
-  }
+  ForEachActiveFace(mesh, [&](const auto&, const FaceKey& key) { ++count[key]; });
   std::vector<Triangle> triangles;
   quads.clear();
-  for (std::size_t c = 0; c < mesh.cells.size(); ++c)
-  {
-    if (!mesh.active[c])
+  ForEachActiveFace(mesh, [&](const auto& face, const FaceKey& key) {
+    if (count[key] != 1)
     {
-      continue;
+      return;
     }
-    for (const auto& face : Faces(mesh.cells[c]))
-    {
-      FaceKey key{ face };
-      std::sort(key.ids.begin(), key.ids.end());
-      if (count[key] != 1)
-      {
-        continue;
-      }
-      const std::array<glm::dvec3, 4> p = { PointAt(mesh, face[0]), PointAt(mesh, face[1]), PointAt(mesh, face[2]),
-        PointAt(mesh, face[3]) };
-      quads.push_back(p);
-      triangles.push_back({ p[0], p[1], p[2] });
-      triangles.push_back({ p[0], p[2], p[3] });
-    }
-  }
+    const std::array<glm::dvec3, 4> p = { PointAt(mesh, face[0]), PointAt(mesh, face[1]), PointAt(mesh, face[2]),
+      PointAt(mesh, face[3]) };
+    quads.push_back(p);
+    triangles.push_back({ p[0], p[1], p[2] });
+    triangles.push_back({ p[0], p[2], p[3] });
+  });
   return triangles;
 }
 
