@@ -1117,13 +1117,6 @@ void ColumnCollapse::Perform(const Plan& plan)
   {
     worklist.push_back(plan.kept[i]);
   }
-  std::vector<int32_t> neighbours;
-  std::vector<uint8_t> boundary;
-  for (std::size_t i = 0, n = worklist.size(); i < n; ++i)
-  {
-    this->Mesh.Neighbours(worklist[i], neighbours, boundary);
-    worklist.insert(worklist.end(), neighbours.begin(), neighbours.end());
-  }
   this->RemoveDoublets(std::move(worklist));
 }
 
@@ -1135,6 +1128,11 @@ void ColumnCollapse::RemoveDoublets(std::vector<int32_t> worklist)
   ColumnMesh& m = this->Mesh;
   std::vector<int32_t> neighbours;
   std::vector<uint8_t> boundary;
+  for (std::size_t i = 0, n = worklist.size(); i < n; ++i)
+  {
+    m.Neighbours(worklist[i], neighbours, boundary);
+    worklist.insert(worklist.end(), neighbours.begin(), neighbours.end());
+  }
   while (!worklist.empty())
   {
     const int32_t node = worklist.back();
@@ -1459,21 +1457,13 @@ int64_t ColumnCollapse::PerformChord(const ChordPath& chord)
     this->Undo(); // not reached: the same chord was valid a moment ago
     return 0;
   }
-  const std::vector<int32_t> survivors = this->Scratch;
+  std::vector<int32_t> survivors = this->Scratch;
   const int64_t removed = static_cast<int64_t>(this->RemovedColumns.size());
   this->Commit();
   ++this->Stats.collapses;
   ++this->Stats.operatorCounts[Chord];
   this->Stats.maxError = std::max(this->Stats.maxError, cost);
-  std::vector<int32_t> worklist = survivors;
-  std::vector<int32_t> neighbours;
-  std::vector<uint8_t> boundary;
-  for (int32_t node : survivors)
-  {
-    this->Mesh.Neighbours(node, neighbours, boundary);
-    worklist.insert(worklist.end(), neighbours.begin(), neighbours.end());
-  }
-  this->RemoveDoublets(std::move(worklist));
+  this->RemoveDoublets(std::move(survivors));
   return removed;
 }
 

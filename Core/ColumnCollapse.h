@@ -192,6 +192,7 @@ private:
   SimplifyReport Finish(int64_t targetColumns, const std::function<void(double)>& progress);
   void Undo();
   void Commit();
+  /// Removes doublets at the nodes given and their neighbours, and at any a removal forms.
   void RemoveDoublets(std::vector<int32_t> worklist);
   void Smooth(int32_t node);
   bool SlideAlongBoundary(int32_t node, double allowed);
