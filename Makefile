@@ -6,7 +6,9 @@ PLUGIN_DIR := $(BUILD_DIR)/lib/paraview-plugins/ReservoirMultiresolution
 PLUGIN := $(PLUGIN_DIR)/ReservoirMultiresolution.so
 DEMO_DECK ?= Testing/Data/demo_faulted_dome.grdecl
 DEMO_OUTPUT ?= demo-output
-XVFB := xvfb-run -a -s '-screen 0 1280x1024x24'
+# -noreset: by default Xvfb resets when its last client leaves, and a client connecting during
+# the reset is refused ("bad X server connection"); tests connect one after another.
+XVFB := xvfb-run -a -s '-screen 0 1280x1024x24 -noreset'
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 # ParaView 5.11 SDK and the -dev packages its CMake config needs; build tools; the test

@@ -316,6 +316,10 @@ bool ColumnCollapse::ShapeKeptAround(const std::vector<int32_t>& nodes)
   }
   std::sort(around.begin(), around.end());
   around.erase(std::unique(around.begin(), around.end()), around.end());
+  if (!this->Exempt.empty())
+  {
+    around.erase(std::remove_if(around.begin(), around.end(), [&](int32_t c) { return this->Exempt[c] != 0; }), around.end());
+  }
   for (int32_t column : around)
   {
     if (this->FoldsOver(column))
@@ -1596,10 +1600,159 @@ int64_t ColumnCollapse::SweepCollapses(int64_t targetColumns)
   return performed;
 }
 
+void ColumnCollapse::RepairInvertedColumns(int64_t targetColumns)
+{
+  if (this->Mesh.AliveColumns() > targetColumns) // a mesh left as it is stays as it came
+  {
+    this->StraightenReflexCorners();
+    this->CollapseInvertedColumns(targetColumns);
+  }
+}
+
+int64_t ColumnCollapse::StraightenReflexCorners()
+{
+  // A corner-point grid can bound its outline with columns whose outer corner turns inward a
+  // little (a staircase along an oblique limit: Brugge, Emerald), inverting every cell of the
+  // column. When that corner's node belongs to this column alone, it moves out past the
+  // chord of its two neighbours at each interface where it turns inward: the outline moves
+  // by that node's distance to the chord plus a margin, and nothing else changes. The margin
+  // grows (to 5% of the chord) until the cells are valid: pillars that lean make a corner
+  // that is barely convex seen from above still invert.
+  ColumnMesh& m = this->Mesh;
+  const double sign = m.OrientationSign;
+  int64_t straightened = 0;
+  std::vector<MovedNode> saved;
+  for (int32_t column : this->AliveList)
+  {
+    if (!this->InvertsCells(column))
+    {
+      continue;
+    }
+    const auto q = m.Corners[column];
+    saved.clear();
+    for (int i = 0; i < 4; ++i)
+    {
+      if (m.ColumnsOfNode[q[i]].size() == 1 && !this->Pinned(q[i]))
+      {
+        saved.push_back(this->SaveNode(q[i]));
+      }
+    }
+    if (saved.empty())
+    {
+      continue;
+    }
+    bool valid = false;
+    for (const double margin : { 1e-4, 1e-3, 1e-2, 2e-2, 5e-2 })
+    {
+      for (const MovedNode& original : saved)
+      {
+        this->RestoreNode(original);
+        const int i = static_cast<int>(std::find(q.begin(), q.end(), original.node) - q.begin());
+        for (int32_t k = 0; k <= m.LayerCount; ++k)
+        {
+          const glm::dvec3 a = m.Position(q[(i + 3) % 4], k), b = m.Position(original.node, k),
+                           c = m.Position(q[(i + 1) % 4], k);
+          const double turn = (b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x);
+          const glm::dvec2 chord(c.x - a.x, c.y - a.y);
+          const double length2 = glm::dot(chord, chord);
+          if (turn * sign >= 0 || !(length2 > 0))
+          {
+            continue;
+          }
+          const double t = std::clamp(glm::dot(glm::dvec2(b.x - a.x, b.y - a.y), chord) / length2, 0.0, 1.0);
+          const glm::dvec2 foot = glm::dvec2(a.x, a.y) + t * chord;
+          // Outward: across the chord from b, away from the column's interior.
+          const glm::dvec2 normal = sign * glm::dvec2(chord.y, -chord.x) / std::sqrt(length2);
+          const glm::dvec2 placed = foot + normal * (margin * std::sqrt(length2));
+          m.SetPosition(original.node, k, glm::dvec3(placed.x, placed.y, b.z));
+        }
+      }
+      if (!this->InvertsCells(column) && !this->FoldsOver(column))
+      {
+        valid = true;
+        break;
+      }
+    }
+    if (!valid)
+    {
+      for (const MovedNode& original : saved)
+      {
+        this->RestoreNode(original);
+      }
+      continue;
+    }
+    ++straightened;
+  }
+  this->Stats.straightenedColumns += straightened;
+  return straightened;
+}
+
+int64_t ColumnCollapse::CollapseInvertedColumns(int64_t targetColumns)
+{
+  // Collapses never create an inverted cell, and a collapse next to a column that is
+  // inverted already is rejected too (its nodes cannot move without judging that column), so
+  // such columns would stay to the end and keep their neighbours. Remove them first, each by
+  // its cheapest valid plan; a column that has none yet is tried again after the others.
+  std::vector<int32_t> pending;
+  for (int32_t column : this->AliveList)
+  {
+    if (this->InvertsCells(column))
+    {
+      pending.push_back(column);
+    }
+  }
+  int64_t removed = 0;
+  const bool stalled = this->Stalled;
+  this->Stalled = true; // ring plans too: these columns' neighbours are often slivers
+  // Inverted columns come in chains (a staircase boundary of reflex corners): a collapse may
+  // leave another column of the chain as it found it, inverted, for its own turn will come.
+  this->Exempt.assign(static_cast<std::size_t>(this->Mesh.ColumnSlots()), 0);
+  for (int32_t column : pending)
+  {
+    this->Exempt[column] = 1;
+  }
+  for (bool progressed = true; progressed && !pending.empty();)
+  {
+    progressed = false;
+    std::vector<int32_t> left;
+    for (int32_t column : pending)
+    {
+      if (this->Mesh.AliveColumns() <= targetColumns)
+      {
+        break;
+      }
+      this->Exempt[column] = 0;
+      if (!this->Mesh.IsColumnAlive(column) || !this->InvertsCells(column))
+      {
+        continue;
+      }
+      Plan plan;
+      if (this->PlanColumn(column, plan))
+      {
+        const int64_t before = this->Mesh.AliveColumns();
+        this->Perform(plan);
+        removed += before - this->Mesh.AliveColumns();
+        progressed = true;
+      }
+      else
+      {
+        this->Exempt[column] = 1;
+        left.push_back(column);
+      }
+    }
+    pending.swap(left);
+  }
+  this->Stalled = stalled;
+  this->Exempt.clear();
+  this->Stats.invertedColumnsCollapsed += removed;
+  return removed;
+}
+
 SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::function<void(double)>& progress)
 {
   ColumnMesh& m = this->Mesh;
   this->Stats.columnsBefore = m.AliveColumns();
+  this->RepairInvertedColumns(targetColumns);
   const int64_t toRemove = std::max<int64_t>(1, m.AliveColumns() - targetColumns);
   int64_t failures = 0;
   int64_t sinceProgress = 0;
@@ -1650,6 +1803,7 @@ SimplifyReport ColumnCollapse::SimplifyGreedy(int64_t targetColumns, const std::
 {
   ColumnMesh& m = this->Mesh;
   this->Stats.columnsBefore = m.AliveColumns();
+  this->RepairInvertedColumns(targetColumns);
   const int64_t toRemove = std::max<int64_t>(1, m.AliveColumns() - targetColumns);
   struct Entry
   {

@@ -41,6 +41,8 @@ struct SimplifyReport
   int64_t rejectedTopology = 0;    ///< candidate options rejected as non-manifold or degenerate
   int64_t relaxations = 0;         ///< times the whole mesh was smoothed to unblock collapses
   int64_t rotations = 0;           ///< edge rotations made to unblock collapses
+  int64_t straightenedColumns = 0; ///< inverted input columns made valid by moving a reflex outline corner
+  int64_t invertedColumnsCollapsed = 0; ///< columns removed first for holding an inverted input cell
   double maxError = 0;             ///< largest cost of a performed collapse
   bool reachedTarget = false;      ///< false: no valid collapse was left
 };
@@ -136,6 +138,14 @@ public:
   /// `targetColumns`; returns the columns removed.
   int64_t MergeAlongBoundaries(int64_t targetColumns);
 
+  /// Ours, not the paper's; Simplify and SimplifyGreedy run it first. Input cells that are
+  /// inverted already (reflex outline corners in Brugge and Emerald) would block every
+  /// collapse around them, for no collapse may leave an inverted cell: those corners are
+  /// straightened (a node of one column only moves out past the chord of its neighbours),
+  /// then the columns still inverted are collapsed. Does nothing if at most `targetColumns`
+  /// columns are alive.
+  void RepairInvertedColumns(int64_t targetColumns);
+
 private:
   // Undo log of the last Apply or ApplyChord: the merged nodes as they were.
   struct NodeState
@@ -207,6 +217,12 @@ private:
   /// If the last time freed no column (`relaxedAt`, the column count then): only pairs and
   /// chord collapses, false if neither removed anything.
   bool Unblock(int64_t& relaxedAt, int64_t targetColumns);
+  /// Moves the reflex outline corners of inverted columns (see the definition); the columns
+  /// made valid.
+  int64_t StraightenReflexCorners();
+  /// Collapses the columns that hold an inverted cell before anything else (see the
+  /// definition); the columns removed.
+  int64_t CollapseInvertedColumns(int64_t targetColumns);
   /// Neither folds a face over nor inverts a cell of the column.
   bool KeepsShape(int32_t column) const;
   /// A node of a locked column: it never moves or merges into another node.
@@ -255,6 +271,7 @@ private:
   std::vector<MovedNode> SavedMoves;  ///< ring nodes a ring plan smoothed
   MovedNode SaveNode(int32_t node) const;
   void RestoreNode(const MovedNode& saved);
+  std::vector<uint8_t> Exempt;       ///< columns the shape tests skip (CollapseInvertedColumns)
   bool Stalled = false;               ///< ring plans are tried (set once collapses run out)
   std::vector<int32_t> RemovedColumns;  ///< by the last Apply or ApplyChord
   bool Pending = false;                 ///< an Apply or ApplyChord awaits Undo or Commit

@@ -686,6 +686,51 @@ void TestMergeAlongBoundary()
   CHECK(squareCollapse.MergeAlongBoundaries(0) == 0);
 }
 
+void TestRepairInvertedColumns()
+{
+  // 4 x 3 unit columns. The outline corner (4, 0) belongs to column 3 alone; moved in to
+  // (3.4, 0.6) it turns inward and inverts the column. It moves out past the chord from
+  // (3, 0) to (4, 1), to its foot (3.5, 0.5) and a hair beyond; nothing else moves.
+  resmr::ColumnMesh outline = Grid(4, 3, 1);
+  const int32_t corner = 4;
+  for (int k = 0; k <= 1; ++k)
+  {
+    outline.SetPosition(corner, k, glm::dvec3(3.4, 0.6, k));
+  }
+  CHECK(!AllColumnsValid(outline));
+  resmr::ColumnCollapse straighten(outline, 1);
+  straighten.RepairInvertedColumns(11);
+  CHECK(straighten.Report().straightenedColumns == 1 && straighten.Report().invertedColumnsCollapsed == 0);
+  CHECK(outline.AliveColumns() == 12 && AllColumnsValid(outline));
+  for (int k = 0; k <= 1; ++k)
+  {
+    const glm::dvec3 p = outline.Position(corner, k);
+    CHECK(std::abs(p.x - 3.5) < 1e-3 && std::abs(p.y - 0.5) < 1e-3 && p.x > 3.5 && p.y < 0.5 && p.z == k);
+  }
+  CHECK(outline.TopologicalCoordinate(corner)[0] == 4 && outline.TopologicalCoordinate(corner)[1] == 0);
+
+  // The interior node (2, 1), moved to (1.4, 0.4), turns inward in column 1 only; four
+  // columns share it, so it cannot move out: column 1 is collapsed first, before any other.
+  resmr::ColumnMesh inside = Grid(4, 3, 1);
+  const int32_t interior = 1 * 5 + 2;
+  for (int k = 0; k <= 1; ++k)
+  {
+    inside.SetPosition(interior, k, glm::dvec3(1.4, 0.4, k));
+  }
+  CHECK(!AllColumnsValid(inside));
+  resmr::ColumnCollapse collapse(inside, 1);
+  CHECK(collapse.Simplify(11).reachedTarget);
+  CHECK(collapse.Report().straightenedColumns == 0 && collapse.Report().invertedColumnsCollapsed == 1);
+  CHECK(!inside.IsColumnAlive(1) && inside.AliveColumns() == 11 && AllColumnsValid(inside));
+
+  // Nothing to remove: the mesh stays as it came, inverted column included.
+  resmr::ColumnMesh kept = Grid(4, 3, 1);
+  kept.SetPosition(corner, 0, glm::dvec3(3.4, 0.6, 0));
+  resmr::ColumnCollapse keep(kept, 1);
+  keep.RepairInvertedColumns(12);
+  CHECK(kept.Position(corner, 0) == glm::dvec3(3.4, 0.6, 0) && keep.Report().straightenedColumns == 0);
+}
+
 void TestConnectedParts()
 {
   CHECK(Grid(4, 3, 1).ConnectedParts() == 1);
@@ -755,6 +800,7 @@ int main(int argc, char** argv)
   TestEdgeRotation();
   TestChordCollapse();
   TestMergeAlongBoundary();
+  TestRepairInvertedColumns();
   TestConnectedParts();
   TestBadInput();
   if (resmr_testing::Failures)
