@@ -1681,6 +1681,16 @@ int64_t ColumnCollapse::StraightenReflexCorners()
       }
       continue;
     }
+    for (const MovedNode& original : saved)
+    {
+      for (int32_t k = 0; k <= m.LayerCount; ++k)
+      {
+        const double* was = &original.positions[3 * static_cast<std::size_t>(k)];
+        const glm::dvec3 now = m.Position(original.node, k);
+        this->Stats.straightenedMove =
+          std::max(this->Stats.straightenedMove, std::hypot(now.x - was[0], now.y - was[1]));
+      }
+    }
     ++straightened;
   }
   this->Stats.straightenedColumns += straightened;

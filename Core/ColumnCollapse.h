@@ -42,6 +42,7 @@ struct SimplifyReport
   int64_t relaxations = 0;         ///< times the whole mesh was smoothed to unblock collapses
   int64_t rotations = 0;           ///< edge rotations made to unblock collapses
   int64_t straightenedColumns = 0; ///< inverted input columns made valid by moving a reflex outline corner
+  double straightenedMove = 0;     ///< farthest a straightened corner moved (x, y)
   int64_t invertedColumnsCollapsed = 0; ///< columns removed first for holding an inverted input cell
   double maxError = 0;             ///< largest cost of a performed collapse
   bool reachedTarget = false;      ///< false: no valid collapse was left

@@ -254,7 +254,7 @@ int SimplifyCommand(int argc, char** argv)
                 "\"reached_target\": %s, \"collapses\": %lld, \"doublets\": %lld, "
                 "\"operators\": {\"internal\": %lld, \"boundary\": %lld, \"corner\": %lld, \"four_boundary\": %lld, "
                 "\"doublet\": %lld, \"strip\": %lld, \"chord\": %lld}, \"rejected_foldover\": %lld, \"rejected_inverted\": %lld, \"rejected_topology\": %lld, "
-                "\"relaxations\": %lld, \"rotations\": %lld, \"straightened_columns\": %lld, \"inverted_columns_collapsed\": %lld, \"max_quadric_error\": %.6g, \"max_lateral_valence\": %d, \"seconds_build\": %.3f, "
+                "\"relaxations\": %lld, \"rotations\": %lld, \"straightened_columns\": %lld, \"straightened_max_move\": %.3f, \"inverted_columns_collapsed\": %lld, \"max_quadric_error\": %.6g, \"max_lateral_valence\": %d, \"seconds_build\": %.3f, "
                 "\"seconds_simplify\": %.3f, \"input_cells_per_second\": %.0f",
       source.c_str(), static_cast<long long>(model.deck.dims[0]), static_cast<long long>(model.deck.dims[1]),
       static_cast<long long>(model.deck.dims[2]), mesh.Layers(), static_cast<long long>(before),
@@ -267,7 +267,8 @@ int SimplifyCommand(int argc, char** argv)
       static_cast<long long>(report.operatorCounts[6]), static_cast<long long>(report.rejectedFoldOver),
       static_cast<long long>(report.rejectedInverted), static_cast<long long>(report.rejectedTopology),
       static_cast<long long>(report.relaxations), static_cast<long long>(report.rotations),
-      static_cast<long long>(report.straightenedColumns), static_cast<long long>(report.invertedColumnsCollapsed), report.maxError, MaxValence(mesh), buildSeconds,
+      static_cast<long long>(report.straightenedColumns), report.straightenedMove,
+      static_cast<long long>(report.invertedColumnsCollapsed), report.maxError, MaxValence(mesh), buildSeconds,
       simplifySeconds, static_cast<double>(inputCells) / std::max(1e-9, buildSeconds + simplifySeconds));
     std::printf(", \"quality_before\": %s, \"quality_after\": %s",
       QualityJson(resmr::MeasureHexahedra(original, mesh.Orientation())).c_str(),
