@@ -54,6 +54,29 @@ double ColumnCollapse::RandomUnit()
   return static_cast<double>(Mix(this->RandomState) >> 11) * (1.0 / 9007199254740992.0);
 }
 
+namespace
+{
+/// Interfaces are placed one by one, so where a layer thins out, the (x, y) of a vertex and
+/// of the one above it can differ by more than the thickness left between them: the cell's
+/// vertical edge turns nearly horizontal and, against faces that slope, inverts the cell. A
+/// placed vertex therefore leans from the one above it (x, y offset over depth) at most as
+/// steeply as the vertices it was placed from do, or as half the inverse of the slope of
+/// the faces there (where the edge still stands clear of them), whichever allows more; in a
+/// pinched-out layer (no thickness) it stands right below.
+glm::dvec3 LimitLean(const glm::dvec3& p, const glm::dvec3& above, double steepest, double slope)
+{
+  const glm::dvec2 lean(p.x - above.x, p.y - above.y);
+  const double length = glm::length(lean), thickness = p.z - above.z;
+  const double factor = std::max(steepest, slope > 0 ? 0.5 / slope : std::numeric_limits<double>::infinity());
+  if (!(length > thickness * factor))
+  {
+    return p;
+  }
+  const glm::dvec2 kept = thickness > 0 ? lean * (thickness * factor / length) : glm::dvec2(0.0);
+  return { above.x + kept.x, above.y + kept.y, p.z };
+}
+} // namespace
+
 void ColumnCollapse::Smooth(int32_t node)
 {
   // Laplacian smoothing in each layer (x, y and the topological coordinate), then the z of
@@ -74,7 +97,7 @@ void ColumnCollapse::Smooth(int32_t node)
     topology[1] += m.Topology[other][1] * weight;
   }
   m.Topology[node] = topology;
-  double above = 0;
+  glm::dvec3 above(0.0);
   for (int32_t k = 0; k <= m.LayerCount; ++k)
   {
     glm::dvec3 average(0.0);
@@ -83,10 +106,11 @@ void ColumnCollapse::Smooth(int32_t node)
     {
       const glm::dvec3 p = m.Position(other, k);
       average += p * weight;
-      bounds.Add(p.z, k > 0 ? m.Position(other, k - 1).z : p.z);
+      bounds.Add(p, k > 0 ? m.Position(other, k - 1) : p);
     }
-    average.z = this->PlaceDepth(node, k, average, bounds, above);
-    above = average.z;
+    average.z = this->PlaceDepth(node, k, average, bounds, above.z);
+    average = k > 0 && this->Stalled ? LimitLean(average, above, bounds.steepest, bounds.Slope()) : average;
+    above = average;
     m.SetPosition(node, k, average);
   }
 }
@@ -272,7 +296,7 @@ void ColumnCollapse::PlaceAtAverage(int32_t node, const NodeState* const* states
     topology[0] += states[i]->topology[0] * weight;
     topology[1] += states[i]->topology[1] * weight;
   }
-  double above = 0;
+  glm::dvec3 above(0.0);
   for (int32_t k = 0; k <= m.LayerCount; ++k)
   {
     glm::dvec3 average(0.0);
@@ -282,10 +306,11 @@ void ColumnCollapse::PlaceAtAverage(int32_t node, const NodeState* const* states
       const std::vector<double>& p = states[i]->positions;
       const glm::dvec3 at(p[k * 3], p[k * 3 + 1], p[k * 3 + 2]);
       average += at * weight;
-      bounds.Add(at.z, k > 0 ? p[(k - 1) * 3 + 2] : at.z);
+      bounds.Add(at, k > 0 ? glm::dvec3(p[(k - 1) * 3], p[(k - 1) * 3 + 1], p[(k - 1) * 3 + 2]) : at);
     }
-    average.z = this->PlaceDepth(node, k, average, bounds, above);
-    above = average.z;
+    average.z = this->PlaceDepth(node, k, average, bounds, above.z);
+    average = k > 0 && this->Stalled ? LimitLean(average, above, bounds.steepest, bounds.Slope()) : average;
+    above = average;
     m.SetPosition(node, k, average);
   }
   m.Topology[node] = topology;
@@ -497,16 +522,17 @@ bool ColumnCollapse::SlideAlongBoundary(int32_t node, double allowed)
   std::vector<double>& saved = this->SlideSaved;
   const std::size_t first = static_cast<std::size_t>(node) * interfaces * 3;
   saved.assign(m.Positions.begin() + first, m.Positions.begin() + first + interfaces * 3);
-  double above = 0;
+  glm::dvec3 above(0.0);
   for (int32_t k = 0; k < interfaces; ++k)
   {
     const glm::dvec3 a = m.Position(ends[0], k), b = m.Position(ends[1], k);
     glm::dvec3 middle = 0.5 * (a + b);
     DepthBounds bounds;
-    bounds.Add(a.z, k > 0 ? m.Position(ends[0], k - 1).z : a.z);
-    bounds.Add(b.z, k > 0 ? m.Position(ends[1], k - 1).z : b.z);
-    middle.z = this->PlaceDepth(node, k, middle, bounds, above);
-    above = middle.z;
+    bounds.Add(a, k > 0 ? m.Position(ends[0], k - 1) : a);
+    bounds.Add(b, k > 0 ? m.Position(ends[1], k - 1) : b);
+    middle.z = this->PlaceDepth(node, k, middle, bounds, above.z);
+    middle = k > 0 && this->Stalled ? LimitLean(middle, above, bounds.steepest, bounds.Slope()) : middle;
+    above = middle;
     m.SetPosition(node, k, middle);
   }
   if (this->NodeError(node) > std::max(allowed, before))
@@ -946,6 +972,7 @@ void ColumnCollapse::TryOption(const Plan& option, Plan& best, bool& found)
     valid = this->Apply(chosen, cost);
     this->Undo();
   }
+
   if (valid && (!found || cost < best.cost))
   {
     best = chosen;

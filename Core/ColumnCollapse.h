@@ -21,6 +21,7 @@
 
 #include "ColumnMesh.h"
 
+#include <cmath>
 #include <cstdint>
 #include <algorithm>
 #include <functional>
@@ -232,18 +233,35 @@ private:
   /// ring for Undo and adding it to Scratch.
   void SmoothRing(bool smoothSurvivor);
   double NodeError(int32_t node) const;
-  /// Depths of an interface around a node being placed, and the thicknesses of the layer
-  /// above it there.
+  /// Depths of an interface around a node being placed, and the thicknesses and leans of the
+  /// layer above it there.
   struct DepthBounds
   {
     double low = std::numeric_limits<double>::infinity(), high = -std::numeric_limits<double>::infinity();
     double thinnest = std::numeric_limits<double>::infinity(), thickest = -std::numeric_limits<double>::infinity();
-    void Add(double z, double zAbove)
+    double steepest = 0; ///< largest lean (x, y offset over depth) from the vertex above
+    glm::dvec2 lowXY = glm::dvec2(std::numeric_limits<double>::infinity());
+    glm::dvec2 highXY = glm::dvec2(-std::numeric_limits<double>::infinity());
+    /// How much the interface slopes there: its depth range over its lateral extent.
+    double Slope() const
     {
-      low = std::min(low, z);
-      high = std::max(high, z);
-      thinnest = std::min(thinnest, z - zAbove);
-      thickest = std::max(thickest, z - zAbove);
+      const double extent = glm::length(highXY - lowXY);
+      return extent > 0 ? (high - low) / extent : 0;
+    }
+    void Add(const glm::dvec3& p, const glm::dvec3& pAbove)
+    {
+      const double thickness = p.z - pAbove.z;
+      const double dx = p.x - pAbove.x, dy = p.y - pAbove.y;
+      low = std::min(low, p.z);
+      high = std::max(high, p.z);
+      lowXY = glm::min(lowXY, glm::dvec2(p.x, p.y));
+      highXY = glm::max(highXY, glm::dvec2(p.x, p.y));
+      thinnest = std::min(thinnest, thickness);
+      thickest = std::max(thickest, thickness);
+      if (thickness > 0)
+      {
+        steepest = std::max(steepest, std::sqrt(dx * dx + dy * dy) / thickness); // not hypot: slow
+      }
     }
   };
   double PlaceDepth(int32_t node, int32_t k, const glm::dvec3& xy, const DepthBounds& bounds, double above) const;
