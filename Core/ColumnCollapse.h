@@ -5,8 +5,10 @@
 // multiple-choice selection (8 random candidates, the cheapest performed). When no candidate
 // is valid any more (slivers fanned around heavy boundary nodes fold whatever collapses next
 // to them), edges are rotated, the mesh is smoothed within the error already spent, and
-// rejected collapses may smooth their whole 1-ring; when that frees nothing either, whole
-// chords of columns collapse; it gives up only when no chord can.
+// rejected collapses may smooth their whole 1-ring, and placed vertices lean no further from
+// the one above than the layer's thickness allows; when that frees nothing either, whole
+// chords of columns collapse; it gives up only when no chord can. Cells the input brings
+// inverted are repaired first (reflex outline corners straightened, then collapses).
 //
 // Contract:
 // - Works in place on a ColumnMesh; every collapse removes one column of nk hexahedra and
