@@ -1770,6 +1770,14 @@ int64_t ColumnCollapse::CollapseInvertedColumns(int64_t targetColumns)
         this->Perform(plan);
         removed += before - this->Mesh.AliveColumns();
         progressed = true;
+        // A column this collapse mended is judged like any other from now on.
+        for (int32_t other : pending)
+        {
+          if (this->Exempt[other] && this->Mesh.IsColumnAlive(other) && !this->InvertsCells(other))
+          {
+            this->Exempt[other] = 0;
+          }
+        }
       }
       else
       {
