@@ -40,7 +40,8 @@ ColumnMesh ColumnMesh::FromCornerPoints(const CornerPointGeometry& geometry, con
 }
 
 ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims, const CellCornersFunction& cellCorners,
-  const std::vector<bool>& active, int64_t i0, int64_t i1, int64_t j0, int64_t j1)
+  const std::vector<bool>& active, int64_t i0, int64_t i1, int64_t j0, int64_t j1,
+  const std::vector<uint8_t>* selected)
 {
   const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
   if (i0 < 0 || j0 < 0 || i1 > nx || j1 > ny || i0 >= i1 || j0 >= j1 || nz < 1)
@@ -55,6 +56,11 @@ ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims, const CellC
       std::to_string(nx * ny * nz) + " cells");
   }
   const int64_t width = i1 - i0, height = j1 - j0;
+  if (selected && static_cast<int64_t>(selected->size()) != width * height)
+  {
+    throw std::invalid_argument("column mesh: selection of " + std::to_string(selected->size()) +
+      " flags for a box of " + std::to_string(width * height) + " columns");
+  }
   ColumnMesh mesh;
   mesh.LayerCount = static_cast<int32_t>(nz);
   const int64_t interfaces = nz + 1;
@@ -65,6 +71,10 @@ ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims, const CellC
   {
     for (int64_t i = i0; i < i1; ++i)
     {
+      if (selected && !(*selected)[static_cast<std::size_t>((j - j0) * width + (i - i0))])
+      {
+        continue;
+      }
       bool any = false;
       for (int64_t k = 0; k < nz && !any; ++k)
       {
@@ -216,10 +226,82 @@ ColumnMesh ColumnMesh::FromParts(int32_t layers, std::vector<double> positions,
   return mesh;
 }
 
-void ColumnMesh::BuildAdjacencyAndQuadrics()
+ColumnMesh ColumnMesh::FromData(ColumnMeshData data)
+{
+  const std::size_t nodes = data.topology.size();
+  const std::size_t interfaces = static_cast<std::size_t>(data.layers) + 1;
+  if (data.layers < 1 || data.positions.size() != nodes * interfaces * 3 || data.quadrics.size() != nodes * interfaces ||
+    data.activeCells.size() != data.corners.size() * static_cast<std::size_t>(data.layers) ||
+    data.origin.size() != data.corners.size())
+  {
+    throw std::invalid_argument("column mesh: inconsistent saved arrays");
+  }
+  for (const auto& quad : data.corners)
+  {
+    for (int32_t node : quad)
+    {
+      if (node < 0 || static_cast<std::size_t>(node) >= nodes)
+      {
+        throw std::invalid_argument("column mesh: a saved column refers to a missing node");
+      }
+    }
+  }
+  ColumnMesh mesh;
+  mesh.LayerCount = data.layers;
+  mesh.Positions = std::move(data.positions);
+  mesh.Topology = std::move(data.topology);
+  mesh.Corners = std::move(data.corners);
+  mesh.ActiveCells = std::move(data.activeCells);
+  mesh.Origin = std::move(data.origin);
+  mesh.BuildAdjacency();
+  mesh.Quadrics = std::move(data.quadrics);
+  mesh.ComputeOrientation();
+  return mesh;
+}
+
+ColumnMeshData ColumnMesh::Export(const std::vector<uint8_t>* keepColumns, std::vector<int32_t>* nodeMap) const
+{
+  ColumnMeshData data;
+  data.layers = this->LayerCount;
+  const std::size_t interfaces = static_cast<std::size_t>(this->LayerCount) + 1;
+  std::vector<int32_t> map(this->Topology.size(), -1);
+  for (std::size_t c = 0; c < this->Corners.size(); ++c)
+  {
+    if (!this->ColumnAlive[c] || (keepColumns && !(*keepColumns)[c]))
+    {
+      continue;
+    }
+    std::array<int32_t, 4> quad;
+    for (int q = 0; q < 4; ++q)
+    {
+      const int32_t node = this->Corners[c][q];
+      if (map[node] < 0)
+      {
+        map[node] = static_cast<int32_t>(data.topology.size());
+        data.topology.push_back(this->Topology[node]);
+        const std::size_t first = static_cast<std::size_t>(node) * interfaces;
+        data.positions.insert(data.positions.end(), this->Positions.begin() + first * 3,
+          this->Positions.begin() + (first + interfaces) * 3);
+        data.quadrics.insert(
+          data.quadrics.end(), this->Quadrics.begin() + first, this->Quadrics.begin() + first + interfaces);
+      }
+      quad[q] = map[node];
+    }
+    data.corners.push_back(quad);
+    data.origin.push_back(this->Origin[c]);
+    const auto cells = this->ActiveCells.begin() + c * static_cast<std::size_t>(this->LayerCount);
+    data.activeCells.insert(data.activeCells.end(), cells, cells + this->LayerCount);
+  }
+  if (nodeMap)
+  {
+    *nodeMap = std::move(map);
+  }
+  return data;
+}
+
+void ColumnMesh::BuildAdjacency()
 {
   const std::size_t nodes = this->Topology.size();
-  const int32_t interfaces = this->LayerCount + 1;
   this->NodeAlive.assign(nodes, 1);
   this->ColumnAlive.assign(this->Corners.size(), 1);
   this->Locked.assign(this->Corners.size(), 0);
@@ -232,6 +314,13 @@ void ColumnMesh::BuildAdjacencyAndQuadrics()
       this->ColumnsOfNode[node].push_back(static_cast<int32_t>(c));
     }
   }
+}
+
+void ColumnMesh::BuildAdjacencyAndQuadrics()
+{
+  const std::size_t nodes = this->Topology.size();
+  const int32_t interfaces = this->LayerCount + 1;
+  this->BuildAdjacency();
   this->Quadrics.assign(nodes * static_cast<std::size_t>(interfaces), Quadric());
   glm::dvec3 normal;
   double d;

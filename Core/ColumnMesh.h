@@ -32,6 +32,22 @@ namespace resmr
 
 class CornerPointGeometry;
 
+/// A column mesh as plain arrays, quadrics included: what the hierarchy builder (Sec. 4.2)
+/// saves for each region and merges again one level up.
+struct ColumnMeshData
+{
+  int32_t layers = 0;
+  std::vector<double> positions; ///< [node][interface][xyz]
+  std::vector<Quadric> quadrics; ///< [node][interface]
+  std::vector<std::array<double, 2>> topology;
+  std::vector<std::array<int32_t, 4>> corners;
+  std::vector<uint8_t> activeCells; ///< [column][layer]
+  std::vector<std::array<int32_t, 2>> origin;
+
+  int64_t NodeCount() const { return static_cast<int64_t>(this->topology.size()); }
+  int64_t ColumnCount() const { return static_cast<int64_t>(this->corners.size()); }
+};
+
 class ColumnMesh
 {
 public:
@@ -48,14 +64,27 @@ public:
   /// The same from any source of cell corners: `corners(i, j, k, out)` gives the 8 corners
   /// (x, y, depth) of cell (i, j, k) in ECLIPSE order (di + 2 dj + 4 dk, dk = 1 deeper).
   using CellCornersFunction = std::function<void(int64_t, int64_t, int64_t, double[8][3])>;
+  /// `selected` (optional, one flag a column of the box, i fastest) leaves out the columns
+  /// whose flag is 0.
   static ColumnMesh FromCells(const std::array<int64_t, 3>& dims, const CellCornersFunction& corners,
-    const std::vector<bool>& active, int64_t i0, int64_t i1, int64_t j0, int64_t j1);
+    const std::vector<bool>& active, int64_t i0, int64_t i1, int64_t j0, int64_t j1,
+    const std::vector<uint8_t>* selected = nullptr);
 
   /// A mesh from explicit data, for tests and other sources: `positions` holds
   /// (layers + 1) * 3 values a node, `corners` four nodes a column (counter-clockwise in
   /// (ti, tj)), `activeCells` `layers` flags a column. Quadrics are computed.
   static ColumnMesh FromParts(int32_t layers, std::vector<double> positions, std::vector<std::array<double, 2>> topology,
     std::vector<std::array<int32_t, 4>> corners, std::vector<uint8_t> activeCells);
+
+  /// A mesh from saved arrays; the quadrics are kept as given (not recomputed), so merged
+  /// regions go on measuring error against the original faces. Throws std::invalid_argument
+  /// for inconsistent arrays.
+  static ColumnMesh FromData(ColumnMeshData data);
+
+  /// The alive columns (those flagged in `keepColumns` too, when given, one flag a column
+  /// slot) and the nodes they use, renumbered in order; `nodeMap` (optional) gets the new
+  /// index of every node slot, -1 for those left out.
+  ColumnMeshData Export(const std::vector<uint8_t>* keepColumns = nullptr, std::vector<int32_t>* nodeMap = nullptr) const;
 
   int32_t Layers() const { return this->LayerCount; }
   int32_t NodeCount() const { return static_cast<int32_t>(this->Topology.size()); }
@@ -119,6 +148,7 @@ public:
 
 private:
   friend class ColumnCollapse;
+  void BuildAdjacency();
   void BuildAdjacencyAndQuadrics();
   void ComputeOrientation();
 

@@ -19,3 +19,9 @@ int SynthCommand(int argc, char** argv);
 
 /// resmr simplify MODEL [options]; argv[1] is "simplify".
 int SimplifyCommand(int argc, char** argv);
+
+/// resmr build INPUT -o OUT.resmr [options]; argv[1] is "build".
+int BuildCommand(int argc, char** argv);
+
+/// resmr info FILE.resmr: levels, regions, sizes and errors as JSON.
+int MultiresolutionInfo(const char* path);

@@ -10,6 +10,10 @@
 //                       writes a synthetic faulted reservoir (ResmrSynth.cpp)
 //   resmr simplify MODEL [options]
 //                       simplifies a model by column collapses, prints quality (ResmrSimplify.cpp)
+//   resmr build INPUT -o OUT.resmr [options]
+//                       builds the multiresolution file (ResmrBuild.cpp)
+//   resmr info FILE.resmr
+//                       levels, regions, sizes and errors of a multiresolution file
 #include "ResmrCommands.h"
 
 #include "CornerPointGeometry.h"
@@ -168,6 +172,27 @@ int Info(const char* path, bool skipMissingIncludes)
 }
 } // namespace
 
+namespace
+{
+/// A .resmr name, or a file starting with its magic.
+bool LooksLikeMultiresolutionFile(const char* path)
+{
+  const std::string name = path;
+  if (name.size() > 6 && name.compare(name.size() - 6, 6, ".resmr") == 0)
+  {
+    return true;
+  }
+  char magic[5] = {};
+  std::FILE* file = std::fopen(path, "rb");
+  const bool read = file && std::fread(magic, 1, 5, file) == 5;
+  if (file)
+  {
+    std::fclose(file);
+  }
+  return read && std::memcmp(magic, "RESMR", 5) == 0;
+}
+} // namespace
+
 int main(int argc, char** argv)
 {
   if (argc >= 2 && std::strcmp(argv[1], "synth") == 0)
@@ -177,6 +202,22 @@ int main(int argc, char** argv)
   if (argc >= 2 && std::strcmp(argv[1], "simplify") == 0)
   {
     return SimplifyCommand(argc, argv);
+  }
+  if (argc >= 2 && std::strcmp(argv[1], "build") == 0)
+  {
+    return BuildCommand(argc, argv);
+  }
+  if (argc == 3 && std::strcmp(argv[1], "info") == 0 && LooksLikeMultiresolutionFile(argv[2]))
+  {
+    try
+    {
+      return MultiresolutionInfo(argv[2]);
+    }
+    catch (const std::exception& error)
+    {
+      std::fprintf(stderr, "resmr: error: %s\n", error.what());
+      return 1;
+    }
   }
   const bool lenient = argc == 4 && std::strcmp(argv[2], "--skip-missing-includes") == 0;
   if ((argc == 3 || lenient) && std::strcmp(argv[1], "info") == 0)
@@ -197,6 +238,10 @@ int main(int argc, char** argv)
                        "usage: resmr synth NX NY NZ -o FILE.EGRID|FILE.GRDECL [options]\n"
                        "  writes a synthetic faulted reservoir model (resmr synth --help)\n"
                        "usage: resmr simplify MODEL [--fraction F | --columns N | --uniform B]\n"
-                       "  column-collapse simplification and its quality (resmr simplify --help)\n");
+                       "  column-collapse simplification and its quality (resmr simplify --help)\n"
+                       "usage: resmr build INPUT -o OUT.resmr [--cmax N] [--threads N] [--memory SIZE]\n"
+                       "  builds the multiresolution file (resmr build --help)\n"
+                       "usage: resmr info FILE.resmr\n"
+                       "  levels, regions, sizes, errors and bytes per cell of a multiresolution file\n");
   return 2;
 }

@@ -1,0 +1,277 @@
+// resmr build: a model to a .resmr multiresolution file (paper Sec. 4.2, 4.3, 6.1), and
+// resmr info FILE.resmr: what the file holds, level by level.
+#include "ResmrCommands.h"
+
+#include "CornerPointGeometry.h"
+#include "EclipseGrid.h"
+#include "GrdeclParser.h"
+#include "HierarchyBuilder.h"
+#include "LayerSource.h"
+#include "MultiresolutionFile.h"
+#include "SyntheticReservoir.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <string>
+#include <sys/resource.h>
+#include <unistd.h>
+
+namespace
+{
+const char* BuildUsage =
+  "usage: resmr build INPUT -o OUT.resmr [--cmax N] [--threads N] [--memory SIZE] [--scratch DIR]\n"
+  "  INPUT: a GRDECL/DATA deck, an EGRID, or synth:NIxNJxNK[:SEED] (streamed from the generator)\n"
+  "  --cmax N      columns a region holds at most (default 4096)\n"
+  "  --threads N   worker threads (default: every core)\n"
+  "  --memory SIZE memory budget, e.g. 4G or 512M (default: half the available memory)\n"
+  "  --scratch DIR scratch folder (default OUT.resmr.scratch, removed at the end)\n"
+  "  Prints a progress bar on stderr and a JSON report on stdout.\n";
+
+int64_t ParseSize(const std::string& text)
+{
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  double scale = 1;
+  if (end && *end)
+  {
+    switch (*end)
+    {
+      case 'k': case 'K': scale = 1024.0; break;
+      case 'm': case 'M': scale = 1024.0 * 1024; break;
+      case 'g': case 'G': scale = 1024.0 * 1024 * 1024; break;
+      default: throw std::invalid_argument("--memory " + text + ": expected a size such as 4G or 512M");
+    }
+  }
+  if (!(value > 0))
+  {
+    throw std::invalid_argument("--memory " + text + ": expected a positive size");
+  }
+  return static_cast<int64_t>(value * scale);
+}
+
+std::string Duration(double seconds)
+{
+  char text[32];
+  const long s = static_cast<long>(std::max(0.0, seconds) + 0.5);
+  if (s >= 3600)
+  {
+    std::snprintf(text, sizeof(text), "%ldh%02ldm", s / 3600, (s / 60) % 60);
+  }
+  else
+  {
+    std::snprintf(text, sizeof(text), "%ldm%02lds", s / 60, s % 60);
+  }
+  return text;
+}
+
+/// Everything a grid file source needs kept alive.
+struct FileModel
+{
+  resmr::GrdeclDeck deck;
+  std::vector<bool> active;
+  std::unique_ptr<resmr::CornerPointGeometry> geometry;
+};
+
+std::unique_ptr<resmr::LayerSource> OpenSource(const std::string& input, FileModel& model)
+{
+  if (input.rfind("synth:", 0) == 0)
+  {
+    resmr::SyntheticParameters p;
+    long long nx = 0, ny = 0, nz = 0;
+    unsigned long long seed = 1;
+    if (std::sscanf(input.c_str() + 6, "%lldx%lldx%lld:%llu", &nx, &ny, &nz, &seed) < 3)
+    {
+      throw std::invalid_argument(input + ": expected synth:NIxNJxNK[:SEED]");
+    }
+    p.nx = nx;
+    p.ny = ny;
+    p.nz = nz;
+    p.seed = seed;
+    p.Validate();
+    return std::unique_ptr<resmr::LayerSource>(new resmr::SyntheticLayerSource(p, input));
+  }
+  if (resmr::LooksLikeEclipseGridFile(input))
+  {
+    resmr::EclipseGrid grid = resmr::ReadEclipseGrid(input);
+    model.active.resize(static_cast<std::size_t>(grid.deck.CellCount()));
+    for (int64_t c = 0; c < grid.deck.CellCount(); ++c)
+    {
+      model.active[c] = grid.IsActive(c);
+    }
+    model.deck = std::move(grid.deck);
+  }
+  else
+  {
+    model.deck = resmr::ParseGrdeclFile(input);
+    const resmr::CellArray* actnum = model.deck.FindArray("ACTNUM");
+    model.active.resize(static_cast<std::size_t>(model.deck.CellCount()));
+    for (int64_t c = 0; c < model.deck.CellCount(); ++c)
+    {
+      model.active[c] = !actnum || actnum->values[c] != 0;
+    }
+  }
+  model.geometry.reset(new resmr::CornerPointGeometry(resmr::CornerPointGeometry::FromDeck(model.deck, false)));
+  return std::unique_ptr<resmr::LayerSource>(new resmr::CornerPointLayerSource(*model.geometry, model.active, input));
+}
+} // namespace
+
+int BuildCommand(int argc, char** argv)
+{
+  std::string input, output;
+  resmr::HierarchyOptions options;
+  bool quiet = false;
+  try
+  {
+    for (int a = 2; a < argc; ++a)
+    {
+      const std::string arg = argv[a];
+      if (arg == "-h" || arg == "--help")
+      {
+        std::fputs(BuildUsage, stdout);
+        return 0;
+      }
+      if (arg == "-o")
+      {
+        output = OptionValue(a, argc, argv);
+      }
+      else if (arg == "--cmax")
+      {
+        options.cmax = std::stoll(OptionValue(a, argc, argv));
+      }
+      else if (arg == "--threads")
+      {
+        options.threads = std::stoi(OptionValue(a, argc, argv));
+      }
+      else if (arg == "--memory")
+      {
+        options.memoryBytes = ParseSize(OptionValue(a, argc, argv));
+      }
+      else if (arg == "--scratch")
+      {
+        options.scratch = OptionValue(a, argc, argv);
+      }
+      else if (arg == "--seed")
+      {
+        options.seed = std::stoull(OptionValue(a, argc, argv));
+      }
+      else if (arg == "--quiet")
+      {
+        quiet = true;
+      }
+      else if (input.empty() && (arg.empty() || arg[0] != '-'))
+      {
+        input = arg;
+      }
+      else
+      {
+        throw std::invalid_argument("unknown option " + arg);
+      }
+    }
+    if (input.empty() || output.empty())
+    {
+      std::fputs(BuildUsage, stderr);
+      return 2;
+    }
+    FileModel model;
+    auto source = OpenSource(input, model);
+    const auto start = std::chrono::steady_clock::now();
+    const bool terminal = isatty(2);
+    double lastShown = -1;
+    std::string lastPhase;
+    const auto progress = [&](const char* phase, double fraction) {
+      if (quiet)
+      {
+        return;
+      }
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (!terminal && fraction - lastShown < 0.05 && fraction < 1.0 && lastPhase == phase)
+      {
+        return;
+      }
+      lastShown = fraction;
+      lastPhase = phase;
+      const int width = 30;
+      const int filled = static_cast<int>(fraction * width + 0.5);
+      const std::string bar = std::string(filled, '#') + std::string(width - filled, '.');
+      const std::string eta = fraction > 0.02 ? Duration(elapsed * (1 - fraction) / fraction) : std::string("?");
+      std::fprintf(stderr, "%s[%s] %5.1f%% %-9s elapsed %s ETA %s%s", terminal ? "\r" : "", bar.c_str(), 100 * fraction,
+        phase, Duration(elapsed).c_str(), eta.c_str(), terminal ? "" : "\n");
+      std::fflush(stderr);
+    };
+    const resmr::HierarchyReport report = resmr::BuildHierarchy(*source, output, options, progress);
+    if (!quiet && terminal)
+    {
+      std::fputc('\n', stderr);
+    }
+    struct rusage usage;
+    getrusage(RUSAGE_SELF, &usage);
+    std::printf("{\"input\": \"%s\", \"output\": \"%s\", \"cells\": %lld, \"active_cells\": %lld, \"columns\": %lld, "
+                "\"leaf_level\": %d, \"regions\": %lld, \"threads\": %d, \"file_bytes\": %llu, \"bytes_per_cell\": %.3f, "
+                "\"partition_s\": %.2f, \"leaves_s\": %.2f, \"simplify_s\": %.2f, \"total_s\": %.2f, "
+                "\"cells_per_s\": %.0f, \"peak_rss_mb\": %.1f}\n",
+      input.c_str(), output.c_str(), static_cast<long long>(report.cells), static_cast<long long>(report.activeCells),
+      static_cast<long long>(report.columns), report.leafLevel, static_cast<long long>(report.regions), report.threadsUsed,
+      static_cast<unsigned long long>(report.fileBytes), double(report.fileBytes) / double(report.cells),
+      report.partitionSeconds, report.leafSeconds, report.simplifySeconds, report.totalSeconds,
+      double(report.cells) / std::max(report.totalSeconds, 1e-9), usage.ru_maxrss / 1024.0);
+    return 0;
+  }
+  catch (const std::exception& error)
+  {
+    std::fprintf(stderr, "\nresmr build: error: %s\n", error.what());
+    return 1;
+  }
+}
+
+int MultiresolutionInfo(const char* path)
+{
+  const resmr::MultiresolutionFile file(path);
+  const auto& h = file.Header();
+  struct Level
+  {
+    int64_t regions = 0, columns = 0, cells = 0, vertices = 0;
+    uint64_t bytes = 0, meshBytes = 0, rawBytes = 0;
+    double error = 0;
+  };
+  std::map<int, Level> levels;
+  for (const auto& r : file.Regions())
+  {
+    Level& level = levels[r.level];
+    ++level.regions;
+    level.columns += r.columns;
+    level.cells += r.activeCells;
+    level.vertices += r.vertices;
+    for (const auto& c : r.chunks)
+    {
+      level.bytes += c.stored;
+      level.rawBytes += c.raw;
+    }
+    level.meshBytes += r.chunks[resmr::RegionRecord::Mesh].stored;
+    level.error = std::max<double>(level.error, r.error);
+  }
+  const double cells = double(h.dims[0]) * double(h.dims[1]) * double(h.dims[2]);
+  std::printf("{\"file\": \"%s\", \"kind\": \"resmr\", \"version\": %u, \"bytes\": %llu, \"dims\": [%lld, %lld, %lld], "
+              "\"cells\": %.0f, \"bytes_per_cell\": %.3f, \"leaf_level\": %d, \"cmax\": %d, \"regions\": %llu, \"levels\": [",
+    path, resmr::MultiresolutionHeader::Version, static_cast<unsigned long long>(file.FileSize()),
+    static_cast<long long>(h.dims[0]), static_cast<long long>(h.dims[1]), static_cast<long long>(h.dims[2]), cells,
+    double(file.FileSize()) / cells, h.leafLevel, h.cmax, static_cast<unsigned long long>(h.regionCount));
+  bool first = true;
+  for (const auto& entry : levels)
+  {
+    const Level& l = entry.second;
+    std::printf("%s\n  {\"level\": %d, \"regions\": %lld, \"columns\": %lld, \"active_cells\": %lld, \"vertices\": %lld, "
+                "\"bytes\": %llu, \"mesh_bytes\": %llu, \"surface_bytes\": %llu, \"uncompressed_bytes\": %llu, "
+                "\"max_error\": %.6g}",
+      first ? "" : ",", entry.first, static_cast<long long>(l.regions), static_cast<long long>(l.columns),
+      static_cast<long long>(l.cells), static_cast<long long>(l.vertices), static_cast<unsigned long long>(l.bytes),
+      static_cast<unsigned long long>(l.meshBytes), static_cast<unsigned long long>(l.bytes - l.meshBytes),
+      static_cast<unsigned long long>(l.rawBytes), l.error);
+    first = false;
+  }
+  std::printf("]}\n");
+  return 0;
+}

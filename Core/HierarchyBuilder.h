@@ -1,0 +1,64 @@
+// Out-of-core build of the multiresolution hierarchy (paper Sec. 4.2, 4.3, 6.1, 6.2): a
+// streaming partition pass into scratch tiles, leaf meshes saved with their quadrics, then
+// bottom-up per diamond: the children's meshes merged, the columns touching the diamond's
+// external boundary locked, the rest simplified by column collapse (Sec. 4.1), the result
+// split into the diamond's two triangles and saved; every region's surfaces extracted and
+// written to the .resmr file as soon as its mesh is final.
+//
+// Contract:
+// - Crack-free: a node on an edge between two regions (a "cut" edge) is never moved or
+//   merged while those regions belong to different diamonds, so any conformal cut of the
+//   tree matches exactly (the diamond's two triangles are always shown together).
+// - Each level keeps at most half the columns of the level below and at most Cmax a region
+//   (the paper's rule is Cmax a region; halving as well keeps every level a real
+//   simplification where leaves hold fewer than Cmax columns).
+// - Bounding volumes and errors are made equal for a diamond's two regions and monotone up
+//   the tree (Sec. 6.2).
+// - Memory: one layer of the input during the partition pass, then one diamond's meshes a
+//   worker thread; worker threads are cut to fit `memoryBytes`. Scratch files go to
+//   `scratch` and are removed as soon as they are used (and on failure).
+// - Deterministic: the same input and Cmax give the same region meshes whatever the thread
+//   count (chunks may lie in another order in the file).
+#pragma once
+
+#include "LayerSource.h"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+namespace resmr
+{
+
+struct HierarchyOptions
+{
+  /// Columns a region holds at most. 4096 (a 64 x 64 patch): top and bottom surfaces of
+  /// about 16k triangles a region, the batch size at which GPUs reach full speed, while a
+  /// diamond's merged mesh stays a few hundred MB for 100 layers.
+  int64_t cmax = 4096;
+  int threads = 0;          ///< 0: every core
+  int64_t memoryBytes = 0;  ///< 0: half the available memory
+  std::string scratch;      ///< scratch folder (default: beside the output)
+  uint64_t seed = 1;
+};
+
+struct HierarchyReport
+{
+  int64_t cells = 0, activeCells = 0, columns = 0;
+  int leafLevel = 0;
+  int64_t regions = 0, nonEmptyRegions = 0;
+  int threadsUsed = 0;
+  uint64_t fileBytes = 0;
+  double partitionSeconds = 0, leafSeconds = 0, simplifySeconds = 0, totalSeconds = 0;
+};
+
+/// Phase name and fraction of the whole build done (0..1).
+using BuildProgress = std::function<void(const char* phase, double fraction)>;
+
+/// Builds `output` (.resmr) from the layers of `source`. Throws std::runtime_error (or a
+/// subclass) naming the input or file on failure; the output is then not created and any
+/// older file of that name is left as it was.
+HierarchyReport BuildHierarchy(
+  LayerSource& source, const std::string& output, const HierarchyOptions& options, const BuildProgress& progress = {});
+
+} // namespace resmr

@@ -1,0 +1,64 @@
+// What the multiresolution file holds for one triangular region (paper Sec. 4.2, 4.3, 6.1): the
+// region's simplified hexahedral column mesh and the external surfaces extracted from it.
+//
+// Contract:
+// - Vertices are numbered node * (layers + 1) + interface; a vertex's topological coordinate
+//   is (ti, tj) of its node and tk = its interface (Sec. 5.1: cell [i, j, k] spans
+//   [i, i+1] x [j, j+1] x [k, k+1], 0-based). Positions are (x, y, depth), depth down.
+// - `cutEdges` bit e of a column: the edge from corner e to e + 1 borders another region of
+//   the same level, not the outside of the model, so it yields no side face.
+// - Surfaces are quads of four vertex numbers: top faces of active cells with no active cell
+//   above, bottom faces with none below, side faces of active cells with no active cell across
+//   (fault, model limit or inactive neighbour, Fig. 4 types 2-4), cut edges excepted. Each
+//   quad turns counter-clockwise seen from outside its cell in a z-up frame (z = -depth).
+// - The single-layer view needs no stored surface: ExtractLayerSurfaces() derives it from the
+//   hexahedral mesh on load.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace resmr
+{
+
+struct RegionSurface
+{
+  std::vector<std::array<uint32_t, 4>> quads;
+  /// Normal cone (Sec. 6.1): unit axis (z up) and the cosine of its half angle; cosine -2
+  /// when the surface is empty.
+  std::array<float, 4> cone{ 0.f, 0.f, 1.f, -2.f };
+};
+
+struct RegionMesh
+{
+  int32_t layers = 0;
+  std::vector<double> positions;             ///< [node][interface][xyz]
+  std::vector<std::array<float, 2>> topology; ///< (ti, tj) per node
+  std::vector<std::array<uint32_t, 4>> corners;
+  std::vector<uint8_t> active;   ///< [column][layer]
+  std::vector<uint8_t> cutEdges; ///< per column, bit e
+  RegionSurface top, bottom, side;
+
+  int64_t NodeCount() const { return static_cast<int64_t>(this->topology.size()); }
+  int64_t ColumnCount() const { return static_cast<int64_t>(this->corners.size()); }
+  int64_t VertexCount() const { return this->NodeCount() * (this->layers + 1); }
+  uint32_t Vertex(uint32_t node, int32_t interface) const
+  {
+    return node * static_cast<uint32_t>(this->layers + 1) + static_cast<uint32_t>(interface);
+  }
+};
+
+/// Top, bottom and side surfaces of the region's hexahedral mesh (Sec. 4.3), with normal
+/// cones for top and bottom. Replaces any surfaces the mesh held.
+void ExtractSurfaces(RegionMesh& mesh);
+
+/// The single-layer view of layer k (Sec. 6.1): the top and bottom faces of its active cells
+/// and their side faces where the neighbour across is absent or inactive in that layer.
+void ExtractLayerSurfaces(const RegionMesh& mesh, int32_t layer, RegionSurface& top, RegionSurface& bottom,
+  RegionSurface& side);
+
+/// +1 if the columns turn counter-clockwise in (x, y) seen from above, -1 otherwise.
+int RegionOrientation(const RegionMesh& mesh);
+
+} // namespace resmr

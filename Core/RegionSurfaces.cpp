@@ -1,0 +1,190 @@
+// External surfaces of a region mesh for the whole-model and single-layer views, paper Sec. 4.3
+// (and Sec. 6.1: normal cones of top and bottom meshes for back-face culling).
+#include "RegionMesh.h"
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+namespace resmr
+{
+namespace
+{
+glm::dvec3 ZUp(const RegionMesh& mesh, uint32_t vertex)
+{
+  const double* p = &mesh.positions[static_cast<std::size_t>(vertex) * 3];
+  return { p[0], p[1], -p[2] };
+}
+
+/// Columns across each edge (-1: none), found through the edge's two nodes.
+std::vector<std::array<int64_t, 4>> EdgeNeighbours(const RegionMesh& mesh)
+{
+  std::unordered_map<uint64_t, int64_t> edges;
+  edges.reserve(mesh.corners.size() * 4);
+  std::vector<std::array<int64_t, 4>> across(mesh.corners.size(), { -1, -1, -1, -1 });
+  for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+  {
+    for (int e = 0; e < 4; ++e)
+    {
+      const uint64_t a = mesh.corners[c][e], b = mesh.corners[c][(e + 1) % 4];
+      const uint64_t key = (std::min(a, b) << 32) | std::max(a, b);
+      const auto inserted = edges.emplace(key, static_cast<int64_t>(c * 4 + e));
+      if (!inserted.second)
+      {
+        const int64_t other = inserted.first->second;
+        across[c][e] = other / 4;
+        across[other / 4][other % 4] = static_cast<int64_t>(c);
+      }
+    }
+  }
+  return across;
+}
+
+void AddTopBottom(const RegionMesh& mesh, std::size_t column, int32_t interface, bool top, int orientation,
+  RegionSurface& surface)
+{
+  const auto& q = mesh.corners[column];
+  std::array<uint32_t, 4> quad;
+  // Counter-clockwise from above is outward for a top face, inward for a bottom face.
+  const bool reverse = (orientation > 0) != top;
+  for (int i = 0; i < 4; ++i)
+  {
+    quad[i] = mesh.Vertex(q[reverse ? 3 - i : i], interface);
+  }
+  surface.quads.push_back(quad);
+}
+
+void AddSide(const RegionMesh& mesh, std::size_t column, int edge, int32_t layer, int orientation, RegionSurface& surface)
+{
+  uint32_t a = mesh.corners[column][edge], b = mesh.corners[column][(edge + 1) % 4];
+  if (orientation < 0)
+  {
+    std::swap(a, b);
+  }
+  // The column lies left of a -> b seen from above: a-top, a-bottom, b-bottom, b-top faces right.
+  surface.quads.push_back({ mesh.Vertex(a, layer), mesh.Vertex(a, layer + 1), mesh.Vertex(b, layer + 1), mesh.Vertex(b, layer) });
+}
+
+void ComputeCone(const RegionMesh& mesh, RegionSurface& surface)
+{
+  std::vector<glm::dvec3> normals;
+  normals.reserve(surface.quads.size());
+  glm::dvec3 sum(0.0);
+  for (const auto& q : surface.quads)
+  {
+    const glm::dvec3 n = glm::cross(ZUp(mesh, q[2]) - ZUp(mesh, q[0]), ZUp(mesh, q[3]) - ZUp(mesh, q[1]));
+    const double length = glm::length(n);
+    if (length > 0 && std::isfinite(length))
+    {
+      normals.push_back(n / length);
+      sum += n / length;
+    }
+  }
+  const double length = glm::length(sum);
+  if (normals.empty() || !(length > 0))
+  {
+    surface.cone = { 0.f, 0.f, 1.f, normals.empty() ? -2.f : -1.f };
+    return;
+  }
+  const glm::dvec3 axis = sum / length;
+  double lowest = 1.0;
+  for (const auto& n : normals)
+  {
+    lowest = std::min(lowest, glm::dot(n, axis));
+  }
+  // Rounded outward so the cone still holds every normal after the cast to float.
+  surface.cone = { static_cast<float>(axis.x), static_cast<float>(axis.y), static_cast<float>(axis.z),
+    static_cast<float>(std::max(-1.0, lowest - 1e-6)) };
+}
+} // namespace
+
+int RegionOrientation(const RegionMesh& mesh)
+{
+  double area = 0;
+  for (const auto& q : mesh.corners)
+  {
+    for (int e = 0; e < 4; ++e)
+    {
+      const double* a = &mesh.positions[static_cast<std::size_t>(mesh.Vertex(q[e], 0)) * 3];
+      const double* b = &mesh.positions[static_cast<std::size_t>(mesh.Vertex(q[(e + 1) % 4], 0)) * 3];
+      area += a[0] * b[1] - b[0] * a[1];
+    }
+  }
+  return area >= 0 ? 1 : -1;
+}
+
+void ExtractSurfaces(RegionMesh& mesh)
+{
+  mesh.top = {};
+  mesh.bottom = {};
+  mesh.side = {};
+  const int orientation = RegionOrientation(mesh);
+  const auto across = EdgeNeighbours(mesh);
+  const int32_t layers = mesh.layers;
+  for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+  {
+    const uint8_t* active = &mesh.active[c * static_cast<std::size_t>(layers)];
+    for (int32_t k = 0; k < layers; ++k)
+    {
+      if (!active[k])
+      {
+        continue;
+      }
+      if (k == 0 || !active[k - 1])
+      {
+        AddTopBottom(mesh, c, k, true, orientation, mesh.top);
+      }
+      if (k == layers - 1 || !active[k + 1])
+      {
+        AddTopBottom(mesh, c, k + 1, false, orientation, mesh.bottom);
+      }
+      for (int e = 0; e < 4; ++e)
+      {
+        const int64_t other = across[c][e];
+        const bool open = other < 0 ? !(mesh.cutEdges[c] & (1u << e))
+                                    : !mesh.active[static_cast<std::size_t>(other) * layers + k];
+        if (open)
+        {
+          AddSide(mesh, c, e, k, orientation, mesh.side);
+        }
+      }
+    }
+  }
+  ComputeCone(mesh, mesh.top);
+  ComputeCone(mesh, mesh.bottom);
+}
+
+void ExtractLayerSurfaces(
+  const RegionMesh& mesh, int32_t layer, RegionSurface& top, RegionSurface& bottom, RegionSurface& side)
+{
+  top = {};
+  bottom = {};
+  side = {};
+  const int orientation = RegionOrientation(mesh);
+  const auto across = EdgeNeighbours(mesh);
+  for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+  {
+    if (!mesh.active[c * static_cast<std::size_t>(mesh.layers) + layer])
+    {
+      continue;
+    }
+    AddTopBottom(mesh, c, layer, true, orientation, top);
+    AddTopBottom(mesh, c, layer + 1, false, orientation, bottom);
+    for (int e = 0; e < 4; ++e)
+    {
+      const int64_t other = across[c][e];
+      const bool open = other < 0 ? !(mesh.cutEdges[c] & (1u << e))
+                                  : !mesh.active[static_cast<std::size_t>(other) * mesh.layers + layer];
+      if (open)
+      {
+        AddSide(mesh, c, e, layer, orientation, side);
+      }
+    }
+  }
+  ComputeCone(mesh, top);
+  ComputeCone(mesh, bottom);
+}
+
+} // namespace resmr
