@@ -31,12 +31,12 @@ namespace resmr
 namespace
 {
 /// A region's mesh between levels: the column mesh with quadrics, which edges border another
-/// region, its own simplification error and its box.
+/// region and which side faces are external.
 struct ScratchRegion
 {
   ColumnMeshData mesh;
   std::vector<uint8_t> cutEdges; ///< per column, bit e
-  double ownError = 0;           ///< largest quadric cost of the simplification that made it
+  std::vector<uint8_t> openSides; ///< per cell, bit e: side face e is external (see RegionMesh)
 };
 
 std::string RegionPath(const std::string& folder, int level, int64_t index)
@@ -71,8 +71,7 @@ void SaveRegion(const std::string& path, const ScratchRegion& region)
   {
     throw std::runtime_error(path + ": cannot create scratch file: " + std::strerror(errno));
   }
-  bool ok = std::fwrite(&region.mesh.layers, sizeof(int32_t), 1, file) == 1 &&
-    std::fwrite(&region.ownError, sizeof(double), 1, file) == 1;
+  bool ok = std::fwrite(&region.mesh.layers, sizeof(int32_t), 1, file) == 1;
   PutVector(file, region.mesh.positions, ok);
   PutVector(file, region.mesh.quadrics, ok);
   PutVector(file, region.mesh.topology, ok);
@@ -80,6 +79,7 @@ void SaveRegion(const std::string& path, const ScratchRegion& region)
   PutVector(file, region.mesh.activeCells, ok);
   PutVector(file, region.mesh.origin, ok);
   PutVector(file, region.cutEdges, ok);
+  PutVector(file, region.openSides, ok);
   ok = (std::fclose(file) == 0) && ok;
   if (!ok)
   {
@@ -95,8 +95,7 @@ bool LoadRegion(const std::string& path, ScratchRegion& region)
   {
     return false; // an empty region saves nothing
   }
-  bool ok = std::fread(&region.mesh.layers, sizeof(int32_t), 1, file) == 1 &&
-    std::fread(&region.ownError, sizeof(double), 1, file) == 1;
+  bool ok = std::fread(&region.mesh.layers, sizeof(int32_t), 1, file) == 1;
   GetVector(file, region.mesh.positions, ok);
   GetVector(file, region.mesh.quadrics, ok);
   GetVector(file, region.mesh.topology, ok);
@@ -104,6 +103,7 @@ bool LoadRegion(const std::string& path, ScratchRegion& region)
   GetVector(file, region.mesh.activeCells, ok);
   GetVector(file, region.mesh.origin, ok);
   GetVector(file, region.cutEdges, ok);
+  GetVector(file, region.openSides, ok);
   std::fclose(file);
   if (!ok)
   {
@@ -135,6 +135,50 @@ int32_t Across(const ColumnMesh& mesh, int32_t column, int e)
   return -1;
 }
 
+/// Open sides of every alive column's cells, from the columns across; edges flagged in `cut`
+/// (one mask a column slot) keep the flags in `openSides` (one byte a cell slot), since the
+/// cells across them lie in another region.
+void UpdateOpenSides(const ColumnMesh& mesh, const std::vector<uint8_t>& cut, std::vector<uint8_t>& openSides)
+{
+  const std::size_t layers = static_cast<std::size_t>(mesh.Layers());
+  openSides.resize(static_cast<std::size_t>(mesh.ColumnSlots()) * layers, 0);
+  for (int32_t c = 0; c < mesh.ColumnSlots(); ++c)
+  {
+    if (!mesh.IsColumnAlive(c))
+    {
+      continue;
+    }
+    for (int e = 0; e < 4; ++e)
+    {
+      if (cut[c] & (1u << e))
+      {
+        continue;
+      }
+      const int32_t other = Across(mesh, c, e);
+      for (std::size_t k = 0; k < layers; ++k)
+      {
+        uint8_t& flags = openSides[c * layers + k];
+        const bool open = other < 0 || !mesh.IsCellActive(other, static_cast<int32_t>(k));
+        flags = static_cast<uint8_t>(open ? flags | (1u << e) : flags & ~(1u << e));
+      }
+    }
+  }
+}
+
+/// The cells of the columns flagged in `keep`, in order.
+std::vector<uint8_t> KeptCells(const std::vector<uint8_t>& perCell, const std::vector<uint8_t>& keep, std::size_t layers)
+{
+  std::vector<uint8_t> out;
+  for (std::size_t c = 0; c < keep.size(); ++c)
+  {
+    if (keep[c])
+    {
+      out.insert(out.end(), perCell.begin() + c * layers, perCell.begin() + (c + 1) * layers);
+    }
+  }
+  return out;
+}
+
 RegionMesh ToRegionMesh(const ScratchRegion& region)
 {
   RegionMesh out;
@@ -155,6 +199,7 @@ RegionMesh ToRegionMesh(const ScratchRegion& region)
   }
   out.active = region.mesh.activeCells;
   out.cutEdges = region.cutEdges;
+  out.openSides = region.openSides;
   ExtractSurfaces(out);
   return out;
 }
@@ -420,6 +465,9 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
   }
   ScratchRegion region;
   region.mesh = halo.Export(&keep);
+  std::vector<uint8_t> openSides;
+  UpdateOpenSides(halo, std::vector<uint8_t>(static_cast<std::size_t>(halo.ColumnSlots()), 0), openSides);
+  region.openSides = KeptCells(openSides, keep, static_cast<std::size_t>(nz));
   for (int32_t c = 0; c < halo.ColumnSlots(); ++c)
   {
     if (!keep[c])
@@ -478,17 +526,21 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond)
     return;
   }
   // Merge: nodes the children share (never moved since they were split apart) are bitwise
-  // equal, topological coordinate and whole vertex stack.
+  // equal, topological coordinate and whole vertex stack. Only nodes of different children
+  // are joined: one child may hold two distinct nodes with equal data (where faults cross,
+  // the diagonal columns at a pillar can agree while their edge neighbours do not).
   const int32_t layers = children.front().mesh.layers;
   const std::size_t interfaces = static_cast<std::size_t>(layers) + 1;
   ColumnMeshData merged;
   merged.layers = layers;
-  std::vector<uint8_t> childCut;
+  std::vector<uint8_t> childCut, openSides;
   std::unordered_multimap<uint64_t, int32_t> nodeByKey;
+  std::vector<int> nodeChild; // the last child a merged node was taken from
   int64_t inputColumns = 0;
-  for (const ScratchRegion& child : children)
+  for (std::size_t which = 0; which < children.size(); ++which)
   {
-    const ColumnMeshData& m = child.mesh;
+    const ColumnMeshData& m = children[which].mesh;
+    const ScratchRegion& child = children[which];
     std::vector<int32_t> map(m.topology.size());
     for (std::size_t n = 0; n < m.topology.size(); ++n)
     {
@@ -500,7 +552,7 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond)
       for (auto it = range.first; it != range.second && found < 0; ++it)
       {
         const int32_t candidate = it->second;
-        if (merged.topology[candidate] == m.topology[n] &&
+        if (nodeChild[candidate] != static_cast<int>(which) && merged.topology[candidate] == m.topology[n] &&
           std::equal(stack, stack + interfaces * 3, &merged.positions[static_cast<std::size_t>(candidate) * interfaces * 3]))
         {
           found = candidate;
@@ -514,7 +566,9 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond)
         merged.quadrics.insert(merged.quadrics.end(), m.quadrics.begin() + n * interfaces,
           m.quadrics.begin() + (n + 1) * interfaces);
         nodeByKey.emplace(key, found);
+        nodeChild.push_back(-1);
       }
+      nodeChild[found] = static_cast<int>(which);
       map[n] = found;
     }
     for (std::size_t c = 0; c < m.corners.size(); ++c)
@@ -524,12 +578,8 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond)
     merged.activeCells.insert(merged.activeCells.end(), m.activeCells.begin(), m.activeCells.end());
     merged.origin.insert(merged.origin.end(), m.origin.begin(), m.origin.end());
     childCut.insert(childCut.end(), child.cutEdges.begin(), child.cutEdges.end());
+    openSides.insert(openSides.end(), child.openSides.begin(), child.openSides.end());
     inputColumns += m.ColumnCount();
-  }
-  double childError = 0;
-  for (const ScratchRegion& child : children)
-  {
-    childError = std::max(childError, child.ownError);
   }
   children.clear();
   ColumnMesh mesh = ColumnMesh::FromData(std::move(merged));
@@ -563,14 +613,15 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond)
   }
   const int triangles = diamond.second >= 0 ? 2 : 1;
   const int64_t target = std::min<int64_t>(this->Options.cmax * triangles, (inputColumns + 1) / 2);
-  double ownError = 0;
   if (mesh.AliveColumns() > target)
   {
     ColumnCollapse collapse(mesh, Mix(this->Options.seed ^ Mix(static_cast<uint64_t>(diamond.level) << 48 ^
                                                              static_cast<uint64_t>(diamond.first))));
     collapse.Simplify(target);
-    ownError = collapse.Report().maxError;
   }
+
+  // Cut edges left are on the diamond's boundary, where columns are locked and unchanged.
+  UpdateOpenSides(mesh, childCut, openSides);
 
   // Split along the diamond's hypotenuse by column centre.
   std::vector<uint8_t> side(static_cast<std::size_t>(slots), 0);
@@ -607,7 +658,7 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond)
     }
     ScratchRegion region;
     region.mesh = mesh.Export(&keep);
-    region.ownError = std::max(ownError, childError);
+    region.openSides = KeptCells(openSides, keep, interfaces - 1);
     for (int32_t c = 0; c < slots; ++c)
     {
       if (!keep[c])

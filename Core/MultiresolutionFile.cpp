@@ -217,7 +217,13 @@ std::vector<uint8_t> EncodeMesh(const RegionMesh& mesh, const MultiresolutionHea
   out.PutBytes(mesh.topology.data(), mesh.topology.size() * sizeof(mesh.topology[0]));
   PutPositions(out, mesh, header);
   out.PutBytes(mesh.corners.data(), mesh.corners.size() * sizeof(mesh.corners[0]));
-  out.PutBytes(mesh.active.data(), mesh.active.size());
+  // One byte a cell: bit 0 active, bits 1-4 open sides.
+  std::vector<uint8_t> cells(mesh.active.size());
+  for (std::size_t i = 0; i < cells.size(); ++i)
+  {
+    cells[i] = static_cast<uint8_t>((mesh.active[i] ? 1 : 0) | (mesh.openSides[i] & 0xF) << 1);
+  }
+  out.PutBytes(cells.data(), cells.size());
   out.PutBytes(mesh.cutEdges.data(), mesh.cutEdges.size());
   return std::move(out.Bytes);
 }
@@ -272,6 +278,17 @@ void DecodeMesh(Reader& in, RegionMesh& mesh, const MultiresolutionHeader& heade
   }
   mesh.active.resize(static_cast<std::size_t>(columns) * layers);
   in.GetBytes(mesh.active.data(), mesh.active.size());
+  mesh.openSides.resize(mesh.active.size());
+  for (std::size_t i = 0; i < mesh.active.size(); ++i)
+  {
+    if (mesh.active[i] >> 5)
+    {
+      throw MultiresolutionFileError(in.Where() + ": cell flags " + std::to_string(mesh.active[i]) + " of cell " +
+        std::to_string(i) + " are not valid");
+    }
+    mesh.openSides[i] = mesh.active[i] >> 1;
+    mesh.active[i] &= 1;
+  }
   mesh.cutEdges.resize(columns);
   in.GetBytes(mesh.cutEdges.data(), mesh.cutEdges.size());
 }

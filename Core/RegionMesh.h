@@ -7,10 +7,12 @@
 //   [i, i+1] x [j, j+1] x [k, k+1], 0-based). Positions are (x, y, depth), depth down.
 // - `cutEdges` bit e of a column: the edge from corner e to e + 1 borders another region of
 //   the same level, not the outside of the model, so it yields no side face.
+// - `openSides` bit e of a cell: its side face on edge e is external (no active cell across:
+//   fault, model limit or inactive neighbour, Fig. 4 types 2-4), across a cut edge too, where
+//   the cell across lies in another region.
 // - Surfaces are quads of four vertex numbers: top faces of active cells with no active cell
-//   above, bottom faces with none below, side faces of active cells with no active cell across
-//   (fault, model limit or inactive neighbour, Fig. 4 types 2-4), cut edges excepted. Each
-//   quad turns counter-clockwise seen from outside its cell in a z-up frame (z = -depth).
+//   above, bottom faces with none below, the open side faces of active cells. Each quad turns
+//   counter-clockwise seen from outside its cell in a z-up frame (z = -depth).
 // - The single-layer view needs no stored surface: ExtractLayerSurfaces() derives it from the
 //   hexahedral mesh on load.
 #pragma once
@@ -38,6 +40,7 @@ struct RegionMesh
   std::vector<std::array<uint32_t, 4>> corners;
   std::vector<uint8_t> active;   ///< [column][layer]
   std::vector<uint8_t> cutEdges; ///< per column, bit e
+  std::vector<uint8_t> openSides; ///< [column][layer], bit e
   RegionSurface top, bottom, side;
 
   int64_t NodeCount() const { return static_cast<int64_t>(this->topology.size()); }
@@ -48,6 +51,10 @@ struct RegionMesh
     return node * static_cast<uint32_t>(this->layers + 1) + static_cast<uint32_t>(interface);
   }
 };
+
+/// Sets the open sides of every edge that is not cut from the columns across it (cut edges
+/// keep theirs; none if openSides was empty).
+void ComputeOpenSides(RegionMesh& mesh);
 
 /// Top, bottom and side surfaces of the region's hexahedral mesh (Sec. 4.3), with normal
 /// cones for top and bottom. Replaces any surfaces the mesh held.

@@ -100,6 +100,30 @@ void ComputeCone(const RegionMesh& mesh, RegionSurface& surface)
 }
 } // namespace
 
+void ComputeOpenSides(RegionMesh& mesh)
+{
+  const std::size_t layers = static_cast<std::size_t>(mesh.layers);
+  mesh.openSides.resize(mesh.corners.size() * layers, 0);
+  const auto across = EdgeNeighbours(mesh);
+  for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+  {
+    for (int e = 0; e < 4; ++e)
+    {
+      if (mesh.cutEdges[c] & (1u << e))
+      {
+        continue;
+      }
+      const int64_t other = across[c][e];
+      for (std::size_t k = 0; k < layers; ++k)
+      {
+        uint8_t& flags = mesh.openSides[c * layers + k];
+        const bool open = other < 0 || !mesh.active[static_cast<std::size_t>(other) * layers + k];
+        flags = static_cast<uint8_t>(open ? flags | (1u << e) : flags & ~(1u << e));
+      }
+    }
+  }
+}
+
 int RegionOrientation(const RegionMesh& mesh)
 {
   double area = 0;
@@ -121,7 +145,6 @@ void ExtractSurfaces(RegionMesh& mesh)
   mesh.bottom = {};
   mesh.side = {};
   const int orientation = RegionOrientation(mesh);
-  const auto across = EdgeNeighbours(mesh);
   const int32_t layers = mesh.layers;
   for (std::size_t c = 0; c < mesh.corners.size(); ++c)
   {
@@ -142,10 +165,7 @@ void ExtractSurfaces(RegionMesh& mesh)
       }
       for (int e = 0; e < 4; ++e)
       {
-        const int64_t other = across[c][e];
-        const bool open = other < 0 ? !(mesh.cutEdges[c] & (1u << e))
-                                    : !mesh.active[static_cast<std::size_t>(other) * layers + k];
-        if (open)
+        if (mesh.openSides[c * static_cast<std::size_t>(layers) + k] & (1u << e))
         {
           AddSide(mesh, c, e, k, orientation, mesh.side);
         }
@@ -163,10 +183,10 @@ void ExtractLayerSurfaces(
   bottom = {};
   side = {};
   const int orientation = RegionOrientation(mesh);
-  const auto across = EdgeNeighbours(mesh);
   for (std::size_t c = 0; c < mesh.corners.size(); ++c)
   {
-    if (!mesh.active[c * static_cast<std::size_t>(mesh.layers) + layer])
+    const std::size_t cell = c * static_cast<std::size_t>(mesh.layers) + layer;
+    if (!mesh.active[cell])
     {
       continue;
     }
@@ -174,10 +194,7 @@ void ExtractLayerSurfaces(
     AddTopBottom(mesh, c, layer + 1, false, orientation, bottom);
     for (int e = 0; e < 4; ++e)
     {
-      const int64_t other = across[c][e];
-      const bool open = other < 0 ? !(mesh.cutEdges[c] & (1u << e))
-                                  : !mesh.active[static_cast<std::size_t>(other) * mesh.layers + layer];
-      if (open)
+      if (mesh.openSides[cell] & (1u << e))
       {
         AddSide(mesh, c, e, layer, orientation, side);
       }

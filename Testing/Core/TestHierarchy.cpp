@@ -1,0 +1,547 @@
+// Tests of the multiresolution hierarchy and its file (paper Sec. 4.2, 4.3, 6.1, 6.2): the
+// diamond tree, exact coverage of the original external faces at the finest level, crack-free
+// conformal cuts, monotone errors and bounding volumes, thread-count independence, and
+// rejection of corrupt and truncated files.
+#include "CoreTesting.h"
+
+#include "ColumnMesh.h"
+#include "CornerPointGeometry.h"
+#include "DiamondHierarchy.h"
+#include "HierarchyBuilder.h"
+#include "LayerSource.h"
+#include "MultiresolutionFile.h"
+#include "RegionMesh.h"
+#include "SyntheticReservoir.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <random>
+#include <set>
+#include <sstream>
+#include <tuple>
+#include <unistd.h>
+
+using namespace resmr;
+
+namespace
+{
+std::string TempPath(const std::string& name)
+{
+  return "/tmp/resmr-test-" + std::to_string(getpid()) + "-" + name;
+}
+
+SyntheticParameters SmallModel()
+{
+  SyntheticParameters p;
+  p.nx = 60;
+  p.ny = 48;
+  p.nz = 6;
+  p.seed = 3;
+  return p;
+}
+
+void TestDiamondTree()
+{
+  const DiamondHierarchy tree(100, 200, 500, 400, 6);
+  // Every triangle of a level is in exactly one diamond; mates share their hypotenuse.
+  for (int level = 0; level <= 6; ++level)
+  {
+    const auto diamonds = tree.Diamonds(level);
+    std::vector<int> seen(static_cast<std::size_t>(DiamondHierarchy::TriangleCount(level)), 0);
+    for (const auto& d : diamonds)
+    {
+      ++seen[static_cast<std::size_t>(d.first)];
+      if (d.second >= 0)
+      {
+        ++seen[static_cast<std::size_t>(d.second)];
+        const auto a = tree.NormalisedTriangle(level, d.first), b = tree.NormalisedTriangle(level, d.second);
+        CHECK(a.left == b.right && a.right == b.left);
+      }
+    }
+    CHECK(std::all_of(seen.begin(), seen.end(), [](int n) { return n == 1; }));
+  }
+  CHECK(tree.Diamonds(0).size() == 1 && tree.Diamonds(0)[0].second == 1);
+  // Locate agrees with the triangles' areas: points sampled inside a triangle land in it, and
+  // codes nest (the level-L triangle is the deep code shifted).
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int n = 0; n < 2000; ++n)
+  {
+    const int level = static_cast<int>(random() % 7);
+    const int64_t index = static_cast<int64_t>(random() % static_cast<uint64_t>(DiamondHierarchy::TriangleCount(level)));
+    const auto t = tree.ModelTriangle(level, index);
+    double a = unit(random), b = unit(random);
+    if (a + b > 1)
+    {
+      a = 1 - a;
+      b = 1 - b;
+    }
+    a = 0.02 + 0.96 * a * 0.98;
+    b = 0.02 + 0.96 * b * 0.98;
+    const double x = t.apex[0] + a * (t.left[0] - t.apex[0]) + b * (t.right[0] - t.apex[0]);
+    const double y = t.apex[1] + a * (t.left[1] - t.apex[1]) + b * (t.right[1] - t.apex[1]);
+    CHECK(tree.Locate(x, y, level) == index);
+    CHECK(static_cast<int64_t>(tree.Code(x, y) >> (DiamondHierarchy::MaxDepth - level)) == index);
+  }
+  // Leaf level: the shallowest with at most Cmax points a leaf.
+  std::vector<uint64_t> codes;
+  for (int n = 0; n < 1000; ++n)
+  {
+    codes.push_back(tree.Code(100 + 400 * unit(random), 200 + 200 * unit(random)));
+  }
+  const int level = DiamondHierarchy::ChooseLeafLevel(codes, 100);
+  std::map<uint64_t, int> counts, coarser;
+  for (uint64_t c : codes)
+  {
+    ++counts[c >> (DiamondHierarchy::MaxDepth - level)];
+    ++coarser[c >> (DiamondHierarchy::MaxDepth - level + 1)];
+  }
+  int largest = 0, largestCoarser = 0;
+  for (const auto& e : counts)
+  {
+    largest = std::max(largest, e.second);
+  }
+  for (const auto& e : coarser)
+  {
+    largestCoarser = std::max(largestCoarser, e.second);
+  }
+  CHECK(largest <= 100 && largestCoarser > 100);
+}
+
+/// A face named by its cell's topological corner coordinates and its outward direction in
+/// (i, j, k) space: the same face of the same cell gives the same key at any level.
+using FaceKey = std::tuple<std::array<std::array<double, 3>, 4>, std::array<int, 3>>;
+
+FaceKey KeyOf(const RegionMesh& mesh, const std::array<uint32_t, 4>& quad)
+{
+  std::array<std::array<double, 3>, 4> corners;
+  for (int v = 0; v < 4; ++v)
+  {
+    const uint32_t node = quad[v] / static_cast<uint32_t>(mesh.layers + 1);
+    const uint32_t k = quad[v] % static_cast<uint32_t>(mesh.layers + 1);
+    corners[v] = { mesh.topology[node][0], mesh.topology[node][1], static_cast<double>(k) };
+  }
+  std::array<double, 3> d1, d2;
+  for (int a = 0; a < 3; ++a)
+  {
+    d1[a] = corners[2][a] - corners[0][a];
+    d2[a] = corners[3][a] - corners[1][a];
+  }
+  const double n[3] = { d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2], d1[0] * d2[1] - d1[1] * d2[0] };
+  std::array<int, 3> direction{ (n[0] > 0) - (n[0] < 0), (n[1] > 0) - (n[1] < 0), (n[2] > 0) - (n[2] < 0) };
+  std::sort(corners.begin(), corners.end());
+  return { corners, direction };
+}
+
+std::multiset<FaceKey> FacesOf(const RegionMesh& mesh)
+{
+  std::multiset<FaceKey> faces;
+  for (const RegionSurface* s : { &mesh.top, &mesh.bottom, &mesh.side })
+  {
+    for (const auto& q : s->quads)
+    {
+      faces.insert(KeyOf(mesh, q));
+    }
+  }
+  return faces;
+}
+
+/// The original model's external faces, from one column mesh of the whole grid.
+std::multiset<FaceKey> OriginalFaces(const SyntheticParameters& p)
+{
+  SyntheticReservoir model(p);
+  GrdeclDeck deck;
+  deck.dims = { p.nx, p.ny, p.nz };
+  deck.coord = model.Coord();
+  deck.zcornSingle.resize(static_cast<std::size_t>(8 * p.CellCount()));
+  std::vector<bool> active(static_cast<std::size_t>(p.CellCount()));
+  SyntheticLayerStream stream(model);
+  SyntheticLayer layer;
+  while (stream.Next(layer))
+  {
+    std::copy(layer.zcorn.begin(), layer.zcorn.end(), deck.zcornSingle.begin() + 8 * p.nx * p.ny * layer.k);
+    for (int64_t c = 0; c < p.nx * p.ny; ++c)
+    {
+      active[static_cast<std::size_t>(layer.k * p.nx * p.ny + c)] = layer.state[c] == SyntheticCellState::Active;
+    }
+  }
+  const CornerPointGeometry geometry = CornerPointGeometry::FromDeck(deck, false);
+  const ColumnMesh whole = ColumnMesh::FromCornerPoints(geometry, active);
+  const ColumnMeshData data = whole.Export();
+  RegionMesh mesh;
+  mesh.layers = data.layers;
+  mesh.positions = data.positions;
+  for (const auto& t : data.topology)
+  {
+    mesh.topology.push_back({ static_cast<float>(t[0]), static_cast<float>(t[1]) });
+  }
+  for (const auto& q : data.corners)
+  {
+    mesh.corners.push_back({ uint32_t(q[0]), uint32_t(q[1]), uint32_t(q[2]), uint32_t(q[3]) });
+  }
+  mesh.active = data.activeCells;
+  mesh.cutEdges.assign(mesh.corners.size(), 0);
+  ComputeOpenSides(mesh);
+  ExtractSurfaces(mesh);
+  return FacesOf(mesh);
+}
+
+/// A region's cut edges as (node data of a, node data of b) in the direction the region
+/// walks them; a neighbour walks the same edge the other way.
+using NodeData = std::pair<std::array<float, 2>, std::vector<double>>;
+using EdgeKey = std::pair<NodeData, NodeData>;
+
+NodeData NodeOf(const RegionMesh& mesh, uint32_t node)
+{
+  const std::size_t interfaces = static_cast<std::size_t>(mesh.layers) + 1;
+  return { mesh.topology[node], std::vector<double>(mesh.positions.begin() + node * interfaces * 3,
+                                  mesh.positions.begin() + (node + 1) * interfaces * 3) };
+}
+
+std::vector<EdgeKey> CutEdgesOf(const RegionMesh& mesh)
+{
+  std::vector<EdgeKey> edges;
+  for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+  {
+    for (int e = 0; e < 4; ++e)
+    {
+      if (mesh.cutEdges[c] & (1u << e))
+      {
+        edges.push_back({ NodeOf(mesh, mesh.corners[c][e]), NodeOf(mesh, mesh.corners[c][(e + 1) % 4]) });
+      }
+    }
+  }
+  return edges;
+}
+
+/// A surface vertex by its data: topological coordinate and position, bit for bit.
+using VertexData = std::array<double, 6>;
+
+VertexData VertexOf(const RegionMesh& mesh, uint32_t vertex)
+{
+  const uint32_t node = vertex / static_cast<uint32_t>(mesh.layers + 1);
+  const double* p = &mesh.positions[static_cast<std::size_t>(vertex) * 3];
+  return { mesh.topology[node][0], mesh.topology[node][1], double(vertex % static_cast<uint32_t>(mesh.layers + 1)), p[0],
+    p[1], p[2] };
+}
+
+/// Two checks that the cut has no crack. (1) Every cut edge of every region is walked the
+/// other way by another region of the cut, with bitwise equal nodes. (2) Independently of
+/// the cut flags: the external surfaces of all regions of the cut, joined by vertex data, are
+/// closed (every directed edge is matched by one walked the other way), as the original
+/// model's surface is. Returns the cut edges checked.
+int64_t CheckCut(const MultiresolutionFile& file, const std::set<std::pair<int, int64_t>>& cut,
+  std::map<std::pair<int, int64_t>, RegionMesh>& cache, const std::string& label)
+{
+  std::multiset<EdgeKey> open;
+  std::map<std::pair<VertexData, VertexData>, int> balance;
+  int64_t checked = 0;
+  for (const auto& region : cut)
+  {
+    const RegionRecord* record = file.Find(region.first, region.second);
+    if (!record)
+    {
+      continue;
+    }
+    auto found = cache.find(region);
+    if (found == cache.end())
+    {
+      found = cache.emplace(region, file.ReadRegion(static_cast<std::size_t>(record - file.Regions().data()))).first;
+    }
+    for (const EdgeKey& edge : CutEdgesOf(found->second))
+    {
+      const EdgeKey reversed{ edge.second, edge.first };
+      const auto match = open.find(reversed);
+      if (match != open.end())
+      {
+        open.erase(match);
+      }
+      else
+      {
+        open.insert(edge);
+      }
+      ++checked;
+    }
+    const RegionMesh& mesh = found->second;
+    for (const RegionSurface* s : { &mesh.top, &mesh.bottom, &mesh.side })
+    {
+      for (const auto& q : s->quads)
+      {
+        for (int v = 0; v < 4; ++v)
+        {
+          const VertexData a = VertexOf(mesh, q[v]), b = VertexOf(mesh, q[(v + 1) % 4]);
+          if (a == b)
+          {
+            continue; // an edge of no length (pinched cell) cannot open a crack
+          }
+          if (a < b)
+          {
+            ++balance[{ a, b }];
+          }
+          else
+          {
+            --balance[{ b, a }];
+          }
+        }
+      }
+    }
+  }
+  int64_t unbalanced = 0;
+  for (const auto& entry : balance)
+  {
+    unbalanced += entry.second != 0;
+    if (entry.second != 0 && getenv("DEBUG_OPEN"))
+    {
+      const auto& a = entry.first.first;
+      const auto& b = entry.first.second;
+      std::fprintf(stderr, "  open %d: (%g %g %g | %.3f %.3f %.3f) - (%g %g %g | %.3f %.3f %.3f)\n", entry.second, a[0], a[1], a[2], a[3], a[4], a[5], b[0], b[1], b[2], b[3], b[4], b[5]);
+    }
+  }
+  if (unbalanced)
+  {
+    std::fprintf(stderr, "%s: %lld surface edges open\n", label.c_str(), static_cast<long long>(unbalanced));
+  }
+  CHECK(unbalanced == 0 && !balance.empty());
+  if (!open.empty())
+  {
+    std::fprintf(stderr, "%s: %zu cut edges without their match\n", label.c_str(), open.size());
+  }
+  CHECK(open.empty());
+  return checked;
+}
+
+void TestHierarchyFile()
+{
+  const SyntheticParameters p = SmallModel();
+  const std::string path = TempPath("small.resmr");
+  HierarchyOptions options;
+  options.cmax = 64;
+  options.threads = 2;
+  SyntheticLayerSource source(p, "synth:small");
+  const HierarchyReport report = BuildHierarchy(source, path, options);
+  CHECK(report.leafLevel >= 4);
+  const MultiresolutionFile file(path);
+  CHECK(file.Header().dims == (std::array<int64_t, 3>{ p.nx, p.ny, p.nz }));
+  CHECK(file.Header().leafLevel == report.leafLevel);
+
+  // Finest level: exactly the original model's external faces, each once.
+  std::multiset<FaceKey> leafFaces;
+  int64_t leafColumns = 0;
+  std::map<int, int64_t> columnsAtLevel;
+  for (std::size_t i = 0; i < file.Regions().size(); ++i)
+  {
+    const RegionRecord& r = file.Regions()[i];
+    columnsAtLevel[r.level] += r.columns;
+    CHECK(r.columns <= options.cmax || r.level == report.leafLevel);
+    if (r.level == report.leafLevel)
+    {
+      const RegionMesh mesh = file.ReadRegion(i);
+      const auto faces = FacesOf(mesh);
+      leafFaces.insert(faces.begin(), faces.end());
+      leafColumns += mesh.ColumnCount();
+    }
+  }
+  const auto original = OriginalFaces(p);
+  CHECK(leafColumns == report.columns);
+  CHECK(!original.empty());
+  CHECK(leafFaces == original);
+  if (leafFaces != original)
+  {
+    std::fprintf(stderr, "finest level: %zu faces, original %zu\n", leafFaces.size(), original.size());
+  }
+  // Each level keeps about half the columns of the one below: locked diamond boundaries keep
+  // more where regions are small, as here (64 columns), so all levels above the leaves
+  // together hold at most 1.2 times the leaves' columns (1 for exact halving).
+  int64_t above = 0;
+  for (int level = 0; level < report.leafLevel; ++level)
+  {
+    CHECK(columnsAtLevel[level] <= 0.7 * columnsAtLevel[level + 1]);
+    above += columnsAtLevel[level];
+  }
+  CHECK(above <= 1.2 * columnsAtLevel[report.leafLevel]);
+
+  // Errors and bounding volumes: equal within a diamond, monotone up the tree.
+  const DiamondHierarchy tree(file.Header().box[0], file.Header().box[1], file.Header().box[2], file.Header().box[3],
+    file.Header().leafLevel);
+  int64_t pairs = 0;
+  for (const RegionRecord& r : file.Regions())
+  {
+    if (r.level > 0)
+    {
+      const RegionRecord* parent = file.Find(r.level - 1, r.index / 2);
+      CHECK(parent != nullptr);
+      if (parent)
+      {
+        CHECK(parent->error >= r.error);
+        for (int a = 0; a < 3; ++a)
+        {
+          CHECK(parent->bounds[a] <= r.bounds[a] && parent->bounds[3 + a] >= r.bounds[3 + a]);
+        }
+        ++pairs;
+      }
+    }
+  }
+  CHECK(pairs > 10);
+  for (int level = 0; level <= report.leafLevel; ++level)
+  {
+    for (const auto& d : tree.Diamonds(level))
+    {
+      const RegionRecord* a = file.Find(level, d.first);
+      const RegionRecord* b = d.second >= 0 ? file.Find(level, d.second) : nullptr;
+      if (a && b)
+      {
+        CHECK(a->error == b->error && a->bounds == b->bounds);
+      }
+    }
+  }
+  CHECK(file.Find(0, 0) && file.Find(0, 0)->error > 0);
+
+  // Conformal cuts: every level whole, and random diamond splits from the roots.
+  std::map<std::pair<int, int64_t>, RegionMesh> cache;
+  int64_t edges = 0;
+  for (int level = 0; level <= report.leafLevel; ++level)
+  {
+    std::set<std::pair<int, int64_t>> cut;
+    for (int64_t t = 0; t < DiamondHierarchy::TriangleCount(level); ++t)
+    {
+      cut.insert({ level, t });
+    }
+    edges += CheckCut(file, cut, cache, "level " + std::to_string(level));
+  }
+  std::mt19937_64 random(11);
+  for (int trial = 0; trial < 12; ++trial)
+  {
+    std::set<std::pair<int, int64_t>> cut{ { 0, 0 }, { 0, 1 } };
+    for (int step = 0; step < 40; ++step)
+    {
+      // Split a random diamond whose triangles are all in the cut.
+      std::vector<DiamondHierarchy::Diamond> splittable;
+      for (int level = 0; level < report.leafLevel; ++level)
+      {
+        for (const auto& d : tree.Diamonds(level))
+        {
+          if (cut.count({ level, d.first }) && (d.second < 0 || cut.count({ level, d.second })))
+          {
+            splittable.push_back(d);
+          }
+        }
+      }
+      if (splittable.empty())
+      {
+        break;
+      }
+      const auto& d = splittable[random() % splittable.size()];
+      for (int64_t t : { d.first, d.second })
+      {
+        if (t >= 0)
+        {
+          cut.erase({ d.level, t });
+          cut.insert({ d.level + 1, 2 * t });
+          cut.insert({ d.level + 1, 2 * t + 1 });
+        }
+      }
+    }
+    edges += CheckCut(file, cut, cache, "random cut " + std::to_string(trial));
+  }
+  CHECK(edges > 100);
+
+  // Thread count changes nothing but the chunks' order.
+  const std::string single = TempPath("single.resmr");
+  options.threads = 1;
+  SyntheticLayerSource again(p, "synth:small");
+  BuildHierarchy(again, single, options);
+  const MultiresolutionFile other(single);
+  CHECK(other.Regions().size() == file.Regions().size());
+  for (std::size_t i = 0; i < file.Regions().size(); ++i)
+  {
+    const RegionRecord& r = file.Regions()[i];
+    const RegionRecord* s = other.Find(r.level, r.index);
+    CHECK(s && s->error == r.error && s->bounds == r.bounds && s->columns == r.columns);
+    if (s && r.level >= report.leafLevel - 2)
+    {
+      const RegionMesh a = file.ReadRegion(i);
+      const RegionMesh b = other.ReadRegion(static_cast<std::size_t>(s - other.Regions().data()));
+      CHECK(a.positions == b.positions && a.corners == b.corners && a.active == b.active && a.cutEdges == b.cutEdges);
+    }
+  }
+  std::remove(single.c_str());
+
+  // Damaged files are refused with the file and the place named.
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string damaged = TempPath("damaged.resmr");
+  const auto writeBytes = [&](const std::string& content) {
+    std::ofstream out(damaged, std::ios::binary | std::ios::trunc);
+    out.write(content.data(), static_cast<std::streamsize>(content.size()));
+  };
+  writeBytes(bytes.substr(0, bytes.size() - 100));
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "truncated", [&] { MultiresolutionFile f(damaged); }, { damaged, "truncated" });
+  writeBytes(bytes.substr(0, 100));
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "stub", [&] { MultiresolutionFile f(damaged); }, { damaged, "too short" });
+  std::string flipped = bytes;
+  const RegionRecord& victim = file.Regions()[file.Regions().size() / 2];
+  flipped[victim.chunks[RegionRecord::Mesh].offset + victim.chunks[RegionRecord::Mesh].stored / 2] ^= 0x5a;
+  writeBytes(flipped);
+  {
+    const MultiresolutionFile f(damaged); // the index is intact: opening works, the chunk does not
+    const std::size_t at = file.Regions().size() / 2;
+    resmr_testing::ExpectError<MultiresolutionFileError>("flipped chunk", [&] { f.ReadRegion(at); },
+      { damaged, "level " + std::to_string(victim.level), "mesh", "checksum" });
+  }
+  flipped = bytes;
+  flipped[bytes.size() - 32 - 192 + 20] ^= 0x01; // inside the last index record
+  writeBytes(flipped);
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "flipped index", [&] { MultiresolutionFile f(damaged); }, { damaged, "index checksum" });
+  flipped = bytes;
+  flipped[40] ^= 0x10;
+  writeBytes(flipped);
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "flipped header", [&] { MultiresolutionFile f(damaged); }, { damaged, "header checksum" });
+  writeBytes("GRDECL file, not ours " + std::string(400, ' '));
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "not ours", [&] { MultiresolutionFile f(damaged); }, { damaged, "not a multiresolution" });
+  std::remove(damaged.c_str());
+  std::remove(path.c_str());
+}
+
+void TestFailedBuildLeavesNothing()
+{
+  // An existing file of the output's name survives a failed build untouched.
+  const std::string path = TempPath("kept.resmr");
+  {
+    std::ofstream out(path);
+    out << "older";
+  }
+  SyntheticParameters p = SmallModel();
+  HierarchyOptions options;
+  options.cmax = 1; // refused
+  SyntheticLayerSource source(p, "synth:kept");
+  resmr_testing::ExpectError<std::invalid_argument>(
+    "cmax", [&] { BuildHierarchy(source, path, options); }, { "--cmax" });
+  std::ifstream in(path);
+  std::string content;
+  in >> content;
+  CHECK(content == "older");
+  std::remove(path.c_str());
+}
+} // namespace
+
+int main()
+{
+  TestDiamondTree();
+  TestHierarchyFile();
+  TestFailedBuildLeavesNothing();
+  if (resmr_testing::Failures)
+  {
+    std::fprintf(stderr, "%d check(s) failed\n", resmr_testing::Failures);
+    return 1;
+  }
+  std::printf("all hierarchy checks passed\n");
+  return 0;
+}
