@@ -240,6 +240,15 @@ double QuadricDistance(const ColumnMeshData& mesh)
   return std::sqrt(largest);
 }
 
+/// Default Cmax: 4096 columns a region (a 64 x 64 patch: top and bottom surfaces of about 16k
+/// triangles, the batch size at which GPUs reach full speed, while a diamond's merged mesh
+/// stays a few hundred MB for 100 layers), but at most a 32nd of the model's columns (and at
+/// least 256), so that small models get five or more levels, not a single one.
+int64_t AutomaticCmax(int64_t columns)
+{
+  return std::max<int64_t>(256, std::min<int64_t>(4096, columns / 32));
+}
+
 /// Runs task(i) for i in [0, count) on `threads` threads; rethrows the first failure.
 void ParallelFor(int64_t count, int threads, const std::function<void(int64_t)>& task)
 {
@@ -330,9 +339,9 @@ public:
     , Progress(progress)
     , Scratch(options.scratch.empty() ? output + ".scratch" : options.scratch)
   {
-    if (this->Options.cmax < 16)
+    if (this->Options.cmax != 0 && this->Options.cmax < 16)
     {
-      throw std::invalid_argument("--cmax must be at least 16 columns");
+      throw std::invalid_argument("--cmax must be at least 16 columns (or 0: chosen from the model)");
     }
   }
 
@@ -728,6 +737,10 @@ HierarchyReport Builder::Run()
     const auto centre = this->Partition->ColumnCentre(columns[n] % nx, columns[n] / nx);
     codes[n] = locator.Code(centre[0], centre[1]);
     coded[n] = { codes[n], columns[n] };
+  }
+  if (this->Options.cmax == 0)
+  {
+    this->Options.cmax = AutomaticCmax(report.columns);
   }
   const int leafLevel = DiamondHierarchy::ChooseLeafLevel(codes, this->Options.cmax);
   this->Tree = DiamondHierarchy(extent[0], extent[1], extent[3], extent[4], leafLevel);

@@ -32,10 +32,11 @@ namespace resmr
 
 struct HierarchyOptions
 {
-  /// Columns a region holds at most. 4096 (a 64 x 64 patch): top and bottom surfaces of
-  /// about 16k triangles a region, the batch size at which GPUs reach full speed, while a
-  /// diamond's merged mesh stays a few hundred MB for 100 layers.
-  int64_t cmax = 4096;
+  /// Columns a region holds at most; 0 (the default): 4096 (a 64 x 64 patch, about 16k
+  /// triangles of top and bottom surface a region, the batch size at which GPUs reach full
+  /// speed), but no more than a 32nd of the model's columns, at least 256, so that small
+  /// models get several levels.
+  int64_t cmax = 0;
   int threads = 0;          ///< 0: every core
   int64_t memoryBytes = 0;  ///< 0: half the available memory
   std::string scratch;      ///< scratch folder (default: beside the output)

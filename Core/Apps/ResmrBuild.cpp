@@ -25,7 +25,8 @@ namespace
 const char* BuildUsage =
   "usage: resmr build INPUT -o OUT.resmr [--cmax N] [--threads N] [--memory SIZE] [--scratch DIR]\n"
   "  INPUT: a GRDECL/DATA deck, an EGRID, or synth:NIxNJxNK[:SEED] (streamed from the generator)\n"
-  "  --cmax N      columns a region holds at most (default 4096)\n"
+  "  --cmax N      columns a region holds at most (default: 4096, or a 32nd of the model's\n"
+  "                columns if fewer, at least 256)\n"
   "  --threads N   worker threads (default: every core)\n"
   "  --memory SIZE memory budget, e.g. 4G or 512M (default: half the available memory)\n"
   "  --scratch DIR scratch folder (default OUT.resmr.scratch, removed at the end)\n"
