@@ -98,19 +98,20 @@ def report(rows, host, path_md):
     if len(synthetic) >= 2:
         big = max(synthetic, key=lambda r: r["cells"])
         seconds_per_cell = big["total_s"] / big["cells"]
-        rss_per_cell = big["peak_rss_mb"] / big["cells"]
         lines += ["", "## A billion cells, extrapolated",
                   f"From the largest run ({big['cells']:,} cells): time grows linearly with cells (each level halves the "
                   f"columns, so the whole build is about twice one level's work), so 1,000,000,000 cells take about "
                   f"{seconds_per_cell * 1e9 / 3600:.1f} h on this {host['cores']}-core machine "
                   f"({1e9 * seconds_per_cell * host['cores'] / 3600:.1f} core-hours) and "
-                  f"{big['bytes_per_cell'] * 1e9 / 1e9:.1f} GB of file. Peak memory does not grow with the model: the "
-                  f"partition pass holds one layer (about 60 bytes a column) and each worker one diamond, all within the "
-                  f"budget (measured {big['peak_rss_mb']:.0f} MB at {big['cells'] / 1e6:.0f}M cells).",
+                  f"{big['bytes_per_cell'] * 1e9 / 1e9:.1f} GB of file. Peak memory is set by the workers, each "
+                  f"holding one diamond (up to 4 Cmax columns of nk + 1 vertices with quadrics: the 1M and 10M models "
+                  f"have smaller Cmax, hence less), plus per-column arrays of a few hundred bytes a column (column "
+                  f"flags, centres and leaf codes, COORD, the generator's per-column state): "
+                  f"{big['peak_rss_mb']:.0f} MB at {big['cells'] / 1e6:.0f}M cells ({big['columns']:,} columns). A "
+                  f"billion cells of 100 layers has 10M columns: about 2 GB more for those arrays, not measured.",
                   "", "Scaling measured:", "", "| cells | total s | s per million cells | peak RSS MB |", "|---|---|---|---|"]
         for r in sorted(synthetic, key=lambda r: r["cells"]):
             lines.append(f"| {r['cells']:,} | {r['total_s']:.1f} | {r['total_s'] / r['cells'] * 1e6:.2f} | {r['peak_rss_mb']:.0f} |")
-        del rss_per_cell
     lines += ["", "## Against the paper (Tables 1-2)",
               "The paper built A100 (96M cells) in 4.0 h and C1200 (1,265M cells) in 37.5 h on 48 threads: about "
               "140-200 cells/s per thread. Its files took 143-185 bytes a cell (A100: 17.8 GB; C1200: 181 GB). "
