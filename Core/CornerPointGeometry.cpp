@@ -165,26 +165,16 @@ void CornerPointGeometry::SetMapAxesApplied(bool apply)
 
 void CornerPointGeometry::PillarPoint(int64_t pillar, double depth, double xyz[3]) const
 {
-  const double* p = &this->CoordValues[static_cast<std::size_t>(6 * pillar)];
-  const double dz = p[5] - p[2];
-  double x = p[0], y = p[1];
-  if (dz != 0.0)
-  {
-    const double t = (depth - p[2]) / dz;
-    x += t * (p[3] - p[0]);
-    y += t * (p[4] - p[1]);
-  }
+  PointOnPillar(&this->CoordValues[static_cast<std::size_t>(6 * pillar)], depth, xyz);
+  const double x = xyz[0], y = xyz[1];
   if (this->MapAxesApplied)
   {
     const auto& m = this->MapTransform;
     const double mx = m[0] + x * m[2] + y * m[4];
     const double my = m[1] + x * m[3] + y * m[5];
-    x = mx;
-    y = my;
+    xyz[0] = mx;
+    xyz[1] = my;
   }
-  xyz[0] = x;
-  xyz[1] = y;
-  xyz[2] = depth;
 }
 
 void CornerPointGeometry::CellCorners(int64_t i, int64_t j, int64_t k, double corners[8][3]) const

@@ -18,6 +18,23 @@
 namespace resmr
 {
 
+/// The point at `depth` on a pillar given as COORD's 6 values (top x y depth, bottom x y
+/// depth); a pillar with no depth extent is vertical.
+inline void PointOnPillar(const double* pillar, double depth, double xyz[3])
+{
+  const double dz = pillar[5] - pillar[2];
+  double x = pillar[0], y = pillar[1];
+  if (dz != 0.0)
+  {
+    const double t = (depth - pillar[2]) / dz;
+    x += t * (pillar[3] - pillar[0]);
+    y += t * (pillar[4] - pillar[1]);
+  }
+  xyz[0] = x;
+  xyz[1] = y;
+  xyz[2] = depth;
+}
+
 class CornerPointGeometry
 {
 public:

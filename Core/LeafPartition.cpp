@@ -1,6 +1,8 @@
 // Streaming partition of a corner-point model into tiles of columns (paper Sec. 4.2, 7).
 #include "LeafPartition.h"
 
+#include "CornerPointGeometry.h"
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -204,18 +206,7 @@ std::array<double, 2> LeafPartition::ColumnCentre(int64_t i, int64_t j) const
 
 void LeafPartition::PillarPoint(int64_t pi, int64_t pj, double depth, double xyz[3]) const
 {
-  const double* p = &this->CoordValues[static_cast<std::size_t>(6 * (pj * (this->Dimensions[0] + 1) + pi))];
-  const double dz = p[5] - p[2];
-  double x = p[0], y = p[1];
-  if (dz != 0.0)
-  {
-    const double t = (depth - p[2]) / dz;
-    x += t * (p[3] - p[0]);
-    y += t * (p[4] - p[1]);
-  }
-  xyz[0] = x;
-  xyz[1] = y;
-  xyz[2] = depth;
+  PointOnPillar(&this->CoordValues[static_cast<std::size_t>(6 * (pj * (this->Dimensions[0] + 1) + pi))], depth, xyz);
 }
 
 void LeafPartition::ReadBox(

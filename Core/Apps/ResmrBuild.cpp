@@ -95,26 +95,7 @@ std::unique_ptr<resmr::LayerSource> OpenSource(const std::string& input, FileMod
     p.Validate();
     return std::unique_ptr<resmr::LayerSource>(new resmr::SyntheticLayerSource(p, input));
   }
-  if (resmr::LooksLikeEclipseGridFile(input))
-  {
-    resmr::EclipseGrid grid = resmr::ReadEclipseGrid(input);
-    model.active.resize(static_cast<std::size_t>(grid.deck.CellCount()));
-    for (int64_t c = 0; c < grid.deck.CellCount(); ++c)
-    {
-      model.active[c] = grid.IsActive(c);
-    }
-    model.deck = std::move(grid.deck);
-  }
-  else
-  {
-    model.deck = resmr::ParseGrdeclFile(input);
-    const resmr::CellArray* actnum = model.deck.FindArray("ACTNUM");
-    model.active.resize(static_cast<std::size_t>(model.deck.CellCount()));
-    for (int64_t c = 0; c < model.deck.CellCount(); ++c)
-    {
-      model.active[c] = !actnum || actnum->values[c] != 0;
-    }
-  }
+  ReadGridFile(input, model.deck, model.active);
   model.geometry.reset(new resmr::CornerPointGeometry(resmr::CornerPointGeometry::FromDeck(model.deck, false)));
   return std::unique_ptr<resmr::LayerSource>(new resmr::CornerPointLayerSource(*model.geometry, model.active, input));
 }

@@ -1,8 +1,11 @@
 // Subcommands of the resmr tool, one file each.
 #pragma once
 
+#include "GrdeclDeck.h"
+
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 /// The value after option argv[a] (advancing a); throws std::invalid_argument if missing.
 inline const char* OptionValue(int& a, int argc, char** argv)
@@ -25,3 +28,6 @@ int BuildCommand(int argc, char** argv);
 
 /// resmr info FILE.resmr: levels, regions, sizes and errors as JSON.
 int MultiresolutionInfo(const char* path);
+
+/// An EGRID or a GRDECL/DATA deck: its deck and one active flag a cell (ACTNUM, all if none).
+void ReadGridFile(const std::string& path, resmr::GrdeclDeck& deck, std::vector<bool>& active);

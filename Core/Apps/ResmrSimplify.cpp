@@ -78,24 +78,7 @@ Model Load(const std::string& source)
     }
     return model;
   }
-  if (resmr::LooksLikeEclipseGridFile(source))
-  {
-    resmr::EclipseGrid grid = resmr::ReadEclipseGrid(source);
-    model.active.resize(static_cast<std::size_t>(grid.deck.CellCount()));
-    for (int64_t c = 0; c < grid.deck.CellCount(); ++c)
-    {
-      model.active[c] = grid.IsActive(c);
-    }
-    model.deck = std::move(grid.deck);
-    return model;
-  }
-  model.deck = resmr::ParseGrdeclFile(source);
-  const resmr::CellArray* actnum = model.deck.FindArray("ACTNUM");
-  model.active.resize(static_cast<std::size_t>(model.deck.CellCount()));
-  for (int64_t c = 0; c < model.deck.CellCount(); ++c)
-  {
-    model.active[c] = !actnum || actnum->values[c] != 0;
-  }
+  ReadGridFile(source, model.deck, model.active);
   return model;
 }
 
