@@ -9,13 +9,14 @@
 // - Crack-free: a node on an edge between two regions (a "cut" edge) is never moved or
 //   merged while those regions belong to different diamonds, so any conformal cut of the
 //   tree matches exactly (the diamond's two triangles are always shown together).
-// - Each level keeps at most half the columns of the level below and at most Cmax a region
-//   (the paper's rule is Cmax a region; halving as well keeps every level a real
-//   simplification where leaves hold fewer than Cmax columns).
+// - Each diamond is simplified to half its children's columns and at most Cmax a region (the
+//   paper's rule is Cmax a region; halving as well keeps every level a real simplification
+//   where leaves hold fewer than Cmax columns). Locked borders may leave a few more.
 // - Bounding volumes and errors are made equal for a diamond's two regions and monotone up
 //   the tree (Sec. 6.2).
 // - Memory: one layer of the input during the partition pass, then one diamond's meshes a
-//   worker thread; worker threads are cut to fit `memoryBytes`. Scratch files go to
+//   worker thread (worker threads are cut to fit `memoryBytes`), plus a few arrays of one
+//   value a column (flags, centres, leaf codes). Scratch files go to
 //   `scratch` and are removed as soon as they are used (and on failure).
 // - Deterministic: the same input and Cmax give the same region meshes whatever the thread
 //   count (chunks may lie in another order in the file).
