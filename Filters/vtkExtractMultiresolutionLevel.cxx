@@ -1,5 +1,7 @@
 #include "vtkExtractMultiresolutionLevel.h"
 
+#include "ResMRFieldData.h"
+
 #include "ConformalCut.h"
 #include "MultiresolutionFile.h"
 #include "RegionMesh.h"
@@ -23,16 +25,7 @@
 
 vtkStandardNewMacro(vtkExtractMultiresolutionLevel);
 
-namespace
-{
-void AddValue(vtkFieldData* field, const char* name, double value)
-{
-  vtkNew<vtkDoubleArray> array;
-  array->SetName(name);
-  array->InsertNextValue(value);
-  field->AddArray(array);
-}
-} // namespace
+using resmr_filters::AddValue;
 
 vtkExtractMultiresolutionLevel::vtkExtractMultiresolutionLevel()
 {

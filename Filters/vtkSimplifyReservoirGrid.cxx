@@ -1,5 +1,7 @@
 #include "vtkSimplifyReservoirGrid.h"
 
+#include "ResMRFieldData.h"
+
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkCellType.h"
@@ -47,16 +49,7 @@ int vtkSimplifyReservoirGrid::FillInputPortInformation(int, vtkInformation* info
   return 1;
 }
 
-namespace
-{
-void AddValue(vtkFieldData* field, const char* name, double value)
-{
-  vtkNew<vtkDoubleArray> array;
-  array->SetName(name);
-  array->InsertNextValue(value);
-  field->AddArray(array);
-}
-} // namespace
+using resmr_filters::AddValue;
 
 int vtkSimplifyReservoirGrid::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
