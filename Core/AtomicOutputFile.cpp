@@ -55,6 +55,18 @@ bool AtomicOutputFile::Write(const void* data, std::size_t size)
   return this->File && std::fwrite(data, 1, size, this->File) == size;
 }
 
+bool AtomicOutputFile::WriteAt(const void* data, std::size_t size, long offset)
+{
+  if (!this->File)
+  {
+    return false;
+  }
+  const long end = std::ftell(this->File);
+  const bool ok = end >= 0 && std::fseek(this->File, offset, SEEK_SET) == 0 &&
+    std::fwrite(data, 1, size, this->File) == size;
+  return std::fseek(this->File, end, SEEK_SET) == 0 && ok;
+}
+
 void AtomicOutputFile::Commit()
 {
   if (!this->File)

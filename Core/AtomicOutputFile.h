@@ -26,6 +26,8 @@ public:
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 
   bool Write(const void* data, std::size_t size);
+  /// Overwrites bytes already written (a header patched at the end); same errors as Write.
+  bool WriteAt(const void* data, std::size_t size, long offset);
   void Commit();
   void Discard();
 

@@ -7,7 +7,10 @@
 #include "LeafPartition.h"
 #include "MemoryBudget.h"
 #include "MultiresolutionFile.h"
+#include "NormalQuantization.h"
+#include "PerfectSpatialHash.h"
 #include "RegionMesh.h"
+#include "SideSurfaceSimplification.h"
 
 #include <algorithm>
 #include <atomic>
@@ -16,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <dirent.h>
 #include <exception>
 #include <limits>
 #include <map>
@@ -179,7 +183,7 @@ std::vector<uint8_t> KeptCells(const std::vector<uint8_t>& perCell, const std::v
   return out;
 }
 
-RegionMesh ToRegionMesh(const ScratchRegion& region)
+RegionMesh ToRegionMesh(const ScratchRegion& region, double sideError)
 {
   RegionMesh out;
   out.layers = region.mesh.layers;
@@ -201,6 +205,8 @@ RegionMesh ToRegionMesh(const ScratchRegion& region)
   out.cutEdges = region.cutEdges;
   out.openSides = region.openSides;
   ExtractSurfaces(out);
+  // Sec. 4.3: side faces simplified up to the error of the hexahedral mesh they bound.
+  out.sideTriangles = SimplifySideSurface(out, sideError);
   return out;
 }
 
@@ -302,32 +308,177 @@ uint64_t Mix(uint64_t x)
   return x ^ (x >> 31);
 }
 
-/// Removes the scratch folder's leftovers on the way out, whatever happens.
-struct ScratchFolder
+/// Little binary files that record a build's progress (resuming, MPI ranks).
+class ManifestOut
 {
-  std::string path;
-  bool created = false;
-  explicit ScratchFolder(std::string folder)
-    : path(std::move(folder))
+public:
+  template <typename T>
+  void Put(const T& value)
   {
-    if (mkdir(this->path.c_str(), 0755) != 0 && errno != EEXIST)
-    {
-      throw std::runtime_error(this->path + ": cannot create the scratch folder: " + std::strerror(errno));
-    }
-    this->created = true;
+    const auto* bytes = reinterpret_cast<const uint8_t*>(&value);
+    this->Bytes.insert(this->Bytes.end(), bytes, bytes + sizeof(T));
   }
-  ~ScratchFolder()
+  void PutString(const std::string& text)
   {
-    if (this->created)
+    this->Put(static_cast<uint64_t>(text.size()));
+    this->Bytes.insert(this->Bytes.end(), text.begin(), text.end());
+  }
+  /// Written under a temporary name and renamed: a manifest is there whole or not at all.
+  void Save(const std::string& path) const
+  {
+    const std::string temporary = path + ".part";
+    std::FILE* file = std::fopen(temporary.c_str(), "wb");
+    bool ok = file && std::fwrite(this->Bytes.data(), 1, this->Bytes.size(), file) == this->Bytes.size();
+    ok = file && (std::fflush(file) == 0) && (fsync(fileno(file)) == 0) && ok;
+    ok = file && (std::fclose(file) == 0) && ok;
+    if (!ok || std::rename(temporary.c_str(), path.c_str()) != 0)
     {
-      const std::string command = "rm -rf '" + this->path + "'";
-      if (std::system(command.c_str()) != 0)
+      unlink(temporary.c_str());
+      throw std::runtime_error(path + ": cannot write the build manifest: " + std::strerror(errno));
+    }
+  }
+  std::vector<uint8_t> Bytes;
+};
+
+class ManifestIn
+{
+public:
+  /// False if the file is absent.
+  bool Load(const std::string& path)
+  {
+    std::FILE* file = std::fopen(path.c_str(), "rb");
+    if (!file)
+    {
+      return false;
+    }
+    uint8_t block[65536];
+    std::size_t got = 0;
+    while ((got = std::fread(block, 1, sizeof(block), file)) > 0)
+    {
+      this->Bytes.insert(this->Bytes.end(), block, block + got);
+    }
+    std::fclose(file);
+    this->Path = path;
+    return true;
+  }
+  template <typename T>
+  T Get()
+  {
+    T value{};
+    if (sizeof(T) > this->Bytes.size() - this->At)
+    {
+      throw std::runtime_error(this->Path + ": build manifest is truncated");
+    }
+    std::memcpy(&value, this->Bytes.data() + this->At, sizeof(T));
+    this->At += sizeof(T);
+    return value;
+  }
+  std::string GetString()
+  {
+    const uint64_t size = this->Get<uint64_t>();
+    if (size > this->Bytes.size() - this->At)
+    {
+      throw std::runtime_error(this->Path + ": build manifest is truncated");
+    }
+    std::string text(this->Bytes.begin() + this->At, this->Bytes.begin() + this->At + size);
+    this->At += size;
+    return text;
+  }
+  std::vector<uint8_t> Bytes;
+  std::size_t At = 0;
+  std::string Path;
+};
+
+constexpr uint64_t BuildManifestMagic = 0x31444c4252534552ull; // "RESRBLD1"
+
+bool Exists(const std::string& path)
+{
+  struct stat info;
+  return stat(path.c_str(), &info) == 0;
+}
+
+void RemoveTree(const std::string& path)
+{
+  DIR* folder = opendir(path.c_str());
+  if (!folder)
+  {
+    unlink(path.c_str());
+    return;
+  }
+  while (const dirent* entry = readdir(folder))
+  {
+    const std::string name = entry->d_name;
+    if (name != "." && name != "..")
+    {
+      RemoveTree(path + "/" + name);
+    }
+  }
+  closedir(folder);
+  rmdir(path.c_str());
+}
+
+/// The cells (natural index) an extracted face of the region may sample through its
+/// interpolated topological coordinates (Sec. 5.2): every cell of the face's box in (i, j,
+/// k) space, on the inner side of a top or bottom face and on both sides of a side face.
+void MarkTouchedCells(const RegionMesh& mesh, const std::array<int64_t, 3>& dims, std::vector<std::atomic<uint64_t>>& bits)
+{
+  const uint32_t interfaces = static_cast<uint32_t>(mesh.layers + 1);
+  const auto mark = [&](const uint32_t* vertices, int count, int kind) {
+    std::array<double, 3> low{ 1e300, 1e300, 1e300 }, high{ -1e300, -1e300, -1e300 };
+    for (int v = 0; v < count; ++v)
+    {
+      const uint32_t node = vertices[v] / interfaces;
+      const double t[3] = { mesh.topology[node][0], mesh.topology[node][1], double(vertices[v] % interfaces) };
+      for (int a = 0; a < 3; ++a)
       {
-        std::fprintf(stderr, "warning: could not remove the scratch folder %s\n", this->path.c_str());
+        low[a] = std::min(low[a], t[a]);
+        high[a] = std::max(high[a], t[a]);
       }
     }
+    std::array<int64_t, 3> first{}, last{};
+    for (int a = 0; a < 3; ++a)
+    {
+      if (high[a] - low[a] < 1e-6)
+      {
+        // Constant coordinate: the cell below a top face, above a bottom face, either side
+        // of a side face.
+        const int64_t t = static_cast<int64_t>(std::llround(low[a]));
+        first[a] = (a == 2 && kind == 0) ? t : t - 1;
+        last[a] = (a == 2 && kind == 1) ? t - 1 : t;
+      }
+      else
+      {
+        first[a] = static_cast<int64_t>(std::floor(low[a]));
+        last[a] = static_cast<int64_t>(std::ceil(high[a])) - 1;
+      }
+      first[a] = std::max<int64_t>(first[a], 0);
+      last[a] = std::min<int64_t>(last[a], dims[a] - 1);
+    }
+    for (int64_t k = first[2]; k <= last[2]; ++k)
+    {
+      for (int64_t j = first[1]; j <= last[1]; ++j)
+      {
+        for (int64_t i = first[0]; i <= last[0]; ++i)
+        {
+          const uint64_t n = static_cast<uint64_t>(i + dims[0] * (j + dims[1] * k));
+          bits[n >> 6].fetch_or(uint64_t(1) << (n & 63), std::memory_order_relaxed);
+        }
+      }
+    }
+  };
+  for (const auto& q : mesh.top.quads)
+  {
+    mark(q.data(), 4, 0);
   }
-};
+  for (const auto& q : mesh.bottom.quads)
+  {
+    mark(q.data(), 4, 1);
+  }
+  for (const auto& t : mesh.sideTriangles)
+  {
+    mark(t.data(), 3, 2);
+  }
+}
 
 class Builder
 {
@@ -342,6 +493,12 @@ public:
     if (this->Options.cmax != 0 && this->Options.cmax < 16)
     {
       throw std::invalid_argument("--cmax must be at least 16 columns (or 0: chosen from the model)");
+    }
+    if (this->Options.ranks < 1 || this->Options.rank < 0 || this->Options.rank >= this->Options.ranks ||
+      (this->Options.ranks > 1 && !this->Options.barrier))
+    {
+      throw std::invalid_argument("hierarchy build: rank " + std::to_string(this->Options.rank) + " of " +
+        std::to_string(this->Options.ranks) + " (several ranks need a barrier)");
     }
   }
 
@@ -360,18 +517,43 @@ private:
   void BuildDiamond(const DiamondHierarchy::Diamond& diamond);
   void Emit(int level, int64_t index, const ScratchRegion& region, bool keepScratch);
   int ThreadsFor(int64_t bytesPerTask) const;
+  void Barrier()
+  {
+    if (this->Options.ranks > 1)
+    {
+      this->Options.barrier();
+    }
+  }
+  /// Runs `work` on every rank; if it fails on any, every rank throws (no rank is left
+  /// waiting at a barrier for one that failed).
+  void Collective(const std::function<void()>& work);
+  std::string LevelManifest(int level, int rank) const
+  {
+    return this->Scratch + "/level-" + std::to_string(level) + ".rank-" + std::to_string(rank);
+  }
+  std::string ChunkPath(int rank) const { return this->Scratch + "/chunks-" + std::to_string(rank) + ".bin"; }
+  std::string NormalsPath(int64_t leaf) const { return this->Scratch + "/normals-" + std::to_string(leaf) + ".bin"; }
+  void SaveLevel(int level);
+  void LoadLevel(int level);
+  bool ReadBuildManifest(MultiresolutionHeader& header, HierarchyReport& report);
+  void WriteBuildManifest(const MultiresolutionHeader& header, const HierarchyReport& report) const;
+  void FinishBoundsAndErrors(int leafLevel);
+  void BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& report, std::vector<ModelChunk>& model);
 
   LayerSource& Source;
   std::string Output;
   HierarchyOptions Options;
   BuildProgress Progress;
-  ScratchFolder Scratch;
+  std::string Scratch;
   std::mutex ProgressLock;
   std::unique_ptr<LeafPartition> Partition;
   DiamondHierarchy Tree;
-  std::unique_ptr<MultiresolutionWriter> Writer;
+  MultiresolutionHeader Header;
+  std::unique_ptr<ChunkFile> Chunks;
+  std::vector<ModelChunk> ActiveLayers; ///< rank 0's
   std::mutex RecordLock;
   std::map<std::pair<int, int64_t>, RegionRecord> Records;
+  std::map<std::pair<int, int64_t>, int> Parts; ///< the rank whose chunk file holds a region
   std::map<std::pair<int, int64_t>, std::array<double, 6>> OwnBoxes;
   std::atomic<int64_t> WorkDone{ 0 };
   int64_t WorkTotal = 1;
@@ -388,21 +570,181 @@ int Builder::ThreadsFor(int64_t bytesPerTask) const
   return static_cast<int>(std::min<int64_t>(threads, fit));
 }
 
+void Builder::Collective(const std::function<void()>& work)
+{
+  std::string failure;
+  try
+  {
+    work();
+  }
+  catch (const std::exception& error)
+  {
+    failure = error.what();
+    if (this->Options.ranks == 1)
+    {
+      throw;
+    }
+    ManifestOut note;
+    note.PutString(failure);
+    try
+    {
+      note.Save(this->Scratch + "/failed.rank-" + std::to_string(this->Options.rank));
+    }
+    catch (const std::exception&)
+    {
+    }
+  }
+  this->Barrier();
+  if (!failure.empty())
+  {
+    throw std::runtime_error(failure);
+  }
+  for (int r = 0; r < this->Options.ranks; ++r)
+  {
+    ManifestIn note;
+    if (note.Load(this->Scratch + "/failed.rank-" + std::to_string(r)))
+    {
+      throw std::runtime_error("rank " + std::to_string(r) + " failed: " + note.GetString());
+    }
+  }
+}
+
 void Builder::Emit(int level, int64_t index, const ScratchRegion& region, bool keepScratch)
 {
   if (keepScratch)
   {
-    SaveRegion(RegionPath(this->Scratch.path, level, index), region);
+    SaveRegion(RegionPath(this->Scratch, level, index), region);
   }
-  const RegionMesh mesh = ToRegionMesh(region);
   RegionRecord record;
   record.level = level;
   record.index = index;
-  record.ownError = static_cast<float>(QuadricDistance(region.mesh));
-  this->Writer->AddRegion(mesh, record);
+  const double ownError = QuadricDistance(region.mesh);
+  record.ownError = static_cast<float>(ownError);
+  // The file rounds positions to its lattice after simplification: allow one step more.
+  const auto& step = this->Header.latticeStep;
+  const RegionMesh mesh = ToRegionMesh(region, ownError + std::sqrt(step[0] * step[0] + step[1] * step[1] + step[2] * step[2]));
+  this->Chunks->AddRegion(mesh, this->Header, record);
   std::lock_guard<std::mutex> guard(this->RecordLock);
   this->Records[{ level, index }] = record;
+  this->Parts[{ level, index }] = this->Options.rank;
   this->OwnBoxes[{ level, index }] = BoxOf(region.mesh.positions);
+}
+
+void Builder::SaveLevel(int level)
+{
+  ManifestOut out;
+  out.Put(BuildManifestMagic);
+  out.Put(static_cast<int32_t>(level));
+  out.Put(static_cast<int32_t>(this->Options.rank));
+  out.Put(this->Chunks->Sync());
+  std::vector<std::pair<int, int64_t>> mine;
+  for (const auto& entry : this->Parts)
+  {
+    if (entry.first.first == level && entry.second == this->Options.rank)
+    {
+      mine.push_back(entry.first);
+    }
+  }
+  out.Put(static_cast<uint64_t>(mine.size()));
+  for (const auto& key : mine)
+  {
+    out.Put(this->Records[key]);
+    out.Put(this->OwnBoxes[key]);
+  }
+  out.Save(this->LevelManifest(level, this->Options.rank));
+}
+
+void Builder::LoadLevel(int level)
+{
+  for (int r = 0; r < this->Options.ranks; ++r)
+  {
+    ManifestIn in;
+    if (!in.Load(this->LevelManifest(level, r)))
+    {
+      throw std::runtime_error(this->LevelManifest(level, r) + ": missing (rank " + std::to_string(r) +
+        " did not finish level " + std::to_string(level) + ")");
+    }
+    if (in.Get<uint64_t>() != BuildManifestMagic || in.Get<int32_t>() != level || in.Get<int32_t>() != r)
+    {
+      throw std::runtime_error(in.Path + ": not the manifest of this level and rank");
+    }
+    in.Get<uint64_t>();
+    const uint64_t count = in.Get<uint64_t>();
+    for (uint64_t n = 0; n < count; ++n)
+    {
+      const RegionRecord record = in.Get<RegionRecord>();
+      const auto box = in.Get<std::array<double, 6>>();
+      const std::pair<int, int64_t> key{ record.level, record.index };
+      this->Records[key] = record;
+      this->Parts[key] = r;
+      this->OwnBoxes[key] = box;
+    }
+  }
+}
+
+void Builder::WriteBuildManifest(const MultiresolutionHeader& header, const HierarchyReport& report) const
+{
+  ManifestOut out;
+  out.Put(BuildManifestMagic);
+  out.PutString(this->Source.Name());
+  out.Put(this->Source.Dims());
+  out.Put(this->Options.cmax);
+  out.Put(this->Options.seed);
+  out.Put(static_cast<int32_t>(this->Options.ranks));
+  out.Put(header.dims);
+  out.Put(header.box);
+  out.Put(header.latticeOrigin);
+  out.Put(header.latticeStep);
+  out.Put(header.leafLevel);
+  out.Put(header.cmax);
+  out.Put(report.cells);
+  out.Put(report.activeCells);
+  out.Put(report.columns);
+  out.Put(static_cast<uint64_t>(this->ActiveLayers.size()));
+  for (const ModelChunk& m : this->ActiveLayers)
+  {
+    out.Put(m);
+  }
+  out.Save(this->Scratch + "/build.manifest");
+}
+
+/// True if the scratch folder holds a build of the same input and options to resume.
+bool Builder::ReadBuildManifest(MultiresolutionHeader& header, HierarchyReport& report)
+{
+  ManifestIn in;
+  if (!this->Options.resume || !in.Load(this->Scratch + "/build.manifest"))
+  {
+    return false;
+  }
+  try
+  {
+    if (in.Get<uint64_t>() != BuildManifestMagic || in.GetString() != this->Source.Name() ||
+      in.Get<std::array<int64_t, 3>>() != this->Source.Dims() || in.Get<int64_t>() != this->Options.cmax ||
+      in.Get<uint64_t>() != this->Options.seed || in.Get<int32_t>() != this->Options.ranks)
+    {
+      return false;
+    }
+    header.dims = in.Get<std::array<int64_t, 3>>();
+    header.box = in.Get<std::array<double, 4>>();
+    header.latticeOrigin = in.Get<std::array<double, 3>>();
+    header.latticeStep = in.Get<std::array<double, 3>>();
+    header.leafLevel = in.Get<int32_t>();
+    header.cmax = in.Get<int32_t>();
+    report.cells = in.Get<int64_t>();
+    report.activeCells = in.Get<int64_t>();
+    report.columns = in.Get<int64_t>();
+    const uint64_t layers = in.Get<uint64_t>();
+    this->ActiveLayers.clear();
+    for (uint64_t k = 0; k < layers; ++k)
+    {
+      this->ActiveLayers.push_back(in.Get<ModelChunk>());
+    }
+  }
+  catch (const std::runtime_error&)
+  {
+    return false;
+  }
+  return true;
 }
 
 void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
@@ -465,6 +807,35 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
       partition.PillarPoint(i0 + i + (c & 1), j0 + j + ((c >> 1) & 1), z[c], out[c]);
     }
   };
+  // Sec. 5.3: the original top and bottom face normals of every cell (z up), 2 bytes each.
+  {
+    ManifestOut normals;
+    normals.Put(static_cast<uint64_t>(columns.size()));
+    double p[8][3];
+    for (int64_t column : columns)
+    {
+      normals.Put(column);
+      for (int64_t k = 0; k < nz; ++k)
+      {
+        corners(column % nx - i0, column / nx - j0, k, p);
+        for (int face = 0; face < 2; ++face)
+        {
+          const auto at = [&](int c) { return glm::dvec3(p[4 * face + c][0], p[4 * face + c][1], -p[4 * face + c][2]); };
+          glm::dvec3 n = glm::cross(at(1) - at(0) + at(3) - at(2), at(2) - at(0) + at(3) - at(1));
+          if ((face == 0 && n.z < 0) || (face == 1 && n.z > 0))
+          {
+            n = -n; // top faces look up, bottom faces down, whichever way the grid turns
+          }
+          if (!(glm::length(n) > 0))
+          {
+            n = glm::dvec3(0, 0, face == 0 ? 1 : -1); // a face of no area: level
+          }
+          normals.Put(EncodeUnitNormal(n.x, n.y, n.z));
+        }
+      }
+    }
+    normals.Save(this->NormalsPath(leaf));
+  }
   const ColumnMesh halo = ColumnMesh::FromCells({ w, h, nz }, corners, active, 0, w, 0, h, &selected);
   std::vector<uint8_t> keep(static_cast<std::size_t>(halo.ColumnSlots()), 0);
   for (int32_t c = 0; c < halo.ColumnSlots(); ++c)
@@ -522,10 +893,9 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond)
     for (int64_t child : { 2 * triangle, 2 * triangle + 1 })
     {
       ScratchRegion region;
-      const std::string path = RegionPath(this->Scratch.path, childLevel, child);
-      if (LoadRegion(path, region))
+      const std::string path = RegionPath(this->Scratch, childLevel, child);
+      if (LoadRegion(path, region)) // removed once the level is finished (resuming needs it)
       {
-        unlink(path.c_str());
         children.push_back(std::move(region));
       }
     }
@@ -699,117 +1069,8 @@ double Seconds()
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-HierarchyReport Builder::Run()
+void Builder::FinishBoundsAndErrors(int leafLevel)
 {
-  HierarchyReport report;
-  const double start = Seconds();
-  const auto dims = this->Source.Dims();
-  const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
-  report.cells = nx * ny * nz;
-  // Tiles of about 64 x 64 columns, fewer and bigger for very wide grids (at most ~1000 files).
-  const int64_t tile = std::max<int64_t>(64, static_cast<int64_t>(std::ceil(std::sqrt(double(nx) * ny / 1000.0))));
-  this->Partition.reset(new LeafPartition(this->Source, this->Scratch.path + "/tiles", tile,
-    [this](double f) { this->Report("partition", 0.1 * f); }));
-  report.partitionSeconds = Seconds() - start;
-  report.activeCells = this->Partition->ActiveCells();
-
-  // Hierarchy over the pillars' extent; leaves by column centre.
-  const auto& extent = this->Partition->Extent();
-  const auto& hasActive = this->Partition->ColumnHasActive();
-  std::vector<int64_t> columns;
-  for (int64_t c = 0; c < nx * ny; ++c)
-  {
-    if (hasActive[static_cast<std::size_t>(c)])
-    {
-      columns.push_back(c);
-    }
-  }
-  if (columns.empty())
-  {
-    throw std::runtime_error(this->Source.Name() + ": the model has no active cell");
-  }
-  report.columns = static_cast<int64_t>(columns.size());
-  DiamondHierarchy locator(extent[0], extent[1], extent[3], extent[4], 0);
-  std::vector<std::pair<uint64_t, int64_t>> coded(columns.size());
-  std::vector<uint64_t> codes(columns.size());
-  for (std::size_t n = 0; n < columns.size(); ++n)
-  {
-    const auto centre = this->Partition->ColumnCentre(columns[n] % nx, columns[n] / nx);
-    codes[n] = locator.Code(centre[0], centre[1]);
-    coded[n] = { codes[n], columns[n] };
-  }
-  if (this->Options.cmax == 0)
-  {
-    this->Options.cmax = AutomaticCmax(report.columns);
-  }
-  const int leafLevel = DiamondHierarchy::ChooseLeafLevel(codes, this->Options.cmax);
-  this->Tree = DiamondHierarchy(extent[0], extent[1], extent[3], extent[4], leafLevel);
-  report.leafLevel = leafLevel;
-  std::sort(coded.begin(), coded.end());
-  std::vector<std::pair<int64_t, std::vector<int64_t>>> leaves;
-  for (const auto& entry : coded)
-  {
-    const int64_t leaf = static_cast<int64_t>(entry.first >> (DiamondHierarchy::MaxDepth - leafLevel));
-    if (leaves.empty() || leaves.back().first != leaf)
-    {
-      leaves.push_back({ leaf, {} });
-    }
-    leaves.back().second.push_back(entry.second);
-  }
-
-  MultiresolutionHeader header;
-  header.dims = dims;
-  header.box = { extent[0], extent[1], extent[3], extent[4] };
-  ChooseLattice(extent, header);
-  header.leafLevel = leafLevel;
-  header.cmax = static_cast<int32_t>(this->Options.cmax);
-  this->Writer.reset(new MultiresolutionWriter(this->Output, header));
-
-  // Work: leaf columns once, then the columns merged at each level (about halving).
-  this->WorkTotal = std::max<int64_t>(1, report.columns);
-  this->WorkStart = 0.1;
-  this->WorkSpan = 0.1;
-  this->Phase = "leaves";
-  const double leafStart = Seconds();
-  const int64_t vertexBytes = 24 + 80 + 40;
-  const int64_t leafTask = (this->Options.cmax * 2) * (nz + 1) * vertexBytes * 2 + this->Options.cmax * 2 * nz * 40;
-  const int leafThreads = this->ThreadsFor(leafTask);
-  ParallelFor(static_cast<int64_t>(leaves.size()), leafThreads,
-    [&](int64_t n) { this->BuildLeaf(leaves[static_cast<std::size_t>(n)].first, leaves[static_cast<std::size_t>(n)].second); });
-  report.leafSeconds = Seconds() - leafStart;
-  this->Partition.reset(); // tiles are no longer needed
-
-  const double simplifyStart = Seconds();
-  this->Phase = "simplify";
-  this->WorkDone = 0;
-  this->WorkTotal = std::max<int64_t>(1, 2 * report.columns);
-  this->WorkStart = 0.2;
-  this->WorkSpan = 0.8;
-  const int64_t diamondTask = 4 * this->Options.cmax * (nz + 1) * vertexBytes * 3;
-  const int diamondThreads = this->ThreadsFor(diamondTask);
-  report.threadsUsed = std::max(leafThreads, diamondThreads);
-  for (int level = leafLevel - 1; level >= 0; --level)
-  {
-    const auto diamonds = this->Tree.Diamonds(level);
-    std::vector<DiamondHierarchy::Diamond> busy;
-    for (const auto& d : diamonds)
-    {
-      const int64_t children[4] = { 2 * d.first, 2 * d.first + 1, d.second >= 0 ? 2 * d.second : -1,
-        d.second >= 0 ? 2 * d.second + 1 : -1 };
-      for (int64_t child : children)
-      {
-        if (child >= 0 && this->Records.count({ level + 1, child }))
-        {
-          busy.push_back(d);
-          break;
-        }
-      }
-    }
-    ParallelFor(static_cast<int64_t>(busy.size()), diamondThreads,
-      [&](int64_t n) { this->BuildDiamond(busy[static_cast<std::size_t>(n)]); });
-  }
-  report.simplifySeconds = Seconds() - simplifyStart;
-
   // Bounding volumes and errors: equal within a diamond, monotone up the tree (Sec. 6.2).
   std::map<std::pair<int, int64_t>, std::array<double, 6>> boxes;
   std::map<std::pair<int, int64_t>, double> errors;
@@ -877,15 +1138,420 @@ HierarchyReport Builder::Run()
       }
     }
   }
-  std::vector<RegionRecord> records;
+}
+
+void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& report, std::vector<ModelChunk>& model)
+{
+  const auto& dims = header.dims;
+  const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
+  const uint64_t cells = static_cast<uint64_t>(nx * ny * nz);
+
+  // The cells that any extracted face of any level may sample (Sec. 5.4): read back from
+  // the chunk files, one region a task.
+  std::vector<std::atomic<uint64_t>> touched((cells + 63) / 64);
+  std::vector<std::unique_ptr<MappedChunkFile>> parts;
+  for (int r = 0; r < this->Options.ranks; ++r)
+  {
+    parts.emplace_back(new MappedChunkFile(this->ChunkPath(r)));
+  }
+  std::vector<std::pair<int, int64_t>> keys;
   for (const auto& entry : this->Records)
   {
-    records.push_back(entry.second);
-    report.nonEmptyRegions += entry.second.columns > 0 ? 1 : 0;
+    if (entry.second.columns > 0)
+    {
+      keys.push_back(entry.first);
+    }
   }
-  report.regions = static_cast<int64_t>(records.size());
-  this->Writer->Commit(records);
-  report.fileBytes = this->Writer->BytesWritten();
+  const int threads = this->ThreadsFor(4 * this->Options.cmax * (nz + 1) * 64);
+  this->Phase = "property side";
+  ParallelFor(static_cast<int64_t>(keys.size()), threads, [&](int64_t n) {
+    const auto& key = keys[static_cast<std::size_t>(n)];
+    const RegionMesh mesh = parts[static_cast<std::size_t>(this->Parts[key])]->ReadRegion(this->Records[key], header);
+    MarkTouchedCells(mesh, dims, touched);
+    this->Report(this->Phase, 0.95 + 0.03 * static_cast<double>(n + 1) / static_cast<double>(keys.size()));
+  });
+  parts.clear();
+
+  // Perfect spatial hash over them (Lefebvre and Hoppe), the cell of each slot.
+  std::vector<std::array<uint32_t, 3>> hashed;
+  for (uint64_t word = 0; word < touched.size(); ++word)
+  {
+    uint64_t bits = touched[word].load(std::memory_order_relaxed);
+    while (bits)
+    {
+      const int bit = __builtin_ctzll(bits);
+      bits &= bits - 1;
+      const uint64_t n = word * 64 + static_cast<uint64_t>(bit);
+      const uint64_t layer = static_cast<uint64_t>(nx * ny);
+      hashed.push_back({ static_cast<uint32_t>(n % layer % static_cast<uint64_t>(nx)),
+        static_cast<uint32_t>(n % layer / static_cast<uint64_t>(nx)), static_cast<uint32_t>(n / layer) });
+    }
+  }
+  std::vector<std::atomic<uint64_t>>().swap(touched);
+  const PerfectSpatialHash hash = BuildPerfectSpatialHash(hashed);
+  header.hashTableSide = hash.tableSide;
+  header.hashOffsetSide = hash.offsetSide;
+  header.hashedCells = hashed.size();
+  report.hashedCells = hashed.size();
+  report.hashSlots = hash.TableSize();
+  report.hashOffsets = static_cast<uint64_t>(hash.offsets.size());
+  const std::size_t slots = static_cast<std::size_t>(hash.TableSize());
+  std::vector<uint64_t> slotCell(slots, ~uint64_t(0));
+  std::vector<std::array<uint16_t, 2>> slotNormals(slots, { 0, 0 });
+  // Cells by column, to gather normals leaf by leaf.
+  std::vector<std::pair<uint64_t, uint64_t>> byColumn(hashed.size()); // (column, k) , slot
+  for (std::size_t c = 0; c < hashed.size(); ++c)
+  {
+    const auto& p = hashed[c];
+    const uint64_t slot = hash.Slot(p[0], p[1], p[2]);
+    slotCell[static_cast<std::size_t>(slot)] = p[0] + static_cast<uint64_t>(nx) * (p[1] + static_cast<uint64_t>(ny) * p[2]);
+    byColumn[c] = { (p[0] + static_cast<uint64_t>(nx) * p[1]) * static_cast<uint64_t>(nz) + p[2], slot };
+  }
+  std::vector<std::array<uint32_t, 3>>().swap(hashed);
+  std::sort(byColumn.begin(), byColumn.end());
+  for (const auto& entry : this->Records)
+  {
+    if (entry.first.first != header.leafLevel || entry.second.columns == 0)
+    {
+      continue;
+    }
+    ManifestIn in;
+    if (!in.Load(this->NormalsPath(entry.first.second)))
+    {
+      throw std::runtime_error(this->NormalsPath(entry.first.second) + ": missing scratch file of cell normals");
+    }
+    const uint64_t count = in.Get<uint64_t>();
+    for (uint64_t c = 0; c < count; ++c)
+    {
+      const uint64_t column = static_cast<uint64_t>(in.Get<int64_t>());
+      const std::size_t stack = in.At;
+      in.At += static_cast<std::size_t>(nz) * 4;
+      if (in.At > in.Bytes.size())
+      {
+        throw std::runtime_error(in.Path + ": truncated");
+      }
+      auto it = std::lower_bound(byColumn.begin(), byColumn.end(), std::make_pair(column * static_cast<uint64_t>(nz), uint64_t(0)));
+      for (; it != byColumn.end() && it->first / static_cast<uint64_t>(nz) == column; ++it)
+      {
+        const uint64_t k = it->first % static_cast<uint64_t>(nz);
+        std::memcpy(slotNormals[static_cast<std::size_t>(it->second)].data(), &in.Bytes[stack + k * 4], 4);
+      }
+    }
+  }
+  std::vector<uint16_t> offsets;
+  for (const auto& o : hash.offsets)
+  {
+    offsets.insert(offsets.end(), o.begin(), o.end());
+  }
+  this->Chunks->AddModelArray(ModelChunk::HashOffsets, offsets.data(), offsets.size() * 2, model);
+  this->Chunks->AddModelArray(ModelChunk::HashCells, slotCell.data(), slotCell.size() * 8, model);
+  this->Chunks->AddModelArray(ModelChunk::CellNormals, slotNormals.data(), slotNormals.size() * 4, model);
+}
+
+HierarchyReport Builder::Run()
+{
+  HierarchyReport report;
+  const double start = Seconds();
+  const bool lead = this->Options.rank == 0;
+  const auto dims = this->Source.Dims();
+  const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
+  report.cells = nx * ny * nz;
+  if (mkdir(this->Scratch.c_str(), 0755) != 0 && errno != EEXIST)
+  {
+    throw std::runtime_error(this->Scratch + ": cannot create the scratch folder: " + std::strerror(errno));
+  }
+
+  // Resume: the last level every rank finished, if the scratch folder holds this build.
+  MultiresolutionHeader header;
+  int finished = -1;
+  if (this->ReadBuildManifest(header, report))
+  {
+    for (int level = header.leafLevel; level >= 0; --level)
+    {
+      bool all = true;
+      for (int r = 0; r < this->Options.ranks; ++r)
+      {
+        all = all && Exists(this->LevelManifest(level, r));
+      }
+      if (!all)
+      {
+        break;
+      }
+      finished = level;
+    }
+  }
+  this->Barrier();
+  if (lead)
+  {
+    // Start over, or clear what the unfinished level left (other ranks wait below).
+    if (finished < 0)
+    {
+      RemoveTree(this->Scratch);
+      if (mkdir(this->Scratch.c_str(), 0755) != 0 && errno != EEXIST)
+      {
+        throw std::runtime_error(this->Scratch + ": cannot create the scratch folder: " + std::strerror(errno));
+      }
+    }
+    for (int r = 0; r < this->Options.ranks; ++r)
+    {
+      unlink((this->Scratch + "/failed.rank-" + std::to_string(r)).c_str());
+    }
+  }
+  this->Barrier();
+  bool keepScratch = false;
+  try
+  {
+    if (finished >= 0)
+    {
+      report.resumedFromLevel = finished;
+      this->Tree = DiamondHierarchy(header.box[0], header.box[1], header.box[2], header.box[3], header.leafLevel);
+      this->Options.cmax = header.cmax;
+      for (int level = header.leafLevel; level >= finished; --level)
+      {
+        this->LoadLevel(level);
+      }
+      ManifestIn own;
+      own.Load(this->LevelManifest(finished, this->Options.rank));
+      own.Get<uint64_t>();
+      own.Get<int32_t>();
+      own.Get<int32_t>();
+      this->Header = header;
+      this->Chunks.reset(new ChunkFile(this->ChunkPath(this->Options.rank), static_cast<int64_t>(own.Get<uint64_t>())));
+      keepScratch = true;
+    }
+    else
+    {
+      this->Chunks.reset(new ChunkFile(this->ChunkPath(this->Options.rank)));
+      // Tiles of about 64 x 64 columns, fewer and bigger for very wide grids (at most ~1000
+      // files). Rank 0 streams the input; the other ranks read its tiles.
+      const int64_t tile = std::max<int64_t>(64, static_cast<int64_t>(std::ceil(std::sqrt(double(nx) * ny / 1000.0))));
+      this->Collective([&] {
+        if (!lead)
+        {
+          return;
+        }
+        std::vector<uint8_t> bits;
+        this->Partition.reset(new LeafPartition(
+          this->Source, this->Scratch + "/tiles", tile, [this](double f) { this->Report("partition", 0.1 * f); },
+          [&](int64_t k, const std::vector<uint8_t>& active) {
+            bits.assign((active.size() + 7) / 8, 0);
+            for (std::size_t c = 0; c < active.size(); ++c)
+            {
+              bits[c >> 3] |= static_cast<uint8_t>((active[c] ? 1 : 0) << (c & 7));
+            }
+            ModelChunk chunk;
+            chunk.kind = ModelChunk::ActiveLayer;
+            chunk.part = static_cast<uint32_t>(k);
+            chunk.chunk = this->Chunks->Put(bits, "active flags of layer " + std::to_string(k + 1));
+            this->ActiveLayers.push_back(chunk);
+          }));
+        this->Partition->SaveState();
+      });
+      if (!lead)
+      {
+        this->Partition.reset(new LeafPartition(this->Scratch + "/tiles"));
+      }
+      report.partitionSeconds = Seconds() - start;
+      report.activeCells = this->Partition->ActiveCells();
+
+      // Hierarchy over the pillars' extent; leaves by column centre.
+      const auto& extent = this->Partition->Extent();
+      const auto& hasActive = this->Partition->ColumnHasActive();
+      std::vector<int64_t> columns;
+      for (int64_t c = 0; c < nx * ny; ++c)
+      {
+        if (hasActive[static_cast<std::size_t>(c)])
+        {
+          columns.push_back(c);
+        }
+      }
+      if (columns.empty())
+      {
+        throw std::runtime_error(this->Source.Name() + ": the model has no active cell");
+      }
+      report.columns = static_cast<int64_t>(columns.size());
+      DiamondHierarchy locator(extent[0], extent[1], extent[3], extent[4], 0);
+      std::vector<std::pair<uint64_t, int64_t>> coded(columns.size());
+      std::vector<uint64_t> codes(columns.size());
+      for (std::size_t n = 0; n < columns.size(); ++n)
+      {
+        const auto centre = this->Partition->ColumnCentre(columns[n] % nx, columns[n] / nx);
+        codes[n] = locator.Code(centre[0], centre[1]);
+        coded[n] = { codes[n], columns[n] };
+      }
+      const int64_t cmax = this->Options.cmax == 0 ? AutomaticCmax(report.columns) : this->Options.cmax;
+      const int leafLevel = DiamondHierarchy::ChooseLeafLevel(codes, cmax);
+      this->Tree = DiamondHierarchy(extent[0], extent[1], extent[3], extent[4], leafLevel);
+      std::sort(coded.begin(), coded.end());
+      std::vector<std::pair<int64_t, std::vector<int64_t>>> leaves;
+      for (const auto& entry : coded)
+      {
+        const int64_t leaf = static_cast<int64_t>(entry.first >> (DiamondHierarchy::MaxDepth - leafLevel));
+        if (leaves.empty() || leaves.back().first != leaf)
+        {
+          leaves.push_back({ leaf, {} });
+        }
+        leaves.back().second.push_back(entry.second);
+      }
+
+      header.dims = dims;
+      header.box = { extent[0], extent[1], extent[3], extent[4] };
+      ChooseLattice(extent, header);
+      header.leafLevel = leafLevel;
+      header.cmax = static_cast<int32_t>(cmax);
+      this->Header = header;
+      if (lead)
+      {
+        this->WriteBuildManifest(header, report);
+      }
+      this->Options.cmax = cmax;
+
+      // Work: leaf columns once, then the columns merged at each level (about halving).
+      this->WorkTotal = std::max<int64_t>(1, report.columns / this->Options.ranks);
+      this->WorkStart = 0.1;
+      this->WorkSpan = 0.1;
+      this->Phase = "leaves";
+      const double leafStart = Seconds();
+      const int64_t vertexBytes = 24 + 80 + 40;
+      const int64_t leafTask = (cmax * 2) * (nz + 1) * vertexBytes * 2 + cmax * 2 * nz * 40;
+      const int leafThreads = this->ThreadsFor(leafTask);
+      report.threadsUsed = leafThreads;
+      std::vector<std::size_t> mine;
+      for (std::size_t n = 0; n < leaves.size(); ++n)
+      {
+        if (static_cast<int>(n % static_cast<std::size_t>(this->Options.ranks)) == this->Options.rank)
+        {
+          mine.push_back(n);
+        }
+      }
+      this->Collective([&] {
+        ParallelFor(static_cast<int64_t>(mine.size()), leafThreads, [&](int64_t n) {
+          const auto& leaf = leaves[mine[static_cast<std::size_t>(n)]];
+          this->BuildLeaf(leaf.first, leaf.second);
+        });
+        this->SaveLevel(leafLevel);
+      });
+      this->LoadLevel(leafLevel);
+      report.leafSeconds = Seconds() - leafStart;
+      finished = leafLevel;
+      keepScratch = true;
+      // Tiles are no longer needed: other ranks close theirs before rank 0 removes them.
+      if (!lead)
+      {
+        this->Partition.reset();
+      }
+      this->Barrier();
+      this->Partition.reset();
+    }
+    report.leafLevel = header.leafLevel;
+
+    const double simplifyStart = Seconds();
+    this->Phase = "simplify";
+    this->WorkDone = 0;
+    this->WorkTotal = std::max<int64_t>(1, 2 * report.columns / this->Options.ranks);
+    this->WorkStart = 0.2;
+    this->WorkSpan = 0.75;
+    const int64_t vertexBytes = 24 + 80 + 40;
+    const int64_t diamondTask = 4 * this->Options.cmax * (nz + 1) * vertexBytes * 3;
+    const int diamondThreads = this->ThreadsFor(diamondTask);
+    report.threadsUsed = std::max(report.threadsUsed, diamondThreads);
+    for (int level = finished - 1; level >= 0; --level)
+    {
+      std::vector<DiamondHierarchy::Diamond> busy;
+      for (const auto& d : this->Tree.Diamonds(level))
+      {
+        const int64_t children[4] = { 2 * d.first, 2 * d.first + 1, d.second >= 0 ? 2 * d.second : -1,
+          d.second >= 0 ? 2 * d.second + 1 : -1 };
+        for (int64_t child : children)
+        {
+          if (child >= 0 && this->Records.count({ level + 1, child }))
+          {
+            busy.push_back(d);
+            break;
+          }
+        }
+      }
+      std::vector<std::size_t> mine;
+      for (std::size_t n = 0; n < busy.size(); ++n)
+      {
+        if (static_cast<int>(n % static_cast<std::size_t>(this->Options.ranks)) == this->Options.rank)
+        {
+          mine.push_back(n);
+        }
+      }
+      this->Collective([&] {
+        ParallelFor(static_cast<int64_t>(mine.size()), diamondThreads,
+          [&](int64_t n) { this->BuildDiamond(busy[mine[static_cast<std::size_t>(n)]]); });
+        this->SaveLevel(level);
+      });
+      this->LoadLevel(level);
+      if (lead)
+      {
+        for (const auto& entry : this->Records)
+        {
+          if (entry.first.first == level + 1)
+          {
+            unlink(RegionPath(this->Scratch, level + 1, entry.first.second).c_str());
+          }
+        }
+      }
+    }
+    report.simplifySeconds = Seconds() - simplifyStart;
+
+    // Rank 0: errors and bounds, the property side, then the file from every rank's chunks.
+    this->Collective([&] {
+      if (!lead)
+      {
+        return;
+      }
+      this->FinishBoundsAndErrors(header.leafLevel);
+      std::vector<ModelChunk> model = this->ActiveLayers;
+      this->BuildPropertySide(header, report, model);
+      this->Chunks->Sync();
+      std::vector<std::string> paths;
+      for (int r = 0; r < this->Options.ranks; ++r)
+      {
+        paths.push_back(this->ChunkPath(r));
+      }
+      std::vector<PartRecord<RegionRecord>> regions;
+      for (const auto& entry : this->Records)
+      {
+        regions.push_back({ this->Parts[entry.first], entry.second });
+        report.nonEmptyRegions += entry.second.columns > 0 ? 1 : 0;
+      }
+      std::vector<PartRecord<ModelChunk>> modelParts;
+      for (const ModelChunk& m : model)
+      {
+        modelParts.push_back({ 0, m });
+      }
+      report.regions = static_cast<int64_t>(regions.size());
+      this->Report("writing", 0.99);
+      AssembleMultiresolutionFile(this->Output, header, paths, regions, modelParts);
+      struct stat info;
+      report.fileBytes = stat(this->Output.c_str(), &info) == 0 ? static_cast<uint64_t>(info.st_size) : 0;
+    });
+  }
+  catch (const std::exception& error)
+  {
+    this->Chunks.reset();
+    this->Partition.reset();
+    if (!keepScratch)
+    {
+      if (lead)
+      {
+        RemoveTree(this->Scratch);
+      }
+      throw;
+    }
+    throw std::runtime_error(std::string(error.what()) + " (finished levels are kept in " + this->Scratch +
+      ": run the same build again to resume)");
+  }
+  this->Chunks.reset();
+  this->Barrier();
+  if (lead)
+  {
+    RemoveTree(this->Scratch);
+  }
   report.totalSeconds = Seconds() - start;
   this->Report("done", 1.0);
   return report;

@@ -16,8 +16,15 @@
 //   the tree (Sec. 6.2).
 // - Memory: one layer of the input during the partition pass, then one diamond's meshes a
 //   worker thread (worker threads are cut to fit `memoryBytes`), plus a few arrays of one
-//   value a column (flags, centres, leaf codes). Scratch files go to
-//   `scratch` and are removed as soon as they are used (and on failure).
+//   value a column (flags, centres, leaf codes), and at the end one bit a cell (which cells
+//   the extracted faces touch) and the perfect hash's tables (Sec. 5.4).
+// - Property side (Sec. 5.3-5.4), built once per geometry: the cells the extracted faces of
+//   every level touch are hashed perfectly; the file holds each slot's cell and its top and
+//   bottom face normals (2 bytes each), and every layer's active flags.
+// - Resumable: scratch files (`scratch`) keep each finished level (region meshes, chunks,
+//   a manifest a level); a build killed after its leaf level resumes from the last finished
+//   level when run again with the same input and options. The scratch folder is removed
+//   when the file is in place; after a failure it stays for resuming.
 // - Deterministic: the same input and Cmax give the same region meshes whatever the thread
 //   count (chunks may lie in another order in the file).
 #pragma once
@@ -40,8 +47,18 @@ struct HierarchyOptions
   int64_t cmax = 0;
   int threads = 0;          ///< 0: every core
   int64_t memoryBytes = 0;  ///< 0: half the available memory
-  std::string scratch;      ///< scratch folder (default: beside the output)
+  std::string scratch;      ///< scratch folder (default: OUTPUT.scratch, beside the output)
   uint64_t seed = 1;
+  /// Continue a build killed in the same scratch folder (same input and options) from its
+  /// last finished level; false: start over.
+  bool resume = true;
+  /// MPI (through ParaView's controller, vtkBuildMultiresolutionHierarchy): this process's
+  /// rank among `ranks`, which share the scratch folder and split the leaves and each
+  /// level's diamonds. `barrier` must return once every rank has called it (required when
+  /// ranks > 1). Rank 0 streams the input and writes the file; the result is the same file
+  /// whatever the ranks and threads (chunks may lie in another order).
+  int rank = 0, ranks = 1;
+  std::function<void()> barrier;
 };
 
 struct HierarchyReport
@@ -50,6 +67,8 @@ struct HierarchyReport
   int leafLevel = 0;
   int64_t regions = 0, nonEmptyRegions = 0;
   int threadsUsed = 0;
+  int resumedFromLevel = -1; ///< the last finished level a resumed build started from, or -1
+  uint64_t hashedCells = 0, hashSlots = 0, hashOffsets = 0; ///< perfect hash (Sec. 5.4)
   uint64_t fileBytes = 0;
   double partitionSeconds = 0, leafSeconds = 0, simplifySeconds = 0, totalSeconds = 0;
 };

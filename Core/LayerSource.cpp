@@ -2,7 +2,12 @@
 #include "LayerSource.h"
 
 #include "CornerPointGeometry.h"
+#include "EclipseGrid.h"
+#include "GrdeclParser.h"
 #include "SyntheticReservoir.h"
+
+#include <cstdio>
+#include <stdexcept>
 
 namespace resmr
 {
@@ -84,6 +89,74 @@ bool CornerPointLayerSource::Next(std::vector<float>& zcorn, std::vector<uint8_t
     }
   }
   return true;
+}
+
+void ReadCornerPointModel(const std::string& path, GrdeclDeck& deck, std::vector<bool>& active)
+{
+  if (LooksLikeEclipseGridFile(path))
+  {
+    EclipseGrid grid = ReadEclipseGrid(path);
+    active.resize(static_cast<std::size_t>(grid.deck.CellCount()));
+    for (int64_t c = 0; c < grid.deck.CellCount(); ++c)
+    {
+      active[static_cast<std::size_t>(c)] = grid.IsActive(c);
+    }
+    deck = std::move(grid.deck);
+    return;
+  }
+  deck = ParseGrdeclFile(path);
+  const CellArray* actnum = deck.FindArray("ACTNUM");
+  active.resize(static_cast<std::size_t>(deck.CellCount()));
+  for (int64_t c = 0; c < deck.CellCount(); ++c)
+  {
+    active[static_cast<std::size_t>(c)] = !actnum || actnum->values[static_cast<std::size_t>(c)] != 0;
+  }
+}
+
+namespace
+{
+/// A grid file's layers, owning the model they come from.
+class GridFileLayerSource : public LayerSource
+{
+public:
+  explicit GridFileLayerSource(const std::string& path)
+  {
+    ReadCornerPointModel(path, this->Deck, this->Active);
+    this->Geometry.reset(new CornerPointGeometry(CornerPointGeometry::FromDeck(this->Deck, false)));
+    this->Layers.reset(new CornerPointLayerSource(*this->Geometry, this->Active, path));
+  }
+  std::array<int64_t, 3> Dims() const override { return this->Layers->Dims(); }
+  const std::vector<double>& Coord() const override { return this->Layers->Coord(); }
+  bool Next(std::vector<float>& zcorn, std::vector<uint8_t>& active) override { return this->Layers->Next(zcorn, active); }
+  std::string Name() const override { return this->Layers->Name(); }
+
+private:
+  GrdeclDeck Deck;
+  std::vector<bool> Active;
+  std::unique_ptr<CornerPointGeometry> Geometry;
+  std::unique_ptr<CornerPointLayerSource> Layers;
+};
+} // namespace
+
+std::unique_ptr<LayerSource> OpenLayerSource(const std::string& input)
+{
+  if (input.rfind("synth:", 0) == 0)
+  {
+    SyntheticParameters p;
+    long long nx = 0, ny = 0, nz = 0;
+    unsigned long long seed = 1;
+    if (std::sscanf(input.c_str() + 6, "%lldx%lldx%lld:%llu", &nx, &ny, &nz, &seed) < 3)
+    {
+      throw std::invalid_argument(input + ": expected synth:NIxNJxNK[:SEED]");
+    }
+    p.nx = nx;
+    p.ny = ny;
+    p.nz = nz;
+    p.seed = seed;
+    p.Validate();
+    return std::unique_ptr<LayerSource>(new SyntheticLayerSource(p, input));
+  }
+  return std::unique_ptr<LayerSource>(new GridFileLayerSource(input));
 }
 
 } // namespace resmr

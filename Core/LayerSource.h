@@ -19,6 +19,7 @@ namespace resmr
 {
 
 class CornerPointGeometry;
+struct GrdeclDeck;
 class SyntheticReservoir;
 class SyntheticLayerStream;
 struct SyntheticParameters;
@@ -69,5 +70,14 @@ private:
   std::string Label;
   int64_t K = 0;
 };
+
+/// An EGRID or a GRDECL/DATA deck: its deck and one active flag a cell (ACTNUM; all active
+/// if none). Throws GrdeclError naming the file and place.
+void ReadCornerPointModel(const std::string& path, GrdeclDeck& deck, std::vector<bool>& active);
+
+/// The layers of `input`: "synth:NIxNJxNK[:SEED]" streamed from the generator, or a grid
+/// file (ReadCornerPointModel; held in memory, then served layer by layer). Throws
+/// std::invalid_argument for a malformed synth: spec.
+std::unique_ptr<LayerSource> OpenLayerSource(const std::string& input);
 
 } // namespace resmr

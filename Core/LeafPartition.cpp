@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fcntl.h>
 #include <limits>
@@ -51,8 +52,9 @@ void ReadAll(int descriptor, void* data, std::size_t size, off_t offset, const s
 }
 } // namespace
 
-LeafPartition::LeafPartition(
-  LayerSource& source, const std::string& folder, int64_t tileSize, const std::function<void(double)>& progress)
+LeafPartition::LeafPartition(LayerSource& source, const std::string& folder, int64_t tileSize,
+  const std::function<void(double)>& progress,
+  const std::function<void(int64_t k, const std::vector<uint8_t>& active)>& onLayer)
   : Dimensions(source.Dims())
   , CoordValues(source.Coord())
   , Tile(std::max<int64_t>(tileSize, 1))
@@ -106,6 +108,10 @@ LeafPartition::LeafPartition(
       static_cast<int64_t>(active.size()) != nx * ny)
     {
       throw std::runtime_error(source.Name() + ": layer " + std::to_string(k + 1) + " is missing or has the wrong size");
+    }
+    if (onLayer)
+    {
+      onLayer(k, active);
     }
     for (int64_t j = 0; j < ny; ++j)
     {
@@ -176,11 +182,98 @@ LeafPartition::~LeafPartition()
   {
     for (int64_t ti = 0; ti < this->TilesX; ++ti)
     {
-      close(this->Descriptors[static_cast<std::size_t>(tj * this->TilesX + ti)]);
-      unlink(this->TilePath(ti, tj).c_str());
+      const std::size_t t = static_cast<std::size_t>(tj * this->TilesX + ti);
+      if (t < this->Descriptors.size())
+      {
+        close(this->Descriptors[t]);
+      }
+      if (this->Owner)
+      {
+        unlink(this->TilePath(ti, tj).c_str());
+      }
     }
   }
-  rmdir(this->Folder.c_str());
+  if (this->Owner)
+  {
+    unlink((this->Folder + "/partition.state").c_str());
+    rmdir(this->Folder.c_str());
+  }
+}
+
+void LeafPartition::SaveState() const
+{
+  const std::string path = this->Folder + "/partition.state";
+  const std::string temporary = path + ".part";
+  std::FILE* file = std::fopen(temporary.c_str(), "wb");
+  if (!file)
+  {
+    throw std::runtime_error(temporary + ": cannot create: " + std::strerror(errno));
+  }
+  const uint64_t coordCount = this->CoordValues.size(), columnCount = this->AnyActive.size();
+  bool ok = std::fwrite(this->Dimensions.data(), sizeof(int64_t), 3, file) == 3;
+  ok = ok && std::fwrite(&this->Tile, sizeof(int64_t), 1, file) == 1;
+  ok = ok && std::fwrite(&this->ActiveCount, sizeof(int64_t), 1, file) == 1;
+  ok = ok && std::fwrite(this->Bounds.data(), sizeof(double), 6, file) == 6;
+  ok = ok && std::fwrite(&coordCount, sizeof(uint64_t), 1, file) == 1;
+  ok = ok && std::fwrite(this->CoordValues.data(), sizeof(double), coordCount, file) == coordCount;
+  ok = ok && std::fwrite(&columnCount, sizeof(uint64_t), 1, file) == 1;
+  ok = ok && std::fwrite(this->AnyActive.data(), 1, columnCount, file) == columnCount;
+  ok = (std::fclose(file) == 0) && ok;
+  if (!ok || std::rename(temporary.c_str(), path.c_str()) != 0)
+  {
+    unlink(temporary.c_str());
+    throw std::runtime_error(path + ": write failed (disk full?)");
+  }
+}
+
+LeafPartition::LeafPartition(const std::string& folder)
+  : Folder(folder)
+  , Owner(false)
+{
+  const std::string path = folder + "/partition.state";
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file)
+  {
+    throw std::runtime_error(path + ": cannot open the partition written by rank 0: " + std::strerror(errno));
+  }
+  uint64_t coordCount = 0, columnCount = 0;
+  bool ok = std::fread(this->Dimensions.data(), sizeof(int64_t), 3, file) == 3;
+  ok = ok && std::fread(&this->Tile, sizeof(int64_t), 1, file) == 1 && this->Tile > 0;
+  ok = ok && std::fread(&this->ActiveCount, sizeof(int64_t), 1, file) == 1;
+  ok = ok && std::fread(this->Bounds.data(), sizeof(double), 6, file) == 6;
+  ok = ok && std::fread(&coordCount, sizeof(uint64_t), 1, file) == 1 && coordCount < (uint64_t(1) << 40);
+  if (ok)
+  {
+    this->CoordValues.resize(coordCount);
+    ok = std::fread(this->CoordValues.data(), sizeof(double), coordCount, file) == coordCount;
+  }
+  ok = ok && std::fread(&columnCount, sizeof(uint64_t), 1, file) == 1 && columnCount < (uint64_t(1) << 40);
+  if (ok)
+  {
+    this->AnyActive.resize(columnCount);
+    ok = std::fread(this->AnyActive.data(), 1, columnCount, file) == columnCount;
+  }
+  std::fclose(file);
+  const int64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
+  if (!ok || nx <= 0 || ny <= 0 || static_cast<int64_t>(columnCount) != nx * ny)
+  {
+    throw std::runtime_error(path + ": truncated or corrupt");
+  }
+  this->TilesX = (nx + this->Tile - 1) / this->Tile;
+  this->TilesY = (ny + this->Tile - 1) / this->Tile;
+  for (int64_t tj = 0; tj < this->TilesY; ++tj)
+  {
+    for (int64_t ti = 0; ti < this->TilesX; ++ti)
+    {
+      const std::string tile = this->TilePath(ti, tj);
+      const int descriptor = open(tile.c_str(), O_RDONLY);
+      if (descriptor < 0)
+      {
+        throw std::runtime_error(tile + ": cannot open a partition tile: " + std::strerror(errno));
+      }
+      this->Descriptors.push_back(descriptor);
+    }
+  }
 }
 
 std::string LeafPartition::TilePath(int64_t ti, int64_t tj) const

@@ -30,8 +30,16 @@ public:
   /// Streams every layer of `source` into tiles of `tileSize` x `tileSize` columns in
   /// `folder` (created if missing). `progress` gets the fraction of layers done. Throws
   /// std::runtime_error naming the file on a failed write.
+  /// `onLayer`, if given, sees each layer's active flags (one a cell, i fastest) as it
+  /// streams by.
   LeafPartition(LayerSource& source, const std::string& folder, int64_t tileSize,
-    const std::function<void(double)>& progress = {});
+    const std::function<void(double)>& progress = {},
+    const std::function<void(int64_t k, const std::vector<uint8_t>& active)>& onLayer = {});
+  /// Opens the tiles another process wrote in `folder` (after its SaveState()), read-only;
+  /// this object leaves them in place. Throws std::runtime_error naming the file.
+  explicit LeafPartition(const std::string& folder);
+  /// Writes what the constructor learnt (columns, extent, tiles) for LeafPartition(folder).
+  void SaveState() const;
   ~LeafPartition();
   LeafPartition(const LeafPartition&) = delete;
   LeafPartition& operator=(const LeafPartition&) = delete;
@@ -61,6 +69,7 @@ private:
   int64_t Tile = 64, TilesX = 0, TilesY = 0;
   std::string Folder;
   std::vector<int> Descriptors;
+  bool Owner = true; ///< created the tiles, so removes them
 };
 
 } // namespace resmr

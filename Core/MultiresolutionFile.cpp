@@ -22,11 +22,13 @@ namespace
 {
 constexpr char HeaderMagic[8] = { 'R', 'E', 'S', 'M', 'R', '\r', '\n', '\x1a' };
 constexpr char TrailerMagic[8] = { 'R', 'E', 'S', 'M', 'R', 'I', 'D', 'X' };
-constexpr std::size_t HeaderBytes = 160;
+constexpr std::size_t HeaderBytes = 256;
 constexpr std::size_t RecordBytes = 192;
+constexpr std::size_t ModelRecordBytes = 32;
 constexpr std::size_t TrailerBytes = 32;
 constexpr uint32_t MeshMagic = 0x4853454d;    // "MESH"
 constexpr uint32_t SurfaceMagic = 0x46525553; // "SURF"
+constexpr uint32_t TrianglesMagic = 0x53495254; // "TRIS"
 /// No chunk of a sane file comes near this (a region holds Cmax columns).
 constexpr uint64_t MaxRawChunk = uint64_t(1) << 31;
 constexpr const char* ChunkNames[4] = { "mesh", "top surface", "bottom surface", "side surface" };
@@ -331,6 +333,43 @@ void DecodeSurface(Reader& in, RegionSurface& surface, uint64_t vertices)
   }
 }
 
+std::vector<uint8_t> EncodeTriangles(const std::vector<std::array<uint32_t, 3>>& triangles)
+{
+  Buffer out;
+  out.Put(TrianglesMagic);
+  out.Put(static_cast<uint32_t>(triangles.size()));
+  out.PutBytes(triangles.data(), triangles.size() * sizeof(triangles[0]));
+  return std::move(out.Bytes);
+}
+
+void DecodeTriangles(Reader& in, std::vector<std::array<uint32_t, 3>>& triangles, uint64_t vertices)
+{
+  const uint32_t magic = in.Get<uint32_t>();
+  const uint32_t count = in.Get<uint32_t>();
+  if (magic != TrianglesMagic)
+  {
+    throw MultiresolutionFileError(in.Where() + ": not a triangle chunk");
+  }
+  if (static_cast<uint64_t>(count) * 12 != in.Left())
+  {
+    throw MultiresolutionFileError(in.Where() + ": " + std::to_string(count) + " triangles in " +
+      std::to_string(in.Left()) + " bytes");
+  }
+  triangles.resize(count);
+  in.GetBytes(triangles.data(), triangles.size() * sizeof(triangles[0]));
+  for (const auto& t : triangles)
+  {
+    for (uint32_t v : t)
+    {
+      if (v >= vertices)
+      {
+        throw MultiresolutionFileError(in.Where() + ": a triangle refers to vertex " + std::to_string(v) + " of " +
+          std::to_string(vertices));
+      }
+    }
+  }
+}
+
 void PutHeader(Buffer& out, const MultiresolutionHeader& h)
 {
   out.PutBytes(HeaderMagic, 8);
@@ -354,7 +393,12 @@ void PutHeader(Buffer& out, const MultiresolutionHeader& h)
   }
   out.Put(h.leafLevel);
   out.Put(h.cmax);
-  out.Put(static_cast<uint64_t>(0)); // reserved; the region count is the index's (trailer)
+  out.Put(h.regionCount);
+  out.Put(h.modelChunkCount);
+  out.Put(h.hashTableSide);
+  out.Put(h.hashOffsetSide);
+  out.Put(h.hashedCells);
+  out.Put(h.geometryId);
   out.Bytes.resize(HeaderBytes - 4, 0);
   out.Put(Crc32(out.Bytes.data(), out.Bytes.size()));
 }
@@ -410,6 +454,102 @@ RegionRecord GetRecord(Reader& in)
 }
 } // namespace
 
+namespace
+{
+std::vector<uint8_t> Decompress(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
+{
+  if (ref.offset > size || ref.stored > size - ref.offset)
+  {
+    throw MultiresolutionFileError(place + ": lies outside the file");
+  }
+  if (Crc32(data + ref.offset, ref.stored) != ref.crc)
+  {
+    throw MultiresolutionFileError(place + ": checksum mismatch (corrupt data)");
+  }
+  std::vector<uint8_t> raw(ref.raw);
+  lzo_uint length = ref.raw;
+  const int status = lzo1x_decompress_safe(data + ref.offset, ref.stored, raw.data(), &length, nullptr);
+  if (status != LZO_E_OK || length != ref.raw)
+  {
+    throw MultiresolutionFileError(place + ": does not decompress to its " + std::to_string(ref.raw) + " bytes");
+  }
+  return raw;
+}
+
+RegionMesh DecodeRegion(const uint8_t* data, uint64_t size, const std::string& path, const RegionRecord& record,
+  const MultiresolutionHeader& header)
+{
+  RegionMesh mesh;
+  const std::string region = path + ": region (level " + std::to_string(record.level) + ", index " +
+    std::to_string(record.index) + ") ";
+  const auto chunk = [&](int c) {
+    return Decompress(data, size, record.chunks[c], region + ChunkNames[c] + " at byte " +
+        std::to_string(record.chunks[c].offset));
+  };
+  {
+    const auto raw = chunk(RegionRecord::Mesh);
+    Reader in(raw.data(), raw.size(), region + ChunkNames[0]);
+    DecodeMesh(in, mesh, header, record);
+  }
+  RegionSurface* surfaces[2] = { &mesh.top, &mesh.bottom };
+  for (int c = RegionRecord::Top; c <= RegionRecord::Bottom; ++c)
+  {
+    const auto raw = chunk(c);
+    Reader in(raw.data(), raw.size(), region + ChunkNames[c]);
+    DecodeSurface(in, *surfaces[c - 1], static_cast<uint64_t>(mesh.VertexCount()));
+  }
+  const auto raw = chunk(RegionRecord::Side);
+  Reader in(raw.data(), raw.size(), region + ChunkNames[RegionRecord::Side]);
+  DecodeTriangles(in, mesh.sideTriangles, static_cast<uint64_t>(mesh.VertexCount()));
+  return mesh;
+}
+
+const uint8_t* MapFile(const std::string& path, uint64_t& size)
+{
+  const int descriptor = open(path.c_str(), O_RDONLY);
+  if (descriptor < 0)
+  {
+    throw MultiresolutionFileError(path + ": cannot open: " + std::strerror(errno));
+  }
+  struct stat info;
+  if (fstat(descriptor, &info) != 0 || !S_ISREG(info.st_mode))
+  {
+    close(descriptor);
+    throw MultiresolutionFileError(path + ": not a regular file");
+  }
+  size = static_cast<uint64_t>(info.st_size);
+  if (size == 0)
+  {
+    close(descriptor);
+    return nullptr;
+  }
+  void* map = mmap(nullptr, size, PROT_READ, MAP_SHARED, descriptor, 0);
+  close(descriptor);
+  if (map == MAP_FAILED)
+  {
+    throw MultiresolutionFileError(path + ": cannot map: " + std::strerror(errno));
+  }
+  return static_cast<const uint8_t*>(map);
+}
+} // namespace
+
+std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw)
+{
+  InitialiseLzo();
+  std::vector<uint8_t> stored(raw.size() + raw.size() / 16 + 64 + 3);
+  std::vector<uint8_t> work(LZO1X_1_MEM_COMPRESS);
+  lzo_uint length = 0;
+  lzo1x_1_compress(raw.data(), raw.size(), stored.data(), &length, work.data());
+  stored.resize(length);
+  return stored;
+}
+
+std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
+{
+  InitialiseLzo();
+  return Decompress(data, size, ref, place);
+}
+
 uint32_t Crc32(const void* data, std::size_t size, uint32_t crc)
 {
   static const auto table = [] {
@@ -445,86 +585,211 @@ void ChooseLattice(const std::array<double, 6>& extent, MultiresolutionHeader& h
   header.latticeStep = { std::ldexp(lateral, -22), std::ldexp(lateral, -22), std::ldexp(vertical, -20) };
 }
 
-MultiresolutionWriter::MultiresolutionWriter(const std::string& path, const MultiresolutionHeader& header)
-  : Output(new AtomicOutputFile(path))
-  , Header(header)
+ChunkFile::ChunkFile(const std::string& path, int64_t keepBytes)
+  : FilePath(path)
 {
   InitialiseLzo();
-  Buffer head;
-  PutHeader(head, header);
-  this->WriteOrThrow(head.Bytes.data(), head.Bytes.size(), "header");
-}
-
-MultiresolutionWriter::~MultiresolutionWriter() = default;
-
-const std::string& MultiresolutionWriter::Path() const
-{
-  return this->Output->Path();
-}
-
-void MultiresolutionWriter::WriteOrThrow(const void* data, std::size_t size, const char* what)
-{
-  if (!this->Output->Write(data, size))
+  this->Descriptor = keepBytes < 0 ? open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644) : open(path.c_str(), O_RDWR);
+  if (this->Descriptor < 0)
   {
-    throw MultiresolutionFileError(this->Output->Path() + ": writing the " + what + " at byte " +
-      std::to_string(this->Offset) + " failed: " + std::strerror(errno));
+    throw MultiresolutionFileError(path + ": cannot open the chunk file: " + std::strerror(errno));
   }
-  this->Offset += size;
+  if (keepBytes >= 0)
+  {
+    struct stat info;
+    if (fstat(this->Descriptor, &info) != 0 || info.st_size < keepBytes || ftruncate(this->Descriptor, keepBytes) != 0)
+    {
+      close(this->Descriptor);
+      throw MultiresolutionFileError(path + ": shorter than the " + std::to_string(keepBytes) +
+        " bytes its manifest records (cannot resume)");
+    }
+    this->Offset = static_cast<uint64_t>(keepBytes);
+  }
 }
 
-void MultiresolutionWriter::AddRegion(const RegionMesh& mesh, RegionRecord& record)
+ChunkFile::~ChunkFile()
 {
-  std::vector<uint8_t> raw[RegionRecord::ChunkCount] = { EncodeMesh(mesh, this->Header), EncodeSurface(mesh.top),
-    EncodeSurface(mesh.bottom), EncodeSurface(mesh.side) };
-  std::vector<uint8_t> stored[RegionRecord::ChunkCount];
+  if (this->Descriptor >= 0)
+  {
+    close(this->Descriptor);
+  }
+}
+
+ChunkRef ChunkFile::Put(const std::vector<uint8_t>& raw, const std::string& what)
+{
+  if (raw.size() >= MaxRawChunk)
+  {
+    throw MultiresolutionFileError(this->FilePath + ": " + what + " of " + std::to_string(raw.size()) +
+      " bytes is too big for a chunk");
+  }
+  std::vector<uint8_t> stored(raw.size() + raw.size() / 16 + 64 + 3);
   std::vector<uint8_t> work(LZO1X_1_MEM_COMPRESS);
+  lzo_uint length = 0;
+  lzo1x_1_compress(raw.data(), raw.size(), stored.data(), &length, work.data());
+  ChunkRef ref;
+  ref.stored = static_cast<uint32_t>(length);
+  ref.raw = static_cast<uint32_t>(raw.size());
+  ref.crc = Crc32(stored.data(), length);
+  std::lock_guard<std::mutex> guard(this->Lock);
+  ref.offset = this->Offset;
+  std::size_t done = 0;
+  while (done < length)
+  {
+    const ssize_t written = pwrite(this->Descriptor, stored.data() + done, length - done, static_cast<off_t>(this->Offset + done));
+    if (written <= 0)
+    {
+      throw MultiresolutionFileError(this->FilePath + ": writing the " + what + " at byte " +
+        std::to_string(this->Offset + done) + " failed: " + std::strerror(errno));
+    }
+    done += static_cast<std::size_t>(written);
+  }
+  this->Offset += length;
+  return ref;
+}
+
+void ChunkFile::AddRegion(const RegionMesh& mesh, const MultiresolutionHeader& header, RegionRecord& record)
+{
+  const std::vector<uint8_t> raw[RegionRecord::ChunkCount] = { EncodeMesh(mesh, header), EncodeSurface(mesh.top),
+    EncodeSurface(mesh.bottom), EncodeTriangles(mesh.sideTriangles) };
+  const std::string region = "region (level " + std::to_string(record.level) + ", index " + std::to_string(record.index) + ") ";
   for (int c = 0; c < RegionRecord::ChunkCount; ++c)
   {
-    if (raw[c].size() >= MaxRawChunk)
-    {
-      throw MultiresolutionFileError(this->Output->Path() + ": region (level " + std::to_string(record.level) + ", index " +
-        std::to_string(record.index) + ") " + ChunkNames[c] + " of " + std::to_string(raw[c].size()) +
-        " bytes is too big for a chunk");
-    }
-    stored[c].resize(raw[c].size() + raw[c].size() / 16 + 64 + 3);
-    lzo_uint length = 0;
-    lzo1x_1_compress(raw[c].data(), raw[c].size(), stored[c].data(), &length, work.data());
-    stored[c].resize(length);
-    record.chunks[c].stored = static_cast<uint32_t>(length);
-    record.chunks[c].raw = static_cast<uint32_t>(raw[c].size());
-    record.chunks[c].crc = Crc32(stored[c].data(), length);
+    record.chunks[c] = this->Put(raw[c], region + ChunkNames[c]);
   }
   record.columns = mesh.ColumnCount();
   record.vertices = mesh.VertexCount();
   record.activeCells = std::count(mesh.active.begin(), mesh.active.end(), uint8_t(1));
   record.topCone = mesh.top.cone;
   record.bottomCone = mesh.bottom.cone;
-  std::lock_guard<std::mutex> guard(this->Lock);
-  for (int c = 0; c < RegionRecord::ChunkCount; ++c)
+}
+
+void ChunkFile::AddModelArray(uint32_t kind, const void* data, std::size_t bytes, std::vector<ModelChunk>& out)
+{
+  const auto* begin = static_cast<const uint8_t*>(data);
+  uint32_t part = 0;
+  for (std::size_t at = 0; at < bytes || (bytes == 0 && part == 0); at += ModelPieceBytes, ++part)
   {
-    record.chunks[c].offset = this->Offset;
-    this->WriteOrThrow(stored[c].data(), stored[c].size(), ChunkNames[c]);
+    const std::size_t size = std::min(ModelPieceBytes, bytes - at);
+    ModelChunk chunk;
+    chunk.kind = kind;
+    chunk.part = part;
+    chunk.chunk = this->Put(std::vector<uint8_t>(begin + at, begin + at + size),
+      "model array " + std::to_string(kind) + " piece " + std::to_string(part));
+    out.push_back(chunk);
+    if (bytes == 0)
+    {
+      break;
+    }
   }
 }
 
-void MultiresolutionWriter::Commit(const std::vector<RegionRecord>& records)
+uint64_t ChunkFile::Sync()
 {
   std::lock_guard<std::mutex> guard(this->Lock);
-  Buffer index;
-  for (const RegionRecord& r : records)
+  if (fsync(this->Descriptor) != 0)
   {
-    PutRecord(index, r);
+    throw MultiresolutionFileError(this->FilePath + ": cannot flush to disk: " + std::strerror(errno));
   }
-  const uint64_t indexOffset = this->Offset;
-  this->WriteOrThrow(index.Bytes.data(), index.Bytes.size(), "index");
+  return this->Offset;
+}
+
+void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader header,
+  const std::vector<std::string>& parts, const std::vector<PartRecord<RegionRecord>>& regions,
+  const std::vector<PartRecord<ModelChunk>>& model)
+{
+  AtomicOutputFile output(path);
+  uint64_t offset = 0;
+  const auto write = [&](const void* data, std::size_t size, const std::string& what) {
+    if (!output.Write(data, size))
+    {
+      throw MultiresolutionFileError(path + ": writing the " + what + " at byte " + std::to_string(offset) +
+        " failed: " + std::strerror(errno));
+    }
+    offset += size;
+  };
+  // The geometry id digests every chunk's checksum and size, in index order: the same
+  // geometry gives the same id whatever the chunks' order in the file.
+  uint32_t digestA = 0, digestB = 0x5eed;
+  for (const auto& r : regions)
+  {
+    for (const ChunkRef& c : r.record.chunks)
+    {
+      digestA = Crc32(&c.crc, 4, Crc32(&c.raw, 4, digestA));
+      digestB = Crc32(&c.stored, 4, Crc32(&c.crc, 4, digestB));
+    }
+  }
+  for (const auto& m : model)
+  {
+    digestA = Crc32(&m.record.chunk.crc, 4, Crc32(&m.record.kind, 4, digestA));
+    digestB = Crc32(&m.record.chunk.raw, 4, Crc32(&m.record.part, 4, digestB));
+  }
+  header.regionCount = regions.size();
+  header.modelChunkCount = model.size();
+  header.geometryId = (static_cast<uint64_t>(digestA) << 32) | digestB;
+  Buffer head;
+  PutHeader(head, header);
+  write(head.Bytes.data(), head.Bytes.size(), "header");
+  std::vector<uint64_t> base(parts.size());
+  std::vector<uint8_t> block(std::size_t(1) << 22);
+  for (std::size_t p = 0; p < parts.size(); ++p)
+  {
+    base[p] = offset;
+    std::FILE* in = std::fopen(parts[p].c_str(), "rb");
+    if (!in)
+    {
+      throw MultiresolutionFileError(parts[p] + ": cannot open the chunk file: " + std::strerror(errno));
+    }
+    std::size_t got = 0;
+    while ((got = std::fread(block.data(), 1, block.size(), in)) > 0)
+    {
+      write(block.data(), got, "chunks of " + parts[p]);
+    }
+    const bool failed = std::ferror(in) != 0;
+    std::fclose(in);
+    if (failed)
+    {
+      throw MultiresolutionFileError(parts[p] + ": read failed: " + std::strerror(errno));
+    }
+  }
+  const auto moved = [&](int part, ChunkRef ref) {
+    if (part < 0 || static_cast<std::size_t>(part) >= parts.size())
+    {
+      throw std::invalid_argument("AssembleMultiresolutionFile: no part " + std::to_string(part));
+    }
+    ref.offset += base[static_cast<std::size_t>(part)];
+    return ref;
+  };
+  Buffer index;
+  for (const auto& r : regions)
+  {
+    RegionRecord record = r.record;
+    for (ChunkRef& c : record.chunks)
+    {
+      c = moved(r.part, c);
+    }
+    PutRecord(index, record);
+  }
+  for (const auto& m : model)
+  {
+    const ChunkRef c = moved(m.part, m.record.chunk);
+    index.Put(m.record.kind);
+    index.Put(m.record.part);
+    index.Put(c.offset);
+    index.Put(c.stored);
+    index.Put(c.raw);
+    index.Put(c.crc);
+    index.Put(static_cast<uint32_t>(0));
+  }
+  const uint64_t indexOffset = offset;
+  write(index.Bytes.data(), index.Bytes.size(), "index");
   Buffer trailer;
   trailer.Put(indexOffset);
   trailer.Put(static_cast<uint64_t>(index.Bytes.size()));
   trailer.Put(Crc32(index.Bytes.data(), index.Bytes.size()));
   trailer.Put(static_cast<uint32_t>(0));
   trailer.PutBytes(TrailerMagic, 8);
-  this->WriteOrThrow(trailer.Bytes.data(), trailer.Bytes.size(), "trailer");
-  this->Output->Commit();
+  write(trailer.Bytes.data(), trailer.Bytes.size(), "trailer");
+  output.Commit();
 }
 
 MultiresolutionFile::MultiresolutionFile(const std::string& path)
@@ -596,7 +861,21 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
     }
     this->Head.leafLevel = head.Get<int32_t>();
     this->Head.cmax = head.Get<int32_t>();
-    head.Get<uint64_t>();
+    this->Head.regionCount = head.Get<uint64_t>();
+    this->Head.modelChunkCount = head.Get<uint64_t>();
+    this->Head.hashTableSide = head.Get<uint32_t>();
+    this->Head.hashOffsetSide = head.Get<uint32_t>();
+    this->Head.hashedCells = head.Get<uint64_t>();
+    this->Head.geometryId = head.Get<uint64_t>();
+    const auto& d = this->Head.dims;
+    const uint64_t slots = uint64_t(this->Head.hashTableSide) * this->Head.hashTableSide * this->Head.hashTableSide;
+    if (d[0] <= 0 || d[1] <= 0 || d[2] <= 0 || d[0] > (int64_t(1) << 24) || d[1] > (int64_t(1) << 24) ||
+      d[2] > (int64_t(1) << 24) || this->Head.leafLevel < 0 || this->Head.leafLevel > 40 ||
+      this->Head.regionCount > (uint64_t(1) << 40) || this->Head.modelChunkCount > (uint64_t(1) << 32) ||
+      this->Head.hashTableSide > 65535 || this->Head.hashOffsetSide > 65535 || this->Head.hashedCells > slots)
+    {
+      throw MultiresolutionFileError(path + ": header holds impossible dimensions, level or counts (corrupt)");
+    }
 
     Reader tail(this->Data + this->Size - TrailerBytes, TrailerBytes, path + ": trailer");
     const uint64_t indexOffset = tail.Get<uint64_t>(), indexSize = tail.Get<uint64_t>();
@@ -609,13 +888,12 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
     }
     const uint64_t indexEnd = this->Size - TrailerBytes;
     if (indexOffset < HeaderBytes || indexOffset > indexEnd || indexSize != indexEnd - indexOffset ||
-      indexSize % RecordBytes != 0)
+      indexSize != this->Head.regionCount * RecordBytes + this->Head.modelChunkCount * ModelRecordBytes)
     {
       throw MultiresolutionFileError(path + ": index at byte " + std::to_string(indexOffset) + " of " +
         std::to_string(indexSize) + " bytes does not fit a file of " + std::to_string(this->Size) +
         " bytes (truncated or corrupt)");
     }
-    this->Head.regionCount = indexSize / RecordBytes;
     if (Crc32(this->Data + indexOffset, indexSize) != indexCrc)
     {
       throw MultiresolutionFileError(path + ": index checksum mismatch (bytes " + std::to_string(indexOffset) + "-" +
@@ -645,6 +923,24 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
       }
       this->Records.push_back(r);
     }
+    for (uint64_t i = 0; i < this->Head.modelChunkCount; ++i)
+    {
+      ModelChunk m;
+      m.kind = index.Get<uint32_t>();
+      m.part = index.Get<uint32_t>();
+      m.chunk.offset = index.Get<uint64_t>();
+      m.chunk.stored = index.Get<uint32_t>();
+      m.chunk.raw = index.Get<uint32_t>();
+      m.chunk.crc = index.Get<uint32_t>();
+      index.Get<uint32_t>();
+      if (m.chunk.offset < HeaderBytes || m.chunk.offset > indexOffset || m.chunk.stored > indexOffset - m.chunk.offset ||
+        m.chunk.raw >= MaxRawChunk || m.kind < ModelChunk::ActiveLayer || m.kind > ModelChunk::CellNormals)
+      {
+        throw MultiresolutionFileError(path + ": model chunk record " + std::to_string(i) + " (kind " +
+          std::to_string(m.kind) + ", part " + std::to_string(m.part) + ") lies outside the data part of the file");
+      }
+      this->Model.push_back(m);
+    }
   }
   catch (...)
   {
@@ -672,22 +968,91 @@ const RegionRecord* MultiresolutionFile::Find(int32_t level, int64_t index) cons
 
 std::vector<uint8_t> MultiresolutionFile::ReadChunk(const RegionRecord& record, int chunk) const
 {
-  const ChunkRef& ref = record.chunks[chunk];
-  const std::string place = this->FilePath + ": region (level " + std::to_string(record.level) + ", index " +
-    std::to_string(record.index) + ") " + ChunkNames[chunk] + " at byte " + std::to_string(ref.offset);
-  if (Crc32(this->Data + ref.offset, ref.stored) != ref.crc)
-  {
-    throw MultiresolutionFileError(place + ": checksum mismatch (corrupt data)");
-  }
-  std::vector<uint8_t> raw(ref.raw);
-  lzo_uint length = ref.raw;
-  const int status = lzo1x_decompress_safe(this->Data + ref.offset, ref.stored, raw.data(), &length, nullptr);
-  if (status != LZO_E_OK || length != ref.raw)
-  {
-    throw MultiresolutionFileError(place + ": does not decompress to its " + std::to_string(ref.raw) + " bytes");
-  }
-  return raw;
+  return this->ReadChunk(record.chunks[chunk], this->FilePath + ": region (level " + std::to_string(record.level) +
+      ", index " + std::to_string(record.index) + ") " + ChunkNames[chunk] + " at byte " +
+      std::to_string(record.chunks[chunk].offset));
 }
+
+std::vector<uint8_t> MultiresolutionFile::ReadChunk(const ChunkRef& ref, const std::string& place) const
+{
+  return Decompress(this->Data, this->Size, ref, place);
+}
+
+std::vector<uint8_t> MultiresolutionFile::ReadActiveLayer(int64_t k) const
+{
+  const int64_t cells = this->Head.dims[0] * this->Head.dims[1];
+  for (const ModelChunk& m : this->Model)
+  {
+    if (m.kind == ModelChunk::ActiveLayer && static_cast<int64_t>(m.part) == k)
+    {
+      const std::string place = this->FilePath + ": active flags of layer " + std::to_string(k + 1) + " at byte " +
+        std::to_string(m.chunk.offset);
+      const auto bits = this->ReadChunk(m.chunk, place);
+      if (static_cast<int64_t>(bits.size()) != (cells + 7) / 8)
+      {
+        throw MultiresolutionFileError(place + ": " + std::to_string(bits.size()) + " bytes for " +
+          std::to_string(cells) + " cells");
+      }
+      std::vector<uint8_t> flags(static_cast<std::size_t>(cells));
+      for (int64_t c = 0; c < cells; ++c)
+      {
+        flags[static_cast<std::size_t>(c)] = (bits[static_cast<std::size_t>(c >> 3)] >> (c & 7)) & 1;
+      }
+      return flags;
+    }
+  }
+  throw MultiresolutionFileError(this->FilePath + ": no active flags for layer " + std::to_string(k + 1));
+}
+
+PerfectSpatialHash MultiresolutionFile::ReadHash() const
+{
+  PerfectSpatialHash hash;
+  hash.tableSide = this->Head.hashTableSide;
+  hash.offsetSide = this->Head.hashOffsetSide;
+  const auto raw = this->ReadModelArray(ModelChunk::HashOffsets);
+  if (raw.size() != hash.OffsetTableSize() * 6)
+  {
+    throw MultiresolutionFileError(this->FilePath + ": hash offsets hold " + std::to_string(raw.size()) +
+      " bytes for an offset table of side " + std::to_string(hash.offsetSide));
+  }
+  hash.offsets.resize(static_cast<std::size_t>(hash.OffsetTableSize()));
+  std::memcpy(hash.offsets.data(), raw.data(), raw.size());
+  for (const auto& o : hash.offsets)
+  {
+    if (o[0] >= hash.tableSide || o[1] >= hash.tableSide || o[2] >= hash.tableSide)
+    {
+      throw MultiresolutionFileError(this->FilePath + ": a hash offset lies outside the table (corrupt)");
+    }
+  }
+  return hash;
+}
+
+std::vector<uint8_t> MultiresolutionFile::ReadModelArray(uint32_t kind) const
+{
+  std::vector<const ModelChunk*> pieces;
+  for (const ModelChunk& m : this->Model)
+  {
+    if (m.kind == kind)
+    {
+      pieces.push_back(&m);
+    }
+  }
+  std::sort(pieces.begin(), pieces.end(), [](const ModelChunk* a, const ModelChunk* b) { return a->part < b->part; });
+  std::vector<uint8_t> out;
+  for (std::size_t p = 0; p < pieces.size(); ++p)
+  {
+    const std::string place = this->FilePath + ": model array " + std::to_string(kind) + " piece " + std::to_string(p) +
+      " at byte " + std::to_string(pieces[p]->chunk.offset);
+    if (pieces[p]->part != p || (p + 1 < pieces.size() && pieces[p]->chunk.raw != ModelPieceBytes))
+    {
+      throw MultiresolutionFileError(place + ": pieces missing or out of order");
+    }
+    const auto raw = this->ReadChunk(pieces[p]->chunk, place);
+    out.insert(out.end(), raw.begin(), raw.end());
+  }
+  return out;
+}
+
 
 RegionMesh MultiresolutionFile::ReadRegion(std::size_t i) const
 {
@@ -695,22 +1060,34 @@ RegionMesh MultiresolutionFile::ReadRegion(std::size_t i) const
   {
     throw std::out_of_range("multiresolution file: no region " + std::to_string(i));
   }
-  const RegionRecord& record = this->Records[i];
-  RegionMesh mesh;
-  const std::string region = this->FilePath + ": region (level " + std::to_string(record.level) + ", index " +
-    std::to_string(record.index) + ") ";
+  return DecodeRegion(this->Data, this->Size, this->FilePath, this->Records[i], this->Head);
+}
+
+MappedChunkFile::MappedChunkFile(const std::string& path)
+  : FilePath(path)
+{
+  InitialiseLzo();
+  this->Data = MapFile(path, this->Size);
+}
+
+MappedChunkFile::~MappedChunkFile()
+{
+  if (this->Data)
   {
-    const auto raw = this->ReadChunk(record, RegionRecord::Mesh);
-    Reader in(raw.data(), raw.size(), region + ChunkNames[0]);
-    DecodeMesh(in, mesh, this->Head, record);
+    munmap(const_cast<uint8_t*>(this->Data), this->Size);
   }
-  RegionSurface* surfaces[3] = { &mesh.top, &mesh.bottom, &mesh.side };
-  for (int c = RegionRecord::Top; c <= RegionRecord::Side; ++c)
-  {
-    const auto raw = this->ReadChunk(record, c);
-    Reader in(raw.data(), raw.size(), region + ChunkNames[c]);
-    DecodeSurface(in, *surfaces[c - 1], static_cast<uint64_t>(mesh.VertexCount()));
-  }
+}
+
+RegionMesh MappedChunkFile::ReadRegion(const RegionRecord& record, const MultiresolutionHeader& header) const
+{
+  return DecodeRegion(this->Data, this->Size, this->FilePath, record, header);
+}
+
+RegionMesh MultiresolutionFile::ReadRegionSurfaces(std::size_t i) const
+{
+  RegionMesh mesh = this->ReadRegion(i);
+  mesh.positions.clear();
+  mesh.positions.shrink_to_fit();
   return mesh;
 }
 

@@ -2,12 +2,18 @@
 // LZO-compressed one chunk each and concatenated, with an index of offsets, sizes, bounding
 // volumes, errors and normal cones, laid out for memory mapping.
 //
-// Layout (little-endian):
-//   header (160 bytes, CRC-32 at its end): magic, version, grid dimensions, hierarchy box,
-//     position lattice, leaf level, Cmax
+// Layout (little-endian), version 2:
+//   header (256 bytes, CRC-32 at its end): magic, version, grid dimensions, hierarchy box,
+//     position lattice, leaf level, Cmax, region and model-chunk counts, perfect-hash sizes,
+//     geometry id
 //   chunks, in any order: LZO1X-1 compressed, CRC-32 of the stored bytes in the index
-//   index: one 192-byte record a region
+//   index: one 192-byte record a region, then one 32-byte record a model chunk
 //   trailer (32 bytes): index offset and size, CRC-32 of the index, magic "RESMRIDX"
+// Model chunks hold what belongs to the grid, not to a region: the active flags of each
+// layer, and the property side of Sec. 5.3-5.4 (perfect spatial hash of the cells the
+// extracted faces touch, the cell of each hash slot, top and bottom normals a slot). Property
+// values never live here (Sec. 5.5): they go to property files (PropertyFile.h) that name
+// this file's geometry id, so adding properties never rewrites geometry.
 // A file is only trusted once the trailer, the index CRC and every offset and size check out
 // against the file; each chunk is checked (CRC, exact decompressed size, every reference in
 // range) when read. Any failure throws MultiresolutionFileError naming the file and the place.
@@ -21,6 +27,7 @@
 // Positions keep depth down (Core's convention); the viewer shows z = -depth.
 #pragma once
 
+#include "PerfectSpatialHash.h"
 #include "RegionMesh.h"
 
 #include <array>
@@ -34,8 +41,6 @@
 namespace resmr
 {
 
-class AtomicOutputFile;
-
 class MultiresolutionFileError : public std::runtime_error
 {
 public:
@@ -44,14 +49,20 @@ public:
 
 struct MultiresolutionHeader
 {
-  static constexpr uint32_t Version = 1;
+  static constexpr uint32_t Version = 2;
   std::array<int64_t, 3> dims{};
   std::array<double, 4> box{};          ///< hierarchy box: xmin, ymin, xmax, ymax
   std::array<double, 3> latticeOrigin{}; ///< x, y, depth
   std::array<double, 3> latticeStep{ 1, 1, 1 };
   int32_t leafLevel = 0;
   int32_t cmax = 0;
-  uint64_t regionCount = 0; ///< read from the index (the header is written before it is known)
+  uint64_t regionCount = 0;
+  uint64_t modelChunkCount = 0;
+  uint32_t hashTableSide = 0;  ///< m: the packed tables hold m^3 slots (Sec. 5.4)
+  uint32_t hashOffsetSide = 0; ///< r: the offset table holds r^3 entries
+  uint64_t hashedCells = 0;    ///< cells the extracted faces touch (filled slots)
+  /// Identifies the geometry (a digest of every chunk's checksum): property files name it.
+  uint64_t geometryId = 0;
 };
 
 /// Where one compressed chunk lies.
@@ -88,32 +99,89 @@ struct RegionRecord
   std::array<ChunkRef, ChunkCount> chunks{};
 };
 
+/// A chunk of the grid rather than of a region.
+struct ModelChunk
+{
+  enum Kind : uint32_t
+  {
+    ActiveLayer = 1, ///< part k: one bit a cell of layer k (i fastest), 1 = active
+    HashOffsets = 2, ///< the offset table: r^3 x 3 uint16
+    HashCells = 3,   ///< per slot, uint64 natural cell index i + nx (j + ny k); all ones if empty
+    CellNormals = 4  ///< per slot, two uint16 (top, bottom face normal, NormalQuantization.h)
+  };
+  uint32_t kind = 0;
+  uint32_t part = 0; ///< layer, or piece of a long array (pieces of at most 2^28 bytes)
+  ChunkRef chunk;
+};
+
 /// Position lattice for a model of this extent (x, y, depth min and max).
 void ChooseLattice(const std::array<double, 6>& extent, MultiresolutionHeader& header);
 
-/// Writes a .resmr file under a temporary name; Commit() writes the index and renames it.
-/// AddRegion may be called from several threads at once.
-class MultiresolutionWriter
+/// Bytes of one piece of a long model array (HashCells, CellNormals).
+constexpr std::size_t ModelPieceBytes = std::size_t(1) << 28;
+
+/// Compressed chunks appended to a scratch file, the body of a .resmr file before it is
+/// assembled (AssembleMultiresolutionFile). Offsets are relative to this file. Thread-safe.
+/// A build's workers (threads, MPI ranks: one file each) append here, so a killed build keeps
+/// what it finished: reopen with `keepBytes`, the size recorded when a level was finished.
+class ChunkFile
 {
 public:
-  MultiresolutionWriter(const std::string& path, const MultiresolutionHeader& header);
-  ~MultiresolutionWriter();
+  /// Creates `path`, or with keepBytes >= 0 reopens it cut to that many bytes.
+  explicit ChunkFile(const std::string& path, int64_t keepBytes = -1);
+  ~ChunkFile();
+  ChunkFile(const ChunkFile&) = delete;
+  ChunkFile& operator=(const ChunkFile&) = delete;
 
-  /// Compresses and appends the region's chunks; fills the record's sizes, counts, chunk
-  /// references and normal cones (bounds and errors are the caller's).
-  void AddRegion(const RegionMesh& mesh, RegionRecord& record);
-  /// Writes the index of `records` and the trailer and puts the file in place.
-  void Commit(const std::vector<RegionRecord>& records);
-
-  const std::string& Path() const;
-  uint64_t BytesWritten() const { return this->Offset; }
+  /// Compresses and appends `raw`; `what` names it in errors.
+  ChunkRef Put(const std::vector<uint8_t>& raw, const std::string& what);
+  /// Encodes the region's chunks; fills the record's counts, chunk references and normal
+  /// cones (bounds and errors are the caller's).
+  void AddRegion(const RegionMesh& mesh, const MultiresolutionHeader& header, RegionRecord& record);
+  /// Appends a long array as model chunks of at most ModelPieceBytes each.
+  void AddModelArray(uint32_t kind, const void* data, std::size_t bytes, std::vector<ModelChunk>& out);
+  /// Flushes to disk; the bytes written so far.
+  uint64_t Sync();
+  const std::string& Path() const { return this->FilePath; }
 
 private:
-  void WriteOrThrow(const void* data, std::size_t size, const char* what);
-  std::unique_ptr<AtomicOutputFile> Output;
-  MultiresolutionHeader Header;
+  std::string FilePath;
+  int Descriptor = -1;
   std::mutex Lock;
   uint64_t Offset = 0;
+};
+
+/// Where a record's chunks lie: which part (ChunkFile) of the assembly.
+template <typename Record>
+struct PartRecord
+{
+  int part = 0;
+  Record record;
+};
+
+/// Writes the .resmr file: header, the parts' bytes in order, the index and trailer, under a
+/// temporary name renamed into place (an older file stays untouched until then). Chunk
+/// offsets are moved from their part to the file. Sets header.regionCount,
+/// modelChunkCount and geometryId.
+void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader header,
+  const std::vector<std::string>& parts, const std::vector<PartRecord<RegionRecord>>& regions,
+  const std::vector<PartRecord<ModelChunk>>& model);
+
+/// A ChunkFile mapped for reading back regions before the file is assembled (the builder's
+/// last pass over its own output). Checks as MultiresolutionFile does.
+class MappedChunkFile
+{
+public:
+  explicit MappedChunkFile(const std::string& path);
+  ~MappedChunkFile();
+  MappedChunkFile(const MappedChunkFile&) = delete;
+  MappedChunkFile& operator=(const MappedChunkFile&) = delete;
+  RegionMesh ReadRegion(const RegionRecord& record, const MultiresolutionHeader& header) const;
+
+private:
+  std::string FilePath;
+  const uint8_t* Data = nullptr;
+  uint64_t Size = 0;
 };
 
 /// A .resmr file opened for reading (memory-mapped).
@@ -132,18 +200,39 @@ public:
   const std::string& Path() const { return this->FilePath; }
 
   /// Decodes region `i` of Regions(), checking every chunk; throws MultiresolutionFileError.
+  /// The side surface comes as triangles (sideTriangles, simplified, Sec. 4.3); side quads
+  /// are not stored (ExtractSurfaces() derives them from the mesh).
   RegionMesh ReadRegion(std::size_t i) const;
+  /// Decodes only the surfaces and the nodes' topological coordinates (what the property
+  /// side needs): positions, corners and cells are left empty.
+  RegionMesh ReadRegionSurfaces(std::size_t i) const;
+
+  const std::vector<ModelChunk>& ModelChunks() const { return this->Model; }
+  /// Active flags of layer k (one byte a cell, i fastest).
+  std::vector<uint8_t> ReadActiveLayer(int64_t k) const;
+  /// The concatenated pieces of a long model array (HashOffsets, HashCells, CellNormals).
+  std::vector<uint8_t> ReadModelArray(uint32_t kind) const;
+  /// The perfect spatial hash of the cells the extracted faces touch (Sec. 5.4).
+  PerfectSpatialHash ReadHash() const;
   /// The record of (level, index), or nullptr.
   const RegionRecord* Find(int32_t level, int64_t index) const;
 
 private:
   std::vector<uint8_t> ReadChunk(const RegionRecord& record, int chunk) const;
+  std::vector<uint8_t> ReadChunk(const ChunkRef& ref, const std::string& place) const;
   std::string FilePath;
   const uint8_t* Data = nullptr;
   uint64_t Size = 0;
   MultiresolutionHeader Head;
   std::vector<RegionRecord> Records;
+  std::vector<ModelChunk> Model;
 };
+
+/// LZO1X-1 compression, what every chunk of .resmr and .resmrp files holds.
+std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw);
+/// Checks a chunk of a mapped file (in the file, CRC, exact size) and decompresses it;
+/// throws MultiresolutionFileError naming `place`.
+std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place);
 
 /// CRC-32 (IEEE 802.3) of a byte range, continuing from `crc`.
 uint32_t Crc32(const void* data, std::size_t size, uint32_t crc = 0);

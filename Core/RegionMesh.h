@@ -13,6 +13,8 @@
 // - Surfaces are quads of four vertex numbers: top faces of active cells with no active cell
 //   above, bottom faces with none below, the open side faces of active cells. Each quad turns
 //   counter-clockwise seen from outside its cell in a z-up frame (z = -depth).
+// - The file stores top and bottom quads and the simplified side triangles
+//   (SideSurfaceSimplification.h); side quads are derived on demand (ExtractSurfaces).
 // - The single-layer view needs no stored surface: ExtractLayerSurfaces() derives it from the
 //   hexahedral mesh on load.
 #pragma once
@@ -42,6 +44,9 @@ struct RegionMesh
   std::vector<uint8_t> cutEdges; ///< per column, bit e
   std::vector<uint8_t> openSides; ///< [column][layer], bit e
   RegionSurface top, bottom, side;
+  /// The side surface simplified for the whole-model view (Sec. 4.3), triangles of mesh
+  /// vertices turning as the quads; what the file stores for the side.
+  std::vector<std::array<uint32_t, 3>> sideTriangles;
 
   int64_t NodeCount() const { return static_cast<int64_t>(this->topology.size()); }
   int64_t ColumnCount() const { return static_cast<int64_t>(this->corners.size()); }

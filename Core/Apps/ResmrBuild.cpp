@@ -29,7 +29,9 @@ const char* BuildUsage =
   "                columns if fewer, at least 256)\n"
   "  --threads N   worker threads (default: every core)\n"
   "  --memory SIZE memory budget, e.g. 4G or 512M (default: half the available memory)\n"
-  "  --scratch DIR scratch folder (default OUT.resmr.scratch, removed at the end)\n"
+  "  --scratch DIR scratch folder (default OUT.resmr.scratch, removed at the end; a killed\n"
+  "                build run again with the same arguments resumes from its last finished level)\n"
+  "  --fresh       ignore a killed build's scratch folder and start over\n"
   "  Prints a progress bar on stderr and a JSON report on stdout.\n";
 
 int64_t ParseSize(const std::string& text)
@@ -69,36 +71,6 @@ std::string Duration(double seconds)
   return text;
 }
 
-/// Everything a grid file source needs kept alive.
-struct FileModel
-{
-  resmr::GrdeclDeck deck;
-  std::vector<bool> active;
-  std::unique_ptr<resmr::CornerPointGeometry> geometry;
-};
-
-std::unique_ptr<resmr::LayerSource> OpenSource(const std::string& input, FileModel& model)
-{
-  if (input.rfind("synth:", 0) == 0)
-  {
-    resmr::SyntheticParameters p;
-    long long nx = 0, ny = 0, nz = 0;
-    unsigned long long seed = 1;
-    if (std::sscanf(input.c_str() + 6, "%lldx%lldx%lld:%llu", &nx, &ny, &nz, &seed) < 3)
-    {
-      throw std::invalid_argument(input + ": expected synth:NIxNJxNK[:SEED]");
-    }
-    p.nx = nx;
-    p.ny = ny;
-    p.nz = nz;
-    p.seed = seed;
-    p.Validate();
-    return std::unique_ptr<resmr::LayerSource>(new resmr::SyntheticLayerSource(p, input));
-  }
-  ReadGridFile(input, model.deck, model.active);
-  model.geometry.reset(new resmr::CornerPointGeometry(resmr::CornerPointGeometry::FromDeck(model.deck, false)));
-  return std::unique_ptr<resmr::LayerSource>(new resmr::CornerPointLayerSource(*model.geometry, model.active, input));
-}
 } // namespace
 
 int BuildCommand(int argc, char** argv)
@@ -140,6 +112,10 @@ int BuildCommand(int argc, char** argv)
       {
         options.seed = std::stoull(OptionValue(a, argc, argv));
       }
+      else if (arg == "--fresh")
+      {
+        options.resume = false;
+      }
       else if (arg == "--quiet")
       {
         quiet = true;
@@ -158,8 +134,7 @@ int BuildCommand(int argc, char** argv)
       std::fputs(BuildUsage, stderr);
       return 2;
     }
-    FileModel model;
-    auto source = OpenSource(input, model);
+    auto source = resmr::OpenLayerSource(input);
     const auto start = std::chrono::steady_clock::now();
     const bool terminal = isatty(2);
     double lastShown = -1;
@@ -194,12 +169,15 @@ int BuildCommand(int argc, char** argv)
     std::printf("{\"input\": \"%s\", \"output\": \"%s\", \"cells\": %lld, \"active_cells\": %lld, \"columns\": %lld, "
                 "\"leaf_level\": %d, \"regions\": %lld, \"threads\": %d, \"file_bytes\": %llu, \"bytes_per_cell\": %.3f, "
                 "\"partition_s\": %.2f, \"leaves_s\": %.2f, \"simplify_s\": %.2f, \"total_s\": %.2f, "
-                "\"cells_per_s\": %.0f, \"peak_rss_mb\": %.1f}\n",
+                "\"cells_per_s\": %.0f, \"peak_rss_mb\": %.1f, \"resumed_from_level\": %d, \"hashed_cells\": %llu, "
+                "\"hash_slots\": %llu, \"hash_offsets\": %llu}\n",
       input.c_str(), output.c_str(), static_cast<long long>(report.cells), static_cast<long long>(report.activeCells),
       static_cast<long long>(report.columns), report.leafLevel, static_cast<long long>(report.regions), report.threadsUsed,
       static_cast<unsigned long long>(report.fileBytes), double(report.fileBytes) / double(report.cells),
       report.partitionSeconds, report.leafSeconds, report.simplifySeconds, report.totalSeconds,
-      double(report.cells) / std::max(report.totalSeconds, 1e-9), usage.ru_maxrss / 1024.0);
+      double(report.cells) / std::max(report.totalSeconds, 1e-9), usage.ru_maxrss / 1024.0, report.resumedFromLevel,
+      static_cast<unsigned long long>(report.hashedCells), static_cast<unsigned long long>(report.hashSlots),
+      static_cast<unsigned long long>(report.hashOffsets));
     return 0;
   }
   catch (const std::exception& error)
@@ -209,7 +187,7 @@ int BuildCommand(int argc, char** argv)
   }
 }
 
-int MultiresolutionInfo(const char* path)
+int MultiresolutionInfo(const char* path, bool listRegions)
 {
   const resmr::MultiresolutionFile file(path);
   const auto& h = file.Header();
@@ -254,6 +232,37 @@ int MultiresolutionInfo(const char* path)
       static_cast<unsigned long long>(l.rawBytes), l.error);
     first = false;
   }
-  std::printf("]}\n");
+  // Sec. 5.4: the packed 3D textures, against the cells they hold and the full grid.
+  const double slots = double(h.hashTableSide) * h.hashTableSide * h.hashTableSide;
+  const double offsets = double(h.hashOffsetSide) * h.hashOffsetSide * h.hashOffsetSide;
+  uint64_t modelBytes = 0;
+  for (const auto& m : file.ModelChunks())
+  {
+    modelBytes += m.chunk.stored;
+  }
+  std::printf("],\n \"model_chunk_bytes\": %llu, \"geometry_id\": \"%016llx\", \"hash\": {\"cells\": %llu, "
+              "\"table_side\": %u, \"offset_side\": %u, \"slots\": %.0f, \"fill\": %.4f, "
+              "\"packed_over_cells_float\": %.4f, \"packed_over_cells_float_with_offsets\": %.4f, "
+              "\"packed_over_full_grid\": %.6f}",
+    static_cast<unsigned long long>(modelBytes), static_cast<unsigned long long>(h.geometryId),
+    static_cast<unsigned long long>(h.hashedCells), h.hashTableSide, h.hashOffsetSide, slots,
+    slots > 0 ? double(h.hashedCells) / slots : 0.0, h.hashedCells ? slots / double(h.hashedCells) : 0.0,
+    h.hashedCells ? (slots * 4 + offsets * 6) / (double(h.hashedCells) * 4) : 0.0, (slots * 4 + offsets * 6) / (cells * 4));
+  if (listRegions)
+  {
+    std::printf(",\n \"region_list\": [");
+    bool firstRegion = true;
+    for (const auto& r : file.Regions())
+    {
+      std::printf("%s\n  [%d, %lld, %lld, %lld, %lld, %.9g, %.9g, [%.9g, %.9g, %.9g, %.9g, %.9g, %.9g], [%u, %u, %u, %u]]",
+        firstRegion ? "" : ",", r.level, static_cast<long long>(r.index), static_cast<long long>(r.columns),
+        static_cast<long long>(r.activeCells), static_cast<long long>(r.vertices), r.error, r.ownError, r.bounds[0],
+        r.bounds[1], r.bounds[2], r.bounds[3], r.bounds[4], r.bounds[5], r.chunks[0].crc, r.chunks[1].crc,
+        r.chunks[2].crc, r.chunks[3].crc);
+      firstRegion = false;
+    }
+    std::printf("]");
+  }
+  std::printf("}\n");
   return 0;
 }

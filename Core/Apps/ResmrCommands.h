@@ -26,8 +26,10 @@ int SimplifyCommand(int argc, char** argv);
 /// resmr build INPUT -o OUT.resmr [options]; argv[1] is "build".
 int BuildCommand(int argc, char** argv);
 
-/// resmr info FILE.resmr: levels, regions, sizes and errors as JSON.
-int MultiresolutionInfo(const char* path);
+/// resmr info [--regions] FILE.resmr: levels, regions, sizes and errors as JSON; with
+/// --regions every region's record too (level, index, counts, errors, bounds, chunk CRCs).
+int MultiresolutionInfo(const char* path, bool listRegions = false);
 
-/// An EGRID or a GRDECL/DATA deck: its deck and one active flag a cell (ACTNUM, all if none).
-void ReadGridFile(const std::string& path, resmr::GrdeclDeck& deck, std::vector<bool>& active);
+/// resmr add-properties FILE.resmr RESULTS... [-o FILE.resmrp]; argv[1] is "add-properties".
+int AddPropertiesCommand(int argc, char** argv);
+

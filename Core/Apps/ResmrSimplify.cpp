@@ -9,6 +9,7 @@
 #include "CornerPointGeometry.h"
 #include "EclipseGrid.h"
 #include "GrdeclParser.h"
+#include "LayerSource.h"
 #include "MeshQuality.h"
 #include "SyntheticReservoir.h"
 #include "UniformCoarsening.h"
@@ -78,7 +79,7 @@ Model Load(const std::string& source)
     }
     return model;
   }
-  ReadGridFile(source, model.deck, model.active);
+  resmr::ReadCornerPointModel(source, model.deck, model.active);
   return model;
 }
 

@@ -12,8 +12,10 @@
 //                       simplifies a model by column collapses, prints quality (ResmrSimplify.cpp)
 //   resmr build INPUT -o OUT.resmr [options]
 //                       builds the multiresolution file (ResmrBuild.cpp)
-//   resmr info FILE.resmr
+//   resmr info [--regions] FILE.resmr
 //                       levels, regions, sizes and errors of a multiresolution file
+//   resmr add-properties FILE.resmr RESULTS... [-o FILE.resmrp]
+//                       property tables beside the geometry (ResmrProperties.cpp)
 #include "ResmrCommands.h"
 
 #include "CornerPointGeometry.h"
@@ -207,11 +209,16 @@ int main(int argc, char** argv)
   {
     return BuildCommand(argc, argv);
   }
-  if (argc == 3 && std::strcmp(argv[1], "info") == 0 && LooksLikeMultiresolutionFile(argv[2]))
+  if (argc >= 2 && std::strcmp(argv[1], "add-properties") == 0)
+  {
+    return AddPropertiesCommand(argc, argv);
+  }
+  const bool listRegions = argc == 4 && std::strcmp(argv[2], "--regions") == 0;
+  if ((argc == 3 || listRegions) && std::strcmp(argv[1], "info") == 0 && LooksLikeMultiresolutionFile(argv[argc - 1]))
   {
     try
     {
-      return MultiresolutionInfo(argv[2]);
+      return MultiresolutionInfo(argv[argc - 1], listRegions);
     }
     catch (const std::exception& error)
     {
@@ -241,7 +248,9 @@ int main(int argc, char** argv)
                        "  column-collapse simplification and its quality (resmr simplify --help)\n"
                        "usage: resmr build INPUT -o OUT.resmr [--cmax N] [--threads N] [--memory SIZE]\n"
                        "  builds the multiresolution file (resmr build --help)\n"
-                       "usage: resmr info FILE.resmr\n"
-                       "  levels, regions, sizes, errors and bytes per cell of a multiresolution file\n");
+                       "usage: resmr info [--regions] FILE.resmr\n"
+                       "  levels, regions, sizes, errors and bytes per cell of a multiresolution file\n"
+                       "usage: resmr add-properties FILE.resmr RESULTS... [-o FILE.resmrp]\n"
+                       "  stores properties of every step apart from the geometry (resmr add-properties --help)\n");
   return 2;
 }

@@ -8,6 +8,8 @@
 #include "CornerPointGeometry.h"
 #include "DiamondHierarchy.h"
 #include "HierarchyBuilder.h"
+#include "NormalQuantization.h"
+#include "PerfectSpatialHash.h"
 #include "LayerSource.h"
 #include "MultiresolutionFile.h"
 #include "RegionMesh.h"
@@ -266,13 +268,28 @@ int64_t CheckCut(const MultiresolutionFile& file, const std::set<std::pair<int, 
       ++checked;
     }
     const RegionMesh& mesh = found->second;
-    for (const RegionSurface* s : { &mesh.top, &mesh.bottom, &mesh.side })
+    // Top and bottom quads and the simplified side triangles, as the file holds them.
+    std::vector<std::vector<uint32_t>> polygons;
+    for (const RegionSurface* s : { &mesh.top, &mesh.bottom })
     {
       for (const auto& q : s->quads)
       {
-        for (int v = 0; v < 4; ++v)
+        polygons.push_back({ q[0], q[1], q[2], q[3] });
+      }
+    }
+    for (const auto& t : mesh.sideTriangles)
+    {
+      polygons.push_back({ t[0], t[1], t[2] });
+    }
+    {
+      for (const auto& q : polygons)
+      {
+        for (std::size_t v = 0; v < q.size(); ++v)
         {
-          const VertexData a = VertexOf(mesh, q[v]), b = VertexOf(mesh, q[(v + 1) % 4]);
+          // By position: a zero-area triangle between two vertices at one place (a pinched
+          // cell's side) is left out of the side surface, which leaves no gap in space.
+          VertexData a = VertexOf(mesh, q[v]), b = VertexOf(mesh, q[(v + 1) % q.size()]);
+          a[0] = a[1] = a[2] = b[0] = b[1] = b[2] = 0;
           if (a == b)
           {
             continue; // an edge of no length (pinched cell) cannot open a crack
@@ -338,7 +355,8 @@ void TestHierarchyFile()
     CHECK(r.columns <= options.cmax || r.level == report.leafLevel);
     if (r.level == report.leafLevel)
     {
-      const RegionMesh mesh = file.ReadRegion(i);
+      RegionMesh mesh = file.ReadRegion(i);
+      ExtractSurfaces(mesh); // side quads are derived, not stored
       const auto faces = FacesOf(mesh);
       leafFaces.insert(faces.begin(), faces.end());
       leafColumns += mesh.ColumnCount();
@@ -352,6 +370,91 @@ void TestHierarchyFile()
   {
     std::fprintf(stderr, "finest level: %zu faces, original %zu\n", leafFaces.size(), original.size());
   }
+  // Property side (Sec. 5.3-5.4): active flags per layer, the perfect hash of the touched
+  // cells, and their normals.
+  {
+    const auto& h = file.Header();
+    int64_t activeCells = 0;
+    std::vector<std::vector<uint8_t>> activeLayers;
+    for (int64_t k = 0; k < p.nz; ++k)
+    {
+      activeLayers.push_back(file.ReadActiveLayer(k));
+      for (uint8_t a : activeLayers.back())
+      {
+        activeCells += a;
+      }
+    }
+    CHECK(activeCells == report.activeCells);
+    const PerfectSpatialHash hash = file.ReadHash();
+    const auto cellBytes = file.ReadModelArray(ModelChunk::HashCells);
+    const auto normalBytes = file.ReadModelArray(ModelChunk::CellNormals);
+    CHECK(cellBytes.size() == hash.TableSize() * 8 && normalBytes.size() == hash.TableSize() * 4);
+    std::vector<uint64_t> slotCell(cellBytes.size() / 8);
+    std::memcpy(slotCell.data(), cellBytes.data(), cellBytes.size());
+    int64_t filled = 0, tops = 0, upward = 0;
+    std::set<uint64_t> hashedCells;
+    for (std::size_t slot = 0; slot < slotCell.size(); ++slot)
+    {
+      const uint64_t n = slotCell[slot];
+      if (n == ~uint64_t(0))
+      {
+        continue;
+      }
+      ++filled;
+      hashedCells.insert(n);
+      const uint32_t i = uint32_t(n % uint64_t(p.nx)), j = uint32_t(n / uint64_t(p.nx) % uint64_t(p.ny)),
+                     k = uint32_t(n / uint64_t(p.nx * p.ny));
+      CHECK(hash.Slot(i, j, k) == slot); // the hash finds every cell where its data lies
+      uint16_t codes[2];
+      std::memcpy(codes, &normalBytes[slot * 4], 4);
+      const auto top = DecodeUnitNormal(codes[0]), bottom = DecodeUnitNormal(codes[1]);
+      if (!activeLayers[k][i + uint32_t(p.nx) * j])
+      {
+        continue; // never shown
+      }
+      ++tops;
+      upward += top[2] > 0 && bottom[2] < 0;
+    }
+    CHECK(filled == static_cast<int64_t>(h.hashedCells) && filled > 0);
+    if (upward != tops)
+    {
+      std::fprintf(stderr, "%lld of %lld cells have a top normal down or a bottom normal up\n",
+        static_cast<long long>(tops - upward), static_cast<long long>(tops));
+    }
+    CHECK(upward == tops); // top normals look up, bottom normals down
+    // Every cell under a top face and over a bottom face of the finest level is hashed.
+    int64_t missing = 0;
+    for (std::size_t i = 0; i < file.Regions().size(); ++i)
+    {
+      if (file.Regions()[i].level != report.leafLevel)
+      {
+        continue;
+      }
+      const RegionMesh mesh = file.ReadRegion(i);
+      const uint32_t interfaces = uint32_t(mesh.layers + 1);
+      for (int which = 0; which < 2; ++which)
+      {
+        for (const auto& q : (which ? mesh.bottom : mesh.top).quads)
+        {
+          double ti = 0, tj = 0;
+          for (uint32_t v : q)
+          {
+            ti += mesh.topology[v / interfaces][0] / 4;
+            tj += mesh.topology[v / interfaces][1] / 4;
+          }
+          const uint64_t k = q[0] % interfaces - (which ? 1 : 0);
+          const uint64_t n = uint64_t(std::floor(ti)) + uint64_t(p.nx) * (uint64_t(std::floor(tj)) + uint64_t(p.ny) * k);
+          missing += hashedCells.count(n) == 0;
+        }
+      }
+    }
+    CHECK(missing == 0);
+    // Packed: the table holds few empty slots (Sec. 5.4; target 1.25 x the cells).
+    std::fprintf(stderr, "hash: %lld cells in %llu slots (side %u), offsets side %u\n", static_cast<long long>(filled),
+      static_cast<unsigned long long>(hash.TableSize()), hash.tableSide, hash.offsetSide);
+    CHECK(double(hash.TableSize()) <= 1.25 * double(filled) + 64);
+  }
+
   // Each level keeps about half the columns of the one below: locked diamond boundaries keep
   // more where regions are small, as here (64 columns), so all levels above the leaves
   // together hold at most 1.2 times the leaves' columns (1 for exact halving).

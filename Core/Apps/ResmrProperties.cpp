@@ -1,0 +1,243 @@
+// resmr add-properties: simulation properties of every step into a property file beside the
+// geometry (paper Sec. 5.5: one hierarchy serves every simulation of the same grid).
+#include "ResmrCommands.h"
+
+#include "EclipseGrid.h"
+#include "EclipseResults.h"
+#include "GrdeclParser.h"
+#include "MultiresolutionFile.h"
+#include "PropertyFile.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+#include <sys/stat.h>
+#include <vector>
+
+namespace
+{
+const char* AddPropertiesUsage =
+  "usage: resmr add-properties FILE.resmr RESULTS... [-o FILE.resmrp]\n"
+  "  RESULTS: an EGRID (its INIT and restart companions are found by name: every INIT\n"
+  "           array and every array of every report step), an INIT or a UNRST/restart file\n"
+  "           beside its EGRID (only that file's arrays), or a GRDECL/DATA deck (its cell\n"
+  "           arrays other than geometry)\n"
+  "  -o FILE  property file (default: FILE.resmrp beside FILE.resmr); tables it already\n"
+  "           holds are kept unless replaced (same name and step). The .resmr file is only\n"
+  "           read, never written.\n";
+
+bool Exists(const std::string& path)
+{
+  struct stat info;
+  return stat(path.c_str(), &info) == 0;
+}
+
+std::string Upper(std::string text)
+{
+  for (char& c : text)
+  {
+    c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  }
+  return text;
+}
+
+std::string Extension(const std::string& path)
+{
+  const std::size_t dot = path.find_last_of('.');
+  const std::size_t slash = path.find_last_of('/');
+  return dot == std::string::npos || (slash != std::string::npos && dot < slash) ? "" : Upper(path.substr(dot + 1));
+}
+
+/// The EGRID beside a results file (same basename, either case, formatted or not).
+std::string GridBeside(const std::string& path)
+{
+  const std::size_t dot = path.find_last_of('.');
+  const std::string stem = path.substr(0, dot);
+  for (const char* ext : { ".EGRID", ".egrid", ".FEGRID", ".fegrid" })
+  {
+    if (Exists(stem + ext))
+    {
+      return stem + ext;
+    }
+  }
+  throw std::invalid_argument(path + ": no EGRID beside it (" + stem + ".EGRID): its active cells are needed to place the values");
+}
+
+/// The geometry's active cells per layer, to check that results belong to this grid.
+int64_t ActiveCount(const resmr::MultiresolutionFile& geometry)
+{
+  int64_t count = 0;
+  for (int64_t k = 0; k < geometry.Header().dims[2]; ++k)
+  {
+    for (uint8_t a : geometry.ReadActiveLayer(k))
+    {
+      count += a;
+    }
+  }
+  return count;
+}
+} // namespace
+
+int AddPropertiesCommand(int argc, char** argv)
+{
+  std::string geometryPath, output;
+  std::vector<std::string> inputs;
+  try
+  {
+    for (int a = 2; a < argc; ++a)
+    {
+      const std::string arg = argv[a];
+      if (arg == "-h" || arg == "--help")
+      {
+        std::fputs(AddPropertiesUsage, stdout);
+        return 0;
+      }
+      if (arg == "-o")
+      {
+        output = OptionValue(a, argc, argv);
+      }
+      else if (!arg.empty() && arg[0] == '-')
+      {
+        throw std::invalid_argument("unknown option " + arg);
+      }
+      else if (geometryPath.empty())
+      {
+        geometryPath = arg;
+      }
+      else
+      {
+        inputs.push_back(arg);
+      }
+    }
+    if (geometryPath.empty() || inputs.empty())
+    {
+      std::fputs(AddPropertiesUsage, stderr);
+      return 2;
+    }
+    if (output.empty())
+    {
+      output = (Extension(geometryPath) == "RESMR" ? geometryPath.substr(0, geometryPath.size() - 6) : geometryPath) + ".resmrp";
+    }
+    const resmr::MultiresolutionFile geometry(geometryPath);
+    const auto& dims = geometry.Header().dims;
+    const int64_t cells = dims[0] * dims[1] * dims[2];
+    const int64_t active = ActiveCount(geometry);
+    std::unique_ptr<resmr::PropertyFile> older;
+    if (Exists(output))
+    {
+      older.reset(new resmr::PropertyFile(output));
+      older->CheckGeometry(geometry);
+    }
+    resmr::PropertyFileWriter writer(output, geometry);
+    std::vector<float> values(static_cast<std::size_t>(cells));
+    const float none = std::numeric_limits<float>::quiet_NaN();
+    int64_t added = 0;
+    const auto add = [&](resmr::PropertyTable table) {
+      writer.Add(table, values);
+      ++added;
+      std::fprintf(stderr, "resmr add-properties: %s%s\n", table.name.c_str(),
+        table.step < 0 ? "" : (" step " + std::to_string(table.step) + " (report " + std::to_string(table.reportNumber) + ")").c_str());
+    };
+    for (const std::string& input : inputs)
+    {
+      const std::string ext = Extension(input);
+      const bool isInit = ext == "INIT" || ext == "FINIT";
+      const bool isRestart = ext == "UNRST" || ext == "FUNRST" || (ext.size() == 5 && (ext[0] == 'X' || ext[0] == 'F') &&
+                                                                    std::isdigit(static_cast<unsigned char>(ext[1])));
+      if (ext == "EGRID" || ext == "FEGRID" || isInit || isRestart)
+      {
+        const std::string gridPath = (isInit || isRestart) ? GridBeside(input) : input;
+        const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath);
+        if (grid.deck.dims != dims)
+        {
+          throw std::invalid_argument(gridPath + ": grid " + std::to_string(grid.deck.dims[0]) + "x" +
+            std::to_string(grid.deck.dims[1]) + "x" + std::to_string(grid.deck.dims[2]) + " is not the grid of " + geometryPath);
+        }
+        if (grid.activeCells != active)
+        {
+          throw std::invalid_argument(gridPath + ": " + std::to_string(grid.activeCells) + " active cells, " + geometryPath +
+            " has " + std::to_string(active) + ": results of another grid");
+        }
+        const resmr::EclipseResults results(gridPath, grid);
+        for (const std::string& warning : results.Warnings())
+        {
+          std::fprintf(stderr, "resmr add-properties: warning: %s\n", warning.c_str());
+        }
+        if (!isRestart)
+        {
+          for (const auto& array : results.StaticArrays())
+          {
+            if (results.ReadStatic<float>(array.name, values.data(), none))
+            {
+              resmr::PropertyTable table;
+              table.name = array.name;
+              add(table);
+            }
+          }
+        }
+        if (!isInit)
+        {
+          const auto& steps = results.Steps();
+          for (std::size_t s = 0; s < steps.size(); ++s)
+          {
+            for (const std::string& name : steps[s].names)
+            {
+              if (results.ReadDynamic<float>(s, name, values.data(), none))
+              {
+                resmr::PropertyTable table;
+                table.name = name;
+                table.step = static_cast<int32_t>(s);
+                table.reportNumber = steps[s].reportNumber;
+                table.days = steps[s].days;
+                add(table);
+              }
+            }
+          }
+        }
+      }
+      else
+      {
+        const resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(input);
+        if (deck.dims != dims)
+        {
+          throw std::invalid_argument(input + ": grid " + std::to_string(deck.dims[0]) + "x" + std::to_string(deck.dims[1]) +
+            "x" + std::to_string(deck.dims[2]) + " is not the grid of " + geometryPath);
+        }
+        for (const auto& array : deck.arrays)
+        {
+          if (resmr::IsGeometryArrayName(array.name) || array.name == "ACTNUM" ||
+            static_cast<int64_t>(array.values.size()) != cells)
+          {
+            continue;
+          }
+          for (int64_t c = 0; c < cells; ++c)
+          {
+            values[static_cast<std::size_t>(c)] = static_cast<float>(array.values[static_cast<std::size_t>(c)]);
+          }
+          resmr::PropertyTable table;
+          table.name = array.name;
+          add(table);
+        }
+      }
+    }
+    if (added == 0)
+    {
+      throw std::invalid_argument("no property found in the inputs; " + output + " not written");
+    }
+    if (older)
+    {
+      writer.CopyFrom(*older);
+    }
+    writer.Commit();
+    std::printf("{\"geometry\": \"%s\", \"properties\": \"%s\", \"tables_added\": %lld, \"tables\": %zu}\n",
+      geometryPath.c_str(), output.c_str(), static_cast<long long>(added), writer.TableCount());
+    return 0;
+  }
+  catch (const std::exception& error)
+  {
+    std::fprintf(stderr, "resmr add-properties: error: %s\n", error.what());
+    return 1;
+  }
+}

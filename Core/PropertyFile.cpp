@@ -1,0 +1,475 @@
+// Property tables apart from geometry, packed through the perfect spatial hash (paper Sec.
+// 5.2, 5.4, 5.5).
+#include "PropertyFile.h"
+
+#include "AtomicOutputFile.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fcntl.h>
+#include <limits>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace resmr
+{
+namespace
+{
+constexpr char Magic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'R', 'P' };
+constexpr char TrailerMagic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'I', 'X' };
+constexpr uint32_t Version = 1;
+constexpr std::size_t HeaderBytes = 128;
+constexpr std::size_t TrailerBytes = 32;
+constexpr std::size_t NameBytes = 32;
+
+template <typename T>
+void Put(std::vector<uint8_t>& out, const T& value)
+{
+  const auto* bytes = reinterpret_cast<const uint8_t*>(&value);
+  out.insert(out.end(), bytes, bytes + sizeof(T));
+}
+
+void PutRef(std::vector<uint8_t>& out, const ChunkRef& c)
+{
+  Put(out, c.offset);
+  Put(out, c.stored);
+  Put(out, c.raw);
+  Put(out, c.crc);
+}
+
+/// Reads what Put wrote, refusing to run past the end.
+class Cursor
+{
+public:
+  Cursor(const uint8_t* data, uint64_t size, std::string place)
+    : Data(data)
+    , Size(size)
+    , Place(std::move(place))
+  {
+  }
+  template <typename T>
+  T Get()
+  {
+    T value;
+    if (sizeof(T) > this->Size - this->At)
+    {
+      throw MultiresolutionFileError(this->Place + ": ends early at byte " + std::to_string(this->At));
+    }
+    std::memcpy(&value, this->Data + this->At, sizeof(T));
+    this->At += sizeof(T);
+    return value;
+  }
+  ChunkRef GetRef()
+  {
+    ChunkRef c;
+    c.offset = this->Get<uint64_t>();
+    c.stored = this->Get<uint32_t>();
+    c.raw = this->Get<uint32_t>();
+    c.crc = this->Get<uint32_t>();
+    return c;
+  }
+
+private:
+  const uint8_t* Data;
+  uint64_t Size;
+  uint64_t At = 0;
+  std::string Place;
+};
+
+std::string TableName(const PropertyTable& t)
+{
+  return t.step < 0 ? t.name : t.name + " of step " + std::to_string(t.step) + " (report " + std::to_string(t.reportNumber) + ")";
+}
+} // namespace
+
+PropertyFile::PropertyFile(const std::string& path)
+  : FilePath(path)
+{
+  const int descriptor = open(path.c_str(), O_RDONLY);
+  if (descriptor < 0)
+  {
+    throw MultiresolutionFileError(path + ": cannot open: " + std::strerror(errno));
+  }
+  struct stat info;
+  if (fstat(descriptor, &info) != 0 || !S_ISREG(info.st_mode))
+  {
+    close(descriptor);
+    throw MultiresolutionFileError(path + ": not a regular file");
+  }
+  this->Size = static_cast<uint64_t>(info.st_size);
+  if (this->Size < HeaderBytes + TrailerBytes)
+  {
+    close(descriptor);
+    throw MultiresolutionFileError(path + ": " + std::to_string(this->Size) + " bytes, too short for a property file (truncated?)");
+  }
+  void* map = mmap(nullptr, this->Size, PROT_READ, MAP_SHARED, descriptor, 0);
+  close(descriptor);
+  if (map == MAP_FAILED)
+  {
+    throw MultiresolutionFileError(path + ": cannot map: " + std::strerror(errno));
+  }
+  this->Data = static_cast<const uint8_t*>(map);
+  try
+  {
+    if (std::memcmp(this->Data, Magic, 8) != 0)
+    {
+      throw MultiresolutionFileError(path + ": not a property (.resmrp) file (bad magic at byte 0)");
+    }
+    uint32_t crc;
+    std::memcpy(&crc, this->Data + HeaderBytes - 4, 4);
+    if (Crc32(this->Data, HeaderBytes - 4) != crc)
+    {
+      throw MultiresolutionFileError(path + ": header checksum mismatch (bytes 0-127 are corrupt)");
+    }
+    Cursor head(this->Data + 8, HeaderBytes - 12, path + ": header");
+    const uint32_t version = head.Get<uint32_t>();
+    if (version != Version)
+    {
+      throw MultiresolutionFileError(path + ": format version " + std::to_string(version) + "; this build reads version " +
+        std::to_string(Version));
+    }
+    this->Geometry = head.Get<uint64_t>();
+    for (int64_t& d : this->Dims)
+    {
+      d = head.Get<int64_t>();
+    }
+    this->TableSide = head.Get<uint32_t>();
+    const uint32_t tables = head.Get<uint32_t>();
+
+    Cursor tail(this->Data + this->Size - TrailerBytes, TrailerBytes, path + ": trailer");
+    const uint64_t indexOffset = tail.Get<uint64_t>(), indexSize = tail.Get<uint64_t>();
+    const uint32_t indexCrc = tail.Get<uint32_t>();
+    tail.Get<uint32_t>();
+    char magic[8];
+    for (char& c : magic)
+    {
+      c = tail.Get<char>();
+    }
+    if (std::memcmp(magic, TrailerMagic, 8) != 0)
+    {
+      throw MultiresolutionFileError(path + ": no index trailer at the end of the file (truncated or unfinished)");
+    }
+    const uint64_t indexEnd = this->Size - TrailerBytes;
+    if (indexOffset < HeaderBytes || indexOffset > indexEnd || indexSize != indexEnd - indexOffset)
+    {
+      throw MultiresolutionFileError(path + ": index at byte " + std::to_string(indexOffset) + " does not fit the file (truncated or corrupt)");
+    }
+    if (Crc32(this->Data + indexOffset, indexSize) != indexCrc)
+    {
+      throw MultiresolutionFileError(path + ": index checksum mismatch (bytes " + std::to_string(indexOffset) + "-" +
+        std::to_string(indexEnd) + " are corrupt)");
+    }
+    if (this->Dims[0] <= 0 || this->Dims[1] <= 0 || this->Dims[2] <= 0 || this->Dims[2] > (int64_t(1) << 24))
+    {
+      throw MultiresolutionFileError(path + ": impossible grid dimensions in the header (corrupt)");
+    }
+    Cursor index(this->Data + indexOffset, indexSize, path + ": index");
+    for (uint32_t t = 0; t < tables; ++t)
+    {
+      PropertyTable table;
+      char name[NameBytes];
+      for (char& c : name)
+      {
+        c = index.Get<char>();
+      }
+      table.name.assign(name, strnlen(name, NameBytes));
+      table.step = index.Get<int32_t>();
+      table.reportNumber = index.Get<int32_t>();
+      table.days = index.Get<double>();
+      table.minimum = index.Get<float>();
+      table.maximum = index.Get<float>();
+      table.packed = index.GetRef();
+      table.layers.resize(static_cast<std::size_t>(this->Dims[2]));
+      for (ChunkRef& layer : table.layers)
+      {
+        layer = index.GetRef();
+      }
+      for (const ChunkRef* c : { &table.packed })
+      {
+        if (c->offset < HeaderBytes || c->offset > indexOffset || c->stored > indexOffset - c->offset)
+        {
+          throw MultiresolutionFileError(path + ": table " + std::to_string(t) + " (" + TableName(table) + ") lies outside the file");
+        }
+      }
+      for (const ChunkRef& c : table.layers)
+      {
+        if (c.offset < HeaderBytes || c.offset > indexOffset || c.stored > indexOffset - c.offset)
+        {
+          throw MultiresolutionFileError(path + ": table " + std::to_string(t) + " (" + TableName(table) + ") lies outside the file");
+        }
+      }
+      this->Entries.push_back(std::move(table));
+    }
+  }
+  catch (...)
+  {
+    munmap(const_cast<uint8_t*>(this->Data), this->Size);
+    throw;
+  }
+}
+
+PropertyFile::~PropertyFile()
+{
+  munmap(const_cast<uint8_t*>(this->Data), this->Size);
+}
+
+int PropertyFile::Find(const std::string& name, int32_t step) const
+{
+  for (std::size_t t = 0; t < this->Entries.size(); ++t)
+  {
+    if (this->Entries[t].name == name && this->Entries[t].step == step)
+    {
+      return static_cast<int>(t);
+    }
+  }
+  return -1;
+}
+
+void PropertyFile::CheckGeometry(const MultiresolutionFile& geometry) const
+{
+  if (geometry.Header().geometryId != this->Geometry || geometry.Header().dims != this->Dims ||
+    geometry.Header().hashTableSide != this->TableSide)
+  {
+    throw MultiresolutionFileError(this->FilePath + ": made for another geometry than " + geometry.Path() +
+      " (geometry id or grid differs): rebuild it with resmr add-properties");
+  }
+}
+
+std::vector<float> PropertyFile::ReadValues(const ChunkRef& ref, uint64_t count, const std::string& place) const
+{
+  const auto raw = DecompressChunk(this->Data, this->Size, ref, place);
+  if (raw.size() != count * 4)
+  {
+    throw MultiresolutionFileError(place + ": " + std::to_string(raw.size()) + " bytes, " + std::to_string(count * 4) + " expected");
+  }
+  std::vector<float> values(count);
+  std::memcpy(values.data(), raw.data(), raw.size());
+  return values;
+}
+
+std::vector<float> PropertyFile::ReadPacked(std::size_t table) const
+{
+  const PropertyTable& t = this->Entries.at(table);
+  const uint64_t m = this->TableSide;
+  return this->ReadValues(t.packed, m * m * m, this->FilePath + ": packed table of " + TableName(t));
+}
+
+std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
+{
+  const PropertyTable& t = this->Entries.at(table);
+  if (k < 0 || k >= this->Dims[2])
+  {
+    throw std::out_of_range(this->FilePath + ": no layer " + std::to_string(k + 1));
+  }
+  return this->ReadValues(t.layers[static_cast<std::size_t>(k)], static_cast<uint64_t>(this->Dims[0] * this->Dims[1]),
+    this->FilePath + ": layer " + std::to_string(k + 1) + " of " + TableName(t));
+}
+
+PropertyFileWriter::PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry)
+  : Output(new AtomicOutputFile(path))
+  , Geometry(geometry.Header().geometryId)
+  , Dims(geometry.Header().dims)
+  , TableSide(geometry.Header().hashTableSide)
+{
+  const auto cells = geometry.ReadModelArray(ModelChunk::HashCells);
+  const uint64_t m = this->TableSide;
+  if (cells.size() != m * m * m * 8)
+  {
+    throw MultiresolutionFileError(geometry.Path() + ": hash cells hold " + std::to_string(cells.size()) +
+      " bytes for a table of side " + std::to_string(m));
+  }
+  this->SlotCells.resize(cells.size() / 8);
+  std::memcpy(this->SlotCells.data(), cells.data(), cells.size());
+  const uint64_t total = static_cast<uint64_t>(this->Dims[0] * this->Dims[1] * this->Dims[2]);
+  for (uint64_t cell : this->SlotCells)
+  {
+    if (cell != ~uint64_t(0) && cell >= total)
+    {
+      throw MultiresolutionFileError(geometry.Path() + ": a hash slot names cell " + std::to_string(cell) + " of " +
+        std::to_string(total));
+    }
+  }
+  for (int64_t k = 0; k < this->Dims[2]; ++k)
+  {
+    this->Active.push_back(geometry.ReadActiveLayer(k));
+  }
+  // The header is final once written: the table count lives in the index (trailer).
+  std::vector<uint8_t> head(Magic, Magic + 8);
+  Put(head, Version);
+  Put(head, this->Geometry);
+  for (int64_t d : this->Dims)
+  {
+    Put(head, d);
+  }
+  Put(head, this->TableSide);
+  Put(head, static_cast<uint32_t>(0)); // table count, patched at Commit
+  head.resize(HeaderBytes - 4, 0);
+  Put(head, Crc32(head.data(), head.size()));
+  this->Write(head.data(), head.size(), "header");
+}
+
+PropertyFileWriter::~PropertyFileWriter() = default;
+
+void PropertyFileWriter::Write(const void* data, std::size_t size, const std::string& what)
+{
+  if (!this->Output->Write(data, size))
+  {
+    throw MultiresolutionFileError(this->Output->Path() + ": writing the " + what + " at byte " +
+      std::to_string(this->Offset) + " failed: " + std::strerror(errno));
+  }
+  this->Offset += size;
+}
+
+ChunkRef PropertyFileWriter::PutChunk(const std::vector<uint8_t>& raw, const std::string& what)
+{
+  const std::vector<uint8_t> stored = CompressChunk(raw);
+  ChunkRef ref;
+  ref.offset = this->Offset;
+  ref.stored = static_cast<uint32_t>(stored.size());
+  ref.raw = static_cast<uint32_t>(raw.size());
+  ref.crc = Crc32(stored.data(), stored.size());
+  this->Write(stored.data(), stored.size(), what);
+  return ref;
+}
+
+ChunkRef PropertyFileWriter::CopyChunk(const PropertyFile& from, const ChunkRef& ref)
+{
+  if (Crc32(from.ChunkBytes(ref), ref.stored) != ref.crc)
+  {
+    throw MultiresolutionFileError(from.Path() + ": chunk at byte " + std::to_string(ref.offset) + ": checksum mismatch (corrupt data)");
+  }
+  ChunkRef moved = ref;
+  moved.offset = this->Offset;
+  this->Write(from.ChunkBytes(ref), ref.stored, "copied table");
+  return moved;
+}
+
+void PropertyFileWriter::Add(PropertyTable table, const std::vector<float>& cellValues)
+{
+  const int64_t nx = this->Dims[0], ny = this->Dims[1], nz = this->Dims[2];
+  if (static_cast<int64_t>(cellValues.size()) != nx * ny * nz)
+  {
+    throw std::invalid_argument(this->Output->Path() + ": " + TableName(table) + " has " + std::to_string(cellValues.size()) +
+      " values for " + std::to_string(nx * ny * nz) + " cells");
+  }
+  if (table.name.empty() || table.name.size() >= NameBytes)
+  {
+    throw std::invalid_argument(this->Output->Path() + ": property name '" + table.name + "' must hold 1 to 31 bytes");
+  }
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  const auto value = [&](uint64_t cell) {
+    const uint64_t layer = static_cast<uint64_t>(nx * ny);
+    return this->Active[cell / layer][cell % layer] ? cellValues[cell] : none;
+  };
+  float low = std::numeric_limits<float>::infinity(), high = -low;
+  std::vector<uint8_t> raw(static_cast<std::size_t>(nx * ny) * 4);
+  table.layers.clear();
+  for (int64_t k = 0; k < nz; ++k)
+  {
+    for (int64_t c = 0; c < nx * ny; ++c)
+    {
+      const float v = value(static_cast<uint64_t>(k * nx * ny + c));
+      if (!std::isnan(v))
+      {
+        low = std::min(low, v);
+        high = std::max(high, v);
+      }
+      std::memcpy(&raw[static_cast<std::size_t>(c) * 4], &v, 4);
+    }
+    table.layers.push_back(this->PutChunk(raw, TableName(table) + " layer " + std::to_string(k + 1)));
+  }
+  table.minimum = low <= high ? low : none;
+  table.maximum = low <= high ? high : none;
+  raw.assign(this->SlotCells.size() * 4, 0);
+  for (std::size_t s = 0; s < this->SlotCells.size(); ++s)
+  {
+    const float v = this->SlotCells[s] == ~uint64_t(0) ? none : value(this->SlotCells[s]);
+    std::memcpy(&raw[s * 4], &v, 4);
+  }
+  table.packed = this->PutChunk(raw, TableName(table) + " packed table");
+  for (auto& old : this->Entries)
+  {
+    if (old.name == table.name && old.step == table.step)
+    {
+      old = std::move(table); // replaced: the older chunks stay unreferenced in this file
+      return;
+    }
+  }
+  this->Entries.push_back(std::move(table));
+}
+
+void PropertyFileWriter::CopyFrom(const PropertyFile& older)
+{
+  if (older.GeometryId() != this->Geometry)
+  {
+    throw MultiresolutionFileError(older.Path() + ": made for another geometry; not merged");
+  }
+  for (const PropertyTable& table : older.Tables())
+  {
+    const bool held = std::any_of(this->Entries.begin(), this->Entries.end(),
+      [&](const PropertyTable& t) { return t.name == table.name && t.step == table.step; });
+    if (held)
+    {
+      continue;
+    }
+    PropertyTable copy = table;
+    copy.packed = this->CopyChunk(older, table.packed);
+    for (ChunkRef& layer : copy.layers)
+    {
+      layer = this->CopyChunk(older, layer);
+    }
+    this->Entries.push_back(std::move(copy));
+  }
+}
+
+void PropertyFileWriter::Commit()
+{
+  std::vector<uint8_t> index;
+  for (const PropertyTable& t : this->Entries)
+  {
+    char name[NameBytes] = {};
+    std::memcpy(name, t.name.data(), std::min(t.name.size(), NameBytes - 1));
+    index.insert(index.end(), name, name + NameBytes);
+    Put(index, t.step);
+    Put(index, t.reportNumber);
+    Put(index, t.days);
+    Put(index, t.minimum);
+    Put(index, t.maximum);
+    PutRef(index, t.packed);
+    for (const ChunkRef& layer : t.layers)
+    {
+      PutRef(index, layer);
+    }
+  }
+  const uint64_t indexOffset = this->Offset;
+  this->Write(index.data(), index.size(), "index");
+  std::vector<uint8_t> trailer;
+  Put(trailer, indexOffset);
+  Put(trailer, static_cast<uint64_t>(index.size()));
+  Put(trailer, Crc32(index.data(), index.size()));
+  Put(trailer, static_cast<uint32_t>(0));
+  trailer.insert(trailer.end(), TrailerMagic, TrailerMagic + 8);
+  this->Write(trailer.data(), trailer.size(), "trailer");
+  // The table count goes in the header, which was written first: rewrite it in place.
+  std::vector<uint8_t> head(Magic, Magic + 8);
+  Put(head, Version);
+  Put(head, this->Geometry);
+  for (int64_t d : this->Dims)
+  {
+    Put(head, d);
+  }
+  Put(head, this->TableSide);
+  Put(head, static_cast<uint32_t>(this->Entries.size()));
+  head.resize(HeaderBytes - 4, 0);
+  Put(head, Crc32(head.data(), head.size()));
+  if (!this->Output->WriteAt(head.data(), head.size(), 0))
+  {
+    throw MultiresolutionFileError(this->Output->Path() + ": rewriting the header failed: " + std::strerror(errno));
+  }
+  this->Output->Commit();
+}
+
+} // namespace resmr

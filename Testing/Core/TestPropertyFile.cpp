@@ -1,0 +1,212 @@
+// Property side apart from geometry (paper Sec. 5.2, 5.4, 5.5), through the resmr tool:
+// resmr build on SPE9 (an OPM Flow run: EGRID, INIT, UNRST), resmr add-properties of every
+// INIT array and every array of every report step, then of the GRDECL deck's arrays;
+// the geometry file's bytes never change; every packed value, found through the geometry's
+// perfect hash, and every layer value equal the simulator's; files of another geometry,
+// truncated or corrupt property files are refused with the file named.
+#include "CoreTesting.h"
+
+#include "EclipseGrid.h"
+#include "EclipseResults.h"
+#include "MultiresolutionFile.h"
+#include "PropertyFile.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <sys/stat.h>
+#include <unistd.h>
+
+using namespace resmr;
+
+namespace
+{
+std::string Slurp(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+int Run(const std::string& command)
+{
+  std::fprintf(stderr, "$ %s\n", command.c_str());
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+bool SameValue(float a, float b)
+{
+  return (std::isnan(a) && std::isnan(b)) || std::memcmp(&a, &b, 4) == 0;
+}
+
+/// Every table of `properties` against the simulator's values, through the geometry's hash
+/// (packed) and layer by layer. Returns the tables checked.
+int CheckTables(const MultiresolutionFile& geometry, const PropertyFile& properties, const EclipseGrid& grid,
+  const EclipseResults& results)
+{
+  const auto& dims = geometry.Header().dims;
+  const int64_t layer = dims[0] * dims[1], cells = layer * dims[2];
+  const PerfectSpatialHash hash = geometry.ReadHash();
+  const auto cellBytes = geometry.ReadModelArray(ModelChunk::HashCells);
+  std::vector<uint64_t> slotCell(cellBytes.size() / 8);
+  std::memcpy(slotCell.data(), cellBytes.data(), cellBytes.size());
+  std::vector<float> expected(static_cast<std::size_t>(cells));
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  int checked = 0;
+  for (std::size_t t = 0; t < properties.Tables().size(); ++t)
+  {
+    const PropertyTable& table = properties.Tables()[t];
+    const bool found = table.step < 0 ? results.ReadStatic<float>(table.name, expected.data(), none)
+                                      : results.ReadDynamic<float>(static_cast<std::size_t>(table.step), table.name,
+                                          expected.data(), none);
+    if (!found)
+    {
+      continue; // a GRDECL table: checked by its own test below
+    }
+    for (int64_t c = 0; c < cells; ++c)
+    {
+      if (!grid.IsActive(c))
+      {
+        expected[static_cast<std::size_t>(c)] = none;
+      }
+    }
+    const std::vector<float> packed = properties.ReadPacked(t);
+    CHECK(packed.size() == hash.TableSize());
+    int64_t wrong = 0;
+    for (std::size_t slot = 0; slot < slotCell.size(); ++slot)
+    {
+      const uint64_t n = slotCell[slot];
+      if (n == ~uint64_t(0))
+      {
+        continue;
+      }
+      const uint32_t i = uint32_t(n % uint64_t(dims[0])), j = uint32_t(n / uint64_t(dims[0]) % uint64_t(dims[1])),
+                     k = uint32_t(n / uint64_t(layer));
+      // What a shader does: the cell's slot from the hash, then the packed value there.
+      wrong += !SameValue(packed[static_cast<std::size_t>(hash.Slot(i, j, k))], expected[n]);
+    }
+    for (int64_t k = 0; k < dims[2]; ++k)
+    {
+      const std::vector<float> values = properties.ReadLayer(t, k);
+      for (int64_t c = 0; c < layer; ++c)
+      {
+        wrong += !SameValue(values[static_cast<std::size_t>(c)], expected[static_cast<std::size_t>(k * layer + c)]);
+      }
+    }
+    if (wrong)
+    {
+      std::fprintf(stderr, "%s step %d: %lld values differ\n", table.name.c_str(), table.step, static_cast<long long>(wrong));
+    }
+    CHECK(wrong == 0);
+    ++checked;
+  }
+  return checked;
+}
+} // namespace
+
+int main(int argc, char** argv)
+{
+  if (argc < 4)
+  {
+    std::fprintf(stderr, "usage: TestPropertyFile RESMR DATA_DIR TEMP_DIR\n");
+    return 2;
+  }
+  const std::string resmrTool = argv[1], data = argv[2], temp = argv[3];
+  mkdir(temp.c_str(), 0755);
+  const std::string egrid = data + "/spe9/opmflow2022_run_of_opm-data_SPE9_CP/SPE9_CP.EGRID";
+  const std::string deck = data + "/spe9/opm-data_deck/SPE9_CP.DATA";
+  const std::string geometryPath = temp + "/spe9.resmr", propertyPath = temp + "/spe9.resmrp";
+  std::remove(propertyPath.c_str());
+  CHECK(Run(resmrTool + " build '" + egrid + "' -o '" + geometryPath + "' --quiet > /dev/null") == 0);
+  const std::string before = Slurp(geometryPath);
+  CHECK(before.size() > 1000);
+
+  // Every INIT array and every array of every step.
+  CHECK(Run(resmrTool + " add-properties '" + geometryPath + "' '" + egrid + "' > /dev/null 2>&1") == 0);
+  CHECK(Slurp(geometryPath) == before); // geometry untouched, byte for byte
+  const EclipseGrid grid = ReadEclipseGrid(egrid);
+  const EclipseResults results(egrid, grid);
+  std::size_t expectedTables = results.StaticArrays().size();
+  for (const auto& step : results.Steps())
+  {
+    expectedTables += step.names.size();
+  }
+  {
+    const MultiresolutionFile geometry(geometryPath);
+    const PropertyFile properties(propertyPath);
+    properties.CheckGeometry(geometry);
+    CHECK(properties.Tables().size() == expectedTables);
+    CHECK(results.Steps().size() > 1 && properties.Find("PRESSURE", int32_t(results.Steps().size() - 1)) >= 0);
+    CHECK(properties.Find("PORO", -1) >= 0);
+    CHECK(CheckTables(geometry, properties, grid, results) == static_cast<int>(expectedTables));
+    const int pressure = properties.Find("PRESSURE", 0);
+    CHECK(pressure >= 0 && properties.Tables()[static_cast<std::size_t>(pressure)].maximum > 1000);
+  }
+
+  // The deck's arrays (PORO, PERMX, ...) replace the INIT arrays of the same name, the
+  // other tables stay; the geometry still does not change.
+  CHECK(Run(resmrTool + " add-properties '" + geometryPath + "' '" + deck + "' > /dev/null 2>&1") == 0);
+  CHECK(Slurp(geometryPath) == before);
+  {
+    const MultiresolutionFile geometry(geometryPath);
+    const PropertyFile properties(propertyPath);
+    CHECK(properties.Tables().size() == expectedTables);
+    CHECK(properties.Find("PRESSURE", 0) >= 0 && properties.Find("PERMX", -1) >= 0);
+    CHECK(CheckTables(geometry, properties, grid, results) == static_cast<int>(expectedTables));
+  }
+
+  // Another geometry (the same grid cut into other regions) is refused by name.
+  const std::string otherPath = temp + "/spe9-cmax.resmr";
+  CHECK(Run(resmrTool + " build '" + egrid + "' -o '" + otherPath + "' --cmax 64 --quiet > /dev/null") == 0);
+  {
+    const MultiresolutionFile other(otherPath);
+    const PropertyFile properties(propertyPath);
+    resmr_testing::ExpectError<MultiresolutionFileError>(
+      "other geometry", [&] { properties.CheckGeometry(other); }, { propertyPath, "another geometry" });
+  }
+  CHECK(Run(resmrTool + " add-properties '" + otherPath + "' '" + egrid + "' -o '" + propertyPath + "' 2>/dev/null") != 0);
+  CHECK(Slurp(otherPath).size() > 0);
+
+  // Damaged property files are refused with the file and the place named.
+  const std::string bytes = Slurp(propertyPath);
+  const std::string damaged = temp + "/damaged.resmrp";
+  const auto writeBytes = [&](const std::string& content) {
+    std::ofstream out(damaged, std::ios::binary | std::ios::trunc);
+    out.write(content.data(), static_cast<std::streamsize>(content.size()));
+  };
+  writeBytes(bytes.substr(0, bytes.size() - 10));
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "truncated", [&] { PropertyFile f(damaged); }, { damaged, "truncated" });
+  std::string flipped = bytes;
+  flipped[200] ^= 0x5a; // inside the first table's first chunk
+  writeBytes(flipped);
+  {
+    const PropertyFile f(damaged);
+    resmr_testing::ExpectError<MultiresolutionFileError>("flipped chunk", [&] {
+      for (std::size_t t = 0; t < f.Tables().size(); ++t)
+      {
+        for (int64_t k = 0; k < 15; ++k)
+        {
+          f.ReadLayer(t, k);
+        }
+        f.ReadPacked(t);
+      }
+    }, { damaged, "checksum" });
+  }
+  std::remove(damaged.c_str());
+  std::remove(otherPath.c_str());
+  std::remove(propertyPath.c_str());
+  std::remove(geometryPath.c_str());
+  if (resmr_testing::Failures)
+  {
+    std::fprintf(stderr, "%d checks failed\n", resmr_testing::Failures);
+    return 1;
+  }
+  std::printf("property file tests passed\n");
+  return 0;
+}
