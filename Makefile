@@ -17,7 +17,7 @@ PACKAGES := paraview paraview-dev python3-paraview python3-numpy xvfb xauth \
   cmake ninja-build g++ liblzo2-dev libglm-dev \
   qtbase5-dev libqt5svg5-dev qttools5-dev libqt5x11extras5-dev qtxmlpatterns5-dev-tools \
   libqt5opengl5-dev libutfcpp-dev libhdf5-dev libnetcdf-dev libgdal-dev libboost-dev \
-  libopenmpi-dev python3-mpi4py libtheora-dev libavcodec-dev libavformat-dev libavutil-dev \
+  libopenmpi-dev openmpi-bin python3-mpi4py libtheora-dev libavcodec-dev libavformat-dev libavutil-dev \
   libswscale-dev libgl2ps-dev libglew-dev libxml2-dev liblz4-dev liblzma-dev libjpeg-dev \
   libpng-dev libtiff-dev libfreetype-dev libexpat1-dev zlib1g-dev libx11-dev libxt-dev \
   python3-dev libgl-dev libdouble-conversion-dev libjsoncpp-dev libpugixml-dev libfmt-dev \
