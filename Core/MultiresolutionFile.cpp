@@ -504,7 +504,26 @@ RegionMesh DecodeRegion(const uint8_t* data, uint64_t size, const std::string& p
   return mesh;
 }
 
-const uint8_t* MapFile(const std::string& path, uint64_t& size)
+} // namespace
+
+std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw)
+{
+  InitialiseLzo();
+  std::vector<uint8_t> stored(raw.size() + raw.size() / 16 + 64 + 3);
+  std::vector<uint8_t> work(LZO1X_1_MEM_COMPRESS);
+  lzo_uint length = 0;
+  lzo1x_1_compress(raw.data(), raw.size(), stored.data(), &length, work.data());
+  stored.resize(length);
+  return stored;
+}
+
+std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
+{
+  InitialiseLzo();
+  return Decompress(data, size, ref, place);
+}
+
+const uint8_t* MapReadOnlyFile(const std::string& path, uint64_t& size)
 {
   const int descriptor = open(path.c_str(), O_RDONLY);
   if (descriptor < 0)
@@ -531,23 +550,13 @@ const uint8_t* MapFile(const std::string& path, uint64_t& size)
   }
   return static_cast<const uint8_t*>(map);
 }
-} // namespace
 
-std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw)
+void UnmapFile(const uint8_t* data, uint64_t size)
 {
-  InitialiseLzo();
-  std::vector<uint8_t> stored(raw.size() + raw.size() / 16 + 64 + 3);
-  std::vector<uint8_t> work(LZO1X_1_MEM_COMPRESS);
-  lzo_uint length = 0;
-  lzo1x_1_compress(raw.data(), raw.size(), stored.data(), &length, work.data());
-  stored.resize(length);
-  return stored;
-}
-
-std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
-{
-  InitialiseLzo();
-  return Decompress(data, size, ref, place);
+  if (data)
+  {
+    munmap(const_cast<uint8_t*>(data), size);
+  }
 }
 
 uint32_t Crc32(const void* data, std::size_t size, uint32_t crc)
@@ -796,31 +805,13 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
   : FilePath(path)
 {
   InitialiseLzo();
-  const int descriptor = open(path.c_str(), O_RDONLY);
-  if (descriptor < 0)
-  {
-    throw MultiresolutionFileError(path + ": cannot open: " + std::strerror(errno));
-  }
-  struct stat info;
-  if (fstat(descriptor, &info) != 0 || !S_ISREG(info.st_mode))
-  {
-    close(descriptor);
-    throw MultiresolutionFileError(path + ": not a regular file");
-  }
-  this->Size = static_cast<uint64_t>(info.st_size);
+  this->Data = MapReadOnlyFile(path, this->Size);
   if (this->Size < HeaderBytes + TrailerBytes)
   {
-    close(descriptor);
+    UnmapFile(this->Data, this->Size);
     throw MultiresolutionFileError(path + ": " + std::to_string(this->Size) +
       " bytes, too short for a multiresolution file (truncated?)");
   }
-  void* map = mmap(nullptr, this->Size, PROT_READ, MAP_SHARED, descriptor, 0);
-  close(descriptor);
-  if (map == MAP_FAILED)
-  {
-    throw MultiresolutionFileError(path + ": cannot map: " + std::strerror(errno));
-  }
-  this->Data = static_cast<const uint8_t*>(map);
   try
   {
     if (std::memcmp(this->Data, HeaderMagic, 8) != 0)
@@ -944,14 +935,14 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
   }
   catch (...)
   {
-    munmap(const_cast<uint8_t*>(this->Data), this->Size);
+    UnmapFile(this->Data, this->Size);
     throw;
   }
 }
 
 MultiresolutionFile::~MultiresolutionFile()
 {
-  munmap(const_cast<uint8_t*>(this->Data), this->Size);
+  UnmapFile(this->Data, this->Size);
 }
 
 const RegionRecord* MultiresolutionFile::Find(int32_t level, int64_t index) const
@@ -1067,15 +1058,12 @@ MappedChunkFile::MappedChunkFile(const std::string& path)
   : FilePath(path)
 {
   InitialiseLzo();
-  this->Data = MapFile(path, this->Size);
+  this->Data = MapReadOnlyFile(path, this->Size);
 }
 
 MappedChunkFile::~MappedChunkFile()
 {
-  if (this->Data)
-  {
-    munmap(const_cast<uint8_t*>(this->Data), this->Size);
-  }
+  UnmapFile(this->Data, this->Size);
 }
 
 RegionMesh MappedChunkFile::ReadRegion(const RegionRecord& record, const MultiresolutionHeader& header) const

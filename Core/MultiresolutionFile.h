@@ -234,6 +234,11 @@ std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw);
 /// throws MultiresolutionFileError naming `place`.
 std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place);
 
+/// Maps a whole regular file read-only (nullptr for an empty one); throws
+/// MultiresolutionFileError naming the file. Release with UnmapFile.
+const uint8_t* MapReadOnlyFile(const std::string& path, uint64_t& size);
+void UnmapFile(const uint8_t* data, uint64_t size);
+
 /// CRC-32 (IEEE 802.3) of a byte range, continuing from `crc`.
 uint32_t Crc32(const void* data, std::size_t size, uint32_t crc = 0);
 

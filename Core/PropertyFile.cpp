@@ -8,11 +8,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fcntl.h>
 #include <limits>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace resmr
 {
@@ -79,6 +75,22 @@ private:
   std::string Place;
 };
 
+std::vector<uint8_t> HeaderOf(uint64_t geometry, const std::array<int64_t, 3>& dims, uint32_t tableSide, uint32_t tables)
+{
+  std::vector<uint8_t> head(Magic, Magic + 8);
+  Put(head, Version);
+  Put(head, geometry);
+  for (int64_t d : dims)
+  {
+    Put(head, d);
+  }
+  Put(head, tableSide);
+  Put(head, tables);
+  head.resize(HeaderBytes - 4, 0);
+  Put(head, Crc32(head.data(), head.size()));
+  return head;
+}
+
 std::string TableName(const PropertyTable& t)
 {
   return t.step < 0 ? t.name : t.name + " of step " + std::to_string(t.step) + " (report " + std::to_string(t.reportNumber) + ")";
@@ -88,30 +100,12 @@ std::string TableName(const PropertyTable& t)
 PropertyFile::PropertyFile(const std::string& path)
   : FilePath(path)
 {
-  const int descriptor = open(path.c_str(), O_RDONLY);
-  if (descriptor < 0)
-  {
-    throw MultiresolutionFileError(path + ": cannot open: " + std::strerror(errno));
-  }
-  struct stat info;
-  if (fstat(descriptor, &info) != 0 || !S_ISREG(info.st_mode))
-  {
-    close(descriptor);
-    throw MultiresolutionFileError(path + ": not a regular file");
-  }
-  this->Size = static_cast<uint64_t>(info.st_size);
+  this->Data = MapReadOnlyFile(path, this->Size);
   if (this->Size < HeaderBytes + TrailerBytes)
   {
-    close(descriptor);
+    UnmapFile(this->Data, this->Size);
     throw MultiresolutionFileError(path + ": " + std::to_string(this->Size) + " bytes, too short for a property file (truncated?)");
   }
-  void* map = mmap(nullptr, this->Size, PROT_READ, MAP_SHARED, descriptor, 0);
-  close(descriptor);
-  if (map == MAP_FAILED)
-  {
-    throw MultiresolutionFileError(path + ": cannot map: " + std::strerror(errno));
-  }
-  this->Data = static_cast<const uint8_t*>(map);
   try
   {
     if (std::memcmp(this->Data, Magic, 8) != 0)
@@ -206,14 +200,14 @@ PropertyFile::PropertyFile(const std::string& path)
   }
   catch (...)
   {
-    munmap(const_cast<uint8_t*>(this->Data), this->Size);
+    UnmapFile(this->Data, this->Size);
     throw;
   }
 }
 
 PropertyFile::~PropertyFile()
 {
-  munmap(const_cast<uint8_t*>(this->Data), this->Size);
+  UnmapFile(this->Data, this->Size);
 }
 
 int PropertyFile::Find(const std::string& name, int32_t step) const
@@ -296,18 +290,8 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
   {
     this->Active.push_back(geometry.ReadActiveLayer(k));
   }
-  // The header is final once written: the table count lives in the index (trailer).
-  std::vector<uint8_t> head(Magic, Magic + 8);
-  Put(head, Version);
-  Put(head, this->Geometry);
-  for (int64_t d : this->Dims)
-  {
-    Put(head, d);
-  }
-  Put(head, this->TableSide);
-  Put(head, static_cast<uint32_t>(0)); // table count, patched at Commit
-  head.resize(HeaderBytes - 4, 0);
-  Put(head, Crc32(head.data(), head.size()));
+  // The table count is patched in at Commit.
+  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSide, 0);
   this->Write(head.data(), head.size(), "header");
 }
 
@@ -454,17 +438,7 @@ void PropertyFileWriter::Commit()
   trailer.insert(trailer.end(), TrailerMagic, TrailerMagic + 8);
   this->Write(trailer.data(), trailer.size(), "trailer");
   // The table count goes in the header, which was written first: rewrite it in place.
-  std::vector<uint8_t> head(Magic, Magic + 8);
-  Put(head, Version);
-  Put(head, this->Geometry);
-  for (int64_t d : this->Dims)
-  {
-    Put(head, d);
-  }
-  Put(head, this->TableSide);
-  Put(head, static_cast<uint32_t>(this->Entries.size()));
-  head.resize(HeaderBytes - 4, 0);
-  Put(head, Crc32(head.data(), head.size()));
+  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSide, static_cast<uint32_t>(this->Entries.size()));
   if (!this->Output->WriteAt(head.data(), head.size(), 0))
   {
     throw MultiresolutionFileError(this->Output->Path() + ": rewriting the header failed: " + std::strerror(errno));
