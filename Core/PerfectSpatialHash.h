@@ -11,9 +11,11 @@
 //   slot (someone else's); callers that need membership must store keys in the table.
 // - m starts at the smallest side with m^3 >= |S|, r at ceil((|S| / 6)^(1/3)) (LH's sigma =
 //   1 / (2 d)), coprime with m. When packing fails r grows (up to about |S| / 4 entries), then
-//   m by one; when two cells agree modulo m * r in every component (cells spread wider than
+//   m by one (sets over 2^20 cells: one packing a side, m by a sixty-fourth, about 5% of
+//   table, since each failed packing costs seconds); when two cells agree modulo m * r in every component (cells spread wider than
 //   m * r, e.g. a long line) no offsets can separate them and r, then m, grow until they
-//   differ. IJK shells (planes of cells) fill 0.92-1.0 of the table with r^3 ~ |S| / 5.
+//   differ. IJK shells (planes of cells) fill 0.92-1.0 of the table with r^3 ~ |S| / 5; the
+//   cells real builds touch (thin sets, nz < r) fill 0.69-0.95 (bench/results/build.md).
 //   Every offset component is < m <= MaxTableSide, so m^3 < 2^32.
 // - Groups are packed by next fit in a fixed order, no randomness: the result depends on the
 //   set of cells only, not on their order.
