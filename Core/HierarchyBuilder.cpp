@@ -1,6 +1,7 @@
 // Out-of-core, multi-threaded build of the diamond hierarchy, paper Sec. 4.2 (with 4.3 and 6.2).
 #include "HierarchyBuilder.h"
 
+#include "ByteStream.h"
 #include "ColumnCollapse.h"
 #include "ColumnMesh.h"
 #include "DiamondHierarchy.h"
@@ -309,20 +310,9 @@ uint64_t Mix(uint64_t x)
 }
 
 /// Little binary files that record a build's progress (resuming, MPI ranks).
-class ManifestOut
+class ManifestOut : public ByteWriter
 {
 public:
-  template <typename T>
-  void Put(const T& value)
-  {
-    const auto* bytes = reinterpret_cast<const uint8_t*>(&value);
-    this->Bytes.insert(this->Bytes.end(), bytes, bytes + sizeof(T));
-  }
-  void PutString(const std::string& text)
-  {
-    this->Put(static_cast<uint64_t>(text.size()));
-    this->Bytes.insert(this->Bytes.end(), text.begin(), text.end());
-  }
   /// Written under a temporary name and renamed: a manifest is there whole or not at all.
   void Save(const std::string& path) const
   {
@@ -337,10 +327,9 @@ public:
       throw std::runtime_error(path + ": cannot write the build manifest: " + std::strerror(errno));
     }
   }
-  std::vector<uint8_t> Bytes;
 };
 
-class ManifestIn
+class ManifestIn : public ByteReader
 {
 public:
   /// False if the file is absent.
@@ -359,33 +348,10 @@ public:
     }
     std::fclose(file);
     this->Path = path;
+    this->Reset(this->Bytes.data(), this->Bytes.size(), path + ": build manifest");
     return true;
   }
-  template <typename T>
-  T Get()
-  {
-    T value{};
-    if (sizeof(T) > this->Bytes.size() - this->At)
-    {
-      throw std::runtime_error(this->Path + ": build manifest is truncated");
-    }
-    std::memcpy(&value, this->Bytes.data() + this->At, sizeof(T));
-    this->At += sizeof(T);
-    return value;
-  }
-  std::string GetString()
-  {
-    const uint64_t size = this->Get<uint64_t>();
-    if (size > this->Bytes.size() - this->At)
-    {
-      throw std::runtime_error(this->Path + ": build manifest is truncated");
-    }
-    std::string text(this->Bytes.begin() + this->At, this->Bytes.begin() + this->At + size);
-    this->At += size;
-    return text;
-  }
   std::vector<uint8_t> Bytes;
-  std::size_t At = 0;
   std::string Path;
 };
 
@@ -1224,17 +1190,12 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
     for (uint64_t c = 0; c < count; ++c)
     {
       const uint64_t column = static_cast<uint64_t>(in.Get<int64_t>());
-      const std::size_t stack = in.At;
-      in.At += static_cast<std::size_t>(nz) * 4;
-      if (in.At > in.Bytes.size())
-      {
-        throw std::runtime_error(in.Path + ": truncated");
-      }
+      const uint8_t* stack = in.Skip(static_cast<std::size_t>(nz) * 4);
       auto it = std::lower_bound(byColumn.begin(), byColumn.end(), std::make_pair(column * static_cast<uint64_t>(nz), uint64_t(0)));
       for (; it != byColumn.end() && it->first / static_cast<uint64_t>(nz) == column; ++it)
       {
         const uint64_t k = it->first % static_cast<uint64_t>(nz);
-        std::memcpy(slotNormals[static_cast<std::size_t>(it->second)].data(), &in.Bytes[stack + k * 4], 4);
+        std::memcpy(slotNormals[static_cast<std::size_t>(it->second)].data(), stack + k * 4, 4);
       }
     }
   }

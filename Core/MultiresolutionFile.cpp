@@ -44,61 +44,6 @@ void InitialiseLzo()
   });
 }
 
-/// Little-endian byte buffer.
-class Buffer
-{
-public:
-  template <typename T>
-  void Put(const T& value)
-  {
-    const auto* bytes = reinterpret_cast<const uint8_t*>(&value);
-    this->Bytes.insert(this->Bytes.end(), bytes, bytes + sizeof(T));
-  }
-  void PutBytes(const void* data, std::size_t size)
-  {
-    const auto* bytes = static_cast<const uint8_t*>(data);
-    this->Bytes.insert(this->Bytes.end(), bytes, bytes + size);
-  }
-  std::vector<uint8_t> Bytes;
-};
-
-/// Reads what Buffer wrote, refusing to run past the end.
-class Reader
-{
-public:
-  Reader(const uint8_t* data, std::size_t size, std::string place)
-    : Data(data)
-    , Size(size)
-    , Place(std::move(place))
-  {
-  }
-  template <typename T>
-  T Get()
-  {
-    T value;
-    this->GetBytes(&value, sizeof(T));
-    return value;
-  }
-  void GetBytes(void* out, std::size_t size)
-  {
-    if (size > this->Size - this->At)
-    {
-      throw MultiresolutionFileError(this->Place + ": ends early (needs " + std::to_string(size) + " more bytes at byte " +
-        std::to_string(this->At) + " of " + std::to_string(this->Size) + ")");
-    }
-    std::memcpy(out, this->Data + this->At, size);
-    this->At += size;
-  }
-  std::size_t Left() const { return this->Size - this->At; }
-  const std::string& Where() const { return this->Place; }
-
-private:
-  const uint8_t* Data;
-  std::size_t Size;
-  std::size_t At = 0;
-  std::string Place;
-};
-
 uint32_t ZigZag(int32_t v)
 {
   return (static_cast<uint32_t>(v) << 1) ^ static_cast<uint32_t>(v >> 31);
@@ -132,7 +77,7 @@ int32_t Predict(int axis, std::size_t k, const std::array<int32_t, 3>& above, co
   return above[axis];
 }
 
-void PutPositions(Buffer& out, const RegionMesh& mesh, const MultiresolutionHeader& header)
+void PutPositions(ByteWriter& out, const RegionMesh& mesh, const MultiresolutionHeader& header)
 {
   const std::size_t interfaces = static_cast<std::size_t>(mesh.layers) + 1;
   const std::size_t count = mesh.positions.size();
@@ -171,7 +116,7 @@ void PutPositions(Buffer& out, const RegionMesh& mesh, const MultiresolutionHead
   }
 }
 
-void GetPositions(Reader& in, RegionMesh& mesh, const MultiresolutionHeader& header)
+void GetPositions(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header)
 {
   const std::size_t interfaces = static_cast<std::size_t>(mesh.layers) + 1;
   const std::size_t count = static_cast<std::size_t>(mesh.NodeCount()) * interfaces * 3;
@@ -211,7 +156,7 @@ void GetPositions(Reader& in, RegionMesh& mesh, const MultiresolutionHeader& hea
 
 std::vector<uint8_t> EncodeMesh(const RegionMesh& mesh, const MultiresolutionHeader& header)
 {
-  Buffer out;
+  ByteWriter out;
   out.Put(MeshMagic);
   out.Put(static_cast<uint32_t>(mesh.layers));
   out.Put(static_cast<uint32_t>(mesh.NodeCount()));
@@ -230,7 +175,7 @@ std::vector<uint8_t> EncodeMesh(const RegionMesh& mesh, const MultiresolutionHea
   return std::move(out.Bytes);
 }
 
-void DecodeMesh(Reader& in, RegionMesh& mesh, const MultiresolutionHeader& header, const RegionRecord& record)
+void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header, const RegionRecord& record)
 {
   const uint32_t magic = in.Get<uint32_t>();
   const uint32_t layers = in.Get<uint32_t>(), nodes = in.Get<uint32_t>(), columns = in.Get<uint32_t>();
@@ -297,7 +242,7 @@ void DecodeMesh(Reader& in, RegionMesh& mesh, const MultiresolutionHeader& heade
 
 std::vector<uint8_t> EncodeSurface(const RegionSurface& surface)
 {
-  Buffer out;
+  ByteWriter out;
   out.Put(SurfaceMagic);
   out.Put(static_cast<uint32_t>(surface.quads.size()));
   out.PutBytes(surface.cone.data(), sizeof(surface.cone));
@@ -305,7 +250,7 @@ std::vector<uint8_t> EncodeSurface(const RegionSurface& surface)
   return std::move(out.Bytes);
 }
 
-void DecodeSurface(Reader& in, RegionSurface& surface, uint64_t vertices)
+void DecodeSurface(ByteReader& in, RegionSurface& surface, uint64_t vertices)
 {
   const uint32_t magic = in.Get<uint32_t>();
   const uint32_t count = in.Get<uint32_t>();
@@ -335,14 +280,14 @@ void DecodeSurface(Reader& in, RegionSurface& surface, uint64_t vertices)
 
 std::vector<uint8_t> EncodeTriangles(const std::vector<std::array<uint32_t, 3>>& triangles)
 {
-  Buffer out;
+  ByteWriter out;
   out.Put(TrianglesMagic);
   out.Put(static_cast<uint32_t>(triangles.size()));
   out.PutBytes(triangles.data(), triangles.size() * sizeof(triangles[0]));
   return std::move(out.Bytes);
 }
 
-void DecodeTriangles(Reader& in, std::vector<std::array<uint32_t, 3>>& triangles, uint64_t vertices)
+void DecodeTriangles(ByteReader& in, std::vector<std::array<uint32_t, 3>>& triangles, uint64_t vertices)
 {
   const uint32_t magic = in.Get<uint32_t>();
   const uint32_t count = in.Get<uint32_t>();
@@ -370,7 +315,7 @@ void DecodeTriangles(Reader& in, std::vector<std::array<uint32_t, 3>>& triangles
   }
 }
 
-void PutHeader(Buffer& out, const MultiresolutionHeader& h)
+void PutHeader(ByteWriter& out, const MultiresolutionHeader& h)
 {
   out.PutBytes(HeaderMagic, 8);
   out.Put(MultiresolutionHeader::Version);
@@ -403,7 +348,7 @@ void PutHeader(Buffer& out, const MultiresolutionHeader& h)
   out.Put(Crc32(out.Bytes.data(), out.Bytes.size()));
 }
 
-void PutRecord(Buffer& out, const RegionRecord& r)
+void PutRecord(ByteWriter& out, const RegionRecord& r)
 {
   const std::size_t start = out.Bytes.size();
   out.Put(r.level);
@@ -427,7 +372,7 @@ void PutRecord(Buffer& out, const RegionRecord& r)
   out.Bytes.resize(start + RecordBytes, 0);
 }
 
-RegionRecord GetRecord(Reader& in)
+RegionRecord GetRecord(ByteReader& in)
 {
   RegionRecord r;
   r.level = in.Get<int32_t>();
@@ -488,18 +433,18 @@ RegionMesh DecodeRegion(const uint8_t* data, uint64_t size, const std::string& p
   };
   {
     const auto raw = chunk(RegionRecord::Mesh);
-    Reader in(raw.data(), raw.size(), region + ChunkNames[0]);
+    ByteReader in(raw.data(), raw.size(), region + ChunkNames[0]);
     DecodeMesh(in, mesh, header, record);
   }
   RegionSurface* surfaces[2] = { &mesh.top, &mesh.bottom };
   for (int c = RegionRecord::Top; c <= RegionRecord::Bottom; ++c)
   {
     const auto raw = chunk(c);
-    Reader in(raw.data(), raw.size(), region + ChunkNames[c]);
+    ByteReader in(raw.data(), raw.size(), region + ChunkNames[c]);
     DecodeSurface(in, *surfaces[c - 1], static_cast<uint64_t>(mesh.VertexCount()));
   }
   const auto raw = chunk(RegionRecord::Side);
-  Reader in(raw.data(), raw.size(), region + ChunkNames[RegionRecord::Side]);
+  ByteReader in(raw.data(), raw.size(), region + ChunkNames[RegionRecord::Side]);
   DecodeTriangles(in, mesh.sideTriangles, static_cast<uint64_t>(mesh.VertexCount()));
   return mesh;
 }
@@ -735,7 +680,7 @@ void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader 
   header.regionCount = regions.size();
   header.modelChunkCount = model.size();
   header.geometryId = (static_cast<uint64_t>(digestA) << 32) | digestB;
-  Buffer head;
+  ByteWriter head;
   PutHeader(head, header);
   write(head.Bytes.data(), head.Bytes.size(), "header");
   std::vector<uint64_t> base(parts.size());
@@ -768,7 +713,7 @@ void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader 
     ref.offset += base[static_cast<std::size_t>(part)];
     return ref;
   };
-  Buffer index;
+  ByteWriter index;
   for (const auto& r : regions)
   {
     RegionRecord record = r.record;
@@ -791,7 +736,7 @@ void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader 
   }
   const uint64_t indexOffset = offset;
   write(index.Bytes.data(), index.Bytes.size(), "index");
-  Buffer trailer;
+  ByteWriter trailer;
   trailer.Put(indexOffset);
   trailer.Put(static_cast<uint64_t>(index.Bytes.size()));
   trailer.Put(Crc32(index.Bytes.data(), index.Bytes.size()));
@@ -818,7 +763,7 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
     {
       throw MultiresolutionFileError(path + ": not a multiresolution (.resmr) file (bad magic at byte 0)");
     }
-    Reader head(this->Data, HeaderBytes, path + ": header");
+    ByteReader head(this->Data, HeaderBytes, path + ": header");
     uint8_t magic[8];
     head.GetBytes(magic, 8);
     const uint32_t version = head.Get<uint32_t>();
@@ -868,7 +813,7 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
       throw MultiresolutionFileError(path + ": header holds impossible dimensions, level or counts (corrupt)");
     }
 
-    Reader tail(this->Data + this->Size - TrailerBytes, TrailerBytes, path + ": trailer");
+    ByteReader tail(this->Data + this->Size - TrailerBytes, TrailerBytes, path + ": trailer");
     const uint64_t indexOffset = tail.Get<uint64_t>(), indexSize = tail.Get<uint64_t>();
     const uint32_t indexCrc = tail.Get<uint32_t>();
     tail.Get<uint32_t>();
@@ -890,7 +835,7 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
       throw MultiresolutionFileError(path + ": index checksum mismatch (bytes " + std::to_string(indexOffset) + "-" +
         std::to_string(indexEnd) + " are corrupt)");
     }
-    Reader index(this->Data + indexOffset, indexSize, path + ": index");
+    ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
     this->Records.reserve(this->Head.regionCount);
     for (uint64_t i = 0; i < this->Head.regionCount; ++i)
     {

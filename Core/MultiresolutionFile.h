@@ -27,6 +27,7 @@
 // Positions keep depth down (Core's convention); the viewer shows z = -depth.
 #pragma once
 
+#include "ByteStream.h"
 #include "PerfectSpatialHash.h"
 #include "RegionMesh.h"
 
@@ -40,12 +41,6 @@
 
 namespace resmr
 {
-
-class MultiresolutionFileError : public std::runtime_error
-{
-public:
-  using std::runtime_error::runtime_error;
-};
 
 struct MultiresolutionHeader
 {

@@ -21,74 +21,39 @@ constexpr std::size_t HeaderBytes = 128;
 constexpr std::size_t TrailerBytes = 32;
 constexpr std::size_t NameBytes = 32;
 
-template <typename T>
-void Put(std::vector<uint8_t>& out, const T& value)
+void PutRef(ByteWriter& out, const ChunkRef& c)
 {
-  const auto* bytes = reinterpret_cast<const uint8_t*>(&value);
-  out.insert(out.end(), bytes, bytes + sizeof(T));
+  out.Put(c.offset);
+  out.Put(c.stored);
+  out.Put(c.raw);
+  out.Put(c.crc);
 }
 
-void PutRef(std::vector<uint8_t>& out, const ChunkRef& c)
+ChunkRef GetRef(ByteReader& in)
 {
-  Put(out, c.offset);
-  Put(out, c.stored);
-  Put(out, c.raw);
-  Put(out, c.crc);
+  ChunkRef c;
+  c.offset = in.Get<uint64_t>();
+  c.stored = in.Get<uint32_t>();
+  c.raw = in.Get<uint32_t>();
+  c.crc = in.Get<uint32_t>();
+  return c;
 }
-
-/// Reads what Put wrote, refusing to run past the end.
-class Cursor
-{
-public:
-  Cursor(const uint8_t* data, uint64_t size, std::string place)
-    : Data(data)
-    , Size(size)
-    , Place(std::move(place))
-  {
-  }
-  template <typename T>
-  T Get()
-  {
-    T value;
-    if (sizeof(T) > this->Size - this->At)
-    {
-      throw MultiresolutionFileError(this->Place + ": ends early at byte " + std::to_string(this->At));
-    }
-    std::memcpy(&value, this->Data + this->At, sizeof(T));
-    this->At += sizeof(T);
-    return value;
-  }
-  ChunkRef GetRef()
-  {
-    ChunkRef c;
-    c.offset = this->Get<uint64_t>();
-    c.stored = this->Get<uint32_t>();
-    c.raw = this->Get<uint32_t>();
-    c.crc = this->Get<uint32_t>();
-    return c;
-  }
-
-private:
-  const uint8_t* Data;
-  uint64_t Size;
-  uint64_t At = 0;
-  std::string Place;
-};
 
 std::vector<uint8_t> HeaderOf(uint64_t geometry, const std::array<int64_t, 3>& dims, uint32_t tableSide, uint32_t tables)
 {
-  std::vector<uint8_t> head(Magic, Magic + 8);
-  Put(head, Version);
-  Put(head, geometry);
+  ByteWriter head;
+  head.PutBytes(Magic, 8);
+  head.Put(Version);
+  head.Put(geometry);
   for (int64_t d : dims)
   {
-    Put(head, d);
+    head.Put(d);
   }
-  Put(head, tableSide);
-  Put(head, tables);
-  head.resize(HeaderBytes - 4, 0);
-  Put(head, Crc32(head.data(), head.size()));
-  return head;
+  head.Put(tableSide);
+  head.Put(tables);
+  head.Bytes.resize(HeaderBytes - 4, 0);
+  head.Put(Crc32(head.Bytes.data(), head.Bytes.size()));
+  return std::move(head.Bytes);
 }
 
 std::string TableName(const PropertyTable& t)
@@ -118,7 +83,7 @@ PropertyFile::PropertyFile(const std::string& path)
     {
       throw MultiresolutionFileError(path + ": header checksum mismatch (bytes 0-127 are corrupt)");
     }
-    Cursor head(this->Data + 8, HeaderBytes - 12, path + ": header");
+    ByteReader head(this->Data + 8, HeaderBytes - 12, path + ": header");
     const uint32_t version = head.Get<uint32_t>();
     if (version != Version)
     {
@@ -133,7 +98,7 @@ PropertyFile::PropertyFile(const std::string& path)
     this->TableSide = head.Get<uint32_t>();
     const uint32_t tables = head.Get<uint32_t>();
 
-    Cursor tail(this->Data + this->Size - TrailerBytes, TrailerBytes, path + ": trailer");
+    ByteReader tail(this->Data + this->Size - TrailerBytes, TrailerBytes, path + ": trailer");
     const uint64_t indexOffset = tail.Get<uint64_t>(), indexSize = tail.Get<uint64_t>();
     const uint32_t indexCrc = tail.Get<uint32_t>();
     tail.Get<uint32_t>();
@@ -160,7 +125,7 @@ PropertyFile::PropertyFile(const std::string& path)
     {
       throw MultiresolutionFileError(path + ": impossible grid dimensions in the header (corrupt)");
     }
-    Cursor index(this->Data + indexOffset, indexSize, path + ": index");
+    ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
     for (uint32_t t = 0; t < tables; ++t)
     {
       PropertyTable table;
@@ -175,11 +140,11 @@ PropertyFile::PropertyFile(const std::string& path)
       table.days = index.Get<double>();
       table.minimum = index.Get<float>();
       table.maximum = index.Get<float>();
-      table.packed = index.GetRef();
+      table.packed = GetRef(index);
       table.layers.resize(static_cast<std::size_t>(this->Dims[2]));
       for (ChunkRef& layer : table.layers)
       {
-        layer = index.GetRef();
+        layer = GetRef(index);
       }
       for (const ChunkRef* c : { &table.packed })
       {
@@ -411,17 +376,17 @@ void PropertyFileWriter::CopyFrom(const PropertyFile& older)
 
 void PropertyFileWriter::Commit()
 {
-  std::vector<uint8_t> index;
+  ByteWriter index;
   for (const PropertyTable& t : this->Entries)
   {
     char name[NameBytes] = {};
     std::memcpy(name, t.name.data(), std::min(t.name.size(), NameBytes - 1));
-    index.insert(index.end(), name, name + NameBytes);
-    Put(index, t.step);
-    Put(index, t.reportNumber);
-    Put(index, t.days);
-    Put(index, t.minimum);
-    Put(index, t.maximum);
+    index.PutBytes(name, NameBytes);
+    index.Put(t.step);
+    index.Put(t.reportNumber);
+    index.Put(t.days);
+    index.Put(t.minimum);
+    index.Put(t.maximum);
     PutRef(index, t.packed);
     for (const ChunkRef& layer : t.layers)
     {
@@ -429,14 +394,14 @@ void PropertyFileWriter::Commit()
     }
   }
   const uint64_t indexOffset = this->Offset;
-  this->Write(index.data(), index.size(), "index");
-  std::vector<uint8_t> trailer;
-  Put(trailer, indexOffset);
-  Put(trailer, static_cast<uint64_t>(index.size()));
-  Put(trailer, Crc32(index.data(), index.size()));
-  Put(trailer, static_cast<uint32_t>(0));
-  trailer.insert(trailer.end(), TrailerMagic, TrailerMagic + 8);
-  this->Write(trailer.data(), trailer.size(), "trailer");
+  this->Write(index.Bytes.data(), index.Bytes.size(), "index");
+  ByteWriter trailer;
+  trailer.Put(indexOffset);
+  trailer.Put(static_cast<uint64_t>(index.Bytes.size()));
+  trailer.Put(Crc32(index.Bytes.data(), index.Bytes.size()));
+  trailer.Put(static_cast<uint32_t>(0));
+  trailer.PutBytes(TrailerMagic, 8);
+  this->Write(trailer.Bytes.data(), trailer.Bytes.size(), "trailer");
   // The table count goes in the header, which was written first: rewrite it in place.
   const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSide, static_cast<uint32_t>(this->Entries.size()));
   if (!this->Output->WriteAt(head.data(), head.size(), 0))
