@@ -1155,8 +1155,8 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
   }
   std::vector<std::atomic<uint64_t>>().swap(touched);
   const PerfectSpatialHash hash = BuildPerfectSpatialHash(hashed);
-  header.hashTableSide = hash.tableSide;
-  header.hashOffsetSide = hash.offsetSide;
+  header.hashTableSides = hash.tableSides;
+  header.hashOffsetSides = hash.offsetSides;
   header.hashedCells = hashed.size();
   report.hashedCells = hashed.size();
   report.hashSlots = hash.TableSize();

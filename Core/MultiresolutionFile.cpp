@@ -340,8 +340,14 @@ void PutHeader(ByteWriter& out, const MultiresolutionHeader& h)
   out.Put(h.cmax);
   out.Put(h.regionCount);
   out.Put(h.modelChunkCount);
-  out.Put(h.hashTableSide);
-  out.Put(h.hashOffsetSide);
+  for (uint32_t side : h.hashTableSides)
+  {
+    out.Put(side);
+  }
+  for (uint32_t side : h.hashOffsetSides)
+  {
+    out.Put(side);
+  }
   out.Put(h.hashedCells);
   out.Put(h.geometryId);
   out.Bytes.resize(HeaderBytes - 4, 0);
@@ -799,16 +805,30 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
     this->Head.cmax = head.Get<int32_t>();
     this->Head.regionCount = head.Get<uint64_t>();
     this->Head.modelChunkCount = head.Get<uint64_t>();
-    this->Head.hashTableSide = head.Get<uint32_t>();
-    this->Head.hashOffsetSide = head.Get<uint32_t>();
+    for (uint32_t& side : this->Head.hashTableSides)
+    {
+      side = head.Get<uint32_t>();
+    }
+    for (uint32_t& side : this->Head.hashOffsetSides)
+    {
+      side = head.Get<uint32_t>();
+    }
     this->Head.hashedCells = head.Get<uint64_t>();
     this->Head.geometryId = head.Get<uint64_t>();
     const auto& d = this->Head.dims;
-    const uint64_t slots = uint64_t(this->Head.hashTableSide) * this->Head.hashTableSide * this->Head.hashTableSide;
+    const auto& m = this->Head.hashTableSides;
+    const auto& r = this->Head.hashOffsetSides;
+    const uint64_t slots = uint64_t(m[0]) * m[1] * m[2];
+    bool sidesInRange = true;
+    for (int a = 0; a < 3; ++a)
+    {
+      sidesInRange = sidesInRange && m[a] >= 1 && r[a] >= 1 && m[a] <= PerfectSpatialHash::MaxSide &&
+        r[a] <= PerfectSpatialHash::MaxSide;
+    }
     if (d[0] <= 0 || d[1] <= 0 || d[2] <= 0 || d[0] > (int64_t(1) << 24) || d[1] > (int64_t(1) << 24) ||
       d[2] > (int64_t(1) << 24) || this->Head.leafLevel < 0 || this->Head.leafLevel > 40 ||
       this->Head.regionCount > (uint64_t(1) << 40) || this->Head.modelChunkCount > (uint64_t(1) << 32) ||
-      this->Head.hashTableSide > 65535 || this->Head.hashOffsetSide > 65535 || this->Head.hashedCells > slots)
+      !sidesInRange || this->Head.hashedCells > slots)
     {
       throw MultiresolutionFileError(path + ": header holds impossible dimensions, level or counts (corrupt)");
     }
@@ -943,19 +963,19 @@ std::vector<uint8_t> MultiresolutionFile::ReadActiveLayer(int64_t k) const
 PerfectSpatialHash MultiresolutionFile::ReadHash() const
 {
   PerfectSpatialHash hash;
-  hash.tableSide = this->Head.hashTableSide;
-  hash.offsetSide = this->Head.hashOffsetSide;
+  hash.tableSides = this->Head.hashTableSides;
+  hash.offsetSides = this->Head.hashOffsetSides;
   const auto raw = this->ReadModelArray(ModelChunk::HashOffsets);
   if (raw.size() != hash.OffsetTableSize() * 6)
   {
     throw MultiresolutionFileError(this->FilePath + ": hash offsets hold " + std::to_string(raw.size()) +
-      " bytes for an offset table of side " + std::to_string(hash.offsetSide));
+      " bytes for an offset table of " + std::to_string(hash.OffsetTableSize()) + " entries");
   }
   hash.offsets.resize(static_cast<std::size_t>(hash.OffsetTableSize()));
   std::memcpy(hash.offsets.data(), raw.data(), raw.size());
   for (const auto& o : hash.offsets)
   {
-    if (o[0] >= hash.tableSide || o[1] >= hash.tableSide || o[2] >= hash.tableSide)
+    if (o[0] >= hash.tableSides[0] || o[1] >= hash.tableSides[1] || o[2] >= hash.tableSides[2])
     {
       throw MultiresolutionFileError(this->FilePath + ": a hash offset lies outside the table (corrupt)");
     }

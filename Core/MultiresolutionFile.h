@@ -44,7 +44,7 @@ namespace resmr
 
 struct MultiresolutionHeader
 {
-  static constexpr uint32_t Version = 2;
+  static constexpr uint32_t Version = 3;
   std::array<int64_t, 3> dims{};
   std::array<double, 4> box{};          ///< hierarchy box: xmin, ymin, xmax, ymax
   std::array<double, 3> latticeOrigin{}; ///< x, y, depth
@@ -53,8 +53,10 @@ struct MultiresolutionHeader
   int32_t cmax = 0;
   uint64_t regionCount = 0;
   uint64_t modelChunkCount = 0;
-  uint32_t hashTableSide = 0;  ///< m: the packed tables hold m^3 slots (Sec. 5.4)
-  uint32_t hashOffsetSide = 0; ///< r: the offset table holds r^3 entries
+  /// m: the packed tables hold m0 m1 m2 slots (Sec. 5.4)
+  std::array<uint32_t, 3> hashTableSides{ 1, 1, 1 };
+  /// r: the offset table holds r0 r1 r2 entries
+  std::array<uint32_t, 3> hashOffsetSides{ 1, 1, 1 };
   uint64_t hashedCells = 0;    ///< cells the extracted faces touch (filled slots)
   /// Identifies the geometry (a digest of every chunk's checksum): property files name it.
   uint64_t geometryId = 0;

@@ -12,9 +12,7 @@ namespace resmr
 namespace
 {
 using Cell = std::array<uint32_t, 3>;
-
-/// Packings tried at one table side before it grows.
-constexpr int PackingsPerSide = 3;
+using Sides = PerfectSpatialHash::Sides;
 
 uint64_t CeilCbrt(uint64_t n)
 {
@@ -61,16 +59,21 @@ int LowestBit(uint64_t word)
     std::to_string(uint64_t(c[1]) + 1) + ", " + std::to_string(uint64_t(c[2]) + 1) + ") listed twice");
 }
 
-/// Whether no two cells agree modulo `product` in every component. With gcd(m, r) = 1 that is
-/// (by the Chinese remainder theorem) whether (h0, h1) = (p mod m, p mod r) is injective on the
-/// cells, which LH require: cells agreeing in both share an entry and hence a slot.
-bool Separable(const std::vector<Cell>& cells, uint64_t product)
+/// Whether no two cells agree modulo m[a] r[a] on every axis a. With gcd(m[a], r[a]) = 1 that
+/// is (by the Chinese remainder theorem) whether (h0, h1) = (p mod m, p mod r) is injective on
+/// the cells, which LH require: cells agreeing in both share an entry and hence a slot.
+bool Separable(const std::vector<Cell>& cells, const Sides& m, const Sides& r)
 {
+  std::array<uint64_t, 3> product;
+  for (int a = 0; a < 3; ++a)
+  {
+    product[a] = uint64_t(m[a]) * r[a];
+  }
   std::vector<std::pair<Cell, uint32_t>> keyed(cells.size());
   for (uint32_t n = 0; n < cells.size(); ++n)
   {
     const Cell& c = cells[n];
-    keyed[n] = { { uint32_t(c[0] % product), uint32_t(c[1] % product), uint32_t(c[2] % product) }, n };
+    keyed[n] = { { uint32_t(c[0] % product[0]), uint32_t(c[1] % product[1]), uint32_t(c[2] % product[2]) }, n };
   }
   std::sort(keyed.begin(), keyed.end());
   bool separable = true;
@@ -100,15 +103,18 @@ bool Separable(const std::vector<Cell>& cells, uint64_t product)
 class Packing
 {
 public:
-  Packing(const std::vector<Cell>& cells, uint32_t m, uint32_t r)
+  Packing(const std::vector<Cell>& cells, const Sides& m, const Sides& r)
     : Cells(cells)
     , M(m)
     , R(r)
-    , Slots(m * m * m)
+    , Slots(m[0] * m[1] * m[2])
   {
-    while ((uint64_t(this->G) * r) % m != 1 % m)
+    for (int a = 0; a < 3; ++a)
     {
-      ++this->G;
+      while ((uint64_t(this->G[a]) * r[a]) % m[a] != 1 % m[a])
+      {
+        ++this->G[a];
+      }
     }
   }
 
@@ -120,9 +126,9 @@ public:
     {
       this->Occupied.back() = ~uint64_t(0) << (this->Slots % 64); // past the table: never free
     }
-    result.tableSide = this->M;
-    result.offsetSide = this->R;
-    result.offsets.assign(this->R * this->R * this->R, { 0, 0, 0 });
+    result.tableSides = this->M;
+    result.offsetSides = this->R;
+    result.offsets.assign(this->R[0] * this->R[1] * this->R[2], { 0, 0, 0 });
     for (uint32_t q : this->Order)
     {
       if (!this->Place(q, result.offsets))
@@ -136,14 +142,14 @@ public:
 private:
   uint32_t Entry(const Cell& c) const
   {
-    return c[0] % this->R + this->R * (c[1] % this->R + this->R * (c[2] % this->R));
+    return c[0] % this->R[0] + this->R[0] * (c[1] % this->R[1] + this->R[1] * (c[2] % this->R[2]));
   }
 
   /// Counting sort of the cells by entry; the non-empty entries, largest group first (ties by
   /// entry, so that the result ignores the input order).
   void Group()
   {
-    const uint32_t entries = this->R * this->R * this->R;
+    const uint32_t entries = this->R[0] * this->R[1] * this->R[2];
     this->First.assign(entries + 1, 0);
     for (const Cell& c : this->Cells)
     {
@@ -172,19 +178,19 @@ private:
 
   bool Free(uint32_t slot) const { return !(this->Occupied[slot >> 6] >> (slot & 63) & 1); }
 
-  uint32_t Wrap(uint32_t value) const { return value >= this->M ? value - this->M : value; }
+  uint32_t Wrap(uint32_t value, int axis) const { return value >= this->M[axis] ? value - this->M[axis] : value; }
 
   /// The permuted slot of a cell of permuted h0 `h` under permuted offset `psi`.
-  uint32_t SlotOf(const std::array<uint32_t, 3>& h, const std::array<uint32_t, 3>& psi) const
+  uint32_t SlotOf(const Sides& h, const Sides& psi) const
   {
-    const uint32_t x = this->Wrap(h[0] + psi[0]), y = this->Wrap(h[1] + psi[1]);
-    return x + this->M * (y + this->M * this->Wrap(h[2] + psi[2]));
+    const uint32_t x = this->Wrap(h[0] + psi[0], 0), y = this->Wrap(h[1] + psi[1], 1);
+    return x + this->M[0] * (y + this->M[1] * this->Wrap(h[2] + psi[2], 2));
   }
 
   /// Whether offset psi (permuted) puts every cell of the current group in a free slot.
-  bool Fits(const std::array<uint32_t, 3>& psi) const
+  bool Fits(const Sides& psi) const
   {
-    for (const std::array<uint32_t, 3>& h : this->H0)
+    for (const Sides& h : this->H0)
     {
       if (!this->Free(this->SlotOf(h, psi)))
       {
@@ -211,7 +217,7 @@ private:
 
   bool Place(uint32_t q, std::vector<std::array<uint16_t, 3>>& offsets)
   {
-    const uint32_t m = this->M, r = this->R, g = this->G;
+    const Sides& m = this->M;
     const uint32_t begin = this->First[q], end = this->First[q + 1];
     // Permuted h0; the member with the least block (the corner of a box of blocks) first, as
     // the anchor that the search puts in free slots.
@@ -222,9 +228,14 @@ private:
     for (uint32_t n = begin; n < end; ++n)
     {
       const Cell& c = this->Cells[this->Members[n]];
-      this->H0.push_back({ g * (c[0] % m) % m, g * (c[1] % m) % m, g * (c[2] % m) % m });
+      Sides h;
+      for (int a = 0; a < 3; ++a)
+      {
+        h[a] = uint32_t(uint64_t(this->G[a]) * (c[a] % m[a]) % m[a]);
+      }
+      this->H0.push_back(h);
       this->H0Cells.push_back(this->Members[n]);
-      const Cell block{ c[2] / r, c[1] / r, c[0] / r };
+      const Cell block{ c[2] / this->R[2], c[1] / this->R[1], c[0] / this->R[0] };
       if (n == begin || block < least)
       {
         least = block;
@@ -240,7 +251,7 @@ private:
     }
     // Every offset that puts the anchor in a free slot, from Resume on, wrapping: the search
     // fails only when no offset exists.
-    const std::array<uint32_t, 3>& h = this->H0[0];
+    const Sides& h = this->H0[0];
     const uint64_t words = this->Occupied.size();
     const uint32_t start = this->Resume;
     uint64_t w = start >> 6;
@@ -251,9 +262,8 @@ private:
       {
         const uint32_t slot = static_cast<uint32_t>(w * 64 + LowestBit(word));
         word &= word - 1;
-        const uint32_t x = slot % m, y = slot / m % m, z = slot / m / m;
-        const std::array<uint32_t, 3> psi{ this->Wrap(x + m - h[0]), this->Wrap(y + m - h[1]),
-          this->Wrap(z + m - h[2]) };
+        const uint32_t x = slot % m[0], y = slot / m[0] % m[1], z = slot / m[0] / m[1];
+        const Sides psi{ this->Wrap(x + m[0] - h[0], 0), this->Wrap(y + m[1] - h[1], 1), this->Wrap(z + m[2] - h[2], 2) };
         if (this->Fits(psi))
         {
           for (std::size_t n = 0; n < this->H0.size(); ++n)
@@ -266,8 +276,10 @@ private:
             this->Occupied[taken >> 6] |= uint64_t(1) << (taken & 63);
           }
           // Back to table coordinates: Phi = r psi.
-          offsets[q] = { static_cast<uint16_t>(r * psi[0] % m), static_cast<uint16_t>(r * psi[1] % m),
-            static_cast<uint16_t>(r * psi[2] % m) };
+          for (int a = 0; a < 3; ++a)
+          {
+            offsets[q][a] = static_cast<uint16_t>(uint64_t(this->R[a]) * psi[a] % m[a]);
+          }
           this->Resume = slot;
           return true;
         }
@@ -284,88 +296,267 @@ private:
   }
 
   const std::vector<Cell>& Cells;
-  const uint32_t M, R;
+  const Sides M, R;
   const uint32_t Slots;
-  uint32_t G = 0;                // r^-1 mod m
+  Sides G{};                     // r^-1 mod m, per axis
   std::vector<uint32_t> First;   // group q is Members[First[q] .. First[q + 1])
   std::vector<uint32_t> Members; // cell indices grouped by entry
   std::vector<uint32_t> Order;   // non-empty entries, largest group first
   std::vector<uint64_t> Occupied; // permuted slots taken
-  std::vector<std::array<uint32_t, 3>> H0; // the current group's permuted h0, anchor first
-  std::vector<uint32_t> H0Cells;           // and its cells
+  std::vector<Sides> H0;          // the current group's permuted h0, anchor first
+  std::vector<uint32_t> H0Cells;  // and its cells
   uint32_t LastSize = 0; // size of the last group placed
   uint32_t Resume = 0;   // where its anchor went
 };
+
+/// The largest table tried before cubes grow without bound: the packed-texture target.
+constexpr double MaxFill = 1.25;
+
+/// Side lengths of the set's bounding box.
+Sides Extent(const std::vector<Cell>& cells)
+{
+  Sides extent{ 1, 1, 1 };
+  for (int a = 0; a < 3; ++a)
+  {
+    const auto [low, high] =
+      std::minmax_element(cells.begin(), cells.end(), [a](const Cell& x, const Cell& y) { return x[a] < y[a]; });
+    extent[a] = static_cast<uint32_t>(std::min<uint64_t>(uint64_t((*high)[a]) - (*low)[a] + 1, UINT32_MAX));
+  }
+  return extent;
+}
+
+/// Sides in proportion to `extent` whose product is about `target`, each in [1, cap[a]]:
+/// axes that reach their cap (or 1) are fixed and the rest rescaled.
+Sides ProportionalSides(const Sides& extent, double target, const Sides& cap)
+{
+  Sides sides{ 1, 1, 1 };
+  bool fixed[3] = { false, false, false };
+  for (int pass = 0; pass < 3; ++pass)
+  {
+    double freeVolume = 1, fixedProduct = 1;
+    int freeAxes = 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      if (fixed[a])
+      {
+        fixedProduct *= sides[a];
+      }
+      else
+      {
+        freeVolume *= extent[a];
+        ++freeAxes;
+      }
+    }
+    if (freeAxes == 0)
+    {
+      break;
+    }
+    const double scale = std::pow(target / fixedProduct / freeVolume, 1.0 / freeAxes);
+    bool changed = false;
+    for (int a = 0; a < 3; ++a)
+    {
+      const double side = extent[a] * scale;
+      if (!fixed[a] && (side >= cap[a] || side < 1))
+      {
+        sides[a] = side < 1 ? 1 : cap[a];
+        fixed[a] = changed = true;
+      }
+    }
+    if (!changed)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        if (!fixed[a])
+        {
+          sides[a] = static_cast<uint32_t>(std::max<double>(1, std::round(extent[a] * scale)));
+        }
+      }
+      break;
+    }
+  }
+  return sides;
+}
+
+/// Table shapes of `target` slots or a little less (never under n), a side at most MaxSide:
+/// shaped like the set (in proportion to its box, or as deep as it with the lateral sides in
+/// proportion, which suits thin sets: a few layers of shell), near cubes (a a b, b b a), and
+/// the set's box itself (whose identity map needs no offsets at all).
+std::vector<Sides> TableShapes(const Sides& extent, uint64_t n, uint64_t target, bool big)
+{
+  constexpr uint32_t maxSide = PerfectSpatialHash::MaxSide;
+  const Sides cap{ std::min(extent[0], maxSide), std::min(extent[1], maxSide), std::min(extent[2], maxSide) };
+  std::vector<Sides> shapes;
+  if (extent[2] <= maxSide)
+  {
+    Sides deep = ProportionalSides({ extent[0], extent[1], 1 }, double(target) / extent[2], { maxSide, maxSide, 1 });
+    deep[2] = extent[2];
+    shapes.push_back(deep);
+  }
+  shapes.push_back(ProportionalSides(extent, double(target), cap));
+  const uint32_t a = static_cast<uint32_t>(std::max<double>(1, std::floor(std::cbrt(double(target)))));
+  const uint32_t b = static_cast<uint32_t>(std::ceil(double(target) / a / a));
+  const uint32_t c = static_cast<uint32_t>(std::ceil(std::sqrt(double(target) / a)));
+  shapes.push_back({ a, a, b });
+  if (!big)
+  {
+    shapes.push_back({ c, c, a });
+    shapes.push_back(extent);
+  }
+  std::vector<Sides> kept;
+  for (const Sides& m : shapes)
+  {
+    const uint64_t slots = uint64_t(m[0]) * m[1] * m[2];
+    if (slots >= n && double(slots) <= double(target) * 1.005 + 1 && m[0] <= maxSide && m[1] <= maxSide && m[2] <= maxSide)
+    {
+      kept.push_back(m);
+    }
+  }
+  return kept;
+}
+
+/// Offset tables for table `m`: shaped like the set, then cubes, with |S| / 6 entries (LH's
+/// sigma = 1 / (2 d)) and |S| / 4 (small sets only), each side coprime with the table's and
+/// at most the table's (1 where the table is flat). The set's box as table: the identity
+/// (one offset) first.
+std::vector<Sides> OffsetShapes(const Sides& extent, uint64_t n, const Sides& m, bool big)
+{
+  std::vector<Sides> shapes;
+  if (m == extent)
+  {
+    shapes.push_back({ 1, 1, 1 });
+  }
+  for (double sigma : { 1.0 / 6, 1.0 / 4 })
+  {
+    if (big && sigma > 0.2)
+    {
+      continue;
+    }
+    const double entries = std::max(1.0, sigma * double(n));
+    const uint32_t cube = static_cast<uint32_t>(std::ceil(std::cbrt(entries)));
+    for (Sides r : { ProportionalSides(extent, entries, m), Sides{ cube, cube, cube } })
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        r[a] = m[a] == 1 ? 1 : CoprimeAtLeast(m[a], std::min(r[a], m[a]));
+        if (r[a] > m[a])
+        {
+          r[a] = 1;
+        }
+      }
+      if (std::find(shapes.begin(), shapes.end(), r) == shapes.end())
+      {
+        shapes.push_back(r);
+      }
+    }
+  }
+  return shapes;
+}
 } // namespace
+
+bool PackPerfectSpatialHash(const std::vector<Cell>& cells, const Sides& tableSides, const Sides& offsetSides,
+  PerfectSpatialHash& hash)
+{
+  ++hash.attempts;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (tableSides[a] < 1 || offsetSides[a] < 1 || tableSides[a] > PerfectSpatialHash::MaxSide ||
+      offsetSides[a] > PerfectSpatialHash::MaxSide || std::gcd(tableSides[a], offsetSides[a]) != 1)
+    {
+      throw std::invalid_argument("perfect spatial hash: table sides must be 1 to " +
+        std::to_string(PerfectSpatialHash::MaxSide) + " and coprime with the offset table's");
+    }
+  }
+  if (cells.empty())
+  {
+    hash.tableSides = tableSides;
+    hash.offsetSides = offsetSides;
+    hash.offsets.assign(static_cast<std::size_t>(hash.OffsetTableSize()), { 0, 0, 0 });
+    return true;
+  }
+  const Sides extent = Extent(cells);
+  const uint64_t slots = uint64_t(tableSides[0]) * tableSides[1] * tableSides[2];
+  if (slots < cells.size() || slots > PerfectSpatialHash::MaxTableSize)
+  {
+    return false;
+  }
+  // Distinct cells no wider apart than m r on every axis are always separated; else check.
+  bool wide = false;
+  for (int a = 0; a < 3; ++a)
+  {
+    wide = wide || uint64_t(tableSides[a]) * offsetSides[a] < extent[a];
+  }
+  if (wide && !Separable(cells, tableSides, offsetSides))
+  {
+    return false;
+  }
+  return Packing(cells, tableSides, offsetSides).Run(hash);
+}
 
 PerfectSpatialHash BuildPerfectSpatialHash(const std::vector<Cell>& cells)
 {
-  constexpr uint32_t maxSide = PerfectSpatialHash::MaxTableSide;
   PerfectSpatialHash hash;
   if (cells.empty())
   {
-    hash.tableSide = hash.offsetSide = 1;
     hash.offsets.assign(1, { 0, 0, 0 });
     return hash;
   }
   const uint64_t n = cells.size();
-  if (n > uint64_t(maxSide) * maxSide * maxSide)
+  if (n > PerfectSpatialHash::MaxTableSize)
   {
     throw std::invalid_argument("perfect spatial hash: " + std::to_string(n) + " cells are too many");
   }
-  // Any m * r >= extent separates the cells (their differences are smaller); with m >= extent,
-  // h0 alone is injective and r = 1 always works (the last resort).
-  uint64_t extent = 0;
-  for (int axis = 0; axis < 3; ++axis)
+  const Sides extent = Extent(cells);
+
+  // Shaped tables first: every table of at most 1.25 |S| slots the shapes below give, smallest
+  // first, each with an offset table of |S| / 6 or |S| / 4 entries shaped like the set.
+  // Small sets try sizes a half percent apart; big ones, where a packing costs seconds, a few.
+  const bool big = n > (uint64_t(1) << 18);
+  const double step = big ? 0.03 : 0.005;
+  std::vector<Sides> tried;
+  for (double target = double(n) * (big ? 1.06 : 1.0); target <= MaxFill * double(n);
+       target = std::max(target + 1, target * (1 + step)))
   {
-    const auto [low, high] = std::minmax_element(cells.begin(), cells.end(),
-      [axis](const Cell& a, const Cell& b) { return a[axis] < b[axis]; });
-    extent = std::max<uint64_t>(extent, uint64_t((*high)[axis]) - (*low)[axis] + 1);
-  }
-  const uint64_t firstR = CeilCbrt((n + 5) / 6); // LH: sigma = 1 / (2 d)
-  // Packing failures grow r up to about |S| / 4 entries (6 bytes each), then m.
-  const uint64_t packingR = std::max(firstR + 2, CeilCbrt((n + 3) / 4));
-  uint64_t inseparable = 0; // the largest m * r known to leave two cells inseparable
-  // Big sets: a failed packing costs seconds, so tables grow by about 5% a step (a
-  // sixty-fourth of the side) and get one packing a side.
-  const int packingsPerSide = n > (uint64_t(1) << 20) ? 1 : PackingsPerSide;
-  for (uint32_t m = static_cast<uint32_t>(CeilCbrt(n));; m += std::max<uint32_t>(1, m / 64))
-  {
-    if (m > maxSide)
+    for (const Sides& m : TableShapes(extent, n, static_cast<uint64_t>(target), big))
     {
-      throw std::invalid_argument("perfect spatial hash: " + std::to_string(n) +
-        " cells spread too thinly for a table of side " + std::to_string(maxSide));
-    }
-    // Products just above an inseparable one rarely help: ask for an eighth more.
-    const uint64_t separatingR = (inseparable + inseparable / 8) / m + 1;
-    const uint64_t lastR = std::min<uint64_t>(m, separatingR > packingR ? m : packingR);
-    uint32_t r = CoprimeAtLeast(m, std::max(firstR, separatingR));
-    for (int packings = 0; r <= m && (packings == 0 || r <= lastR) && packings < packingsPerSide;)
-    {
-      ++hash.attempts;
-      const uint64_t product = uint64_t(m) * r;
-      if (product < extent && !Separable(cells, product))
+      if (std::find(tried.begin(), tried.end(), m) != tried.end())
       {
-        inseparable = std::max(inseparable, product);
-        r = CoprimeAtLeast(m, (inseparable + inseparable / 8) / m + 1);
         continue;
       }
-      if (Packing(cells, m, r).Run(hash))
+      tried.push_back(m);
+      for (const Sides& r : OffsetShapes(extent, n, m, big))
       {
-        return hash;
-      }
-      ++packings;
-      r = CoprimeAtLeast(m, r + 1);
-    }
-    if (m >= extent)
-    {
-      ++hash.attempts;
-      if (Packing(cells, m, 1).Run(hash))
-      {
-        return hash;
+        if (PackPerfectSpatialHash(cells, m, r, hash))
+        {
+          return hash;
+        }
       }
     }
   }
+
+  // Then cubes growing without bound (about 2% a step), offset tables growing up to the table:
+  // sets spread wider than m r (a long line, far-apart cells) separate only when m r grows.
+  for (uint32_t m = static_cast<uint32_t>(CeilCbrt(n)); m <= PerfectSpatialHash::MaxSide; m += std::max<uint32_t>(1, m / 48))
+  {
+    const uint64_t slots = uint64_t(m) * m * m;
+    if (slots > PerfectSpatialHash::MaxTableSize)
+    {
+      break;
+    }
+    for (uint64_t r = CeilCbrt((n + 5) / 6); r <= m; r += 1 + r / 4)
+    {
+      const uint32_t coprime = CoprimeAtLeast(m, r);
+      if (coprime <= m && PackPerfectSpatialHash(cells, { m, m, m }, { coprime, coprime, coprime }, hash))
+      {
+        return hash;
+      }
+    }
+    if (PackPerfectSpatialHash(cells, { m, m, m }, { 1, 1, 1 }, hash))
+    {
+      return hash;
+    }
+  }
+  throw std::invalid_argument("perfect spatial hash: " + std::to_string(n) +
+    " cells spread too thinly for a table of side " + std::to_string(PerfectSpatialHash::MaxSide));
 }
 
 std::vector<uint64_t> CellSlots(const PerfectSpatialHash& hash, const std::vector<Cell>& cells)

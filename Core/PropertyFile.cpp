@@ -16,7 +16,7 @@ namespace
 {
 constexpr char Magic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'R', 'P' };
 constexpr char TrailerMagic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'I', 'X' };
-constexpr uint32_t Version = 1;
+constexpr uint32_t Version = 2;
 constexpr std::size_t HeaderBytes = 128;
 constexpr std::size_t TrailerBytes = 32;
 constexpr std::size_t NameBytes = 32;
@@ -39,7 +39,8 @@ ChunkRef GetRef(ByteReader& in)
   return c;
 }
 
-std::vector<uint8_t> HeaderOf(uint64_t geometry, const std::array<int64_t, 3>& dims, uint32_t tableSide, uint32_t tables)
+std::vector<uint8_t> HeaderOf(
+  uint64_t geometry, const std::array<int64_t, 3>& dims, const std::array<uint32_t, 3>& tableSides, uint32_t tables)
 {
   ByteWriter head;
   head.PutBytes(Magic, 8);
@@ -49,7 +50,10 @@ std::vector<uint8_t> HeaderOf(uint64_t geometry, const std::array<int64_t, 3>& d
   {
     head.Put(d);
   }
-  head.Put(tableSide);
+  for (uint32_t side : tableSides)
+  {
+    head.Put(side);
+  }
   head.Put(tables);
   head.Bytes.resize(HeaderBytes - 4, 0);
   head.Put(Crc32(head.Bytes.data(), head.Bytes.size()));
@@ -95,7 +99,10 @@ PropertyFile::PropertyFile(const std::string& path)
     {
       d = head.Get<int64_t>();
     }
-    this->TableSide = head.Get<uint32_t>();
+    for (uint32_t& side : this->TableSides)
+    {
+      side = head.Get<uint32_t>();
+    }
     const uint32_t tables = head.Get<uint32_t>();
 
     ByteReader tail(this->Data + this->Size - TrailerBytes, TrailerBytes, path + ": trailer");
@@ -190,7 +197,7 @@ int PropertyFile::Find(const std::string& name, int32_t step) const
 void PropertyFile::CheckGeometry(const MultiresolutionFile& geometry) const
 {
   if (geometry.Header().geometryId != this->Geometry || geometry.Header().dims != this->Dims ||
-    geometry.Header().hashTableSide != this->TableSide)
+    geometry.Header().hashTableSides != this->TableSides)
   {
     throw MultiresolutionFileError(this->FilePath + ": made for another geometry than " + geometry.Path() +
       " (geometry id or grid differs): rebuild it with resmr add-properties");
@@ -212,8 +219,8 @@ std::vector<float> PropertyFile::ReadValues(const ChunkRef& ref, uint64_t count,
 std::vector<float> PropertyFile::ReadPacked(std::size_t table) const
 {
   const PropertyTable& t = this->Entries.at(table);
-  const uint64_t m = this->TableSide;
-  return this->ReadValues(t.packed, m * m * m, this->FilePath + ": packed table of " + TableName(t));
+  const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
+  return this->ReadValues(t.packed, slots, this->FilePath + ": packed table of " + TableName(t));
 }
 
 std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
@@ -231,14 +238,14 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
   : Output(new AtomicOutputFile(path))
   , Geometry(geometry.Header().geometryId)
   , Dims(geometry.Header().dims)
-  , TableSide(geometry.Header().hashTableSide)
+  , TableSides(geometry.Header().hashTableSides)
 {
   const auto cells = geometry.ReadModelArray(ModelChunk::HashCells);
-  const uint64_t m = this->TableSide;
-  if (cells.size() != m * m * m * 8)
+  const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
+  if (cells.size() != slots * 8)
   {
     throw MultiresolutionFileError(geometry.Path() + ": hash cells hold " + std::to_string(cells.size()) +
-      " bytes for a table of side " + std::to_string(m));
+      " bytes for a table of " + std::to_string(slots) + " slots");
   }
   this->SlotCells.resize(cells.size() / 8);
   std::memcpy(this->SlotCells.data(), cells.data(), cells.size());
@@ -256,7 +263,7 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
     this->Active.push_back(geometry.ReadActiveLayer(k));
   }
   // The table count is patched in at Commit.
-  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSide, 0);
+  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, 0);
   this->Write(head.data(), head.size(), "header");
 }
 
@@ -403,7 +410,7 @@ void PropertyFileWriter::Commit()
   trailer.PutBytes(TrailerMagic, 8);
   this->Write(trailer.Bytes.data(), trailer.Bytes.size(), "trailer");
   // The table count goes in the header, which was written first: rewrite it in place.
-  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSide, static_cast<uint32_t>(this->Entries.size()));
+  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, static_cast<uint32_t>(this->Entries.size()));
   if (!this->Output->WriteAt(head.data(), head.size(), 0))
   {
     throw MultiresolutionFileError(this->Output->Path() + ": rewriting the header failed: " + std::strerror(errno));

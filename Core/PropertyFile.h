@@ -59,7 +59,7 @@ public:
   /// Throws MultiresolutionFileError if this file was not made for `geometry`.
   void CheckGeometry(const MultiresolutionFile& geometry) const;
 
-  /// The packed table (m^3 values, Sec. 5.4).
+  /// The packed table (m0 m1 m2 values, Sec. 5.4).
   std::vector<float> ReadPacked(std::size_t table) const;
   /// Layer k of the table (nx ny values).
   std::vector<float> ReadLayer(std::size_t table, int64_t k) const;
@@ -73,7 +73,7 @@ private:
   uint64_t Size = 0;
   uint64_t Geometry = 0;
   std::array<int64_t, 3> Dims{};
-  uint32_t TableSide = 0;
+  std::array<uint32_t, 3> TableSides{};
   std::vector<PropertyTable> Entries;
 };
 
@@ -101,7 +101,7 @@ private:
   uint64_t Offset = 0;
   uint64_t Geometry = 0;
   std::array<int64_t, 3> Dims{};
-  uint32_t TableSide = 0;
+  std::array<uint32_t, 3> TableSides{};
   std::vector<uint64_t> SlotCells;         ///< from the geometry
   std::vector<std::vector<uint8_t>> Active; ///< per layer
   std::vector<PropertyTable> Entries;

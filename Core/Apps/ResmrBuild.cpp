@@ -233,19 +233,21 @@ int MultiresolutionInfo(const char* path, bool listRegions)
     first = false;
   }
   // Sec. 5.4: the packed 3D textures, against the cells they hold and the full grid.
-  const double slots = double(h.hashTableSide) * h.hashTableSide * h.hashTableSide;
-  const double offsets = double(h.hashOffsetSide) * h.hashOffsetSide * h.hashOffsetSide;
+  const auto& m = h.hashTableSides;
+  const auto& r = h.hashOffsetSides;
+  const double slots = double(m[0]) * m[1] * m[2];
+  const double offsets = double(r[0]) * r[1] * r[2];
   uint64_t modelBytes = 0;
   for (const auto& m : file.ModelChunks())
   {
     modelBytes += m.chunk.stored;
   }
   std::printf("],\n \"model_chunk_bytes\": %llu, \"geometry_id\": \"%016llx\", \"hash\": {\"cells\": %llu, "
-              "\"table_side\": %u, \"offset_side\": %u, \"slots\": %.0f, \"fill\": %.4f, "
+              "\"table_sides\": [%u, %u, %u], \"offset_sides\": [%u, %u, %u], \"slots\": %.0f, \"offsets\": %.0f, \"fill\": %.4f, "
               "\"packed_over_cells_float\": %.4f, \"packed_over_cells_float_with_offsets\": %.4f, "
               "\"packed_over_full_grid\": %.6f}",
     static_cast<unsigned long long>(modelBytes), static_cast<unsigned long long>(h.geometryId),
-    static_cast<unsigned long long>(h.hashedCells), h.hashTableSide, h.hashOffsetSide, slots,
+    static_cast<unsigned long long>(h.hashedCells), m[0], m[1], m[2], r[0], r[1], r[2], slots, offsets,
     slots > 0 ? double(h.hashedCells) / slots : 0.0, h.hashedCells ? slots / double(h.hashedCells) : 0.0,
     h.hashedCells ? (slots * 4 + offsets * 6) / (double(h.hashedCells) * 4) : 0.0, (slots * 4 + offsets * 6) / (cells * 4));
   if (listRegions)
