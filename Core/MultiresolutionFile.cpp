@@ -25,7 +25,6 @@ constexpr char TrailerMagic[8] = { 'R', 'E', 'S', 'M', 'R', 'I', 'D', 'X' };
 constexpr std::size_t HeaderBytes = 256;
 constexpr std::size_t RecordBytes = 192;
 constexpr std::size_t ModelRecordBytes = 32;
-constexpr std::size_t TrailerBytes = 32;
 constexpr uint32_t MeshMagic = 0x4853454d;    // "MESH"
 constexpr uint32_t SurfaceMagic = 0x46525553; // "SURF"
 constexpr uint32_t TrianglesMagic = 0x53495254; // "TRIS"
@@ -175,6 +174,23 @@ std::vector<uint8_t> EncodeMesh(const RegionMesh& mesh, const MultiresolutionHea
   return std::move(out.Bytes);
 }
 
+
+/// Every index of `polygons` is below `limit`; else the chunk is corrupt ("<what> 12 of 10").
+template <typename Polygon>
+void CheckIndices(const ByteReader& in, const std::vector<Polygon>& polygons, uint64_t limit, const char* what)
+{
+  for (const Polygon& polygon : polygons)
+  {
+    for (uint32_t index : polygon)
+    {
+      if (index >= limit)
+      {
+        throw MultiresolutionFileError(in.Where() + ": " + what + " " + std::to_string(index) + " of " + std::to_string(limit));
+      }
+    }
+  }
+}
+
 void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header, const RegionRecord& record)
 {
   const uint32_t magic = in.Get<uint32_t>();
@@ -212,17 +228,7 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
   }
   mesh.corners.resize(columns);
   in.GetBytes(mesh.corners.data(), mesh.corners.size() * sizeof(mesh.corners[0]));
-  for (const auto& q : mesh.corners)
-  {
-    for (uint32_t node : q)
-    {
-      if (node >= nodes)
-      {
-        throw MultiresolutionFileError(in.Where() + ": a column refers to node " + std::to_string(node) + " of " +
-          std::to_string(nodes));
-      }
-    }
-  }
+  CheckIndices(in, mesh.corners, nodes, "a column refers to node");
   mesh.active.resize(static_cast<std::size_t>(columns) * layers);
   in.GetBytes(mesh.active.data(), mesh.active.size());
   mesh.openSides.resize(mesh.active.size());
@@ -265,17 +271,7 @@ void DecodeSurface(ByteReader& in, RegionSurface& surface, uint64_t vertices)
   }
   surface.quads.resize(count);
   in.GetBytes(surface.quads.data(), surface.quads.size() * sizeof(surface.quads[0]));
-  for (const auto& q : surface.quads)
-  {
-    for (uint32_t v : q)
-    {
-      if (v >= vertices)
-      {
-        throw MultiresolutionFileError(in.Where() + ": a quad refers to vertex " + std::to_string(v) + " of " +
-          std::to_string(vertices));
-      }
-    }
-  }
+  CheckIndices(in, surface.quads, vertices, "a quad refers to vertex");
 }
 
 std::vector<uint8_t> EncodeTriangles(const std::vector<std::array<uint32_t, 3>>& triangles)
@@ -302,17 +298,7 @@ void DecodeTriangles(ByteReader& in, std::vector<std::array<uint32_t, 3>>& trian
   }
   triangles.resize(count);
   in.GetBytes(triangles.data(), triangles.size() * sizeof(triangles[0]));
-  for (const auto& t : triangles)
-  {
-    for (uint32_t v : t)
-    {
-      if (v >= vertices)
-      {
-        throw MultiresolutionFileError(in.Where() + ": a triangle refers to vertex " + std::to_string(v) + " of " +
-          std::to_string(vertices));
-      }
-    }
-  }
+  CheckIndices(in, triangles, vertices, "a triangle refers to vertex");
 }
 
 void PutHeader(ByteWriter& out, const MultiresolutionHeader& h)
@@ -534,6 +520,44 @@ uint32_t Crc32(const void* data, std::size_t size, uint32_t crc)
   return ~crc;
 }
 
+std::vector<uint8_t> IndexTrailer(uint64_t indexOffset, const std::vector<uint8_t>& index, const char (&magic)[8])
+{
+  ByteWriter trailer;
+  trailer.Put(indexOffset);
+  trailer.Put(static_cast<uint64_t>(index.size()));
+  trailer.Put(Crc32(index.data(), index.size()));
+  trailer.Put(static_cast<uint32_t>(0));
+  trailer.PutBytes(magic, 8);
+  return std::move(trailer.Bytes);
+}
+
+std::pair<uint64_t, uint64_t> ReadIndexTrailer(
+  const uint8_t* data, uint64_t size, uint64_t headerBytes, const char (&magic)[8], const std::string& path)
+{
+  ByteReader tail(data + size - IndexTrailerBytes, IndexTrailerBytes, path + ": trailer");
+  const uint64_t indexOffset = tail.Get<uint64_t>(), indexSize = tail.Get<uint64_t>();
+  const uint32_t indexCrc = tail.Get<uint32_t>();
+  tail.Get<uint32_t>();
+  char stored[8];
+  tail.GetBytes(stored, 8);
+  if (std::memcmp(stored, magic, 8) != 0)
+  {
+    throw MultiresolutionFileError(path + ": no index trailer at the end of the file (truncated or unfinished)");
+  }
+  const uint64_t indexEnd = size - IndexTrailerBytes;
+  if (indexOffset < headerBytes || indexOffset > indexEnd || indexSize != indexEnd - indexOffset)
+  {
+    throw MultiresolutionFileError(path + ": index at byte " + std::to_string(indexOffset) + " of " +
+      std::to_string(indexSize) + " bytes does not fit a file of " + std::to_string(size) + " bytes (truncated or corrupt)");
+  }
+  if (Crc32(data + indexOffset, indexSize) != indexCrc)
+  {
+    throw MultiresolutionFileError(path + ": index checksum mismatch (bytes " + std::to_string(indexOffset) + "-" +
+      std::to_string(indexEnd) + " are corrupt)");
+  }
+  return { indexOffset, indexSize };
+}
+
 void ChooseLattice(const std::array<double, 6>& extent, MultiresolutionHeader& header)
 {
   const double lateral = std::max({ extent[3] - extent[0], extent[4] - extent[1], 1.0 });
@@ -742,13 +766,8 @@ void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader 
   }
   const uint64_t indexOffset = offset;
   write(index.Bytes.data(), index.Bytes.size(), "index");
-  ByteWriter trailer;
-  trailer.Put(indexOffset);
-  trailer.Put(static_cast<uint64_t>(index.Bytes.size()));
-  trailer.Put(Crc32(index.Bytes.data(), index.Bytes.size()));
-  trailer.Put(static_cast<uint32_t>(0));
-  trailer.PutBytes(TrailerMagic, 8);
-  write(trailer.Bytes.data(), trailer.Bytes.size(), "trailer");
+  const auto trailer = IndexTrailer(indexOffset, index.Bytes, TrailerMagic);
+  write(trailer.data(), trailer.size(), "trailer");
   output.Commit();
 }
 
@@ -757,7 +776,7 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
 {
   InitialiseLzo();
   this->Data = MapReadOnlyFile(path, this->Size);
-  if (this->Size < HeaderBytes + TrailerBytes)
+  if (this->Size < HeaderBytes + IndexTrailerBytes)
   {
     UnmapFile(this->Data, this->Size);
     throw MultiresolutionFileError(path + ": " + std::to_string(this->Size) +
@@ -833,27 +852,12 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
       throw MultiresolutionFileError(path + ": header holds impossible dimensions, level or counts (corrupt)");
     }
 
-    ByteReader tail(this->Data + this->Size - TrailerBytes, TrailerBytes, path + ": trailer");
-    const uint64_t indexOffset = tail.Get<uint64_t>(), indexSize = tail.Get<uint64_t>();
-    const uint32_t indexCrc = tail.Get<uint32_t>();
-    tail.Get<uint32_t>();
-    tail.GetBytes(magic, 8);
-    if (std::memcmp(magic, TrailerMagic, 8) != 0)
+    const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
+    if (indexSize != this->Head.regionCount * RecordBytes + this->Head.modelChunkCount * ModelRecordBytes)
     {
-      throw MultiresolutionFileError(path + ": no index trailer at the end of the file (truncated or unfinished)");
-    }
-    const uint64_t indexEnd = this->Size - TrailerBytes;
-    if (indexOffset < HeaderBytes || indexOffset > indexEnd || indexSize != indexEnd - indexOffset ||
-      indexSize != this->Head.regionCount * RecordBytes + this->Head.modelChunkCount * ModelRecordBytes)
-    {
-      throw MultiresolutionFileError(path + ": index at byte " + std::to_string(indexOffset) + " of " +
-        std::to_string(indexSize) + " bytes does not fit a file of " + std::to_string(this->Size) +
-        " bytes (truncated or corrupt)");
-    }
-    if (Crc32(this->Data + indexOffset, indexSize) != indexCrc)
-    {
-      throw MultiresolutionFileError(path + ": index checksum mismatch (bytes " + std::to_string(indexOffset) + "-" +
-        std::to_string(indexEnd) + " are corrupt)");
+      throw MultiresolutionFileError(path + ": index of " + std::to_string(indexSize) + " bytes at byte " +
+        std::to_string(indexOffset) + " does not hold the header's " + std::to_string(this->Head.regionCount) +
+        " regions and " + std::to_string(this->Head.modelChunkCount) + " model chunks (corrupt)");
     }
     ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
     this->Records.reserve(this->Head.regionCount);

@@ -18,7 +18,6 @@ constexpr char Magic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'R', 'P' };
 constexpr char TrailerMagic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'I', 'X' };
 constexpr uint32_t Version = 2;
 constexpr std::size_t HeaderBytes = 128;
-constexpr std::size_t TrailerBytes = 32;
 constexpr std::size_t NameBytes = 32;
 
 void PutRef(ByteWriter& out, const ChunkRef& c)
@@ -70,7 +69,7 @@ PropertyFile::PropertyFile(const std::string& path)
   : FilePath(path)
 {
   this->Data = MapReadOnlyFile(path, this->Size);
-  if (this->Size < HeaderBytes + TrailerBytes)
+  if (this->Size < HeaderBytes + IndexTrailerBytes)
   {
     UnmapFile(this->Data, this->Size);
     throw MultiresolutionFileError(path + ": " + std::to_string(this->Size) + " bytes, too short for a property file (truncated?)");
@@ -105,29 +104,7 @@ PropertyFile::PropertyFile(const std::string& path)
     }
     const uint32_t tables = head.Get<uint32_t>();
 
-    ByteReader tail(this->Data + this->Size - TrailerBytes, TrailerBytes, path + ": trailer");
-    const uint64_t indexOffset = tail.Get<uint64_t>(), indexSize = tail.Get<uint64_t>();
-    const uint32_t indexCrc = tail.Get<uint32_t>();
-    tail.Get<uint32_t>();
-    char magic[8];
-    for (char& c : magic)
-    {
-      c = tail.Get<char>();
-    }
-    if (std::memcmp(magic, TrailerMagic, 8) != 0)
-    {
-      throw MultiresolutionFileError(path + ": no index trailer at the end of the file (truncated or unfinished)");
-    }
-    const uint64_t indexEnd = this->Size - TrailerBytes;
-    if (indexOffset < HeaderBytes || indexOffset > indexEnd || indexSize != indexEnd - indexOffset)
-    {
-      throw MultiresolutionFileError(path + ": index at byte " + std::to_string(indexOffset) + " does not fit the file (truncated or corrupt)");
-    }
-    if (Crc32(this->Data + indexOffset, indexSize) != indexCrc)
-    {
-      throw MultiresolutionFileError(path + ": index checksum mismatch (bytes " + std::to_string(indexOffset) + "-" +
-        std::to_string(indexEnd) + " are corrupt)");
-    }
+    const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
     if (this->Dims[0] <= 0 || this->Dims[1] <= 0 || this->Dims[2] <= 0 || this->Dims[2] > (int64_t(1) << 24))
     {
       throw MultiresolutionFileError(path + ": impossible grid dimensions in the header (corrupt)");
@@ -402,13 +379,8 @@ void PropertyFileWriter::Commit()
   }
   const uint64_t indexOffset = this->Offset;
   this->Write(index.Bytes.data(), index.Bytes.size(), "index");
-  ByteWriter trailer;
-  trailer.Put(indexOffset);
-  trailer.Put(static_cast<uint64_t>(index.Bytes.size()));
-  trailer.Put(Crc32(index.Bytes.data(), index.Bytes.size()));
-  trailer.Put(static_cast<uint32_t>(0));
-  trailer.PutBytes(TrailerMagic, 8);
-  this->Write(trailer.Bytes.data(), trailer.Bytes.size(), "trailer");
+  const auto trailer = IndexTrailer(indexOffset, index.Bytes, TrailerMagic);
+  this->Write(trailer.data(), trailer.size(), "trailer");
   // The table count goes in the header, which was written first: rewrite it in place.
   const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, static_cast<uint32_t>(this->Entries.size()));
   if (!this->Output->WriteAt(head.data(), head.size(), 0))
