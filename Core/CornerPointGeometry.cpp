@@ -134,13 +134,23 @@ CornerPointGeometry CornerPointGeometry::FromDeck(GrdeclDeck& deck, bool applyMa
     BuildCartesian(deck, geometry.CoordValues, geometry.ZcornValues);
   }
   geometry.MapAxesAvailable = deck.hasMapAxes && !deck.gridUnitIsMap;
-  if (geometry.MapAxesAvailable && !MapTransformOf(deck.mapAxes, geometry.MapTransform))
+  CheckMapAxes(deck);
+  if (geometry.MapAxesAvailable)
+  {
+    MapTransformOf(deck.mapAxes, geometry.MapTransform);
+  }
+  geometry.SetMapAxesApplied(applyMapAxes);
+  return geometry;
+}
+
+void CornerPointGeometry::CheckMapAxes(const GrdeclDeck& deck)
+{
+  std::array<double, 6> transform;
+  if (deck.hasMapAxes && !deck.gridUnitIsMap && !MapTransformOf(deck.mapAxes, transform))
   {
     throw GrdeclError(deck.files.empty() ? std::string("deck") : deck.files.front(), 0, "MAPAXES",
       "axis points coincide with the origin");
   }
-  geometry.SetMapAxesApplied(applyMapAxes);
-  return geometry;
 }
 
 bool CornerPointGeometry::MapTransformOf(const MapAxes& axes, std::array<double, 6>& transform)

@@ -68,6 +68,11 @@ public:
   SharedCorners BuildSharedCorners() const;
 
   const std::vector<double>& Coord() const { return this->CoordValues; }
+  /// Origin and unit axes from MAPAXES; false if an axis point coincides with the origin.
+  static bool MapTransformOf(const MapAxes& axes, std::array<double, 6>& transform);
+  /// Throws the GrdeclError FromDeck throws for MAPAXES the deck cannot use (axis points on
+  /// the origin), whether or not the transform is applied.
+  static void CheckMapAxes(const GrdeclDeck& deck);
   /// True when corner depths are held in single precision (as EGRID stores them).
   bool HasSinglePrecisionDepths() const { return !this->ZcornSingle.empty(); }
 
@@ -87,8 +92,6 @@ private:
   std::vector<double> CoordValues;
   std::vector<double> ZcornValues;
   std::vector<float> ZcornSingle; ///< used instead of ZcornValues when not empty
-  /// Origin and unit axes from MAPAXES; false if an axis point coincides with the origin.
-  static bool MapTransformOf(const MapAxes& axes, std::array<double, 6>& transform);
 
   bool MapAxesAvailable = false; ///< MAPAXES given and valid, grid not already in map units
   bool MapAxesApplied = false;

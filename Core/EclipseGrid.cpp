@@ -52,13 +52,9 @@ bool AllFinite(const Real* values, std::size_t count)
 }
 } // namespace
 
-EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
+EclipseGridLayout LocateEclipseGrid(const EclipseKeywordFile& file, int64_t maxCells)
 {
-  if (maxCells <= 0)
-  {
-    maxCells = MaxCellsForThisMachine();
-  }
-  const EclipseKeywordFile file(path);
+  const std::string& path = file.Path();
   const auto fail = [&](const EclipseRecord* record, const std::string& what) -> void {
     file.Fail(record, record ? record->headerOffset : 0, what);
   };
@@ -76,8 +72,8 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
     fail(nullptr, "no GRIDHEAD keyword: not an EGRID file");
   }
 
-  EclipseGrid grid;
-  GrdeclDeck& deck = grid.deck;
+  EclipseGridLayout layout;
+  GrdeclDeck& deck = layout.deck;
   deck.files.push_back(path);
   std::vector<double> numbers;
   std::vector<int32_t> integers;
@@ -92,7 +88,7 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
     {
       global = false;
       const std::vector<std::string> names = file.ReadStrings(record);
-      grid.localGridNames.push_back(names.empty() ? std::string("?") : names.front());
+      layout.localGridNames.push_back(names.empty() ? std::string("?") : names.front());
       continue;
     }
     if (name == "NNCHEAD" && record.IsNumeric() && record.count >= 2)
@@ -104,7 +100,7 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
     }
     if (name == "NNC1")
     {
-      grid.nonNeighbourConnections += globalConnections ? record.count : 0;
+      layout.nonNeighbourConnections += globalConnections ? record.count : 0;
       continue;
     }
     if (name == "ENDGRID")
@@ -120,7 +116,7 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
     {
       integers.resize(static_cast<std::size_t>(record.count));
       file.Read(record, integers.data());
-      grid.dualPorosity = integers[5] != 0;
+      layout.dualPorosityHeader = integers[5] != 0;
     }
     else if (name == "GRIDHEAD")
     {
@@ -165,7 +161,7 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
     {
       const auto values = file.ReadStrings(record);
       deck.gridUnit = values.empty() ? "" : values.front();
-      grid.units = deck.gridUnit;
+      layout.units = deck.gridUnit;
       deck.gridUnitIsMap = values.size() > 1 && values[1] == "MAP";
     }
     else if (name == "COORD" || name == "ZCORN" || name == "ACTNUM")
@@ -184,41 +180,67 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
             std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) +
             " grid, file has " + std::to_string(record.count) + " of type " + record.typeName);
       }
-      if (name == "ACTNUM")
+      (name == "COORD" ? layout.coord : name == "ZCORN" ? layout.zcorn : layout.actnum) = &record;
+    }
+  }
+  if (!sawGridHead || !layout.coord || !layout.zcorn)
+  {
+    fail(nullptr, std::string("the global grid lacks ") +
+        (!sawGridHead ? "GRIDHEAD" : !layout.coord ? "COORD" : "ZCORN"));
+  }
+  return layout;
+}
+
+namespace
+{
+/// Reads a COORD or ZCORN record whole into `target`; every value must be finite.
+template <typename Real>
+void ReadFiniteRecord(const EclipseKeywordFile& file, const EclipseRecord& record, std::vector<Real>& target)
+{
+  target.clear();
+  ResizeLarge(target, static_cast<std::size_t>(record.count));
+  file.Read(record, target.data());
+  if (!AllFinite(target.data(), target.size()))
+  {
+    for (std::size_t v = 0; v < target.size(); ++v)
+    {
+      if (!std::isfinite(target[v]))
       {
-        ResizeLarge(grid.actnum, static_cast<std::size_t>(expected));
-        file.Read(record, grid.actnum.data());
-        continue;
-      }
-      const auto readFinite = [&](auto& target) {
-        target.clear();
-        ResizeLarge(target, static_cast<std::size_t>(expected));
-        file.Read(record, target.data());
-        if (!AllFinite(target.data(), target.size()))
-        {
-          for (std::size_t v = 0; v < target.size(); ++v)
-          {
-            if (!std::isfinite(target[v]))
-            {
-              fail(&record, "value " + std::to_string(v + 1) + " is not finite");
-            }
-          }
-        }
-      };
-      if (name == "ZCORN" && record.type == EclipseDataType::Real)
-      {
-        readFinite(deck.zcornSingle); // EGRID's float32 depths, kept as they are
-      }
-      else
-      {
-        readFinite(name == "COORD" ? deck.coord : deck.zcorn);
+        file.Fail(&record, record.headerOffset, "value " + std::to_string(v + 1) + " is not finite");
       }
     }
   }
-  if (!sawGridHead || !deck.HasCornerPointGeometry())
+}
+} // namespace
+
+EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
+{
+  if (maxCells <= 0)
   {
-    fail(nullptr, std::string("the global grid lacks ") +
-        (!sawGridHead ? "GRIDHEAD" : deck.coord.empty() ? "COORD" : "ZCORN"));
+    maxCells = MaxCellsForThisMachine();
+  }
+  const EclipseKeywordFile file(path);
+  EclipseGridLayout layout = LocateEclipseGrid(file, maxCells);
+  EclipseGrid grid;
+  GrdeclDeck& deck = grid.deck;
+  deck = std::move(layout.deck);
+  grid.dualPorosity = layout.dualPorosityHeader;
+  grid.localGridNames = std::move(layout.localGridNames);
+  grid.nonNeighbourConnections = layout.nonNeighbourConnections;
+  grid.units = std::move(layout.units);
+  ReadFiniteRecord(file, *layout.coord, deck.coord);
+  if (layout.zcorn->type == EclipseDataType::Real)
+  {
+    ReadFiniteRecord(file, *layout.zcorn, deck.zcornSingle); // EGRID's float32 depths, kept as they are
+  }
+  else
+  {
+    ReadFiniteRecord(file, *layout.zcorn, deck.zcorn);
+  }
+  if (layout.actnum)
+  {
+    ResizeLarge(grid.actnum, static_cast<std::size_t>(layout.actnum->count));
+    file.Read(*layout.actnum, grid.actnum.data());
   }
   const int64_t cells = deck.CellCount();
   if (grid.actnum.empty())

@@ -11,6 +11,8 @@
 //   returned; `activeCells` counts matrix cells, `fractureCells` the fracture ones.
 // - Old-style .GRID files and non-corner-point grids are rejected with GrdeclError, as is
 //   every inconsistency (array sizes, dims, non-finite coordinates).
+// - LocateEclipseGrid does the same checks of the records' names, types and counts without
+//   reading COORD, ZCORN or ACTNUM: a layer-by-layer reader then reads what it needs.
 #pragma once
 
 #include "GrdeclDeck.h"
@@ -21,6 +23,15 @@
 
 namespace resmr
 {
+
+class EclipseKeywordFile;
+struct EclipseRecord;
+
+/// Active flag of an ACTNUM value: the matrix value in dual porosity (1 or 3), > 0 else.
+inline bool ActiveCellValue(int32_t value, bool dualPorosity)
+{
+  return dualPorosity ? (value & 1) != 0 : value > 0;
+}
 
 struct EclipseGrid
 {
@@ -37,10 +48,31 @@ struct EclipseGrid
 
   bool IsActive(int64_t cell) const
   {
-    const int32_t value = this->actnum[static_cast<std::size_t>(cell)];
-    return this->dualPorosity ? (value & 1) != 0 : value > 0;
+    return ActiveCellValue(this->actnum[static_cast<std::size_t>(cell)], this->dualPorosity);
   }
 };
+
+/// The global grid of an EGRID, its records located and checked (GRIDHEAD, dims, the counts
+/// and types of COORD/ZCORN/ACTNUM) but COORD, ZCORN and ACTNUM not read.
+struct EclipseGridLayout
+{
+  /// dims, map axes and units; no coord, zcorn or cell arrays.
+  GrdeclDeck deck;
+  /// The global grid's records (the last of each name, as ReadEclipseGrid keeps), pointing
+  /// into the file's index; `actnum` is null when the file has none.
+  const EclipseRecord* coord = nullptr;
+  const EclipseRecord* zcorn = nullptr;
+  const EclipseRecord* actnum = nullptr;
+  bool dualPorosityHeader = false; ///< FILEHEAD says dual porosity (ACTNUM 2/3 says so too)
+  std::vector<std::string> localGridNames;
+  int64_t nonNeighbourConnections = 0;
+  std::string units;
+};
+
+/// Locates the global grid of an open EGRID/FEGRID; maxCells as ReadEclipseGrid's. Throws
+/// GrdeclError as ReadEclipseGrid does for everything but the values of COORD, ZCORN and
+/// ACTNUM.
+EclipseGridLayout LocateEclipseGrid(const EclipseKeywordFile& file, int64_t maxCells);
 
 /// Cheap check for file dialogs: the file starts with an EGRID's FILEHEAD or GRIDHEAD
 /// record, unformatted or formatted.

@@ -877,48 +877,59 @@ void EclipseKeywordFile::IndexFormatted()
   }
 }
 
+namespace
+{
+/// Converts the next token of a formatted record, value `i` (0-based), to T.
+template <typename T>
+void ReadFormattedValue(
+  const EclipseKeywordFile& file, const EclipseRecord& record, TextCursor& cursor, int64_t i, T& out)
+{
+  std::string token;
+  bool quoted = false;
+  int64_t start = 0;
+  if (!cursor.Next(token, quoted, start) || quoted)
+  {
+    file.Fail(&record, cursor.Offset, "missing value " + std::to_string(i + 1));
+  }
+  bool ok = true;
+  switch (record.type)
+  {
+    case EclipseDataType::Integer:
+    {
+      int64_t value = 0;
+      ok = ParseInteger(token, value) && value >= INT32_MIN && value <= INT32_MAX;
+      out = static_cast<T>(value);
+      break;
+    }
+    case EclipseDataType::Logical:
+      ok = token == "T" || token == "F";
+      out = token == "T" ? T(1) : T(0);
+      break;
+    default:
+    {
+      double value = 0;
+      ok = ParseReal(token, value);
+      out = Narrowed<T>(value);
+      break;
+    }
+  }
+  ok = ok && token.size() <= MaxNumberCharacters; // longer ones were cut by the cursor
+  if (!ok)
+  {
+    file.Fail(&record, start, "value " + std::to_string(i + 1) + " '" + token.substr(0, 30) +
+        (token.size() > 30 ? "...' (" + std::to_string(token.size()) + "+ characters)" : "'") +
+        " is not a valid " + record.typeName);
+  }
+}
+} // namespace
+
 template <typename T>
 void EclipseKeywordFile::ReadFormatted(const EclipseRecord& record, T* out) const
 {
   TextCursor cursor(this->Descriptor, this->FileSize, record.dataOffset);
-  std::string token;
-  bool quoted = false;
-  int64_t start = 0;
   for (int64_t i = 0; i < record.count; ++i)
   {
-    if (!cursor.Next(token, quoted, start) || quoted)
-    {
-      this->Fail(&record, cursor.Offset, "missing value " + std::to_string(i + 1));
-    }
-    bool ok = true;
-    switch (record.type)
-    {
-      case EclipseDataType::Integer:
-      {
-        int64_t value = 0;
-        ok = ParseInteger(token, value) && value >= INT32_MIN && value <= INT32_MAX;
-        out[i] = static_cast<T>(value);
-        break;
-      }
-      case EclipseDataType::Logical:
-        ok = token == "T" || token == "F";
-        out[i] = token == "T" ? T(1) : T(0);
-        break;
-      default:
-      {
-        double value = 0;
-        ok = ParseReal(token, value);
-        out[i] = Narrowed<T>(value);
-        break;
-      }
-    }
-    ok = ok && token.size() <= MaxNumberCharacters; // longer ones were cut by the cursor
-    if (!ok)
-    {
-      this->Fail(&record, start, "value " + std::to_string(i + 1) + " '" + token.substr(0, 30) +
-          (token.size() > 30 ? "...' (" + std::to_string(token.size()) + "+ characters)" : "'") +
-          " is not a valid " + record.typeName);
-    }
+    ReadFormattedValue(*this, record, cursor, i, out[i]);
   }
 }
 
@@ -939,5 +950,103 @@ std::vector<std::string> EclipseKeywordFile::ReadFormattedStrings(const EclipseR
   }
   return values;
 }
+
+// ------------------------------------------------------------------ record cursor
+
+struct EclipseRecordCursor::Text
+{
+  TextCursor Tokens;
+};
+
+EclipseRecordCursor::EclipseRecordCursor(const EclipseKeywordFile& file, const EclipseRecord& record)
+  : File(file)
+  , Header(record)
+{
+  if (!record.IsNumeric())
+  {
+    file.Fail(&record, record.headerOffset, "expected numeric data, found type " + record.typeName);
+  }
+  this->NextBlock = record.dataOffset;
+  if (file.Formatted)
+  {
+    this->Formatted.reset(new Text{ TextCursor(file.Descriptor, file.FileSize, record.dataOffset) });
+  }
+}
+
+EclipseRecordCursor::~EclipseRecordCursor() = default;
+
+const unsigned char* EclipseRecordCursor::Ensure(int64_t offset, int64_t size)
+{
+  if (offset < this->BufferStart || offset + size > this->BufferEnd)
+  {
+    const int64_t want = std::min(std::max(size, ChunkBytes), this->Header.endOffset - offset);
+    if (want < size)
+    {
+      this->File.Fail(&this->Header, offset, "data records run past the end of the keyword");
+    }
+    this->Buffer.resize(static_cast<std::size_t>(want));
+    this->File.ReadRaw(offset, this->Buffer.data(), want, &this->Header);
+    this->BufferStart = offset;
+    this->BufferEnd = offset + want;
+  }
+  return this->Buffer.data() + (offset - this->BufferStart);
+}
+
+template <typename T>
+void EclipseRecordCursor::Read(int64_t count, T* out)
+{
+  const EclipseRecord& record = this->Header;
+  if (count < 0 || count > record.count - this->Done)
+  {
+    this->File.Fail(&record, record.headerOffset,
+      "asked for values " + std::to_string(this->Done + 1) + " to " + std::to_string(this->Done + count) +
+        " of a record of " + std::to_string(record.count));
+  }
+  if (this->Formatted)
+  {
+    for (int64_t i = 0; i < count; ++i)
+    {
+      ReadFormattedValue(this->File, record, this->Formatted->Tokens, this->Done + i, out[i]);
+    }
+    this->Done += count;
+    return;
+  }
+  while (count > 0)
+  {
+    if (this->BlockLeft == 0)
+    {
+      // The next Fortran data record: checked as ForEachBlock checks it.
+      const int64_t remaining = record.count - this->Done;
+      const int64_t position = this->NextBlock;
+      const int64_t length = BigEndian32(this->Ensure(position, 4));
+      if (length == 0 || length % record.elementSize != 0 || length > remaining * record.elementSize)
+      {
+        this->File.Fail(&record, position,
+          "data record of " + std::to_string(length) + " bytes does not fit the " +
+            std::to_string(remaining) + " remaining elements of " + std::to_string(record.elementSize) +
+            " bytes");
+      }
+      const unsigned char* block = this->Ensure(position, length + 8);
+      if (BigEndian32(block + 4 + length) != static_cast<uint32_t>(length))
+      {
+        this->File.Fail(&record, position + 4 + length, "data record end marker differs from its start marker");
+      }
+      this->BlockData = position + 4;
+      this->BlockLeft = length / record.elementSize;
+      this->NextBlock = position + length + 8;
+    }
+    const int64_t n = std::min(count, this->BlockLeft);
+    ConvertBigEndian(record.type, this->Ensure(this->BlockData, n * record.elementSize), n, out);
+    out += n;
+    count -= n;
+    this->Done += n;
+    this->BlockLeft -= n;
+    this->BlockData += n * record.elementSize;
+  }
+}
+
+template void EclipseRecordCursor::Read<int32_t>(int64_t, int32_t*);
+template void EclipseRecordCursor::Read<float>(int64_t, float*);
+template void EclipseRecordCursor::Read<double>(int64_t, double*);
 
 } // namespace resmr

@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -108,6 +109,7 @@ public:
   [[noreturn]] void Fail(const EclipseRecord* record, int64_t offset, const std::string& what) const;
 
 private:
+  friend class EclipseRecordCursor;
   void IndexUnformatted();
   void IndexFormatted();
   int64_t WalkBlocks(const EclipseRecord& record) const;
@@ -126,6 +128,48 @@ private:
   int64_t FileSize = 0;
   bool Formatted = false;
   std::vector<EclipseRecord> Index;
+};
+
+/// Reads one numeric record front to back in pieces of the caller's choosing (a layer of
+/// ZCORN, of ACTNUM ...), holding at most one read chunk (4 MiB) of it: what a layer-by-layer
+/// reader needs from a record bigger than memory.
+///
+/// Contract:
+/// - Read(count, out) gives the next `count` values converted to T as
+///   EclipseKeywordFile::Read converts them; asking for more values than remain, and corrupt
+///   or truncated data met on the way, throw GrdeclError naming the file, the keyword and the
+///   byte offset.
+/// - Unformatted records are walked data record by data record (any block size, markers
+///   checked as Read checks them), formatted ones token by token. Forward only.
+/// - `file` must outlive the cursor; one cursor serves one thread.
+class EclipseRecordCursor
+{
+public:
+  EclipseRecordCursor(const EclipseKeywordFile& file, const EclipseRecord& record);
+  ~EclipseRecordCursor();
+  EclipseRecordCursor(const EclipseRecordCursor&) = delete;
+  EclipseRecordCursor& operator=(const EclipseRecordCursor&) = delete;
+
+  /// Defined for int32_t, float and double.
+  template <typename T>
+  void Read(int64_t count, T* out);
+  /// Values read so far: the index of the next one.
+  int64_t Position() const { return this->Done; }
+  const EclipseRecord& Record() const { return this->Header; }
+
+private:
+  const unsigned char* Ensure(int64_t offset, int64_t size);
+
+  struct Text;
+  const EclipseKeywordFile& File;
+  EclipseRecord Header;
+  int64_t Done = 0;
+  int64_t NextBlock = 0;  ///< byte offset of the next data record's start marker
+  int64_t BlockData = 0;  ///< byte offset of the next unread element of the current one
+  int64_t BlockLeft = 0;  ///< elements left in the current data record
+  std::vector<unsigned char> Buffer;
+  int64_t BufferStart = 0, BufferEnd = 0; ///< absolute offsets of the bytes held in Buffer
+  std::unique_ptr<Text> Formatted;        ///< formatted files: the token cursor
 };
 
 } // namespace resmr

@@ -161,6 +161,76 @@ enum class Section
   Schedule
 };
 
+/// The cells of a box in ECLIPSE order (i fastest), one after the other.
+class BoxWalk
+{
+public:
+  BoxWalk(const Box& box, const std::array<int64_t, 3>& dims)
+    : Range(box.range)
+    , Dims(dims)
+    , I(box.range[0])
+    , J(box.range[2])
+    , K(box.range[4])
+  {
+  }
+  int64_t Next()
+  {
+    const int64_t cell = (this->K * this->Dims[1] + this->J) * this->Dims[0] + this->I;
+    if (++this->I > this->Range[1])
+    {
+      this->I = this->Range[0];
+      if (++this->J > this->Range[3])
+      {
+        this->J = this->Range[2];
+        ++this->K;
+      }
+    }
+    return cell;
+  }
+
+private:
+  std::array<int64_t, 6> Range;
+  std::array<int64_t, 3> Dims;
+  int64_t I, J, K;
+};
+
+/// Values of a spooled array put cell by cell, written in runs of consecutive cells.
+template <typename T>
+class SpoolWriter
+{
+public:
+  explicit SpoolWriter(SpoolFile& file)
+    : File(file)
+  {
+  }
+  void Put(int64_t cell, T value)
+  {
+    if (!this->Values.empty() && cell != this->First + static_cast<int64_t>(this->Values.size()))
+    {
+      this->Flush();
+    }
+    if (this->Values.empty())
+    {
+      this->First = cell;
+    }
+    this->Values.push_back(value);
+    if (this->Values.size() >= (1u << 16))
+    {
+      this->Flush();
+    }
+  }
+  void Flush()
+  {
+    this->File.Write(this->First, this->Values.data(), static_cast<int64_t>(this->Values.size()));
+    this->Values.clear();
+  }
+
+private:
+  SpoolFile& File;
+  int64_t First = 0;
+  std::vector<T> Values;
+};
+
 class Parser
 {
 public:
@@ -171,6 +241,13 @@ public:
     {
       this->Options.maxCells = MaxCellsForThisMachine();
     }
+  }
+
+  /// Bounded-memory mode (ParseGrdeclGrid): grid arrays to `spool`, properties dropped.
+  void SpoolTo(const std::string& folder, GrdeclGridSpool& spool)
+  {
+    this->SpoolFolder = folder;
+    this->Spool = &spool;
   }
 
   GrdeclDeck Run(const std::string& path)
@@ -389,6 +466,74 @@ private:
     }
   }
 
+  /// Calls visit(first cell, count) for each row of the box (cells consecutive in i).
+  template <typename Visit>
+  void ForEachRow(const Box& box, Visit&& visit)
+  {
+    const auto& d = this->Deck.dims;
+    for (int64_t k = box.range[4]; k <= box.range[5]; ++k)
+    {
+      for (int64_t j = box.range[2]; j <= box.range[3]; ++j)
+      {
+        visit((k * d[1] + j) * d[0] + box.range[0], box.range[1] - box.range[0] + 1);
+      }
+    }
+  }
+
+  // ---------------------------------------------------------------- bounded-memory mode
+  bool Spooling() const { return this->Spool != nullptr; }
+
+  /// Spooling: the cell arrays kept (in temporary files); any other one is dropped.
+  bool Spooled(const std::string& name) const
+  {
+    return this->Spooling() && IsGeometryArrayName(name);
+  }
+
+  std::unique_ptr<SpoolFile>& SpoolSlot(const std::string& name)
+  {
+    GrdeclGridSpool& spool = *this->Spool;
+    return name == "ACTNUM" ? spool.actnum
+      : name == "DX"        ? spool.dx
+      : name == "DY"        ? spool.dy
+      : name == "DZ"        ? spool.dz
+                            : spool.tops;
+  }
+
+  /// The spooled array `name`, created all NaN ("not given") if new, as ArrayFor creates.
+  SpoolFile& SpoolFor(const std::string& name)
+  {
+    std::unique_ptr<SpoolFile>& slot = this->SpoolSlot(name);
+    if (!slot)
+    {
+      const int64_t n = this->CellCount(name);
+      slot.reset(new SpoolFile(this->SpoolFolder, name));
+      slot->Fill(0, n, std::numeric_limits<double>::quiet_NaN());
+    }
+    return *slot;
+  }
+
+  /// Spooling: true if the array was given (kept or dropped).
+  bool Defined(const std::string& name)
+  {
+    return this->Spooled(name) ? this->SpoolSlot(name) != nullptr : this->DroppedArrays.count(name) > 0;
+  }
+
+  /// Applies edit(value&) to the cells of `box` in a spooled array, a row at a time.
+  template <typename Edit>
+  void EditSpool(SpoolFile& file, const Box& box, Edit&& edit)
+  {
+    std::vector<double> row;
+    this->ForEachRow(box, [&](int64_t first, int64_t count) {
+      row.resize(static_cast<std::size_t>(count));
+      file.Read(first, row.data(), count);
+      for (double& value : row)
+      {
+        edit(value);
+      }
+      file.Write(first, row.data(), count);
+    });
+  }
+
   // ---------------------------------------------------------------- number arrays
   /// Reads numbers up to '/' and hands each to store(index, value); exactly `expected` values.
   /// Returns false (without consuming the unexpected token) if `lenient` and the data turn
@@ -494,6 +639,26 @@ private:
       this->ReadTops();
       return;
     }
+    if (this->Spooling() && !this->Spooled(keyword))
+    {
+      // A property: checked as below, not kept.
+      if (!this->ReadNumbers(keyword, expected, lenient, true, [](int64_t, double) {}))
+      {
+        this->SkipRestOfKeyword();
+        return;
+      }
+      this->DroppedArrays.insert(keyword);
+      return;
+    }
+    if (this->Spooling())
+    {
+      SpoolWriter<double> writer(this->SpoolFor(keyword));
+      BoxWalk cells(box, this->Deck.dims);
+      this->ReadNumbers(keyword, expected, false, true,
+        [&](int64_t, double value) { writer.Put(cells.Next(), value); });
+      writer.Flush();
+      return;
+    }
     if (lenient)
     {
       std::vector<double> values;
@@ -527,6 +692,14 @@ private:
   {
     const int64_t n = this->CellCount("TOPS");
     const int64_t layer = this->Deck.dims[0] * this->Deck.dims[1];
+    if (this->Spooling())
+    {
+      SpoolWriter<double> writer(this->SpoolFor("TOPS"));
+      this->ReadNumbers(
+        "TOPS", n, false, true, [&](int64_t index, double value) { writer.Put(index, value); }, layer);
+      writer.Flush();
+      return;
+    }
     double* tops = this->ArrayFor("TOPS").values.data();
     this->ReadNumbers(
       "TOPS", n, false, true, [&](int64_t index, double value) { tops[index] = value; }, layer);
@@ -682,6 +855,34 @@ private:
       const std::string target = Upper(items[0]);
       const Box box = this->RecordBox(items, 2, lastBox, keyword);
       lastBox = box;
+      if (keyword == "COPY" && this->Spooling())
+      {
+        const std::string destination = Upper(items[1]);
+        if (!this->Defined(target))
+        {
+          this->FailHere(keyword, "source array " + target + " has not been defined");
+        }
+        if (!this->Spooled(destination))
+        {
+          this->DroppedArrays.insert(destination);
+          continue;
+        }
+        if (!this->Spooled(target))
+        {
+          this->FailHere(keyword, "cannot copy " + target + " into " + destination +
+              ": when the grid is read with bounded memory (resmr build) property arrays are "
+              "not kept; give " + destination + " its values directly (or with EQUALS)");
+        }
+        SpoolFile& in = *this->SpoolSlot(target);
+        SpoolFile& out = this->SpoolFor(destination);
+        std::vector<double> row;
+        this->ForEachRow(box, [&](int64_t first, int64_t count) {
+          row.resize(static_cast<std::size_t>(count));
+          in.Read(first, row.data(), count);
+          out.Write(first, row.data(), count);
+        });
+        continue;
+      }
       if (keyword == "COPY")
       {
         const std::string destination = Upper(items[1]);
@@ -700,6 +901,35 @@ private:
       if (!std::isfinite(value))
       {
         this->FailHere(keyword, "value for " + target + " is not finite");
+      }
+      if (this->Spooling())
+      {
+        if (keyword == "EQUALS" && !this->Spooled(target))
+        {
+          this->DroppedArrays.insert(target);
+          continue;
+        }
+        if (keyword != "EQUALS" && !this->Defined(target))
+        {
+          this->FailHere(keyword, "array " + target + " has not been defined");
+        }
+        if (this->Spooled(target))
+        {
+          SpoolFile& file = this->SpoolFor(target);
+          if (keyword == "EQUALS")
+          {
+            this->EditSpool(file, box, [&](double& v) { v = value; });
+          }
+          else if (keyword == "MULTIPLY")
+          {
+            this->EditSpool(file, box, [&](double& v) { v *= value; });
+          }
+          else
+          {
+            this->EditSpool(file, box, [&](double& v) { v += value; });
+          }
+        }
+        continue;
       }
       if (keyword == "EQUALS")
       {
@@ -827,6 +1057,16 @@ private:
       const auto& d = this->Deck.dims;
       this->CellCount(keyword);
       this->ReadDenseArray(keyword, this->Deck.coord, 6 * (d[0] + 1) * (d[1] + 1));
+    }
+    else if (keyword == "ZCORN" && this->Spooling())
+    {
+      const int64_t expected = 8 * this->CellCount(keyword);
+      std::unique_ptr<SpoolFile> file(new SpoolFile(this->SpoolFolder, keyword));
+      SpoolWriter<float> writer(*file);
+      this->ReadNumbers(keyword, expected, false, false,
+        [&](int64_t index, double value) { writer.Put(index, static_cast<float>(value)); });
+      writer.Flush();
+      this->Spool->zcorn = std::move(file); // a second ZCORN replaces the first
     }
     else if (keyword == "ZCORN")
     {
@@ -1035,6 +1275,22 @@ private:
           fail("expected " + std::to_string(expected) + " values, file has " +
             std::to_string(header.count));
         }
+        if (keyword == "ZCORN" && this->Spooling())
+        {
+          std::unique_ptr<SpoolFile> file(new SpoolFile(this->SpoolFolder, keyword));
+          this->SpoolRecord<float>(reader, header, *file, [&](const double* v, int64_t count, float* out) {
+            for (int64_t i = 0; i < count; ++i)
+            {
+              if (!std::isfinite(v[i]))
+              {
+                fail("holds a value that is not finite");
+              }
+              out[i] = static_cast<float>(v[i]);
+            }
+          });
+          this->Spool->zcorn = std::move(file);
+          continue;
+        }
         reader.ReadNumbers(header, *target);
         for (double v : *target)
         {
@@ -1054,12 +1310,44 @@ private:
         }
         continue;
       }
+      if (this->Spooling())
+      {
+        if (!this->Spooled(keyword))
+        {
+          this->DroppedArrays.insert(keyword);
+          continue;
+        }
+        std::unique_ptr<SpoolFile> file(new SpoolFile(this->SpoolFolder, keyword));
+        this->SpoolRecord<double>(reader, header, *file, [](const double* v, int64_t count, double* out) {
+          std::copy(v, v + count, out);
+        });
+        this->SpoolSlot(keyword) = std::move(file); // replaces any earlier values, as below
+        continue;
+      }
       reader.ReadNumbers(header, values);
       CellArray& array = this->ArrayFor(keyword);
       array.isInteger = header.type == EclipseDataType::Integer || IsIntegerArrayName(keyword);
       array.values.swap(values);
     }
     this->CurrentFile = savedFile;
+  }
+
+  /// Copies a binary record into a spool file piece by piece: convert(values as doubles,
+  /// count, out) fills the spool's values (checking them).
+  template <typename T, typename Convert>
+  void SpoolRecord(const EclipseKeywordFile& reader, const EclipseRecord& header, SpoolFile& file, Convert&& convert)
+  {
+    constexpr int64_t Piece = 1 << 16;
+    std::vector<double> values(static_cast<std::size_t>(std::min<int64_t>(Piece, header.count)));
+    std::vector<T> converted(values.size());
+    EclipseRecordCursor cursor(reader, header);
+    for (int64_t first = 0; first < header.count; first += Piece)
+    {
+      const int64_t count = std::min(Piece, header.count - first);
+      cursor.Read(count, values.data());
+      convert(values.data(), count, converted.data());
+      file.Write(first, converted.data(), count);
+    }
   }
 
   // ---------------------------------------------------------------- final checks
@@ -1071,10 +1359,36 @@ private:
     {
       throw GrdeclError(file, 0, "SPECGRID", "no SPECGRID or DIMENS: grid dimensions unknown");
     }
-    if (deck.coord.empty() != deck.zcorn.empty())
+    const bool hasZcorn = this->Spooling() ? this->Spool->zcorn != nullptr : !deck.zcorn.empty();
+    if (deck.coord.empty() == hasZcorn)
     {
       throw GrdeclError(file, 0, deck.coord.empty() ? "COORD" : "ZCORN",
         std::string("missing; corner-point grids need both COORD and ZCORN"));
+    }
+    if (this->Spooling() && this->Spool->actnum)
+    {
+      // As below, a piece at a time.
+      SpoolFile& actnum = *this->Spool->actnum;
+      const int64_t n = deck.CellCount();
+      std::vector<double> values;
+      for (int64_t first = 0; first < n; first += 1 << 16)
+      {
+        const int64_t count = std::min<int64_t>(1 << 16, n - first);
+        values.resize(static_cast<std::size_t>(count));
+        actnum.Read(first, values.data(), count);
+        for (double& value : values)
+        {
+          if (std::isnan(value))
+          {
+            value = 1;
+          }
+          else if (value != std::floor(value) || value < 0)
+          {
+            throw GrdeclError(file, 0, "ACTNUM", "values must be non-negative integers");
+          }
+        }
+        actnum.Write(first, values.data(), count);
+      }
     }
     if (CellArray* actnum = deck.FindArray("ACTNUM"))
     {
@@ -1102,6 +1416,9 @@ private:
   bool Stopped = false;
   std::optional<Box> CurrentBox;
   std::unordered_map<std::string, std::size_t> FaultIndex;
+  GrdeclGridSpool* Spool = nullptr; ///< bounded-memory mode when set
+  std::string SpoolFolder;
+  std::unordered_set<std::string> DroppedArrays; ///< bounded-memory mode: given, not kept
 };
 } // namespace
 
@@ -1142,6 +1459,29 @@ bool LooksLikeGrdeclFile(const std::string& path)
 GrdeclDeck ParseGrdeclFile(const std::string& path, const GrdeclParseOptions& options)
 {
   Parser parser(options);
+  return parser.Run(path);
+}
+
+SpoolFile* GrdeclGridSpool::Find(const std::string& name) const
+{
+  return name == "ACTNUM" ? this->actnum.get()
+    : name == "DX"        ? this->dx.get()
+    : name == "DY"        ? this->dy.get()
+    : name == "DZ"        ? this->dz.get()
+    : name == "TOPS"      ? this->tops.get()
+                          : nullptr;
+}
+
+GrdeclDeck ParseGrdeclGrid(const std::string& path, const std::string& spoolFolder,
+  GrdeclGridSpool& spool, GrdeclParseOptions options)
+{
+  if (options.maxCells <= 0)
+  {
+    options.maxCells = std::numeric_limits<int64_t>::max(); // nothing cell-sized is held
+  }
+  spool = GrdeclGridSpool();
+  Parser parser(options);
+  parser.SpoolTo(spoolFolder, spool);
   return parser.Run(path);
 }
 

@@ -12,8 +12,10 @@
 #pragma once
 
 #include "GrdeclDeck.h"
+#include "SpoolFile.h"
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 namespace resmr
@@ -32,6 +34,32 @@ struct GrdeclParseOptions
 /// Parses an ASCII deck (.grdecl, .DATA, .inc ...) or a binary GRDECL (.bgrdecl), chosen by
 /// content. Throws GrdeclError.
 GrdeclDeck ParseGrdeclFile(const std::string& path, const GrdeclParseOptions& options = {});
+
+/// The grid arrays of a deck parsed with bounded memory (ParseGrdeclGrid), in temporary files
+/// rather than in the deck. Destroying it frees the files.
+struct GrdeclGridSpool
+{
+  /// ZCORN: 8 nx ny nz float32 depths, ECLIPSE order (the double values rounded to float, as
+  /// the layer sources hand them on); null when the deck has none.
+  std::unique_ptr<SpoolFile> zcorn;
+  /// ACTNUM, DX, DY, DZ, TOPS: one float64 a cell, ECLIPSE order, NaN where not given (ACTNUM
+  /// after the parse: 1 there, as ParseGrdeclFile does); null when the deck has none.
+  std::unique_ptr<SpoolFile> actnum, dx, dy, dz, tops;
+
+  /// The array of that name (ACTNUM, DX, DY, DZ, TOPS), or nullptr.
+  SpoolFile* Find(const std::string& name) const;
+};
+
+/// Bounded-memory parse for building a hierarchy from a deck (paper Sec. 4.2: the model is
+/// streamed): as ParseGrdeclFile, but ZCORN and the grid's cell arrays (ACTNUM, DX, DY, DZ,
+/// TOPS) go to temporary files in `spoolFolder` (`spool`), and every other cell array is read,
+/// checked and dropped. EQUALS, MULTIPLY, ADD and COPY (BOX-limited or not) edit the spooled
+/// arrays in their files; COPY from a dropped array into a spooled one throws GrdeclError
+/// naming the file, line and keyword. The deck returned holds dims, COORD, DXV/DYV/DZV, map
+/// axes, units, faults, files and warnings: no zcorn and no cell arrays. Memory: COORD and
+/// buffers of a few hundred KiB, whatever the grid's size; maxCells 0 means no limit here.
+GrdeclDeck ParseGrdeclGrid(const std::string& path, const std::string& spoolFolder,
+  GrdeclGridSpool& spool, GrdeclParseOptions options = {});
 
 /// Cheap check for file dialogs: binary GRDECL, or text with an ECLIPSE keyword in column 1
 /// within its first 64 KiB.

@@ -454,7 +454,7 @@ public:
     , Output(output)
     , Options(options)
     , Progress(progress)
-    , Scratch(options.scratch.empty() ? output + ".scratch" : options.scratch)
+    , Scratch(ScratchFolder(output, options))
   {
     if (this->Options.cmax != 0 && this->Options.cmax < 16)
     {
@@ -1518,6 +1518,11 @@ HierarchyReport Builder::Run()
   return report;
 }
 } // namespace
+
+std::string ScratchFolder(const std::string& output, const HierarchyOptions& options)
+{
+  return options.scratch.empty() ? output + ".scratch" : options.scratch;
+}
 
 HierarchyReport BuildHierarchy(
   LayerSource& source, const std::string& output, const HierarchyOptions& options, const BuildProgress& progress)

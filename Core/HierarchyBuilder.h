@@ -76,6 +76,11 @@ struct HierarchyReport
 /// Phase name and fraction of the whole build done (0..1).
 using BuildProgress = std::function<void(const char* phase, double fraction)>;
 
+/// The scratch folder a build of `output` uses: options.scratch, else OUTPUT.scratch. Also
+/// where OpenLayerSource is told to spool a deck's grid (its files are unlinked at once, so
+/// the builder's clearing of the folder never meets them).
+std::string ScratchFolder(const std::string& output, const HierarchyOptions& options);
+
 /// Builds `output` (.resmr) from the layers of `source`. Throws std::runtime_error (or a
 /// subclass) naming the input or file on failure; the output is then not created and any
 /// older file of that name is left as it was.

@@ -75,9 +75,18 @@ private:
 /// if none). Throws GrdeclError naming the file and place.
 void ReadCornerPointModel(const std::string& path, GrdeclDeck& deck, std::vector<bool>& active);
 
-/// The layers of `input`: "synth:NIxNJxNK[:SEED]" streamed from the generator, or a grid
-/// file (ReadCornerPointModel; held in memory, then served layer by layer). Throws
-/// std::invalid_argument for a malformed synth: spec.
-std::unique_ptr<LayerSource> OpenLayerSource(const std::string& input);
+/// The layers of `input`, streamed whatever the model's size:
+/// - "synth:NIxNJxNK[:SEED]": from the generator;
+/// - an EGRID/FEGRID: COORD read whole, then each layer's ZCORN and ACTNUM read from the file
+///   as Next() asks for it (EclipseRecordCursor). Checked as ReadEclipseGrid checks; the
+///   checks of ZCORN's values happen layer by layer;
+/// - a GRDECL/DATA deck: parsed once with ParseGrdeclGrid, ZCORN and ACTNUM (DX, DY, DZ, TOPS
+///   for Cartesian decks) spooled to unlinked temporary files in `spoolFolder` (created if
+///   missing; the system temporary folder when empty), freed with the source.
+/// Memory: COORD and O(nx ny) a layer. Layers, Coord() and Dims() are exactly those of a
+/// CornerPointLayerSource over ReadCornerPointModel and CornerPointGeometry::FromDeck(deck,
+/// false). Throws GrdeclError naming the file and place, std::invalid_argument for a
+/// malformed synth: spec.
+std::unique_ptr<LayerSource> OpenLayerSource(const std::string& input, const std::string& spoolFolder = "");
 
 } // namespace resmr

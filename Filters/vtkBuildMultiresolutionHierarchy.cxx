@@ -66,8 +66,10 @@ int vtkBuildMultiresolutionHierarchy::RequestData(
       throw std::invalid_argument("Input and FileName are both needed");
     }
     // Only rank 0 streams the input (the others read its partition), but every rank needs
-    // its size: each opens it, which for a grid file means reading it.
-    std::unique_ptr<resmr::LayerSource> source = resmr::OpenLayerSource(this->Input);
+    // its size: each opens it (an EGRID's header; a deck is parsed, its grid spooled to
+    // unique unlinked files in the shared scratch folder, so ranks never collide).
+    std::unique_ptr<resmr::LayerSource> source =
+      resmr::OpenLayerSource(this->Input, resmr::ScratchFolder(this->FileName, options));
     const resmr::HierarchyReport report =
       resmr::BuildHierarchy(*source, this->FileName, options, [this](const char* phase, double fraction) {
         this->SetProgressText(phase);

@@ -114,13 +114,13 @@ def report(rows, host, path_md):
     lines += ["", "## Property side (Sec. 5.3-5.5)",
               "The perfect spatial hash packs the cells any extracted face of any level touches (Sec. 5.4). "
               "'packed / cells' is the packed table's slots over those cells: the size of one property's 3D "
-              "texture against the bytes of the cells it holds (target <= 1.25); '+ offsets' adds the offset "
+              "texture against the bytes of the cells it holds (target <= 1.25). Tables need not be cubes: they take the shape (sides m0 x m1 x m2) of the first that packs among those shaped like the set, as deep as it, near cubes and its box, from 1.0 to 1.25 x the cells. 'offsets / cells' is the offset table's entries per hashed cell; '+ offsets' adds the offset "
               "table (6 bytes an entry, shared by every property) to one float property; 'of full grid' is the "
               "packed texture against a full ni x nj x nk texture. Property files: `resmr add-properties OUT.resmr "
               "MODEL.EGRID` (every INIT array and every array of every report step); the geometry file is compared "
               "byte for byte before and after.", "",
-              "| model | hashed cells | table side m | offsets side r | packed / cells | + offsets | of full grid | property tables | property MB | add s | geometry unchanged |",
-              "|---|---|---|---|---|---|---|---|---|---|---|"]
+              "| model | hashed cells | table m0 x m1 x m2 | offsets r0 x r1 x r2 | offsets / cells | packed / cells | + offsets | of full grid | property tables | property MB | add s | geometry unchanged |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         if "error" in r or "hash" not in r.get("info", {}):
             continue
@@ -128,7 +128,9 @@ def report(rows, host, path_md):
         p = r.get("properties", {})
         props = (f"{p['tables']} | {p['bytes'] / 1e6:.2f} | {p['seconds']:.2f} | {'yes' if p['geometry_unchanged'] else 'NO'}"
                  if "tables" in p else "- | - | - | -")
-        lines.append(f"| {r['name']} | {h['cells']:,} | {h['table_side']} | {h['offset_side']} | "
+        sides = lambda s: " x ".join(str(v) for v in s)
+        lines.append(f"| {r['name']} | {h['cells']:,} | {sides(h['table_sides'])} | {sides(h['offset_sides'])} | "
+                     f"{h['offsets'] / max(1, h['cells']):.3f} | "
                      f"{h['packed_over_cells_float']:.3f} | {h['packed_over_cells_float_with_offsets']:.3f} | "
                      f"{h['packed_over_full_grid']:.4f} | {props} |")
     synthetic = [r for r in rows if r["model"].startswith("synth:") and "error" not in r]

@@ -134,7 +134,8 @@ int BuildCommand(int argc, char** argv)
       std::fputs(BuildUsage, stderr);
       return 2;
     }
-    auto source = resmr::OpenLayerSource(input);
+    // A deck's grid is spooled to the scratch folder: memory stays O(one layer) for any input.
+    auto source = resmr::OpenLayerSource(input, resmr::ScratchFolder(output, options));
     const auto start = std::chrono::steady_clock::now();
     const bool terminal = isatty(2);
     double lastShown = -1;

@@ -3,8 +3,10 @@
 #pragma once
 
 #include <cstdio>
+#include <exception>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace resmr_testing
@@ -46,5 +48,26 @@ void ExpectError(const std::string& label, const std::function<void()>& action,
       }
     }
   }
+}
+
+/// Runs each named test, counting an exception it lets out as a failure, and prints one line
+/// a test; true when nothing failed.
+inline bool RunNamedTests(const std::vector<std::pair<const char*, std::function<void()>>>& tests)
+{
+  for (const auto& test : tests)
+  {
+    const int before = Failures;
+    try
+    {
+      test.second();
+    }
+    catch (const std::exception& error)
+    {
+      std::fprintf(stderr, "%s: unexpected exception: %s\n", test.first, error.what());
+      ++Failures;
+    }
+    std::printf("%-24s %s\n", test.first, Failures == before ? "ok" : "FAILED");
+  }
+  return Failures == 0;
 }
 } // namespace resmr_testing

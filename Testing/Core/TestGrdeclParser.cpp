@@ -398,20 +398,7 @@ int main()
     { "faulted sharing", TestFaultedSharing }, { "cartesian and edits", TestCartesianAndEdits },
     { "includes and mapaxes", TestIncludesAndMapAxes }, { "binary grdecl", TestBinaryGrdecl },
     { "bad input", TestBadInput } };
-  for (const auto& test : tests)
-  {
-    const int before = resmr_testing::Failures;
-    try
-    {
-      test.second();
-    }
-    catch (const std::exception& error)
-    {
-      std::fprintf(stderr, "%s: unexpected exception: %s\n", test.first, error.what());
-      ++resmr_testing::Failures;
-    }
-    std::printf("%-24s %s\n", test.first, resmr_testing::Failures == before ? "ok" : "FAILED");
-  }
+  const bool passed = resmr_testing::RunNamedTests(tests);
   std::system(("rm -rf '" + Directory + "'").c_str());
-  return resmr_testing::Failures == 0 ? 0 : 1;
+  return passed ? 0 : 1;
 }
