@@ -213,7 +213,7 @@ void ReadFiniteRecord(const EclipseKeywordFile& file, const EclipseRecord& recor
 }
 } // namespace
 
-EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
+EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells, EclipseGridParts parts)
 {
   if (maxCells <= 0)
   {
@@ -228,14 +228,17 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells)
   grid.localGridNames = std::move(layout.localGridNames);
   grid.nonNeighbourConnections = layout.nonNeighbourConnections;
   grid.units = std::move(layout.units);
-  ReadFiniteRecord(file, *layout.coord, deck.coord);
-  if (layout.zcorn->type == EclipseDataType::Real)
+  if (parts == EclipseGridParts::Everything)
   {
-    ReadFiniteRecord(file, *layout.zcorn, deck.zcornSingle); // EGRID's float32 depths, kept as they are
-  }
-  else
-  {
-    ReadFiniteRecord(file, *layout.zcorn, deck.zcorn);
+    ReadFiniteRecord(file, *layout.coord, deck.coord);
+    if (layout.zcorn->type == EclipseDataType::Real)
+    {
+      ReadFiniteRecord(file, *layout.zcorn, deck.zcornSingle); // EGRID's float32 depths, kept as they are
+    }
+    else
+    {
+      ReadFiniteRecord(file, *layout.zcorn, deck.zcorn);
+    }
   }
   if (layout.actnum)
   {

@@ -78,7 +78,17 @@ EclipseGridLayout LocateEclipseGrid(const EclipseKeywordFile& file, int64_t maxC
 /// record, unformatted or formatted.
 bool LooksLikeEclipseGridFile(const std::string& path);
 
+/// What ReadEclipseGrid reads: everything, or only what maps results to cells (dims and
+/// ACTNUM; deck.coord and the depths left empty), a ninth of the memory for callers that
+/// draw nothing (resmr add-properties).
+enum class EclipseGridParts
+{
+  Everything,
+  ActiveCellsOnly
+};
+
 /// Reads an EGRID or FEGRID file; maxCells 0 means "what this machine can hold".
-EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells = 0);
+EclipseGrid ReadEclipseGrid(
+  const std::string& path, int64_t maxCells = 0, EclipseGridParts parts = EclipseGridParts::Everything);
 
 } // namespace resmr

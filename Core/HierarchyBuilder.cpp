@@ -525,11 +525,14 @@ private:
   int64_t WorkTotal = 1;
   double WorkStart = 0, WorkSpan = 1;
   const char* Phase = "";
+  int64_t CellCount = 0;
 };
 
 int Builder::ThreadsFor(int64_t bytesPerTask) const
 {
-  int threads = this->Options.threads > 0 ? this->Options.threads : static_cast<int>(std::thread::hardware_concurrency());
+  constexpr int64_t cellsPerThread = 16384;
+  int threads = this->Options.threads > 0 ? this->Options.threads : static_cast<int>(std::min<int64_t>(
+    std::thread::hardware_concurrency(), (this->CellCount + cellsPerThread - 1) / cellsPerThread));
   threads = std::max(threads, 1);
   const int64_t budget = this->Options.memoryBytes > 0 ? this->Options.memoryBytes : AvailableMemoryBytes() / 2;
   const int64_t fit = std::max<int64_t>(1, budget / std::max<int64_t>(bytesPerTask, 1));
@@ -1217,6 +1220,7 @@ HierarchyReport Builder::Run()
   const auto dims = this->Source.Dims();
   const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
   report.cells = nx * ny * nz;
+  this->CellCount = report.cells;
   if (mkdir(this->Scratch.c_str(), 0755) != 0 && errno != EEXIST)
   {
     throw std::runtime_error(this->Scratch + ": cannot create the scratch folder: " + std::strerror(errno));

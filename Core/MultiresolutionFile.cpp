@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -447,9 +448,10 @@ std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw)
 {
   InitialiseLzo();
   std::vector<uint8_t> stored(raw.size() + raw.size() / 16 + 64 + 3);
-  std::vector<uint8_t> work(LZO1X_1_MEM_COMPRESS);
+  // LZO's dictionary, one a thread, never zeroed: it needs no initial contents.
+  thread_local std::unique_ptr<uint8_t[]> work(new uint8_t[LZO1X_1_MEM_COMPRESS]);
   lzo_uint length = 0;
-  lzo1x_1_compress(raw.data(), raw.size(), stored.data(), &length, work.data());
+  lzo1x_1_compress(raw.data(), raw.size(), stored.data(), &length, work.get());
   stored.resize(length);
   return stored;
 }
@@ -606,10 +608,8 @@ ChunkRef ChunkFile::Put(const std::vector<uint8_t>& raw, const std::string& what
     throw MultiresolutionFileError(this->FilePath + ": " + what + " of " + std::to_string(raw.size()) +
       " bytes is too big for a chunk");
   }
-  std::vector<uint8_t> stored(raw.size() + raw.size() / 16 + 64 + 3);
-  std::vector<uint8_t> work(LZO1X_1_MEM_COMPRESS);
-  lzo_uint length = 0;
-  lzo1x_1_compress(raw.data(), raw.size(), stored.data(), &length, work.data());
+  const std::vector<uint8_t> stored = CompressChunk(raw);
+  const std::size_t length = stored.size();
   ChunkRef ref;
   ref.stored = static_cast<uint32_t>(length);
   ref.raw = static_cast<uint32_t>(raw.size());
@@ -714,7 +714,15 @@ void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader 
   PutHeader(head, header);
   write(head.Bytes.data(), head.Bytes.size(), "header");
   std::vector<uint64_t> base(parts.size());
-  std::vector<uint8_t> block(std::size_t(1) << 22);
+  // Copied in blocks of 4 MiB, or of the largest part if smaller (no memory to zero for nothing).
+  std::size_t blockSize = 1;
+  for (const std::string& part : parts)
+  {
+    struct stat status;
+    blockSize = std::max<std::size_t>(blockSize, stat(part.c_str(), &status) == 0 ? static_cast<std::size_t>(status.st_size) : 0);
+  }
+  blockSize = std::min<std::size_t>(blockSize, std::size_t(1) << 22);
+  std::unique_ptr<uint8_t[]> block(new uint8_t[blockSize]);
   for (std::size_t p = 0; p < parts.size(); ++p)
   {
     base[p] = offset;
@@ -724,9 +732,9 @@ void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader 
       throw MultiresolutionFileError(parts[p] + ": cannot open the chunk file: " + std::strerror(errno));
     }
     std::size_t got = 0;
-    while ((got = std::fread(block.data(), 1, block.size(), in)) > 0)
+    while ((got = std::fread(block.get(), 1, blockSize, in)) > 0)
     {
-      write(block.data(), got, "chunks of " + parts[p]);
+      write(block.get(), got, "chunks of " + parts[p]);
     }
     const bool failed = std::ferror(in) != 0;
     std::fclose(in);

@@ -149,7 +149,7 @@ int AddPropertiesCommand(int argc, char** argv)
       if (ext == "EGRID" || ext == "FEGRID" || isInit || isRestart)
       {
         const std::string gridPath = (isInit || isRestart) ? GridBeside(input) : input;
-        const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath);
+        const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath, 0, resmr::EclipseGridParts::ActiveCellsOnly);
         if (grid.deck.dims != dims)
         {
           throw std::invalid_argument(gridPath + ": grid " + std::to_string(grid.deck.dims[0]) + "x" +
