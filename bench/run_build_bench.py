@@ -91,7 +91,7 @@ def report(all_rows, host, path_md):
         "# Multiresolution build (issue 6)",
         "",
         f"Machine: {host['cpu']}, {host['cores']} cores, {host['memory_gib']} GiB; memory budget `--memory {budget}`.",
-        "Command: `resmr build MODEL -o OUT.resmr --memory 4G` (Cmax: 4096, or a 32nd of the columns for small models, at least 256; every core), then `resmr info`.",
+        "Command: `resmr build MODEL -o OUT.resmr --memory 4G` (Cmax: 4096, or a 32nd of the columns for small models, at least 256; every core, but one a 16,384 cells), then `resmr info`.",
         "Peak RSS from /usr/bin/time. Cells are all ni x nj x nk cells, as the paper counts them.",
         "",
         "| model | cells | active | levels | regions | total s | cells/s | cells/s/core | peak RSS MB | file MB | bytes/cell |",
