@@ -7,6 +7,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace resmr
@@ -22,9 +23,12 @@ public:
 class ByteWriter
 {
 public:
+  /// A value's bytes as they lie in memory (little-endian machines only, as the formats say):
+  /// numbers, and std::arrays of them, which hold no padding.
   template <typename T>
   void Put(const T& value)
   {
+    static_assert(std::is_trivially_copyable<T>::value, "raw bytes of a trivially copyable value only");
     this->PutBytes(&value, sizeof(T));
   }
   void PutBytes(const void* data, std::size_t size)
@@ -55,9 +59,16 @@ public:
   template <typename T>
   T Get()
   {
+    static_assert(std::is_trivially_copyable<T>::value, "raw bytes of a trivially copyable value only");
     T value{};
     this->GetBytes(&value, sizeof(T));
     return value;
+  }
+  /// Get() into an existing variable (its type says how many bytes).
+  template <typename T>
+  void Get(T& value)
+  {
+    value = this->Get<T>();
   }
   void GetBytes(void* out, std::size_t size)
   {

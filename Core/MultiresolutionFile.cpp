@@ -307,34 +307,16 @@ void PutHeader(ByteWriter& out, const MultiresolutionHeader& h)
   out.PutBytes(HeaderMagic, 8);
   out.Put(MultiresolutionHeader::Version);
   out.Put(static_cast<uint32_t>(HeaderBytes));
-  for (int64_t d : h.dims)
-  {
-    out.Put(d);
-  }
-  for (double v : h.box)
-  {
-    out.Put(v);
-  }
-  for (double v : h.latticeOrigin)
-  {
-    out.Put(v);
-  }
-  for (double v : h.latticeStep)
-  {
-    out.Put(v);
-  }
+  out.Put(h.dims);
+  out.Put(h.box);
+  out.Put(h.latticeOrigin);
+  out.Put(h.latticeStep);
   out.Put(h.leafLevel);
   out.Put(h.cmax);
   out.Put(h.regionCount);
   out.Put(h.modelChunkCount);
-  for (uint32_t side : h.hashTableSides)
-  {
-    out.Put(side);
-  }
-  for (uint32_t side : h.hashOffsetSides)
-  {
-    out.Put(side);
-  }
+  out.Put(h.hashTableSides);
+  out.Put(h.hashOffsetSides);
   out.Put(h.hashedCells);
   out.Put(h.geometryId);
   out.Bytes.resize(HeaderBytes - 4, 0);
@@ -812,34 +794,16 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
       throw MultiresolutionFileError(path + ": header checksum mismatch (bytes 0-159 are corrupt)");
     }
     head.Get<uint32_t>();
-    for (int64_t& d : this->Head.dims)
-    {
-      d = head.Get<int64_t>();
-    }
-    for (double& v : this->Head.box)
-    {
-      v = head.Get<double>();
-    }
-    for (double& v : this->Head.latticeOrigin)
-    {
-      v = head.Get<double>();
-    }
-    for (double& v : this->Head.latticeStep)
-    {
-      v = head.Get<double>();
-    }
-    this->Head.leafLevel = head.Get<int32_t>();
-    this->Head.cmax = head.Get<int32_t>();
-    this->Head.regionCount = head.Get<uint64_t>();
-    this->Head.modelChunkCount = head.Get<uint64_t>();
-    for (uint32_t& side : this->Head.hashTableSides)
-    {
-      side = head.Get<uint32_t>();
-    }
-    for (uint32_t& side : this->Head.hashOffsetSides)
-    {
-      side = head.Get<uint32_t>();
-    }
+    head.Get(this->Head.dims);
+    head.Get(this->Head.box);
+    head.Get(this->Head.latticeOrigin);
+    head.Get(this->Head.latticeStep);
+    head.Get(this->Head.leafLevel);
+    head.Get(this->Head.cmax);
+    head.Get(this->Head.regionCount);
+    head.Get(this->Head.modelChunkCount);
+    head.Get(this->Head.hashTableSides);
+    head.Get(this->Head.hashOffsetSides);
     this->Head.hashedCells = head.Get<uint64_t>();
     this->Head.geometryId = head.Get<uint64_t>();
     const auto& d = this->Head.dims;

@@ -45,14 +45,8 @@ std::vector<uint8_t> HeaderOf(
   head.PutBytes(Magic, 8);
   head.Put(Version);
   head.Put(geometry);
-  for (int64_t d : dims)
-  {
-    head.Put(d);
-  }
-  for (uint32_t side : tableSides)
-  {
-    head.Put(side);
-  }
+  head.Put(dims);
+  head.Put(tableSides);
   head.Put(tables);
   head.Bytes.resize(HeaderBytes - 4, 0);
   head.Put(Crc32(head.Bytes.data(), head.Bytes.size()));
@@ -94,14 +88,8 @@ PropertyFile::PropertyFile(const std::string& path)
         std::to_string(Version));
     }
     this->Geometry = head.Get<uint64_t>();
-    for (int64_t& d : this->Dims)
-    {
-      d = head.Get<int64_t>();
-    }
-    for (uint32_t& side : this->TableSides)
-    {
-      side = head.Get<uint32_t>();
-    }
+    head.Get(this->Dims);
+    head.Get(this->TableSides);
     const uint32_t tables = head.Get<uint32_t>();
 
     const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
