@@ -1,0 +1,65 @@
+/**
+ * @class   vtkMultiresolutionReader
+ * @brief   Opens a .resmr file as a small descriptor of the model, not its cells.
+ *
+ * The multiresolution view (paper Sec. 6) reads meshes from the file itself, as the camera
+ * asks for them; the pipeline only carries what ParaView needs to list and colour the model:
+ * the model's bounding box as 8 points and its 12 edges (z up, z = -depth), and one cell
+ * array a property of the property file beside it (FILE.resmrp, or PropertyFileName), each
+ * holding that property's minimum and maximum at the requested time step, so Color By lists
+ * the properties and Rescale finds their ranges. The property file's report steps (in days)
+ * are the time steps. A damaged file, or a property file of another geometry, is an error
+ * naming the file.
+ */
+#ifndef vtkMultiresolutionReader_h
+#define vtkMultiresolutionReader_h
+
+#include "ResMRRepresentationsModule.h"
+#include "vtkPolyDataAlgorithm.h"
+
+#include <string>
+#include <vector>
+
+class RESMRREPRESENTATIONS_EXPORT vtkMultiresolutionReader : public vtkPolyDataAlgorithm
+{
+public:
+  static vtkMultiresolutionReader* New();
+  vtkTypeMacro(vtkMultiresolutionReader, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// The .resmr file.
+  vtkSetStdStringFromCharMacro(FileName);
+  vtkGetCharFromStdStringMacro(FileName);
+
+  /// The property file; empty (the default): FILE.resmrp beside the .resmr, if it exists.
+  vtkSetStdStringFromCharMacro(PropertyFileName);
+  vtkGetCharFromStdStringMacro(PropertyFileName);
+
+  /// The property file actually used after the last update (empty if none).
+  const std::string& GetResolvedPropertyFileName() const { return this->ResolvedPropertyFile; }
+
+  /// Why the last update failed; empty if it did not.
+  const char* GetLastError() const { return this->LastError.c_str(); }
+
+protected:
+  vtkMultiresolutionReader();
+  ~vtkMultiresolutionReader() override;
+
+  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+private:
+  vtkMultiresolutionReader(const vtkMultiresolutionReader&) = delete;
+  void operator=(const vtkMultiresolutionReader&) = delete;
+
+  std::string PropertyPathFor() const;
+  int Fail(const std::string& message);
+
+  std::string FileName;
+  std::string PropertyFileName;
+  std::string ResolvedPropertyFile;
+  std::string LastError;
+  std::vector<double> StepDays; ///< per report step, from the property file
+};
+
+#endif
