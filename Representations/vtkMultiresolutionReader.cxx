@@ -59,9 +59,11 @@ int vtkMultiresolutionReader::RequestInformation(
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
   this->StepDays.clear();
   this->LastError.clear();
+  this->InformationFailed.clear();
   if (this->FileName.empty())
   {
-    return this->Fail("no FileName: a .resmr file is needed");
+    this->InformationFailed = "no FileName: a .resmr file is needed";
+    return this->Fail(this->InformationFailed);
   }
   try
   {
@@ -95,7 +97,8 @@ int vtkMultiresolutionReader::RequestInformation(
   }
   catch (const std::exception& error)
   {
-    return this->Fail(error.what());
+    this->InformationFailed = error.what();
+    return this->Fail(this->InformationFailed);
   }
   return 1;
 }
@@ -105,10 +108,11 @@ int vtkMultiresolutionReader::RequestData(
 {
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   vtkPolyData* output = vtkPolyData::GetData(outInfo);
-  if (!this->LastError.empty())
+  if (!this->InformationFailed.empty())
   {
-    return 0; // RequestInformation failed: the message stands
+    return this->Fail(this->InformationFailed); // the file did not open: the message stands
   }
+  this->LastError.clear();
   // One piece: the descriptor is tiny, and the view reads the file wherever it renders.
   if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()) &&
     outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()) > 0)

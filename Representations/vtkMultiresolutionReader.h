@@ -59,6 +59,7 @@ private:
   std::string PropertyFileName;
   std::string ResolvedPropertyFile;
   std::string LastError;
+  std::string InformationFailed; ///< why RequestInformation failed (the file did not open)
   std::vector<double> StepDays; ///< per report step, from the property file
 };
 
