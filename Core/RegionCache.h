@@ -1,0 +1,134 @@
+// Out-of-core loading of region meshes, paper Sec. 6.2 (Fig. 10): a loader thread receives
+// each frame's wanted regions, decompresses their meshes from the memory-mapped file,
+// prepares draw buffers and marks them resident; a least-recently-used budget bounds what
+// stays resident. The render thread only ever looks up what is ready: it never waits on disk.
+//
+// Contract:
+// - Draw buffers (RegionDrawBuffers): per vertex x, y, z (z = -depth, relative to the
+//   model origin the cache reports, so float32 keeps millimetres over a whole field) and the
+//   cell coordinate c (the topological coordinate moved half a cell inward along the face's
+//   constant axis: floor(c) at any point of a face is the 0-based (i, j, k) of the cell the
+//   face belongs to, and c is an integer + 0.5 on that axis). Triangles: the top surface,
+//   then the bottom, then the side (the file's simplified side triangles), counter-clockwise
+//   seen from outside in the z-up frame.
+// - Resident bytes (the buffers' sizes) stay within the budget, except that the roots and
+//   the regions requested by the newest frame are never evicted to load others: when the
+//   wanted set outgrows the budget, loading stops there (the selection then draws ancestors).
+//   Least recently requested regions are evicted first.
+// - Property tables (Sec. 5.4: one value a hash slot) load on the same thread; the previous
+//   table stays current until the new one is ready.
+// - Errors reading the file (damaged chunk) are kept, not thrown on the render thread:
+//   LastError() names the file and the region; the region is never resident.
+#pragma once
+
+#include "MultiresolutionFile.h"
+#include "PropertyFile.h"
+
+#include <array>
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace resmr
+{
+
+struct RegionDrawBuffers
+{
+  std::vector<float> vertices;   ///< per vertex: x, y, z, ci, cj, ck
+  std::vector<uint32_t> indices; ///< triangles: top, bottom, side
+  uint32_t topIndices = 0, bottomIndices = 0, sideIndices = 0; ///< index counts of each part
+  std::size_t Bytes() const { return this->vertices.size() * 4 + this->indices.size() * 4; }
+};
+
+/// +1 or -1: the sign of the determinant of d(x, y, z) / d(i, j, k) over the model (z up),
+/// which tells which side of a side face its cell lies on. From the first cell found.
+int TopologyHandedness(const MultiresolutionFile& file);
+
+/// Draw buffers of a decoded region (surfaces and topological coordinates are enough).
+RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin,
+  int handedness);
+
+struct PropertyTableData
+{
+  std::string name;
+  int32_t step = -1;
+  std::vector<float> values; ///< one a hash slot
+};
+
+class RegionCache
+{
+public:
+  /// Starts the loader thread. `properties` may be null.
+  RegionCache(std::shared_ptr<const MultiresolutionFile> file, std::shared_ptr<const PropertyFile> properties,
+    std::size_t budgetBytes);
+  ~RegionCache(); ///< stops and joins the loader thread
+  RegionCache(const RegionCache&) = delete;
+  RegionCache& operator=(const RegionCache&) = delete;
+
+  /// World position of the vertices' origin: (latticeOrigin x, y, -depth).
+  std::array<double, 3> Origin() const { return this->ModelOrigin; }
+
+  /// The buffers of a resident region, or null. Never blocks on loading.
+  std::shared_ptr<const RegionDrawBuffers> Get(std::size_t region) const;
+  bool IsResident(std::size_t region) const;
+
+  /// The frame's wanted regions in loading order (replaces the previous request), then regions
+  /// wanted by predicted frames, loaded after and evicted first.
+  void Request(const std::vector<std::size_t>& wanted, const std::vector<std::size_t>& predicted = {});
+  /// Asks for a property table (name, step); Property() keeps the previous one until it loads.
+  void RequestProperty(const std::string& name, int32_t step);
+  std::shared_ptr<const PropertyTableData> Property() const;
+
+  /// True while a requested region or property table is not loaded yet and can still be
+  /// (not over budget, no error).
+  bool Pending() const;
+  /// Waits until nothing is pending or `timeout` passes; true if nothing is pending.
+  bool WaitIdle(std::chrono::milliseconds timeout) const;
+
+  void SetBudget(std::size_t bytes);
+  std::size_t Budget() const;
+  std::size_t ResidentBytes() const;
+  std::size_t ResidentCount() const;
+  /// Bumped whenever a region becomes resident or is evicted (mirrors drop what changed).
+  uint64_t Generation() const;
+  std::string LastError() const;
+
+private:
+  void Run();
+  // (members are the implementation's)
+  std::shared_ptr<const MultiresolutionFile> File;
+  std::shared_ptr<const PropertyFile> Properties;
+  std::array<double, 3> ModelOrigin{};
+  int Handedness = 1;
+  mutable std::mutex Lock;
+  mutable std::condition_variable Wake, Idle;
+  std::thread Loader;
+  bool Stopping = false;
+  std::size_t BudgetBytes = 0;
+  std::size_t Bytes = 0;
+  uint64_t Changes = 0;
+  uint64_t Clock = 0;
+  struct Entry
+  {
+    std::shared_ptr<const RegionDrawBuffers> buffers;
+    uint64_t lastRequested = 0;
+    bool failed = false;
+  };
+  std::map<std::size_t, Entry> Entries;
+  std::vector<std::size_t> Wanted, Predicted;
+  std::vector<std::size_t> Pinned;
+  std::string Error;
+  std::string PropertyName;
+  int32_t PropertyStep = -1;
+  bool PropertyWanted = false;
+  std::shared_ptr<const PropertyTableData> CurrentProperty;
+};
+
+} // namespace resmr

@@ -1,0 +1,92 @@
+// View-dependent selection of region meshes for one frame, paper Sec. 6.2: a stateless
+// top-down traversal of the diamond hierarchy that splits a diamond while its projected error
+// (Lindstrom's bound) exceeds a pixel tolerance, culls regions outside the view frustum, culls
+// top and bottom surfaces facing away by their normal cones, and draws a region whose
+// children are not resident yet with the region itself (never a hole, never a crack).
+//
+// Contract:
+// - World coordinates are VTK's: (x, y, z) with z = -depth (z up). The file's bounds are
+//   (x, y, depth); the selection converts them.
+// - Projected error of a diamond: its model-space error e (RegionRecord::error, the same for
+//   both triangles, never smaller than a descendant's) seen as a sphere of radius e at the
+//   point of the diamond's bounding box nearest the eye: pixels = e * PixelsPerUnit / d,
+//   d = that distance (perspective; infinite when the eye is inside the box), or
+//   e * PixelsPerUnit (parallel projection).
+// - Conformity: a diamond is split only when every triangle of it is in the cut and all of
+//   their children (absent regions are empty and count as resident) are resident. Bounding
+//   boxes enclose every descendant, so projected errors never grow down the tree and the cut
+//   of an all-resident hierarchy is the ideal one.
+// - A root region that is not resident is not drawn (the caller loads the roots first).
+// - `wanted` lists the regions of the ideal cut (as if everything were resident) and the
+//   ancestors leading to them, coarse before fine and near before far: the loading order.
+#pragma once
+
+#include "MultiresolutionFile.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace resmr
+{
+
+struct ViewParameters
+{
+  /// World to clip coordinates, row-major (clip = M * (x, y, z, 1)); OpenGL clip space.
+  std::array<double, 16> worldToClip{};
+  std::array<double, 3> eye{};       ///< camera position, world
+  std::array<double, 3> direction{}; ///< unit view direction, world (parallel projection)
+  bool parallel = false;
+  /// Pixels one world unit covers at distance 1 (perspective: viewport height / (2 tan(fovy/2)))
+  /// or anywhere (parallel: viewport height / (2 parallel scale)).
+  double pixelsPerUnit = 1;
+  double tolerancePixels = 1;
+};
+
+struct DrawnRegion
+{
+  std::size_t region = 0; ///< index into MultiresolutionFile::Regions()
+  bool top = true, bottom = true, side = true; ///< surfaces not culled by their normal cones
+};
+
+struct ViewSelection
+{
+  std::vector<DrawnRegion> drawn;  ///< what to draw this frame (resident regions only)
+  std::vector<std::size_t> wanted; ///< the loading order (see the contract)
+  /// Largest projected error (pixels) of a drawn region's diamond; what the tolerance holds
+  /// once everything wanted is resident.
+  double largestProjectedError = 0;
+  /// Drawn regions standing in for wanted descendants that are not resident.
+  std::size_t substituted = 0;
+};
+
+/// The diamond tree of one file, built once: children and diamond partners of every region.
+class ViewSelector
+{
+public:
+  explicit ViewSelector(const MultiresolutionFile& file);
+
+  /// Selects for `view`; `resident(region)` says whether a region's mesh is ready to draw.
+  ViewSelection Select(const ViewParameters& view, const std::function<bool(std::size_t)>& resident) const;
+
+  /// The root regions (level 0), which the caller keeps resident.
+  const std::vector<std::size_t>& Roots() const { return this->RootRegions; }
+
+private:
+  struct Node
+  {
+    std::array<int64_t, 2> children{ -1, -1 }; ///< region indices, -1: absent (empty)
+    int64_t partner = -1;                      ///< the other triangle of its diamond, -1: none
+  };
+  const MultiresolutionFile* File = nullptr;
+  std::vector<Node> Nodes;
+  std::vector<std::size_t> RootRegions;
+};
+
+/// Where the camera will probably be a frame ahead: the last two views extrapolated linearly
+/// (eye and clip matrix), for loading ahead of need.
+ViewParameters PredictNextView(const ViewParameters& previous, const ViewParameters& current);
+
+} // namespace resmr
