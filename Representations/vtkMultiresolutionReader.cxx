@@ -58,6 +58,7 @@ int vtkMultiresolutionReader::RequestInformation(
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
   this->StepDays.clear();
+  this->StepNumbers.clear();
   this->LastError.clear();
   this->InformationFailed.clear();
   if (this->FileName.empty())
@@ -85,6 +86,7 @@ int vtkMultiresolutionReader::RequestInformation(
     }
     for (const auto& step : steps)
     {
+      this->StepNumbers.push_back(step.first);
       this->StepDays.push_back(step.second);
     }
     if (!this->StepDays.empty())
@@ -163,19 +165,18 @@ int vtkMultiresolutionReader::RequestData(
     }
     output->SetPoints(points);
     output->SetLines(edges);
+    int32_t step = 0;
 
     if (!this->ResolvedPropertyFile.empty())
     {
       const resmr::PropertyFile properties(this->ResolvedPropertyFile);
       properties.CheckGeometry(geometry);
       // The step shown: the last whose time is not after the requested one.
-      int32_t step = 0;
       if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()) && !this->StepDays.empty())
       {
         const double time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
-        const auto after = std::upper_bound(this->StepDays.begin(), this->StepDays.end(), time);
-        step = static_cast<int32_t>(std::max<std::ptrdiff_t>(0, (after - this->StepDays.begin()) - 1));
-        output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), this->StepDays[static_cast<std::size_t>(step)]);
+        step = this->GetStepNumber(time);
+        output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), this->StepDays[this->StepIndex(time)]);
       }
       // Each property's range at that step (static ones at every step): what Color By lists
       // and Rescale reads. Names without a table at this step get NaN.
@@ -208,6 +209,17 @@ int vtkMultiresolutionReader::RequestData(
     return this->Fail(error.what());
   }
   return 1;
+}
+
+std::size_t vtkMultiresolutionReader::StepIndex(double time) const
+{
+  const auto after = std::upper_bound(this->StepDays.begin(), this->StepDays.end(), time);
+  return static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (after - this->StepDays.begin()) - 1));
+}
+
+int vtkMultiresolutionReader::GetStepNumber(double time) const
+{
+  return this->StepNumbers.empty() ? 0 : this->StepNumbers[this->StepIndex(time)];
 }
 
 int vtkMultiresolutionReader::Fail(const std::string& message)

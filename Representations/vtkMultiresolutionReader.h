@@ -38,6 +38,9 @@ public:
   /// The property file actually used after the last update (empty if none).
   const std::string& GetResolvedPropertyFileName() const { return this->ResolvedPropertyFile; }
 
+  /// The property file's step shown at `time` (days): the last not after it (0 if none).
+  int GetStepNumber(double time) const;
+
   /// Why the last update failed; empty if it did not.
   const char* GetLastError() const { return this->LastError.c_str(); }
 
@@ -53,6 +56,7 @@ private:
   void operator=(const vtkMultiresolutionReader&) = delete;
 
   std::string PropertyPathFor() const;
+  std::size_t StepIndex(double time) const;
   int Fail(const std::string& message);
 
   std::string FileName;
@@ -60,7 +64,8 @@ private:
   std::string ResolvedPropertyFile;
   std::string LastError;
   std::string InformationFailed; ///< why RequestInformation failed (the file did not open)
-  std::vector<double> StepDays; ///< per report step, from the property file
+  std::vector<double> StepDays;     ///< per report step, from the property file
+  std::vector<int32_t> StepNumbers; ///< the property file's step of each
 };
 
 #endif

@@ -1,0 +1,37 @@
+// Holding a target frame rate by the projected error tolerance, paper Sec. 6.3: the primitive
+// count, and so the frame time, falls as the tolerance grows, so the tolerance is scaled by
+// the ratio of measured to target frame time, a little each frame.
+//
+// Contract:
+// - Update(frameSeconds) takes the last frame's measured time and gives the tolerance (pixels)
+//   for the next frame. Frames slower than the target raise the tolerance at once in
+//   proportion (the 99th percentile matters more than the mean); faster ones lower it
+//   gently, and only while the frame time leaves a margin (below 80% of the target), so the
+//   tolerance does not oscillate around the target.
+// - The tolerance stays within [MinimumPixels, MaximumPixels].
+// - Tolerance grows as frame time to the power 1/2: triangles drawn go as about 1 / tol^2
+//   for surfaces (screen-space error bounds a linear size).
+#pragma once
+
+namespace resmr
+{
+
+class FrameRateController
+{
+public:
+  static constexpr double MinimumPixels = 0.5;
+  static constexpr double MaximumPixels = 256;
+
+  void SetTargetFramesPerSecond(double fps) { this->TargetSeconds = fps > 0 ? 1.0 / fps : 0.1; }
+  double TargetFramesPerSecond() const { return 1.0 / this->TargetSeconds; }
+  void Reset(double tolerancePixels);
+  double Tolerance() const { return this->Pixels; }
+  /// The tolerance for the next frame, from the time the last one took.
+  double Update(double frameSeconds);
+
+private:
+  double TargetSeconds = 0.1;
+  double Pixels = 1;
+};
+
+} // namespace resmr

@@ -1,0 +1,113 @@
+//VTK::System::Dec
+//VTK::Output::Dec
+// Multiresolution surface, fragment stage (paper Sec. 5.1-5.4): the original cell under the
+// fragment is floor(cell coordinate); its property and top/bottom normal are found through
+// the perfect spatial hash (two texel fetches); the original grid lines are where the
+// coordinate crosses an integer, drawn a fixed width in pixels and faded out where cells
+// shrink below a few pixels.
+
+in vec3 cellCoord;
+in vec3 viewPosition;
+
+uniform int colorMode;    // 0: solid colour, 1: property, 2: cell id (debug), 3: layer k
+uniform int faceKind;     // 0: top, 1: bottom, 2: side
+uniform ivec3 gridDims;   // nx, ny, nz
+uniform ivec3 tableSides; // m
+uniform ivec3 offsetSides; // r
+uniform usampler3D hashOffsets;  // r0 x r1 x r2, RGB16UI
+uniform usampler3D cellNormals;  // m0 x m1 x m2, RG16UI (top, bottom)
+uniform sampler3D propertyTable; // m0 x m1 x m2, R32F
+uniform sampler2D colorMap;      // N x 1, RGBA8
+uniform vec2 scalarRange;        // lookup table range (log10 of it when logScale)
+uniform int logScale;
+uniform vec4 nanColor;
+uniform vec3 solidColor;
+uniform int gridLines;
+uniform float gridLineWidth;     // pixels
+uniform vec3 gridLineColor;
+uniform float ambient;
+uniform float diffuse;
+uniform float specular;
+uniform float specularPower;
+uniform mat3 normalToView;
+
+ivec3 HashSlot(ivec3 cell)
+{
+  ivec3 offset = ivec3(texelFetch(hashOffsets, cell % offsetSides, 0).xyz);
+  return (cell % tableSides + offset) % tableSides;
+}
+
+vec3 DecodeNormal(uint code)
+{
+  vec2 e = max(vec2(bitfieldExtract(int(code), 0, 8), bitfieldExtract(int(code), 8, 8)) / 127.0, vec2(-1.0));
+  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+  float t = max(-n.z, 0.0);
+  n.xy -= t * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+  return normalize(n);
+}
+
+void main()
+{
+  ivec3 cell = clamp(ivec3(floor(cellCoord)), ivec3(0), gridDims - 1);
+  if (colorMode == 2)
+  {
+    int id = cell.x + gridDims.x * (cell.y + gridDims.y * cell.z) + 1;
+    gl_FragData[0] = vec4(float(id & 255), float((id >> 8) & 255), float((id >> 16) & 255), 255.0) / 255.0;
+    return;
+  }
+  ivec3 slot = HashSlot(cell);
+
+  vec3 color = solidColor;
+  if (colorMode == 1)
+  {
+    float value = texelFetch(propertyTable, slot, 0).r;
+    if (isnan(value))
+    {
+      color = nanColor.rgb;
+    }
+    else
+    {
+      float v = value;
+      if (logScale == 1)
+      {
+        v = value > 0.0 ? log(value) / log(10.0) : scalarRange.x;
+      }
+      float span = scalarRange.y - scalarRange.x;
+      float t = span > 0.0 ? clamp((v - scalarRange.x) / span, 0.0, 1.0) : 0.5;
+      int size = textureSize(colorMap, 0).x;
+      color = texelFetch(colorMap, ivec2(min(int(t * float(size)), size - 1), 0), 0).rgb;
+    }
+  }
+
+  // Normal (view space): the original cell's top or bottom face normal (Sec. 5.3), the
+  // facet's own for sides. Lit from the camera (headlight), both sides.
+  vec3 facet = normalize(cross(dFdx(viewPosition), dFdy(viewPosition)));
+  vec3 normal = facet;
+  if (faceKind < 2)
+  {
+    uvec2 codes = texelFetch(cellNormals, slot, 0).xy;
+    normal = normalize(normalToView * DecodeNormal(faceKind == 0 ? codes.x : codes.y));
+  }
+  if (dot(normal, facet) < 0.0 && faceKind == 2)
+  {
+    normal = -normal;
+  }
+  vec3 toEye = normalize(-viewPosition);
+  float lambert = abs(dot(normal, toEye));
+  float highlight = pow(lambert, specularPower);
+  color = color * (ambient + diffuse * lambert) + vec3(specular * highlight);
+
+  if (gridLines == 1)
+  {
+    // Distance to the nearest integer of each coordinate, in pixels; the constant axis sits
+    // half a cell from any integer with a zero derivative, so it never makes a line.
+    vec3 perPixel = max(fwidth(cellCoord), vec3(1e-6));
+    vec3 pixels = abs(fract(cellCoord + 0.5) - 0.5) / perPixel;
+    vec3 cellPixels = 1.0 / perPixel;
+    vec3 fade = smoothstep(vec3(3.0), vec3(8.0), cellPixels);
+    vec3 line = (1.0 - smoothstep(vec3(0.5 * gridLineWidth - 0.5), vec3(0.5 * gridLineWidth + 0.5), pixels)) * fade;
+    float strength = max(line.x, max(line.y, line.z));
+    color = mix(color, gridLineColor, strength);
+  }
+  gl_FragData[0] = vec4(color, 1.0);
+}

@@ -1,0 +1,734 @@
+#include "vtkMultiresolutionSurfaceMapper.h"
+
+#include "FrameRateController.h"
+#include "MultiresolutionFile.h"
+#include "PropertyFile.h"
+#include "RegionCache.h"
+#include "ViewSelection.h"
+
+#include "vtkActor.h"
+#include "vtkCamera.h"
+#include "vtkFieldData.h"
+#include "vtkInformation.h"
+#include "vtkMath.h"
+#include "vtkMatrix3x3.h"
+#include "vtkMatrix4x4.h"
+#include "vtkOpenGLCamera.h"
+#include "vtkObjectFactory.h"
+#include "vtkOpenGLBufferObject.h"
+#include "vtkOpenGLError.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLShaderCache.h"
+#include "vtkOpenGLState.h"
+#include "vtkOpenGLVertexArrayObject.h"
+#include "vtkPolyData.h"
+#include "vtkProperty.h"
+#include "vtkRenderer.h"
+#include "vtkScalarsToColors.h"
+#include "vtkShaderProgram.h"
+#include "vtkStringArray.h"
+#include "vtkTextureObject.h"
+#include "vtk_glew.h"
+
+#include "MultiresolutionSurfaceFS.h"
+#include "MultiresolutionSurfaceVS.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+
+vtkStandardNewMacro(vtkMultiresolutionSurfaceMapper);
+
+namespace
+{
+using Matrix = std::array<double, 16>; // row-major
+
+Matrix Multiply(const Matrix& a, const Matrix& b)
+{
+  Matrix c{};
+  for (int i = 0; i < 4; ++i)
+  {
+    for (int j = 0; j < 4; ++j)
+    {
+      for (int k = 0; k < 4; ++k)
+      {
+        c[4 * i + j] += a[4 * i + k] * b[4 * k + j];
+      }
+    }
+  }
+  return c;
+}
+
+/// VTK's OpenGL key matrices are stored transposed (ready for column-major upload).
+Matrix FromTransposed(vtkMatrix4x4* m)
+{
+  Matrix r{};
+  for (int i = 0; i < 4; ++i)
+  {
+    for (int j = 0; j < 4; ++j)
+    {
+      r[4 * i + j] = m->GetElement(j, i);
+    }
+  }
+  return r;
+}
+
+Matrix FromRowMajor(vtkMatrix4x4* m)
+{
+  Matrix r{};
+  for (int i = 0; i < 16; ++i)
+  {
+    r[i] = m->GetElement(i / 4, i % 4);
+  }
+  return r;
+}
+
+void ColumnMajor(const Matrix& m, float out[16])
+{
+  for (int i = 0; i < 4; ++i)
+  {
+    for (int j = 0; j < 4; ++j)
+    {
+      out[4 * j + i] = static_cast<float>(m[4 * i + j]);
+    }
+  }
+}
+
+struct GpuRegion
+{
+  vtkNew<vtkOpenGLBufferObject> vertices;
+  vtkNew<vtkOpenGLBufferObject> indices;
+  vtkNew<vtkOpenGLVertexArrayObject> layout;
+  std::shared_ptr<const resmr::RegionDrawBuffers> buffers;
+  std::size_t bytes = 0;
+  bool ready = false;
+};
+} // namespace
+
+struct vtkMultiresolutionSurfaceMapper::Internals
+{
+  // Files (reopened when the descriptor names others).
+  std::string FilePath, PropertyPath;
+  int32_t Step = 0;
+  std::shared_ptr<const resmr::MultiresolutionFile> File;
+  std::shared_ptr<const resmr::PropertyFile> Properties;
+  std::unique_ptr<resmr::ViewSelector> Selector;
+  std::unique_ptr<resmr::RegionCache> Cache;
+  std::string Error;
+  double Bounds[6] = { 0, 0, 0, 0, 0, 0 };
+
+  // GPU side.
+  std::map<std::size_t, std::unique_ptr<GpuRegion>> Gpu;
+  std::size_t GpuBytes = 0;
+  vtkNew<vtkTextureObject> OffsetTexture, NormalTexture, PropertyTexture, ColorTexture;
+  bool HashUploaded = false;
+  std::shared_ptr<const resmr::PropertyTableData> UploadedProperty;
+  vtkMTimeType ColorTableTime = 0;
+  vtkScalarsToColors* ColorTable = nullptr;
+  double ColorRange[2] = { 0, 1 };
+  vtkOpenGLRenderWindow* Window = nullptr;
+  unsigned int TimerQuery = 0;
+  bool TimerPending = false;
+  double GpuMs = 0;
+
+  // View state and readout.
+  resmr::FrameRateController Controller;
+  bool HavePreviousView = false;
+  resmr::ViewParameters PreviousView;
+  double Tolerance = 1;
+  vtkIdType Triangles = 0;
+  int Drawn = 0, Substituted = 0;
+  double FrameMs = 0;
+  bool Pending = false;
+
+  void Close()
+  {
+    this->Cache.reset();
+    this->Selector.reset();
+    this->Properties.reset();
+    this->File.reset();
+    this->FilePath.clear();
+    this->PropertyPath.clear();
+    this->HashUploaded = false;
+    this->UploadedProperty.reset();
+  }
+
+  void ReleaseGpu()
+  {
+    for (auto& entry : this->Gpu)
+    {
+      entry.second->layout->ReleaseGraphicsResources();
+      entry.second->vertices->ReleaseGraphicsResources();
+      entry.second->indices->ReleaseGraphicsResources();
+    }
+    this->Gpu.clear();
+    this->GpuBytes = 0;
+    this->HashUploaded = false;
+    this->UploadedProperty.reset();
+    this->ColorTableTime = 0;
+  }
+};
+
+vtkMultiresolutionSurfaceMapper::vtkMultiresolutionSurfaceMapper()
+  : Internal(new Internals)
+{
+  this->Internal->Controller.Reset(this->PixelTolerance);
+}
+
+vtkMultiresolutionSurfaceMapper::~vtkMultiresolutionSurfaceMapper() = default;
+
+int vtkMultiresolutionSurfaceMapper::FillInputPortInformation(int, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  return 1;
+}
+
+double vtkMultiresolutionSurfaceMapper::GetCurrentTolerance() const
+{
+  return this->Internal->Tolerance;
+}
+double vtkMultiresolutionSurfaceMapper::GetResidentMB() const
+{
+  const std::size_t bytes = this->Internal->Cache ? this->Internal->Cache->ResidentBytes() : 0;
+  return double(bytes) / (1 << 20);
+}
+vtkIdType vtkMultiresolutionSurfaceMapper::GetTrianglesDrawn() const
+{
+  return this->Internal->Triangles;
+}
+int vtkMultiresolutionSurfaceMapper::GetRegionsDrawn() const
+{
+  return this->Internal->Drawn;
+}
+int vtkMultiresolutionSurfaceMapper::GetRegionsSubstituted() const
+{
+  return this->Internal->Substituted;
+}
+double vtkMultiresolutionSurfaceMapper::GetLastFrameMs() const
+{
+  return this->Internal->FrameMs;
+}
+bool vtkMultiresolutionSurfaceMapper::GetLoadsPending() const
+{
+  return this->Internal->Pending;
+}
+const char* vtkMultiresolutionSurfaceMapper::GetLastError() const
+{
+  if (this->Internal->Error.empty() && this->Internal->Cache)
+  {
+    static thread_local std::string cacheError;
+    cacheError = this->Internal->Cache->LastError();
+    return cacheError.c_str();
+  }
+  return this->Internal->Error.c_str();
+}
+
+double* vtkMultiresolutionSurfaceMapper::GetBounds()
+{
+  vtkPolyData* input = vtkPolyData::SafeDownCast(this->GetInputDataObject(0, 0));
+  if (input && input->GetNumberOfPoints() > 0)
+  {
+    input->GetBounds(this->Bounds);
+  }
+  else
+  {
+    vtkMath::UninitializeBounds(this->Bounds);
+  }
+  return this->Bounds;
+}
+
+void vtkMultiresolutionSurfaceMapper::ReleaseGraphicsResources(vtkWindow* window)
+{
+  Internals& in = *this->Internal;
+  in.ReleaseGpu();
+  in.OffsetTexture->ReleaseGraphicsResources(window);
+  in.NormalTexture->ReleaseGraphicsResources(window);
+  in.PropertyTexture->ReleaseGraphicsResources(window);
+  in.ColorTexture->ReleaseGraphicsResources(window);
+  if (in.TimerQuery != 0)
+  {
+    glDeleteQueries(1, &in.TimerQuery);
+    in.TimerQuery = 0;
+    in.TimerPending = false;
+  }
+  in.Window = nullptr;
+  this->Modified();
+}
+
+namespace
+{
+/// (.resmr path, .resmrp path, step) from the descriptor; false if it has none.
+bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties, int32_t& step)
+{
+  vtkFieldData* fields = input ? input->GetFieldData() : nullptr;
+  vtkStringArray* source =
+    fields ? vtkStringArray::SafeDownCast(fields->GetAbstractArray(vtkMultiresolutionSurfaceMapper::SourceArrayName()))
+           : nullptr;
+  if (!source || source->GetNumberOfValues() < 3)
+  {
+    return false;
+  }
+  file = source->GetValue(0);
+  properties = source->GetValue(1);
+  step = static_cast<int32_t>(std::stol(source->GetValue(2)));
+  return true;
+}
+
+void UploadInteger3D(vtkTextureObject* texture, vtkOpenGLRenderWindow* window, const std::array<uint32_t, 3>& sides,
+  int components, unsigned int internalFormat, unsigned int format, const void* data)
+{
+  texture->SetContext(window);
+  texture->ResetFormatAndType();
+  texture->SetInternalFormat(internalFormat);
+  texture->SetFormat(format);
+  texture->SetDataType(GL_UNSIGNED_SHORT);
+  texture->SetMinificationFilter(vtkTextureObject::Nearest);
+  texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+  texture->Create3DFromRaw(sides[0], sides[1], sides[2], components, VTK_UNSIGNED_SHORT, const_cast<void*>(data));
+}
+} // namespace
+
+void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* actor)
+{
+  Internals& in = *this->Internal;
+  const auto start = std::chrono::steady_clock::now();
+  in.Triangles = 0;
+  in.Drawn = 0;
+  in.Substituted = 0;
+  if (renderer->GetSelector())
+  {
+    return; // hardware picking: the descriptor has no cells to name
+  }
+  vtkDataObject* input = this->GetInputDataObject(0, 0);
+  std::string filePath, propertyPath;
+  int32_t step = 0;
+  if (!ReadSource(input, filePath, propertyPath, step))
+  {
+    return; // an empty piece (another rank) or no file yet
+  }
+
+  // (Re)open the files when the descriptor names others.
+  if (filePath != in.FilePath || propertyPath != in.PropertyPath || !in.Cache)
+  {
+    in.Close();
+    in.ReleaseGpu();
+    in.Error.clear();
+    try
+    {
+      in.File = std::make_shared<const resmr::MultiresolutionFile>(filePath);
+      if (!propertyPath.empty())
+      {
+        auto properties = std::make_shared<const resmr::PropertyFile>(propertyPath);
+        properties->CheckGeometry(*in.File);
+        in.Properties = properties;
+      }
+      in.Selector.reset(new resmr::ViewSelector(*in.File));
+      in.Cache.reset(new resmr::RegionCache(in.File, in.Properties, std::size_t(this->MemoryBudgetMB) << 20));
+      in.FilePath = filePath;
+      in.PropertyPath = propertyPath;
+    }
+    catch (const std::exception& error)
+    {
+      in.Close();
+      in.FilePath = filePath;
+      in.PropertyPath = propertyPath;
+      if (in.Error != error.what())
+      {
+        in.Error = error.what();
+        vtkErrorMacro(<< in.Error);
+      }
+      return;
+    }
+  }
+  if (!in.Cache)
+  {
+    return; // the files failed to open; the error was reported once
+  }
+  resmr::RegionCache& cache = *in.Cache;
+  cache.SetBudget(std::size_t(this->MemoryBudgetMB) << 20);
+  const resmr::MultiresolutionHeader& header = in.File->Header();
+
+  // Property table wanted this frame.
+  // (a static property has one table, step -1, for every step)
+  int32_t tableStep = step;
+  bool wantProperty = false;
+  if (this->ColorMode == PropertyColors && in.Properties && this->ArrayName && *this->ArrayName)
+  {
+    tableStep = in.Properties->Find(this->ArrayName, step) >= 0 ? step : -1;
+    wantProperty = in.Properties->Find(this->ArrayName, tableStep) >= 0;
+  }
+  if (wantProperty)
+  {
+    cache.RequestProperty(this->ArrayName, tableStep);
+  }
+
+  // The view, in model coordinates (the actor's matrix folded into the projection).
+  vtkOpenGLRenderWindow* window = vtkOpenGLRenderWindow::SafeDownCast(renderer->GetRenderWindow());
+  if (in.Window != window)
+  {
+    in.ReleaseGpu();
+    in.Window = window;
+  }
+  vtkOpenGLCamera* camera = vtkOpenGLCamera::SafeDownCast(renderer->GetActiveCamera());
+  vtkMatrix4x4 *worldToView, *worldToClip;
+  vtkMatrix3x3* normalMatrix;
+  vtkMatrix4x4* viewToClip;
+  camera->GetKeyMatrices(renderer, worldToView, normalMatrix, viewToClip, worldToClip);
+  vtkNew<vtkMatrix4x4> actorMatrix;
+  actor->GetMatrix(actorMatrix);
+  const Matrix modelToWorld = FromRowMajor(actorMatrix);
+  const Matrix modelToClip = Multiply(FromTransposed(worldToClip), modelToWorld);
+  const Matrix modelToView = Multiply(FromTransposed(worldToView), modelToWorld);
+  int width = 0, height = 0, x0 = 0, y0 = 0;
+  renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+  resmr::ViewParameters view;
+  view.worldToClip = modelToClip;
+  {
+    vtkNew<vtkMatrix4x4> inverse;
+    inverse->DeepCopy(actorMatrix);
+    inverse->Invert();
+    double eye[4] = { 0, 0, 0, 1 }, position[4];
+    camera->GetPosition(eye);
+    inverse->MultiplyPoint(eye, position);
+    view.eye = { position[0], position[1], position[2] };
+    double direction[3];
+    camera->GetDirectionOfProjection(direction);
+    view.direction = { direction[0], direction[1], direction[2] };
+  }
+  view.parallel = camera->GetParallelProjection() != 0;
+  view.pixelsPerUnit = view.parallel
+    ? height / (2.0 * std::max(camera->GetParallelScale(), 1e-30))
+    : height / (2.0 * std::tan(vtkMath::RadiansFromDegrees(camera->GetViewAngle()) / 2));
+  if (this->TargetFrameRate > 0)
+  {
+    in.Controller.SetTargetFramesPerSecond(this->TargetFrameRate);
+    in.Tolerance = in.Controller.Tolerance();
+  }
+  else
+  {
+    in.Tolerance = this->PixelTolerance;
+    in.Controller.Reset(std::max(this->PixelTolerance, 1.0));
+  }
+  view.tolerancePixels = in.Tolerance;
+
+  // Select, ask for what is missing (and what the next frame will probably want), and for
+  // still renders wait until the wanted set is resident.
+  const auto resident = [&cache](std::size_t region) { return cache.IsResident(region); };
+  resmr::ViewSelection selection = in.Selector->Select(view, resident);
+  std::vector<std::size_t> predicted;
+  if (in.HavePreviousView)
+  {
+    const auto all = [](std::size_t) { return true; };
+    predicted = in.Selector->Select(resmr::PredictNextView(in.PreviousView, view), all).wanted;
+  }
+  cache.Request(selection.wanted, predicted);
+  if (this->WaitForDetailMs > 0)
+  {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(this->WaitForDetailMs);
+    while (cache.Pending() && std::chrono::steady_clock::now() < deadline)
+    {
+      cache.WaitIdle(std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()));
+      selection = in.Selector->Select(view, resident);
+      cache.Request(selection.wanted, predicted);
+    }
+  }
+  in.PreviousView = view;
+  in.HavePreviousView = true;
+
+  // GPU buffers follow the cache: drop what it evicted, upload what is drawn.
+  for (auto entry = in.Gpu.begin(); entry != in.Gpu.end();)
+  {
+    if (!cache.IsResident(entry->first))
+    {
+      in.GpuBytes -= entry->second->bytes;
+      entry->second->layout->ReleaseGraphicsResources();
+      entry->second->vertices->ReleaseGraphicsResources();
+      entry->second->indices->ReleaseGraphicsResources();
+      entry = in.Gpu.erase(entry);
+    }
+    else
+    {
+      ++entry;
+    }
+  }
+
+  vtkOpenGLState* state = window->GetState();
+  vtkShaderProgram* program =
+    window->GetShaderCache()->ReadyShaderProgram(MultiresolutionSurfaceVS, MultiresolutionSurfaceFS, "");
+  if (!program)
+  {
+    if (in.Error.empty())
+    {
+      in.Error = "the multiresolution surface shaders did not compile (see the output window)";
+      vtkErrorMacro(<< in.Error);
+    }
+    return;
+  }
+  const GLuint handle = static_cast<GLuint>(program->GetHandle());
+  const auto uniform3i = [handle](const char* name, int a, int b, int c) {
+    glUniform3i(glGetUniformLocation(handle, name), a, b, c);
+  };
+
+  // Model tables: the hash's offsets and the cells' normals (once a file), the property
+  // table when another is current, the colour map when the lookup table changes.
+  if (!in.HashUploaded)
+  {
+    state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    const resmr::PerfectSpatialHash hash = in.File->ReadHash();
+    UploadInteger3D(in.OffsetTexture, window, hash.offsetSides, 3, GL_RGB16UI, GL_RGB_INTEGER, hash.offsets.data());
+    const std::vector<uint8_t> normals = in.File->ReadModelArray(resmr::ModelChunk::CellNormals);
+    if (normals.size() == hash.TableSize() * 4)
+    {
+      UploadInteger3D(in.NormalTexture, window, hash.tableSides, 2, GL_RG16UI, GL_RG_INTEGER, normals.data());
+    }
+    else
+    {
+      const std::vector<uint16_t> up(hash.TableSize() * 2, 0); // code 0 is +z
+      UploadInteger3D(in.NormalTexture, window, hash.tableSides, 2, GL_RG16UI, GL_RG_INTEGER, up.data());
+    }
+    in.HashUploaded = true;
+  }
+  if (in.PropertyTexture->GetHandle() == 0)
+  {
+    // Until a property loads, every sampler still needs a texture of its type.
+    float none = std::numeric_limits<float>::quiet_NaN();
+    in.PropertyTexture->SetContext(window);
+    in.PropertyTexture->Create3DFromRaw(1, 1, 1, 1, VTK_FLOAT, &none);
+    unsigned char white[4] = { 255, 255, 255, 255 };
+    in.ColorTexture->SetContext(window);
+    in.ColorTexture->Create2DFromRaw(1, 1, 4, VTK_UNSIGNED_CHAR, white);
+  }
+  std::shared_ptr<const resmr::PropertyTableData> property = wantProperty ? cache.Property() : nullptr;
+  if (property && (property->name != this->ArrayName || property->step != tableStep))
+  {
+    property.reset(); // still the previous property: the solid colour until this one loads
+  }
+  if (property && property != in.UploadedProperty)
+  {
+    state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    in.PropertyTexture->SetContext(window);
+    in.PropertyTexture->ResetFormatAndType();
+    in.PropertyTexture->SetMinificationFilter(vtkTextureObject::Nearest);
+    in.PropertyTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    in.PropertyTexture->Create3DFromRaw(header.hashTableSides[0], header.hashTableSides[1], header.hashTableSides[2],
+      1, VTK_FLOAT, const_cast<float*>(property->values.data()));
+    in.UploadedProperty = property;
+  }
+  vtkScalarsToColors* table = this->GetLookupTable();
+  if (property && (table != in.ColorTable || table->GetMTime() != in.ColorTableTime))
+  {
+    const int size = 1024;
+    const double* range = table->GetRange();
+    in.ColorRange[0] = range[0];
+    in.ColorRange[1] = range[1];
+    const bool logScale = table->UsingLogScale() != 0;
+    std::vector<double> values(size);
+    for (int i = 0; i < size; ++i)
+    {
+      const double t = (i + 0.5) / size;
+      values[i] = logScale ? std::pow(10.0, std::log10(range[0]) + t * (std::log10(range[1]) - std::log10(range[0])))
+                           : range[0] + t * (range[1] - range[0]);
+    }
+    std::vector<unsigned char> rgba(size * 4);
+    for (int i = 0; i < size; ++i)
+    {
+      const unsigned char* color = table->MapValue(values[i]);
+      std::copy(color, color + 4, &rgba[4 * i]);
+    }
+    state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    in.ColorTexture->SetContext(window);
+    in.ColorTexture->ResetFormatAndType();
+    in.ColorTexture->SetMinificationFilter(vtkTextureObject::Nearest);
+    in.ColorTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    in.ColorTexture->Create2DFromRaw(size, 1, 4, VTK_UNSIGNED_CHAR, rgba.data());
+    in.ColorTable = table;
+    in.ColorTableTime = table->GetMTime();
+  }
+  const int colorMode = this->ColorMode == PropertyColors && !property ? SolidColor : this->ColorMode;
+
+  // GPU time of an earlier frame, when the driver has it (never waits).
+  if (in.TimerQuery != 0 && in.TimerPending)
+  {
+    GLint available = 0;
+    glGetQueryObjectiv(in.TimerQuery, GL_QUERY_RESULT_AVAILABLE, &available);
+    if (available)
+    {
+      GLuint64 nanoseconds = 0;
+      glGetQueryObjectui64v(in.TimerQuery, GL_QUERY_RESULT, &nanoseconds);
+      in.GpuMs = nanoseconds * 1e-6;
+      in.TimerPending = false;
+    }
+  }
+  if (in.TimerQuery == 0)
+  {
+    glGenQueries(1, &in.TimerQuery);
+  }
+  const bool timing = !in.TimerPending;
+  if (timing)
+  {
+    glBeginQuery(GL_TIME_ELAPSED, in.TimerQuery);
+  }
+
+  // Uniforms.
+  const std::array<double, 3> origin = cache.Origin();
+  Matrix shift{ 1, 0, 0, origin[0], 0, 1, 0, origin[1], 0, 0, 1, origin[2], 0, 0, 0, 1 };
+  float packed[16];
+  ColumnMajor(Multiply(modelToClip, shift), packed);
+  program->SetUniformMatrix4x4("modelToClip", packed);
+  ColumnMajor(Multiply(modelToView, shift), packed);
+  program->SetUniformMatrix4x4("modelToView", packed);
+  {
+    // Normals: the inverse transpose of model-to-view's linear part.
+    vtkNew<vtkMatrix4x4> linear;
+    for (int i = 0; i < 4; ++i)
+    {
+      for (int j = 0; j < 4; ++j)
+      {
+        linear->SetElement(i, j, i < 3 && j < 3 ? modelToView[4 * i + j] : (i == j ? 1 : 0));
+      }
+    }
+    linear->Invert();
+    float normal[9];
+    for (int i = 0; i < 3; ++i)
+    {
+      for (int j = 0; j < 3; ++j)
+      {
+        normal[3 * j + i] = static_cast<float>(linear->GetElement(j, i)); // transpose, column-major
+      }
+    }
+    program->SetUniformMatrix3x3("normalToView", normal);
+  }
+  program->SetUniformi("colorMode", colorMode);
+  uniform3i("gridDims", int(header.dims[0]), int(header.dims[1]), int(header.dims[2]));
+  uniform3i("tableSides", int(header.hashTableSides[0]), int(header.hashTableSides[1]), int(header.hashTableSides[2]));
+  uniform3i(
+    "offsetSides", int(header.hashOffsetSides[0]), int(header.hashOffsetSides[1]), int(header.hashOffsetSides[2]));
+  in.OffsetTexture->Activate();
+  program->SetUniformi("hashOffsets", in.OffsetTexture->GetTextureUnit());
+  in.NormalTexture->Activate();
+  program->SetUniformi("cellNormals", in.NormalTexture->GetTextureUnit());
+  in.PropertyTexture->Activate();
+  program->SetUniformi("propertyTable", in.PropertyTexture->GetTextureUnit());
+  in.ColorTexture->Activate();
+  program->SetUniformi("colorMap", in.ColorTexture->GetTextureUnit());
+  if (colorMode == PropertyColors)
+  {
+    const bool logScale = table->UsingLogScale() != 0;
+    float range[2] = { float(in.ColorRange[0]), float(in.ColorRange[1]) };
+    if (logScale)
+    {
+      range[0] = float(std::log10(std::max(in.ColorRange[0], 1e-30)));
+      range[1] = float(std::log10(std::max(in.ColorRange[1], 1e-30)));
+    }
+    program->SetUniform2f("scalarRange", range);
+    program->SetUniformi("logScale", logScale ? 1 : 0);
+    const unsigned char* nan = table->MapValue(std::numeric_limits<double>::quiet_NaN());
+    const float nanColor[4] = { nan[0] / 255.f, nan[1] / 255.f, nan[2] / 255.f, nan[3] / 255.f };
+    program->SetUniform4f("nanColor", nanColor);
+  }
+  vtkProperty* look = actor->GetProperty();
+  program->SetUniform3f("solidColor", look->GetDiffuseColor());
+  program->SetUniformi("gridLines", this->GridLines && colorMode != CellIdColors ? 1 : 0);
+  program->SetUniformf("gridLineWidth", static_cast<float>(this->GridLineWidth));
+  program->SetUniform3f("gridLineColor", this->GridLineColor);
+  program->SetUniformf("ambient", static_cast<float>(look->GetAmbient() + (look->GetLighting() ? 0 : 1)));
+  program->SetUniformf("diffuse", static_cast<float>(look->GetLighting() ? look->GetDiffuse() : 0));
+  program->SetUniformf("specular", static_cast<float>(look->GetLighting() ? look->GetSpecular() : 0));
+  program->SetUniformf("specularPower", static_cast<float>(std::max(1.0, look->GetSpecularPower())));
+
+  state->vtkglEnable(GL_DEPTH_TEST);
+  state->vtkglDepthMask(GL_TRUE);
+  state->vtkglDisable(GL_CULL_FACE);
+  state->vtkglDisable(GL_BLEND);
+
+  // Draw.
+  for (const resmr::DrawnRegion& drawn : selection.drawn)
+  {
+    auto found = in.Gpu.find(drawn.region);
+    if (found == in.Gpu.end())
+    {
+      std::shared_ptr<const resmr::RegionDrawBuffers> buffers = cache.Get(drawn.region);
+      if (!buffers)
+      {
+        continue; // evicted since the selection: its ancestor is not drawn either this frame
+      }
+      auto gpu = std::make_unique<GpuRegion>();
+      gpu->buffers = buffers;
+      if (!buffers->indices.empty())
+      {
+        gpu->layout->Bind();
+        gpu->vertices->Upload(buffers->vertices, vtkOpenGLBufferObject::ArrayBuffer);
+        gpu->indices->Upload(buffers->indices, vtkOpenGLBufferObject::ElementArrayBuffer);
+        gpu->layout->AddAttributeArray(program, gpu->vertices, "vertexPosition", 0, 24, VTK_FLOAT, 3, false);
+        gpu->layout->AddAttributeArray(program, gpu->vertices, "cellCoordinate", 12, 24, VTK_FLOAT, 3, false);
+        gpu->layout->Release();
+      }
+      gpu->bytes = buffers->Bytes();
+      in.GpuBytes += gpu->bytes;
+      found = in.Gpu.emplace(drawn.region, std::move(gpu)).first;
+    }
+    GpuRegion& gpu = *found->second;
+    const resmr::RegionDrawBuffers& buffers = *gpu.buffers;
+    if (buffers.indices.empty())
+    {
+      continue;
+    }
+    gpu.layout->Bind();
+    gpu.indices->Bind();
+    const struct
+    {
+      bool shown;
+      uint32_t first, count;
+      int kind;
+    } parts[3] = { { drawn.top, 0, buffers.topIndices, 0 },
+      { drawn.bottom, buffers.topIndices, buffers.bottomIndices, 1 },
+      { drawn.side, buffers.topIndices + buffers.bottomIndices, buffers.sideIndices, 2 } };
+    for (const auto& part : parts)
+    {
+      if (part.shown && part.count > 0)
+      {
+        program->SetUniformi("faceKind", part.kind);
+        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(part.count), GL_UNSIGNED_INT,
+          reinterpret_cast<const void*>(std::size_t(part.first) * sizeof(uint32_t)));
+        in.Triangles += part.count / 3;
+      }
+    }
+    gpu.indices->Release();
+    gpu.layout->Release();
+    ++in.Drawn;
+  }
+  in.Substituted = static_cast<int>(selection.substituted);
+  in.PropertyTexture->Deactivate();
+  in.ColorTexture->Deactivate();
+  in.OffsetTexture->Deactivate();
+  in.NormalTexture->Deactivate();
+  if (timing)
+  {
+    glEndQuery(GL_TIME_ELAPSED);
+    in.TimerPending = true;
+  }
+  vtkOpenGLCheckErrorMacro("after drawing the multiresolution surface");
+
+  in.Pending = cache.Pending();
+  const double cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  in.FrameMs = cpuMs + in.GpuMs;
+  if (this->TargetFrameRate > 0)
+  {
+    in.Controller.Update(in.FrameMs / 1000);
+  }
+}
+
+void vtkMultiresolutionSurfaceMapper::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "ColorMode: " << this->ColorMode << "\n";
+  os << indent << "PixelTolerance: " << this->PixelTolerance << "\n";
+  os << indent << "TargetFrameRate: " << this->TargetFrameRate << "\n";
+  os << indent << "MemoryBudgetMB: " << this->MemoryBudgetMB << "\n";
+  os << indent << "GridLines: " << this->GridLines << "\n";
+  os << indent << "WaitForDetailMs: " << this->WaitForDetailMs << "\n";
+}

@@ -1,0 +1,122 @@
+/**
+ * @class   vtkMultiresolutionSurfaceMapper
+ * @brief   Draws a .resmr file's surfaces at the detail the camera needs (paper Sec. 5, 6.2, 6.3).
+ *
+ * Each render selects region meshes from the exact camera (Lindstrom's projected error
+ * against a pixel tolerance, frustum and normal-cone culling; resmr::ViewSelector), asks a
+ * loader thread for what is missing (resmr::RegionCache, under a memory budget) and draws
+ * what is resident, standing in an ancestor for any region not loaded yet, so the render
+ * thread never waits on disk. Fragments find their original cell from the topological
+ * coordinate and paint its property through the perfect-hash tables and the lookup table,
+ * the original grid lines and the cell's face normal. With a target frame rate the pixel
+ * tolerance follows the measured frame times (resmr::FrameRateController).
+ *
+ * The input is a copy of the descriptor vtkMultiresolutionReader writes (its bounds are the
+ * model's) with a string field array (SourceArrayName) naming the .resmr file, the property
+ * file and the step, added by vtkMultiresolutionSurfaceRepresentation. Opaque only.
+ */
+#ifndef vtkMultiresolutionSurfaceMapper_h
+#define vtkMultiresolutionSurfaceMapper_h
+
+#include "ResMRRepresentationsModule.h"
+#include "vtkMapper.h"
+
+#include <memory>
+#include <string>
+
+class RESMRREPRESENTATIONS_EXPORT vtkMultiresolutionSurfaceMapper : public vtkMapper
+{
+public:
+  static vtkMultiresolutionSurfaceMapper* New();
+  vtkTypeMacro(vtkMultiresolutionSurfaceMapper, vtkMapper);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// The input's field array naming the files and step: .resmr path, .resmrp path (or
+  /// empty), step number (decimal).
+  static const char* SourceArrayName() { return "ResMR Source"; }
+
+  enum ColorModes
+  {
+    SolidColor = 0,
+    PropertyColors = 1,
+    CellIdColors = 2 ///< debug: RGB = 1 + i + nx (j + ny k), unlit, for image comparisons
+  };
+
+  /// What paints the surface (ColorModes). Property colours need a property (ColorArrayName,
+  /// vtkMapper's ArrayName) and fall back to the solid colour until its table is loaded.
+  vtkSetClampMacro(ColorMode, int, SolidColor, CellIdColors);
+  vtkGetMacro(ColorMode, int);
+
+  /// Projected error tolerance in pixels when no frame rate is targeted (0: full detail).
+  vtkSetClampMacro(PixelTolerance, double, 0.0, 1024.0);
+  vtkGetMacro(PixelTolerance, double);
+
+  /// Frames per second to hold by adjusting the tolerance (Sec. 6.3); 0: fixed tolerance.
+  vtkSetClampMacro(TargetFrameRate, double, 0.0, 1000.0);
+  vtkGetMacro(TargetFrameRate, double);
+
+  /// Memory budget of resident meshes, MB (CPU, and the same again at most on the GPU).
+  vtkSetClampMacro(MemoryBudgetMB, int, 16, 1 << 20);
+  vtkGetMacro(MemoryBudgetMB, int);
+
+  /// Original grid lines (Sec. 5.1) and their width in pixels.
+  vtkSetMacro(GridLines, bool);
+  vtkGetMacro(GridLines, bool);
+  vtkSetClampMacro(GridLineWidth, double, 0.5, 16.0);
+  vtkGetMacro(GridLineWidth, double);
+  vtkSetVector3Macro(GridLineColor, double);
+  vtkGetVector3Macro(GridLineColor, double);
+
+  /// Still renders wait (at most this many ms) until every mesh the view wants is loaded:
+  /// batch scripts and screenshots; 0 (interactive use) never waits.
+  vtkSetClampMacro(WaitForDetailMs, int, 0, 600000);
+  vtkGetMacro(WaitForDetailMs, int);
+
+  ///@{
+  /// Live readout, updated each render.
+  double GetCurrentTolerance() const;
+  double GetResidentMB() const;
+  vtkIdType GetTrianglesDrawn() const;
+  int GetRegionsDrawn() const;
+  /// Regions drawn in place of wanted descendants not resident yet.
+  int GetRegionsSubstituted() const;
+  /// Milliseconds the last frame took (CPU selection and submission, plus GPU time when the
+  /// driver reports it, of the frame before).
+  double GetLastFrameMs() const;
+  /// Whether meshes or tables the view wants are still loading.
+  bool GetLoadsPending() const;
+  ///@}
+
+  /// Why the files could not be used, empty if they could.
+  const char* GetLastError() const;
+
+  void Render(vtkRenderer* renderer, vtkActor* actor) override;
+  void ReleaseGraphicsResources(vtkWindow* window) override;
+  double* GetBounds() override;
+  void GetBounds(double bounds[6]) override { this->vtkMapper::GetBounds(bounds); }
+  bool HasOpaqueGeometry() override { return true; }
+  bool HasTranslucentPolygonalGeometry() override { return false; }
+
+protected:
+  vtkMultiresolutionSurfaceMapper();
+  ~vtkMultiresolutionSurfaceMapper() override;
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+
+private:
+  vtkMultiresolutionSurfaceMapper(const vtkMultiresolutionSurfaceMapper&) = delete;
+  void operator=(const vtkMultiresolutionSurfaceMapper&) = delete;
+
+  int ColorMode = PropertyColors;
+  double PixelTolerance = 1.0;
+  double TargetFrameRate = 0.0;
+  int MemoryBudgetMB = 1024;
+  bool GridLines = true;
+  double GridLineWidth = 1.0;
+  double GridLineColor[3] = { 0.1, 0.1, 0.1 };
+  int WaitForDetailMs = 0;
+
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+};
+
+#endif
