@@ -14,7 +14,16 @@
 // - Resident bytes (the buffers' sizes) stay within the budget, except that the roots and
 //   the regions requested by the newest frame are never evicted to load others: when the
 //   wanted set outgrows the budget, loading stops there (the selection then draws ancestors).
-//   Least recently requested regions are evicted first.
+//   Least recently requested regions are evicted first. Precisely: roots load whatever the
+//   budget; any other region becomes resident only if the total then is within the budget
+//   (after evicting, least recently requested first, regions neither roots nor wanted by the
+//   newest Request; predicted ones only for a wanted one), so ResidentBytes() <=
+//   max(budget, bytes of the roots). SetBudget evicts at once what may go; what stays (roots,
+//   the newest frame's regions) may exceed a lowered budget until the next Request. When the
+//   next region of the request cannot fit, loading stops there (Pending() false) until the
+//   next Request or SetBudget.
+// - Buffers are made from MultiresolutionFile::ReadRegion (ReadRegionSurfaces drops the
+//   positions).
 // - Property tables (Sec. 5.4: one value a hash slot) load on the same thread; the previous
 //   table stays current until the new one is ready.
 // - Errors reading the file (damaged chunk) are kept, not thrown on the render thread:
@@ -102,6 +111,15 @@ public:
 
 private:
   void Run();
+  /// The next region to load (roots, then wanted, then predicted), or -1; may mark loading
+  /// blocked when a region whose size is known cannot fit. Lock held.
+  int64_t NextRegionLocked();
+  bool PendingLocked() const;
+  /// Resident regions that may be evicted to load `region`, least recently requested first.
+  std::vector<std::size_t> EvictableLocked(std::size_t region) const;
+  /// Makes room and inserts, or refuses (blocking the rest of the request). Lock held.
+  void InsertLocked(std::size_t region, std::shared_ptr<const RegionDrawBuffers> buffers);
+  void EvictLocked(std::size_t region);
   // (members are the implementation's)
   std::shared_ptr<const MultiresolutionFile> File;
   std::shared_ptr<const PropertyFile> Properties;
@@ -119,10 +137,14 @@ private:
   {
     std::shared_ptr<const RegionDrawBuffers> buffers;
     uint64_t lastRequested = 0;
+    std::size_t bytes = 0; ///< known once prepared (also for a region refused for the budget)
     bool failed = false;
   };
   std::map<std::size_t, Entry> Entries;
   std::vector<std::size_t> Wanted, Predicted;
+  std::vector<uint8_t> InWanted, InPredicted, IsPinned; ///< per region
+  bool WantedBlocked = false, PredictedBlocked = false; ///< loading stopped for the budget
+  std::size_t Resident = 0;
   std::vector<std::size_t> Pinned;
   std::string Error;
   std::string PropertyName;

@@ -1,0 +1,727 @@
+// Out-of-core loading of region meshes, paper Sec. 6.2-6.3: draw buffers with cell
+// coordinates, and the loader thread with its least-recently-used memory budget.
+#include "RegionCache.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <map>
+
+namespace resmr
+{
+namespace
+{
+using Vector = std::array<double, 3>;
+
+Vector Minus(const Vector& a, const Vector& b)
+{
+  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
+}
+
+Vector Cross(const Vector& a, const Vector& b)
+{
+  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
+}
+
+double Dot(const Vector& a, const Vector& b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/// Position of a vertex, z up.
+Vector ZUp(const RegionMesh& mesh, uint32_t vertex)
+{
+  const double* p = &mesh.positions[static_cast<std::size_t>(vertex) * 3];
+  return { p[0], p[1], -p[2] };
+}
+
+/// Topological coordinate (ti, tj, tk) of a vertex: its node's (ti, tj) and its interface.
+Vector Topological(const RegionMesh& mesh, uint32_t vertex)
+{
+  const uint32_t perNode = static_cast<uint32_t>(mesh.layers + 1);
+  const auto& t = mesh.topology[vertex / perNode];
+  return { t[0], t[1], static_cast<double>(vertex % perNode) };
+}
+
+/// sign(det d(x, y, z)/d(i, j, k)) of one cell, 0 if degenerate: the images of the column's
+/// diagonals and of the layer's thickness against the diagonals in topological space.
+int CellHandedness(const RegionMesh& mesh, std::size_t column, int32_t layer)
+{
+  const auto& q = mesh.corners[column];
+  const auto middle = [&](uint32_t node) {
+    const Vector a = ZUp(mesh, mesh.Vertex(node, layer)), b = ZUp(mesh, mesh.Vertex(node, layer + 1));
+    return Vector{ (a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2 };
+  };
+  const Vector u = Minus(middle(q[2]), middle(q[0])), v = Minus(middle(q[3]), middle(q[1]));
+  Vector w{ 0, 0, 0 };
+  for (int n = 0; n < 4; ++n)
+  {
+    const Vector d = Minus(ZUp(mesh, mesh.Vertex(q[n], layer + 1)), ZUp(mesh, mesh.Vertex(q[n], layer)));
+    w = { w[0] + d[0], w[1] + d[1], w[2] + d[2] };
+  }
+  const double physical = Dot(u, Cross(v, w));
+  const auto& t0 = mesh.topology[q[0]];
+  const auto& t1 = mesh.topology[q[1]];
+  const auto& t2 = mesh.topology[q[2]];
+  const auto& t3 = mesh.topology[q[3]];
+  const double topological = double(t2[0] - t0[0]) * double(t3[1] - t1[1]) - double(t2[1] - t0[1]) * double(t3[0] - t1[0]);
+  const double scale = std::sqrt(Dot(u, u) * Dot(v, v) * Dot(w, w));
+  if (!(std::fabs(physical) > 1e-9 * scale) || topological == 0 || !std::isfinite(physical))
+  {
+    return 0;
+  }
+  return (physical > 0) == (topological > 0) ? 1 : -1;
+}
+
+/// Whether `offset` moves the triangle's centre into an active cell of the region whose open
+/// side lies on the triangle's plane along `axis`.
+bool OwnsSide(const RegionMesh& mesh, const Vector& centre, double plane, int axis, const std::array<double, 3>& offset,
+  const std::map<std::pair<int64_t, int64_t>, std::size_t>& columns)
+{
+  const int64_t i = static_cast<int64_t>(std::floor(centre[0] + offset[0]));
+  const int64_t j = static_cast<int64_t>(std::floor(centre[1] + offset[1]));
+  const int64_t k = static_cast<int64_t>(std::floor(centre[2] + offset[2]));
+  const auto found = columns.find({ i, j });
+  if (found == columns.end() || k < 0 || k >= mesh.layers)
+  {
+    return false;
+  }
+  const std::size_t cell = found->second * static_cast<std::size_t>(mesh.layers) + static_cast<std::size_t>(k);
+  const auto& q = mesh.corners[found->second];
+  for (int e = 0; mesh.active[cell] && e < 4; ++e)
+  {
+    if (mesh.topology[q[e]][axis] == plane && mesh.topology[q[(e + 1) % 4]][axis] == plane &&
+      ((mesh.openSides[cell] >> e) & 1))
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+/// Checks the offset the normal gave a side triangle against the region's cells and corrects
+/// it where it is wrong: a triangle with no area in topological space (a sliver along a face's
+/// edge) has no normal, and a long simplified triangle over curved cells can turn the other
+/// way in topological space than in space. Tries the cells around the triangle, half a cell
+/// off on each axis its vertices share, and takes the first active cell of the region whose
+/// open side lies on the triangle's plane. Only for regions of whole cells (integer
+/// topological coordinates, the leaves); a triangle spanning two faces keeps its offset.
+void CheckSideCell(const RegionMesh& mesh, const std::array<Vector, 3>& t,
+  const std::map<std::pair<int64_t, int64_t>, std::size_t>& columns, std::array<double, 3>& offset)
+{
+  bool shared[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    shared[a] = t[0][a] == t[1][a] && t[1][a] == t[2][a];
+  }
+  // A point inside the triangle (or its segment) that falls on no cell boundary.
+  const double w0 = 1.0 / 3 + 1.4142135623730951e-3, w1 = 1.0 / 3 + 1.7320508075688772e-3, w2 = 1 - w0 - w1;
+  Vector centre;
+  for (int a = 0; a < 3; ++a)
+  {
+    centre[a] = shared[a] ? t[0][a] : w0 * t[0][a] + w1 * t[1][a] + w2 * t[2][a];
+  }
+  for (int axis = 0; axis < 2; ++axis)
+  {
+    if (shared[axis] && OwnsSide(mesh, centre, t[0][axis], axis, offset, columns))
+    {
+      return;
+    }
+  }
+  for (int axis = 0; axis < 2; ++axis)
+  {
+    if (!shared[axis])
+    {
+      continue;
+    }
+    // Every combination of half-cell steps on the shared axes.
+    for (int signs = 0; signs < 8; ++signs)
+    {
+      std::array<double, 3> step{ 0, 0, 0 };
+      bool valid = true;
+      for (int a = 0; a < 3; ++a)
+      {
+        if (shared[a])
+        {
+          step[a] = (signs >> a) & 1 ? 0.5 : -0.5;
+        }
+        else if ((signs >> a) & 1)
+        {
+          valid = false; // one try for an axis the vertices do not share
+        }
+      }
+      if (valid && OwnsSide(mesh, centre, t[0][axis], axis, step, columns))
+      {
+        offset = step;
+        return;
+      }
+    }
+  }
+}
+
+/// The region's columns by cell (i, j), or none if its topological coordinates are not all
+/// integers (a simplified region).
+std::map<std::pair<int64_t, int64_t>, std::size_t> ColumnsByCell(const RegionMesh& mesh)
+{
+  std::map<std::pair<int64_t, int64_t>, std::size_t> columns;
+  if (mesh.active.empty() || mesh.openSides.empty())
+  {
+    return columns;
+  }
+  for (const auto& t : mesh.topology)
+  {
+    if (t[0] != std::floor(t[0]) || t[1] != std::floor(t[1]))
+    {
+      return columns;
+    }
+  }
+  for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+  {
+    const auto& q = mesh.corners[c];
+    float i = mesh.topology[q[0]][0], j = mesh.topology[q[0]][1];
+    for (int n = 1; n < 4; ++n)
+    {
+      i = std::min(i, mesh.topology[q[n]][0]);
+      j = std::min(j, mesh.topology[q[n]][1]);
+    }
+    columns[{ static_cast<int64_t>(i), static_cast<int64_t>(j) }] = c;
+  }
+  return columns;
+}
+
+constexpr uint32_t Unused = std::numeric_limits<uint32_t>::max();
+
+void PushVertex(RegionDrawBuffers& out, const Vector& position, const std::array<double, 3>& origin, const Vector& cell)
+{
+  out.vertices.push_back(static_cast<float>(position[0] - origin[0]));
+  out.vertices.push_back(static_cast<float>(position[1] - origin[1]));
+  out.vertices.push_back(static_cast<float>(position[2] - origin[2]));
+  out.vertices.push_back(static_cast<float>(cell[0]));
+  out.vertices.push_back(static_cast<float>(cell[1]));
+  out.vertices.push_back(static_cast<float>(cell[2]));
+}
+
+/// Top or bottom quads as triangles; vertices shared within the surface, the cell coordinate
+/// half a layer into the cell (down for a top face: k grows downward).
+void AddQuads(const RegionMesh& mesh, const RegionSurface& surface, double kOffset, const std::array<double, 3>& origin,
+  std::vector<uint32_t>& map, RegionDrawBuffers& out)
+{
+  std::fill(map.begin(), map.end(), Unused);
+  const auto index = [&](uint32_t vertex) {
+    uint32_t& slot = map[vertex];
+    if (slot == Unused)
+    {
+      slot = static_cast<uint32_t>(out.vertices.size() / 6);
+      Vector cell = Topological(mesh, vertex);
+      cell[2] += kOffset;
+      PushVertex(out, ZUp(mesh, vertex), origin, cell);
+    }
+    return slot;
+  };
+  for (const auto& q : surface.quads)
+  {
+    const uint32_t a = index(q[0]), b = index(q[1]), c = index(q[2]), d = index(q[3]);
+    out.indices.insert(out.indices.end(), { a, b, c, a, c, d });
+  }
+}
+} // namespace
+
+int TopologyHandedness(const MultiresolutionFile& file)
+{
+  for (std::size_t r = 0; r < file.Regions().size(); ++r)
+  {
+    if (file.Regions()[r].columns <= 0)
+    {
+      continue;
+    }
+    RegionMesh mesh;
+    try
+    {
+      mesh = file.ReadRegion(r);
+    }
+    catch (const std::exception&)
+    {
+      continue; // a damaged region: the next one tells as well
+    }
+    for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+    {
+      for (int32_t k = 0; k < mesh.layers; ++k)
+      {
+        const int sign = CellHandedness(mesh, c, k);
+        if (sign != 0)
+        {
+          return sign;
+        }
+      }
+    }
+  }
+  return 1;
+}
+
+RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin, int handedness)
+{
+  RegionDrawBuffers out;
+  std::vector<uint32_t> map(static_cast<std::size_t>(mesh.VertexCount()), Unused);
+  // A top face lies on its cell's upper interface k: the cell is at k + 0.5; a bottom face on
+  // the lower interface k + 1: the cell is at (k + 1) - 0.5.
+  AddQuads(mesh, mesh.top, 0.5, origin, map, out);
+  out.topIndices = static_cast<uint32_t>(out.indices.size());
+  AddQuads(mesh, mesh.bottom, -0.5, origin, map, out);
+  out.bottomIndices = static_cast<uint32_t>(out.indices.size()) - out.topIndices;
+  // Side triangles: the face's constant axis is the largest component of its normal in
+  // topological space n_T; the physical outward normal is det(A) A^-T n_T (A = d(x, y, z) /
+  // d(i, j, k)), so the outward direction along that axis has the sign of
+  // handedness * n_T[axis] and the cell lies on the other side. Each triangle has its own
+  // vertices, since the offset belongs to the triangle.
+  const auto columns = ColumnsByCell(mesh);
+  for (const auto& t : mesh.sideTriangles)
+  {
+    const Vector t0 = Topological(mesh, t[0]), t1 = Topological(mesh, t[1]), t2 = Topological(mesh, t[2]);
+    const Vector n = Cross(Minus(t1, t0), Minus(t2, t0));
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+    {
+      if (std::fabs(n[a]) > std::fabs(n[axis]))
+      {
+        axis = a;
+      }
+    }
+    std::array<double, 3> offset{ 0, 0, 0 };
+    offset[axis] = 0.5 * (n[axis] > 0 ? -handedness : n[axis] < 0 ? handedness : 0);
+    if (!columns.empty())
+    {
+      CheckSideCell(mesh, { t0, t1, t2 }, columns, offset);
+    }
+    const uint32_t first = static_cast<uint32_t>(out.vertices.size() / 6);
+    for (int v = 0; v < 3; ++v)
+    {
+      Vector cell = Topological(mesh, t[v]);
+      for (int a = 0; a < 3; ++a)
+      {
+        cell[a] += offset[a];
+      }
+      PushVertex(out, ZUp(mesh, t[v]), origin, cell);
+    }
+    out.indices.insert(out.indices.end(), { first, first + 1, first + 2 });
+  }
+  out.sideIndices = static_cast<uint32_t>(out.indices.size()) - out.topIndices - out.bottomIndices;
+  return out;
+}
+
+RegionCache::RegionCache(std::shared_ptr<const MultiresolutionFile> file, std::shared_ptr<const PropertyFile> properties,
+  std::size_t budgetBytes)
+  : File(std::move(file))
+  , Properties(std::move(properties))
+  , BudgetBytes(budgetBytes)
+{
+  const auto& origin = this->File->Header().latticeOrigin;
+  this->ModelOrigin = { origin[0], origin[1], -origin[2] };
+  const std::size_t count = this->File->Regions().size();
+  this->InWanted.assign(count, 0);
+  this->InPredicted.assign(count, 0);
+  this->IsPinned.assign(count, 0);
+  for (std::size_t r = 0; r < count; ++r)
+  {
+    if (this->File->Regions()[r].level == 0)
+    {
+      this->Pinned.push_back(r);
+      this->IsPinned[r] = 1;
+    }
+  }
+  this->Loader = std::thread([this] { this->Run(); });
+}
+
+RegionCache::~RegionCache()
+{
+  {
+    std::lock_guard<std::mutex> lock(this->Lock);
+    this->Stopping = true;
+  }
+  this->Wake.notify_all();
+  this->Idle.notify_all();
+  this->Loader.join();
+}
+
+std::shared_ptr<const RegionDrawBuffers> RegionCache::Get(std::size_t region) const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  const auto found = this->Entries.find(region);
+  return found == this->Entries.end() ? nullptr : found->second.buffers;
+}
+
+bool RegionCache::IsResident(std::size_t region) const
+{
+  return this->Get(region) != nullptr;
+}
+
+void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vector<std::size_t>& predicted)
+{
+  {
+    std::lock_guard<std::mutex> lock(this->Lock);
+    for (std::size_t r : this->Wanted)
+    {
+      this->InWanted[r] = 0;
+    }
+    for (std::size_t r : this->Predicted)
+    {
+      this->InPredicted[r] = 0;
+    }
+    this->Wanted.clear();
+    this->Predicted.clear();
+    // Wanted regions get the newest time, predicted ones just under it: among regions of one
+    // request, predicted ones are evicted first.
+    this->Clock += 2;
+    const std::size_t count = this->InWanted.size();
+    for (std::size_t r : wanted)
+    {
+      if (r < count && !this->InWanted[r])
+      {
+        this->InWanted[r] = 1;
+        this->Wanted.push_back(r);
+        this->Entries[r].lastRequested = this->Clock;
+      }
+    }
+    for (std::size_t r : predicted)
+    {
+      if (r < count && !this->InWanted[r] && !this->InPredicted[r])
+      {
+        this->InPredicted[r] = 1;
+        this->Predicted.push_back(r);
+        this->Entries[r].lastRequested = this->Clock - 1;
+      }
+    }
+    this->WantedBlocked = this->PredictedBlocked = false;
+  }
+  this->Wake.notify_all();
+}
+
+void RegionCache::RequestProperty(const std::string& name, int32_t step)
+{
+  {
+    std::lock_guard<std::mutex> lock(this->Lock);
+    this->PropertyName = name;
+    this->PropertyStep = step;
+    this->PropertyWanted =
+      !(this->CurrentProperty && this->CurrentProperty->name == name && this->CurrentProperty->step == step);
+  }
+  this->Wake.notify_all();
+}
+
+std::shared_ptr<const PropertyTableData> RegionCache::Property() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->CurrentProperty;
+}
+
+bool RegionCache::PendingLocked() const
+{
+  if (this->PropertyWanted)
+  {
+    return true;
+  }
+  const auto missing = [&](std::size_t r) {
+    const auto found = this->Entries.find(r);
+    return found == this->Entries.end() || (!found->second.buffers && !found->second.failed);
+  };
+  if (std::any_of(this->Pinned.begin(), this->Pinned.end(), missing))
+  {
+    return true;
+  }
+  if (!this->WantedBlocked && std::any_of(this->Wanted.begin(), this->Wanted.end(), missing))
+  {
+    return true;
+  }
+  return !this->WantedBlocked && !this->PredictedBlocked &&
+    std::any_of(this->Predicted.begin(), this->Predicted.end(), missing);
+}
+
+bool RegionCache::Pending() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->PendingLocked();
+}
+
+bool RegionCache::WaitIdle(std::chrono::milliseconds timeout) const
+{
+  std::unique_lock<std::mutex> lock(this->Lock);
+  return this->Idle.wait_for(lock, timeout, [this] { return !this->PendingLocked(); });
+}
+
+void RegionCache::SetBudget(std::size_t bytes)
+{
+  {
+    std::lock_guard<std::mutex> lock(this->Lock);
+    this->BudgetBytes = bytes;
+    // Evict at once what may go (neither a root nor wanted by the newest frame).
+    for (std::size_t r : this->EvictableLocked(std::numeric_limits<std::size_t>::max()))
+    {
+      if (this->Bytes <= this->BudgetBytes)
+      {
+        break;
+      }
+      this->EvictLocked(r);
+    }
+    this->WantedBlocked = this->PredictedBlocked = false;
+  }
+  this->Wake.notify_all();
+  this->Idle.notify_all();
+}
+
+std::size_t RegionCache::Budget() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->BudgetBytes;
+}
+
+std::size_t RegionCache::ResidentBytes() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->Bytes;
+}
+
+std::size_t RegionCache::ResidentCount() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->Resident;
+}
+
+uint64_t RegionCache::Generation() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->Changes;
+}
+
+std::string RegionCache::LastError() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->Error;
+}
+
+std::vector<std::size_t> RegionCache::EvictableLocked(std::size_t region) const
+{
+  // Loading a wanted region may evict predicted ones; loading anything else may not evict
+  // what the newest frame wants or predicts. Roots never go.
+  const bool wanted = region < this->InWanted.size() && this->InWanted[region];
+  std::vector<std::pair<uint64_t, std::size_t>> order;
+  for (const auto& entry : this->Entries)
+  {
+    const std::size_t r = entry.first;
+    if (entry.second.buffers && r != region && !this->IsPinned[r] && !this->InWanted[r] &&
+      (wanted || !this->InPredicted[r]))
+    {
+      order.emplace_back(entry.second.lastRequested, r);
+    }
+  }
+  std::sort(order.begin(), order.end());
+  std::vector<std::size_t> regions;
+  for (const auto& o : order)
+  {
+    regions.push_back(o.second);
+  }
+  return regions;
+}
+
+void RegionCache::EvictLocked(std::size_t region)
+{
+  Entry& entry = this->Entries[region];
+  if (entry.buffers)
+  {
+    this->Bytes -= entry.buffers->Bytes();
+    entry.buffers.reset();
+    --this->Resident;
+    ++this->Changes;
+  }
+}
+
+int64_t RegionCache::NextRegionLocked()
+{
+  const auto missing = [&](std::size_t r) {
+    const auto found = this->Entries.find(r);
+    return found == this->Entries.end() || (!found->second.buffers && !found->second.failed);
+  };
+  for (std::size_t r : this->Pinned)
+  {
+    if (missing(r))
+    {
+      return static_cast<int64_t>(r);
+    }
+  }
+  for (int list = 0; list < 2; ++list)
+  {
+    const bool wanted = list == 0;
+    if (this->WantedBlocked || (!wanted && this->PredictedBlocked))
+    {
+      return -1;
+    }
+    for (std::size_t r : wanted ? this->Wanted : this->Predicted)
+    {
+      if (!missing(r))
+      {
+        continue;
+      }
+      // A region refused earlier for the budget is not decoded again while it cannot fit.
+      const std::size_t known = this->Entries[r].bytes;
+      if (known > 0)
+      {
+        std::size_t freeable = 0;
+        for (std::size_t e : this->EvictableLocked(r))
+        {
+          freeable += this->Entries[e].buffers->Bytes();
+        }
+        if (this->Bytes - freeable + known > this->BudgetBytes)
+        {
+          (wanted ? this->WantedBlocked : this->PredictedBlocked) = true;
+          break;
+        }
+      }
+      return static_cast<int64_t>(r);
+    }
+  }
+  return -1;
+}
+
+void RegionCache::InsertLocked(std::size_t region, std::shared_ptr<const RegionDrawBuffers> buffers)
+{
+  Entry& entry = this->Entries[region];
+  const std::size_t need = buffers->Bytes();
+  entry.bytes = need;
+  if (!this->IsPinned[region] && this->Bytes + need > this->BudgetBytes)
+  {
+    const bool requested = this->InWanted[region] || this->InPredicted[region];
+    const std::vector<std::size_t> evictable =
+      requested ? this->EvictableLocked(region) : std::vector<std::size_t>();
+    std::size_t freeable = 0;
+    for (std::size_t e : evictable)
+    {
+      freeable += this->Entries[e].buffers->Bytes();
+    }
+    if (this->Bytes - freeable + need > this->BudgetBytes)
+    {
+      // Loading stops here: the selection draws ancestors instead.
+      if (this->InWanted[region])
+      {
+        this->WantedBlocked = true;
+      }
+      else if (this->InPredicted[region])
+      {
+        this->PredictedBlocked = true;
+      }
+      return;
+    }
+    for (std::size_t e : evictable)
+    {
+      if (this->Bytes + need <= this->BudgetBytes)
+      {
+        break;
+      }
+      this->EvictLocked(e);
+    }
+  }
+  this->Entries[region].buffers = std::move(buffers);
+  this->Bytes += need;
+  ++this->Resident;
+  ++this->Changes;
+}
+
+void RegionCache::Run()
+{
+  int handedness = 1;
+  std::string failure;
+  try
+  {
+    handedness = TopologyHandedness(*this->File);
+  }
+  catch (const std::exception& error)
+  {
+    failure = error.what();
+  }
+  std::unique_lock<std::mutex> lock(this->Lock);
+  this->Handedness = handedness;
+  if (!failure.empty())
+  {
+    this->Error = failure;
+  }
+  while (!this->Stopping)
+  {
+    const int64_t next = this->PropertyWanted ? -1 : this->NextRegionLocked();
+    if (this->PropertyWanted)
+    {
+      const std::string name = this->PropertyName;
+      const int32_t step = this->PropertyStep;
+      lock.unlock();
+      std::shared_ptr<PropertyTableData> table;
+      std::string error;
+      try
+      {
+        const int index = this->Properties ? this->Properties->Find(name, step) : -1;
+        if (index < 0)
+        {
+          error = (this->Properties ? this->Properties->Path() : std::string("no property file")) + ": property " +
+            name + " step " + std::to_string(step) + " not found";
+        }
+        else
+        {
+          table = std::make_shared<PropertyTableData>();
+          table->name = name;
+          table->step = step;
+          table->values = this->Properties->ReadPacked(static_cast<std::size_t>(index));
+        }
+      }
+      catch (const std::exception& e)
+      {
+        table.reset();
+        error = "property " + name + " step " + std::to_string(step) + ": " + e.what();
+      }
+      lock.lock();
+      if (name == this->PropertyName && step == this->PropertyStep)
+      {
+        this->PropertyWanted = false;
+        this->CurrentProperty = table; // null when the table could not be read
+        if (!error.empty())
+        {
+          this->Error = error;
+        }
+      }
+      this->Idle.notify_all();
+      continue;
+    }
+    if (next < 0)
+    {
+      this->Idle.notify_all();
+      this->Wake.wait(lock);
+      continue;
+    }
+    const std::size_t region = static_cast<std::size_t>(next);
+    lock.unlock();
+    std::shared_ptr<RegionDrawBuffers> buffers;
+    std::string error;
+    try
+    {
+      // ReadRegion, not ReadRegionSurfaces: the buffers need the positions.
+      const RegionMesh mesh = this->File->ReadRegion(region);
+      buffers = std::make_shared<RegionDrawBuffers>(PrepareRegionDrawBuffers(mesh, this->ModelOrigin, handedness));
+    }
+    catch (const std::exception& e)
+    {
+      error = e.what();
+    }
+    lock.lock();
+    if (this->Stopping)
+    {
+      break;
+    }
+    if (!error.empty())
+    {
+      this->Entries[region].failed = true;
+      this->Error = error;
+    }
+    else
+    {
+      this->InsertLocked(region, std::move(buffers));
+    }
+    this->Idle.notify_all();
+  }
+}
+
+} // namespace resmr

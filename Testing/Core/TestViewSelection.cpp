@@ -1,0 +1,912 @@
+// View-dependent selection and out-of-core loading (paper Sec. 6.2-6.3) on .resmr files built
+// by the resmr tool from real models (Reek, Brugge, SPE9, the six-cell handedness grids) and
+// a synthetic one: the extremes of the projected error against SelectByError, conformity
+// under random residency, frustum and normal-cone culling, resident ancestors standing in,
+// draw buffers whose cell coordinates land in the right active cell, and the region cache's
+// budget, LRU eviction, damaged chunks, prompt shutdown and property tables.
+#include "CoreTesting.h"
+
+#include "ConformalCut.h"
+#include "DiamondHierarchy.h"
+#include "MultiresolutionFile.h"
+#include "PropertyFile.h"
+#include "RegionCache.h"
+#include "ViewSelection.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <random>
+#include <set>
+#include <string>
+#include <sys/stat.h>
+#include <unistd.h>
+
+using namespace resmr;
+
+namespace
+{
+std::string Tool, Data, Temp;
+
+int Run(const std::string& command)
+{
+  std::fprintf(stderr, "$ %s\n", command.c_str());
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string Build(const std::string& input, const std::string& name, const std::string& options = "")
+{
+  const std::string out = Temp + "/" + name + ".resmr";
+  CHECK(Run(Tool + " build '" + input + "' -o '" + out + "' --quiet " + options + " > /dev/null") == 0);
+  return out;
+}
+
+using Vec = std::array<double, 3>;
+using Mat = std::array<double, 16>;
+
+Mat Multiply(const Mat& a, const Mat& b)
+{
+  Mat m{};
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 4; ++k)
+        m[4 * r + c] += a[4 * r + k] * b[4 * k + c];
+  return m;
+}
+
+Vec Normalise(Vec v)
+{
+  const double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  return { v[0] / l, v[1] / l, v[2] / l };
+}
+
+Vec CrossProduct(const Vec& a, const Vec& b)
+{
+  return { a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0] };
+}
+
+Mat LookAt(const Vec& eye, const Vec& target, const Vec& up)
+{
+  const Vec f = Normalise({ target[0] - eye[0], target[1] - eye[1], target[2] - eye[2] });
+  const Vec s = Normalise(CrossProduct(f, up)), u = CrossProduct(s, f);
+  const auto dot = [](const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  return { s[0], s[1], s[2], -dot(s, eye), u[0], u[1], u[2], -dot(u, eye), -f[0], -f[1], -f[2], dot(f, eye), 0, 0, 0,
+    1 };
+}
+
+/// A perspective camera (viewport 1000 pixels high, square).
+ViewParameters Perspective(const Vec& eye, const Vec& target, const Vec& up, double fovyDegrees, double nearPlane,
+  double farPlane, double tolerance)
+{
+  const double t = 1 / std::tan(fovyDegrees * M_PI / 360);
+  const Mat projection{ t, 0, 0, 0, 0, t, 0, 0, 0, 0, (farPlane + nearPlane) / (nearPlane - farPlane),
+    2 * farPlane * nearPlane / (nearPlane - farPlane), 0, 0, -1, 0 };
+  ViewParameters view;
+  view.worldToClip = Multiply(projection, LookAt(eye, target, up));
+  view.eye = eye;
+  view.direction = Normalise({ target[0] - eye[0], target[1] - eye[1], target[2] - eye[2] });
+  view.pixelsPerUnit = 1000 * t / 2;
+  view.tolerancePixels = tolerance;
+  return view;
+}
+
+/// A clip matrix that holds every point of the model (no culling), with the eye given apart.
+Mat Everything(double scale)
+{
+  return { scale, 0, 0, 0, 0, scale, 0, 0, 0, 0, scale, 0, 0, 0, 0, 1 };
+}
+
+struct Model
+{
+  std::string path;
+  std::unique_ptr<MultiresolutionFile> file;
+  std::unique_ptr<ViewSelector> selector;
+  Vec centre{}, low{}, high{};
+  double radius = 0;
+  std::map<std::pair<int32_t, int64_t>, std::size_t> byName;
+
+  explicit Model(const std::string& p)
+    : path(p)
+    , file(new MultiresolutionFile(p))
+    , selector(new ViewSelector(*file))
+  {
+    low = { 1e300, 1e300, 1e300 };
+    high = { -1e300, -1e300, -1e300 };
+    for (std::size_t r = 0; r < file->Regions().size(); ++r)
+    {
+      const auto& b = file->Regions()[r].bounds;
+      byName[{ file->Regions()[r].level, file->Regions()[r].index }] = r;
+      const Vec lo{ b[0], b[1], -b[5] }, hi{ b[3], b[4], -b[2] };
+      for (int a = 0; a < 3; ++a)
+      {
+        low[a] = std::min(low[a], lo[a]);
+        high[a] = std::max(high[a], hi[a]);
+      }
+    }
+    for (int a = 0; a < 3; ++a)
+    {
+      centre[a] = (low[a] + high[a]) / 2;
+      radius += (high[a] - low[a]) * (high[a] - low[a]) / 4;
+    }
+    radius = std::sqrt(radius);
+  }
+  int64_t Parent(std::size_t r) const
+  {
+    const auto& rec = file->Regions()[r];
+    if (rec.level == 0)
+      return -1;
+    const auto found = byName.find({ rec.level - 1, rec.index / 2 });
+    return found == byName.end() ? -1 : static_cast<int64_t>(found->second);
+  }
+  bool IsAncestor(std::size_t a, std::size_t r) const // strict
+  {
+    for (int64_t p = Parent(r); p >= 0; p = Parent(static_cast<std::size_t>(p)))
+      if (static_cast<std::size_t>(p) == a)
+        return true;
+    return false;
+  }
+  std::vector<std::size_t> Leaves() const
+  {
+    std::vector<std::size_t> leaves;
+    for (std::size_t r = 0; r < file->Regions().size(); ++r)
+      if (file->Regions()[r].level == file->Header().leafLevel)
+        leaves.push_back(r);
+    return leaves;
+  }
+};
+
+std::vector<std::size_t> DrawnSet(const ViewSelection& selection)
+{
+  std::vector<std::size_t> drawn;
+  for (const auto& d : selection.drawn)
+    drawn.push_back(d.region);
+  std::sort(drawn.begin(), drawn.end());
+  return drawn;
+}
+
+const auto AllResident = [](std::size_t) { return true; };
+
+/// Independent frustum test of a region's box.
+bool BoxOutside(const RegionRecord& record, const Mat& m)
+{
+  const auto& b = record.bounds;
+  for (int plane = 0; plane < 6; ++plane)
+  {
+    int out = 0;
+    for (int c = 0; c < 8; ++c)
+    {
+      const double p[4] = { (c & 1) ? b[3] : b[0], (c & 2) ? b[4] : b[1], -((c & 4) ? b[2] : b[5]), 1 };
+      double clip[4] = { 0, 0, 0, 0 };
+      for (int r = 0; r < 4; ++r)
+        for (int k = 0; k < 4; ++k)
+          clip[r] += m[4 * r + k] * p[k];
+      const double v = clip[plane / 2];
+      out += (plane % 2 == 0) ? v < -clip[3] : v > clip[3];
+    }
+    if (out == 8)
+      return true;
+  }
+  return false;
+}
+
+/// Crack-freeness of a drawn set: no drawn region next to an ancestor or descendant, no drawn
+/// triangle with another's vertex at the midpoint of one of its edges (T-junction), the
+/// partner of a drawn region never split further, and (full view) every leaf covered once.
+void CheckConformity(const Model& model, const ViewSelection& selection, bool fullView,
+  const std::function<bool(std::size_t)>& resident, const char* label)
+{
+  const auto& header = model.file->Header();
+  const DiamondHierarchy tree(header.box[0], header.box[1], header.box[2], header.box[3], header.leafLevel);
+  const std::vector<std::size_t> drawn = DrawnSet(selection);
+  const std::set<std::size_t> drawnSet(drawn.begin(), drawn.end());
+  int failures = 0;
+  std::set<std::pair<double, double>> vertices;
+  for (std::size_t r : drawn)
+  {
+    failures += !resident(r);
+    const auto& rec = model.file->Regions()[r];
+    const auto t = tree.NormalisedTriangle(rec.level, rec.index);
+    for (const auto& p : { t.apex, t.left, t.right })
+      vertices.insert({ p[0], p[1] });
+    for (int64_t p = model.Parent(r); p >= 0; p = model.Parent(static_cast<std::size_t>(p)))
+      failures += drawnSet.count(static_cast<std::size_t>(p)) != 0;
+  }
+  for (std::size_t r : drawn)
+  {
+    const auto& rec = model.file->Regions()[r];
+    const auto t = tree.NormalisedTriangle(rec.level, rec.index);
+    const DiamondHierarchy::Point corners[3] = { t.apex, t.left, t.right };
+    for (int e = 0; e < 3; ++e)
+    {
+      const auto& a = corners[e];
+      const auto& b = corners[(e + 1) % 3];
+      if (vertices.count({ (a[0] + b[0]) / 2, (a[1] + b[1]) / 2 }))
+      {
+        std::fprintf(stderr, "%s: T-junction on region (%d, %lld)\n", label, rec.level, (long long)rec.index);
+        ++failures;
+      }
+    }
+    // The partner: itself drawn or covered by a drawn ancestor, never by a drawn descendant.
+    for (const auto& diamond : tree.Diamonds(rec.level))
+    {
+      if (diamond.first != rec.index && diamond.second != rec.index)
+        continue;
+      const int64_t other = diamond.first == rec.index ? diamond.second : diamond.first;
+      const auto found = model.byName.find({ rec.level, other });
+      if (other < 0 || found == model.byName.end())
+        break;
+      const std::size_t partner = found->second;
+      for (std::size_t d : drawn)
+        failures += model.IsAncestor(partner, d);
+      if (fullView)
+      {
+        bool covered = drawnSet.count(partner) != 0;
+        for (int64_t p = model.Parent(partner); p >= 0; p = model.Parent(static_cast<std::size_t>(p)))
+          covered = covered || drawnSet.count(static_cast<std::size_t>(p));
+        failures += !covered;
+      }
+      break;
+    }
+  }
+  if (fullView)
+  {
+    for (std::size_t leaf : model.Leaves())
+    {
+      int covering = drawnSet.count(leaf) ? 1 : 0;
+      for (int64_t p = model.Parent(leaf); p >= 0; p = model.Parent(static_cast<std::size_t>(p)))
+        covering += drawnSet.count(static_cast<std::size_t>(p)) ? 1 : 0;
+      failures += covering != 1;
+    }
+  }
+  if (failures)
+    std::fprintf(stderr, "%s: %d conformity failures among %zu drawn\n", label, failures, drawn.size());
+  CHECK(failures == 0);
+}
+
+void TestExtremes(const Model& model)
+{
+  const auto& regions = model.file->Regions();
+  ViewParameters view;
+  view.worldToClip = Everything(1e-9);
+  view.eye = { model.centre[0], model.centre[1], model.high[2] + model.radius };
+  view.tolerancePixels = 1;
+  view.pixelsPerUnit = 1e15;
+  const auto finest = model.selector->Select(view, AllResident);
+  CHECK(DrawnSet(finest) == SelectByError(*model.file, 0));
+  CHECK(finest.substituted == 0);
+  view.pixelsPerUnit = 1e-15;
+  const auto coarsest = model.selector->Select(view, AllResident);
+  std::vector<std::size_t> roots = model.selector->Roots();
+  std::sort(roots.begin(), roots.end());
+  CHECK(DrawnSet(coarsest) == roots);
+  std::printf("  %s: %zu regions, leaf level %d, finest cut %zu, roots %zu\n", model.path.c_str(), regions.size(),
+    model.file->Header().leafLevel, finest.drawn.size(), roots.size());
+  // Parallel: projected error = e * pixelsPerUnit, so the cut is SelectByError(tol / ppu).
+  view.parallel = true;
+  view.direction = { 0, 0, -1 };
+  view.pixelsPerUnit = 2.5;
+  int distinct = 0;
+  std::size_t previous = 0;
+  for (double tolerance : { 0.7, 3.3, 17.0, 61.0, 240.0, 900.0, 4100.0 })
+  {
+    view.tolerancePixels = tolerance;
+    const auto selection = model.selector->Select(view, AllResident);
+    const auto expected = SelectByError(*model.file, tolerance / view.pixelsPerUnit);
+    CHECK(DrawnSet(selection) == expected);
+    double largest = 0;
+    for (const auto& d : selection.drawn)
+      largest = std::max(largest, regions[d.region].error * view.pixelsPerUnit);
+    CHECK(selection.largestProjectedError == largest);
+    distinct += expected.size() != previous;
+    previous = expected.size();
+    CheckConformity(model, selection, true, AllResident, "parallel");
+  }
+  CHECK(distinct >= 3);
+}
+
+void TestConformity(const Model& model)
+{
+  std::mt19937_64 random(11);
+  const std::size_t count = model.file->Regions().size();
+  int views = 0;
+  std::size_t mostDrawn = 0;
+  for (int trial = 0; trial < 40; ++trial)
+  {
+    std::vector<uint8_t> resident(count);
+    const double fraction = (trial % 5) / 4.0;
+    for (std::size_t r = 0; r < count; ++r)
+      resident[r] = model.file->Regions()[r].level == 0 || std::uniform_real_distribution<double>(0, 1)(random) < fraction;
+    const auto isResident = [&](std::size_t r) { return resident[r] != 0; };
+    const double angle = trial * 0.7;
+    const Vec eye{ model.centre[0] + 1.5 * model.radius * std::cos(angle),
+      model.centre[1] + 1.5 * model.radius * std::sin(angle), model.centre[2] + model.radius * (0.2 + trial % 3) };
+    // Full view (no culling), then a narrow frustum through the same eye.
+    ViewParameters view;
+    view.worldToClip = Everything(1e-9);
+    view.eye = eye;
+    view.pixelsPerUnit = 1000;
+    view.tolerancePixels = std::pow(2.0, trial % 9);
+    const auto full = model.selector->Select(view, isResident);
+    CheckConformity(model, full, true, isResident, "full view");
+    mostDrawn = std::max(mostDrawn, full.drawn.size());
+    const Vec target{ model.centre[0] + 0.3 * model.radius * std::cos(3 * angle), model.centre[1], model.centre[2] };
+    const auto narrow =
+      model.selector->Select(Perspective(eye, target, { 0, 0, 1 }, 12, 1, 10 * model.radius, view.tolerancePixels), isResident);
+    CheckConformity(model, narrow, false, isResident, "narrow frustum");
+    views += 2;
+  }
+  std::printf("  conformity: %d views, up to %zu regions drawn\n", views, mostDrawn);
+}
+
+void TestFrustum(const Model& model)
+{
+  const Vec above{ model.centre[0], model.centre[1], model.high[2] + model.radius };
+  // Looking up, away from the model: nothing.
+  const auto away = model.selector->Select(
+    Perspective(above, { above[0], above[1], above[2] + 1 }, { 0, 1, 0 }, 60, 1, 10 * model.radius, 1), AllResident);
+  CHECK(away.drawn.empty() && away.wanted.empty());
+  // Everything in sight, then a narrow frustum at a corner.
+  const Vec eye{ model.centre[0], model.centre[1], model.high[2] + 3 * model.radius };
+  const auto wide =
+    model.selector->Select(Perspective(eye, model.centre, { 0, 1, 0 }, 90, 1, 10 * model.radius, 1e-9), AllResident);
+  CHECK(DrawnSet(wide) == SelectByError(*model.file, 0));
+  const auto& b = model.file->Regions()[model.Leaves()[0]].bounds;
+  const Vec target{ (b[0] + b[3]) / 2, (b[1] + b[4]) / 2, -(b[2] + b[5]) / 2 };
+  const ViewParameters narrowView = Perspective(eye, target, { 0, 1, 0 }, 8, 1, 10 * model.radius, 1e-9);
+  const auto narrow = model.selector->Select(narrowView, AllResident);
+  CHECK(!narrow.drawn.empty() && narrow.drawn.size() < wide.drawn.size());
+  const std::vector<std::size_t> drawn = DrawnSet(narrow);
+  std::size_t culled = 0;
+  for (std::size_t r : SelectByError(*model.file, 0))
+  {
+    if (!std::binary_search(drawn.begin(), drawn.end(), r))
+    {
+      ++culled;
+      CHECK(BoxOutside(model.file->Regions()[r], narrowView.worldToClip));
+    }
+  }
+  for (std::size_t r : drawn)
+    CHECK(!BoxOutside(model.file->Regions()[r], narrowView.worldToClip));
+  std::printf("  frustum: wide %zu drawn, narrow %zu drawn, %zu finest regions culled\n", wide.drawn.size(),
+    narrow.drawn.size(), culled);
+}
+
+void TestNormalCones(const Model& model)
+{
+  const auto& regions = model.file->Regions();
+  int topsShown = 0, bottomsCulled = 0, emptyHidden = 0;
+  for (int parallel = 0; parallel < 2; ++parallel)
+  {
+    const Vec eye{ model.centre[0], model.centre[1], model.high[2] + 4 * model.radius };
+    ViewParameters view = Perspective(eye, model.centre, { 0, 1, 0 }, 60, 1, 10 * model.radius, 1e-9);
+    view.parallel = parallel == 1;
+    const auto selection = model.selector->Select(view, AllResident);
+    for (const auto& d : selection.drawn)
+    {
+      const auto& top = regions[d.region].topCone;
+      const auto& bottom = regions[d.region].bottomCone;
+      CHECK(d.side);
+      if (bottom[3] > 0.9f && bottom[2] < -0.9f)
+      {
+        CHECK(!d.bottom);
+        bottomsCulled += !d.bottom;
+      }
+      if (top[3] > -1.5f && top[2] > 0.5f && top[3] > 0.5f)
+      {
+        CHECK(d.top);
+        topsShown += d.top;
+      }
+      if (top[3] < -1.5f)
+      {
+        CHECK(!d.top);
+        ++emptyHidden;
+      }
+      if (bottom[3] < -1.5f)
+        CHECK(!d.bottom);
+    }
+  }
+  // From below, the other way round.
+  const Vec below{ model.centre[0], model.centre[1], model.low[2] - 4 * model.radius };
+  const auto fromBelow = model.selector->Select(
+    Perspective(below, model.centre, { 0, 1, 0 }, 60, 1, 10 * model.radius, 1e-9), AllResident);
+  int topsCulled = 0;
+  for (const auto& d : fromBelow.drawn)
+  {
+    const auto& top = regions[d.region].topCone;
+    if (top[3] > 0.9f && top[2] > 0.9f)
+    {
+      CHECK(!d.top);
+      ++topsCulled;
+    }
+  }
+  CHECK(topsShown > 0 && bottomsCulled > 0 && topsCulled > 0);
+  std::printf("  normal cones: from above %d tops shown, %d bottoms culled; from below %d tops culled\n", topsShown,
+    bottomsCulled, topsCulled);
+}
+
+void TestFallback(const Model& model)
+{
+  const auto& roots = model.selector->Roots();
+  const auto onlyRoots = [&](std::size_t r) { return model.file->Regions()[r].level == 0; };
+  const Vec eye{ model.centre[0], model.centre[1], model.high[2] + model.radius };
+  const ViewParameters view = Perspective(eye, model.centre, { 0, 1, 0 }, 90, 1, 10 * model.radius, 0.5);
+  const auto selection = model.selector->Select(view, onlyRoots);
+  std::vector<std::size_t> sortedRoots(roots.begin(), roots.end());
+  std::sort(sortedRoots.begin(), sortedRoots.end());
+  CHECK(DrawnSet(selection) == sortedRoots);
+  CHECK(selection.substituted == roots.size());
+  CHECK(selection.wanted.size() > roots.size());
+  std::set<std::size_t> seen;
+  for (std::size_t i = 0; i < selection.wanted.size(); ++i)
+  {
+    const std::size_t r = selection.wanted[i];
+    if (i < roots.size())
+      CHECK(model.file->Regions()[r].level == 0);
+    const int64_t parent = model.Parent(r);
+    CHECK(parent < 0 || seen.count(static_cast<std::size_t>(parent)));
+    if (i > 0)
+      CHECK(model.file->Regions()[selection.wanted[i - 1]].level <= model.file->Regions()[r].level);
+    seen.insert(r);
+  }
+  // No root resident: nothing drawn.
+  CHECK(model.selector->Select(view, [](std::size_t) { return false; }).drawn.empty());
+  // Loading what is wanted, frame after frame, reaches the ideal cut.
+  const auto ideal = model.selector->Select(view, AllResident);
+  std::set<std::size_t> loaded(roots.begin(), roots.end());
+  int frames = 0;
+  for (; frames < 20; ++frames)
+  {
+    const auto frame = model.selector->Select(view, [&](std::size_t r) { return loaded.count(r) != 0; });
+    if (frame.substituted == 0)
+    {
+      CHECK(DrawnSet(frame) == DrawnSet(ideal));
+      break;
+    }
+    for (std::size_t r : frame.wanted)
+      loaded.insert(r);
+  }
+  CHECK(frames <= 2);
+  std::printf("  fallback: roots drawn for %zu wanted, ideal cut %zu after %d frames\n", selection.wanted.size(),
+    ideal.drawn.size(), frames);
+}
+
+void TestPrediction()
+{
+  ViewParameters a, b;
+  a.eye = { 1, 2, 3 };
+  b.eye = { 2, 4, 5 };
+  for (int e = 0; e < 16; ++e)
+  {
+    a.worldToClip[e] = e;
+    b.worldToClip[e] = 2 * e + 1;
+  }
+  b.tolerancePixels = 3;
+  b.pixelsPerUnit = 7;
+  const ViewParameters next = PredictNextView(a, b);
+  CHECK(next.eye == (Vec{ 3, 6, 7 }));
+  CHECK(next.worldToClip[5] == 17 && next.worldToClip[0] == 2);
+  CHECK(next.tolerancePixels == 3 && next.pixelsPerUnit == 7);
+}
+
+/// Cell coordinates of the draw buffers on every leaf region: the floor of an interior point
+/// of every triangle is an active cell whose face it is (top: nothing active above, bottom:
+/// nothing below, side: an open side of that cell on the face's plane).
+void TestDrawBuffers(const std::string& path, int expectedHandedness)
+{
+  const MultiresolutionFile file(path);
+  const int handedness = TopologyHandedness(file);
+  CHECK(handedness == expectedHandedness || expectedHandedness == 0);
+  const auto& dims = file.Header().dims;
+  std::vector<std::vector<uint8_t>> active;
+  for (int64_t k = 0; k < dims[2]; ++k)
+    active.push_back(file.ReadActiveLayer(k));
+  const auto isActive = [&](int64_t i, int64_t j, int64_t k) {
+    return i >= 0 && j >= 0 && k >= 0 && i < dims[0] && j < dims[1] && k < dims[2] &&
+      active[static_cast<std::size_t>(k)][static_cast<std::size_t>(i + dims[0] * j)] != 0;
+  };
+  const auto& o = file.Header().latticeOrigin;
+  const std::array<double, 3> origin{ o[0], o[1], -o[2] };
+  // Generic barycentric weights: an interior point that never falls on a cell boundary.
+  const double w[3] = { 1.0 / 3 + std::sqrt(2.0) * 1e-3, 1.0 / 3 + std::sqrt(3.0) * 1e-3, 0 };
+  const double w2 = 1 - w[0] - w[1];
+  std::size_t regions = 0, triangles = 0, bad = 0, spanning = 0, sideBad = 0;
+  double largestError = 0;
+  for (std::size_t r = 0; r < file.Regions().size(); ++r)
+  {
+    if (file.Regions()[r].level != file.Header().leafLevel)
+      continue;
+    ++regions;
+    const RegionMesh mesh = file.ReadRegion(r);
+    const RegionDrawBuffers buffers = PrepareRegionDrawBuffers(mesh, origin, handedness);
+    const std::size_t vertexCount = buffers.vertices.size() / 6;
+    CHECK(buffers.vertices.size() % 6 == 0 && buffers.indices.size() % 3 == 0);
+    CHECK(buffers.topIndices + buffers.bottomIndices + buffers.sideIndices == buffers.indices.size());
+    CHECK(buffers.topIndices == 6 * mesh.top.quads.size() && buffers.bottomIndices == 6 * mesh.bottom.quads.size());
+    CHECK(buffers.sideIndices == 3 * mesh.sideTriangles.size());
+    std::set<uint32_t> topUsed, bottomUsed;
+    for (const auto& q : mesh.top.quads)
+      topUsed.insert(q.begin(), q.end());
+    for (const auto& q : mesh.bottom.quads)
+      bottomUsed.insert(q.begin(), q.end());
+    CHECK(vertexCount == topUsed.size() + bottomUsed.size() + 3 * mesh.sideTriangles.size());
+    std::vector<uint8_t> referenced(vertexCount, 0);
+    for (uint32_t i : buffers.indices)
+    {
+      CHECK(i < vertexCount);
+      if (i < vertexCount)
+        referenced[i] = 1;
+    }
+    CHECK(std::all_of(referenced.begin(), referenced.end(), [](uint8_t x) { return x != 0; }));
+    // Positions: the first top vertex against the mesh.
+    if (!mesh.top.quads.empty())
+    {
+      const double* p = &mesh.positions[mesh.top.quads[0][0] * 3];
+      largestError = std::max({ largestError, std::fabs(buffers.vertices[0] + origin[0] - p[0]),
+        std::fabs(buffers.vertices[1] + origin[1] - p[1]), std::fabs(buffers.vertices[2] + origin[2] + p[2]) });
+    }
+    // The region's columns by cell (i, j).
+    std::map<std::pair<int64_t, int64_t>, std::size_t> columns;
+    for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+    {
+      double i = 1e300, j = 1e300;
+      for (uint32_t n : mesh.corners[c])
+      {
+        i = std::min(i, double(mesh.topology[n][0]));
+        j = std::min(j, double(mesh.topology[n][1]));
+      }
+      columns[{ int64_t(i), int64_t(j) }] = c;
+    }
+    for (std::size_t t = 0; t < buffers.indices.size(); t += 3)
+    {
+      ++triangles;
+      double point[3] = { 0, 0, 0 };
+      for (int v = 0; v < 3; ++v)
+        for (int a = 0; a < 3; ++a)
+          point[a] += (v == 2 ? w2 : w[v]) * buffers.vertices[buffers.indices[t + v] * 6 + 3 + a];
+      const int64_t i = int64_t(std::floor(point[0])), j = int64_t(std::floor(point[1])), k = int64_t(std::floor(point[2]));
+      bool ok = isActive(i, j, k);
+      if (t < buffers.topIndices)
+        ok = ok && !isActive(i, j, k - 1);
+      else if (t < buffers.topIndices + buffers.bottomIndices)
+        ok = ok && !isActive(i, j, k + 1);
+      else
+      {
+        // The face's plane: the axis whose coordinate is an integer + 0.5 at every vertex.
+        int axis = -1;
+        for (int a = 0; a < 3 && axis < 0; ++a)
+        {
+          bool half = true;
+          for (int v = 0; v < 3; ++v)
+          {
+            const double c = buffers.vertices[buffers.indices[t + v] * 6 + 3 + a];
+            half = half && std::fabs(c - std::floor(c) - 0.5) < 1e-6 && std::fabs(c - point[a]) < 1e-6;
+          }
+          if (half)
+            axis = a;
+        }
+        const auto column = columns.find({ i, j });
+        ok = ok && column != columns.end();
+        if (axis != 0 && axis != 1)
+        {
+          // Simplified across a pillar: the triangle spans an i face and a j face, so no one
+          // cell owns it; counted, not checked.
+          ++spanning;
+          continue;
+        }
+        if (ok)
+        {
+          // The face plane: the vertices' topological coordinate along the axis, on the cell's
+          // low or high side; the cell's edge lying there must be open.
+          const auto& tv = mesh.topology;
+          const std::size_t side = (t - buffers.topIndices - buffers.bottomIndices) / 3;
+          const uint32_t node = mesh.sideTriangles[side][0] / static_cast<uint32_t>(mesh.layers + 1);
+          const double plane = tv[node][axis];
+          ok = plane == double(axis == 0 ? i : j) || plane == double(axis == 0 ? i : j) + 1;
+          const auto& q = mesh.corners[column->second];
+          bool open = false;
+          for (int e = 0; e < 4; ++e)
+          {
+            if (tv[q[e]][axis] == plane && tv[q[(e + 1) % 4]][axis] == plane)
+              open = (mesh.openSides[column->second * mesh.layers + k] >> e) & 1;
+          }
+          ok = ok && open;
+        }
+      }
+      if (!ok && t >= buffers.topIndices + buffers.bottomIndices)
+        ++sideBad;
+      if (!ok && bad < 4)
+      {
+        const int part = t < buffers.topIndices ? 0 : t < buffers.topIndices + buffers.bottomIndices ? 1 : 2;
+        std::fprintf(stderr, "    misplaced %s triangle in region %zu at (%.3f %.3f %.3f): active %d above %d below %d\n",
+          part == 0 ? "top" : part == 1 ? "bottom" : "side", r, point[0], point[1], point[2], int(isActive(i, j, k)),
+          int(isActive(i, j, k - 1)), int(isActive(i, j, k + 1)));
+        if (part == 2)
+          for (int v = 0; v < 3; ++v)
+          {
+            const float* x = &buffers.vertices[buffers.indices[t + v] * 6];
+            std::fprintf(stderr, "      %g %g %g | %g %g %g\n", x[0], x[1], x[2], x[3], x[4], x[5]);
+          }
+      }
+      bad += !ok;
+    }
+  }
+  std::printf("  draw buffers %s: handedness %+d, %zu leaf regions, %zu triangles, %zu misplaced, %zu side triangles "
+    "across a pillar, position error %.3g\n", path.c_str(), handedness, regions, triangles, bad, spanning, largestError);
+  // Top and bottom faces are exact; a simplified side triangle may stray over a cell it does
+  // not own (it approximates a staircase of open faces): a few in a thousand at most.
+  CHECK(bad == sideBad && triangles > 0);
+  CHECK(sideBad * 1000 < triangles && spanning * 100 < triangles);
+  CHECK(largestError < 1e-2);
+}
+
+std::vector<std::size_t> RegionBytes(const MultiresolutionFile& file)
+{
+  const int handedness = TopologyHandedness(file);
+  const auto& o = file.Header().latticeOrigin;
+  std::vector<std::size_t> bytes;
+  for (std::size_t r = 0; r < file.Regions().size(); ++r)
+    bytes.push_back(PrepareRegionDrawBuffers(file.ReadRegion(r), { o[0], o[1], -o[2] }, handedness).Bytes());
+  return bytes;
+}
+
+void TestCache(const std::string& path)
+{
+  using namespace std::chrono;
+  const auto file = std::make_shared<const MultiresolutionFile>(path);
+  const Model model(path);
+  const auto leaves = model.Leaves();
+  const auto roots = model.selector->Roots();
+  const std::vector<std::size_t> sizes = RegionBytes(*file);
+  std::size_t rootBytes = 0, leafBytes = 0;
+  for (std::size_t r : roots)
+    rootBytes += sizes[r];
+  for (std::size_t r : leaves)
+    leafBytes += sizes[r];
+  {
+    // Unlimited: the roots before any request, then every leaf.
+    RegionCache cache(file, nullptr, SIZE_MAX);
+    CHECK(cache.WaitIdle(seconds(10)));
+    CHECK(cache.ResidentCount() == roots.size() && cache.ResidentBytes() == rootBytes);
+    const auto start = steady_clock::now();
+    cache.Request(leaves);
+    CHECK(cache.WaitIdle(seconds(10)));
+    const double seconds = duration<double>(steady_clock::now() - start).count();
+    CHECK(cache.ResidentCount() == roots.size() + leaves.size());
+    CHECK(cache.ResidentBytes() == rootBytes + leafBytes);
+    CHECK(cache.Generation() == roots.size() + leaves.size());
+    std::size_t sum = 0;
+    for (std::size_t r = 0; r < file->Regions().size(); ++r)
+      if (auto b = cache.Get(r))
+        sum += b->Bytes();
+    CHECK(sum == cache.ResidentBytes());
+    const auto& o = file->Header().latticeOrigin;
+    CHECK(cache.Origin() == (std::array<double, 3>{ o[0], o[1], -o[2] }));
+    const auto expected = PrepareRegionDrawBuffers(file->ReadRegion(leaves[0]), cache.Origin(), TopologyHandedness(*file));
+    CHECK(cache.Get(leaves[0]) && cache.Get(leaves[0])->vertices == expected.vertices &&
+      cache.Get(leaves[0])->indices == expected.indices);
+    CHECK(cache.LastError().empty());
+    std::printf("  cache: %zu leaves (%zu bytes) + %zu roots (%zu bytes) loaded in %.3f s\n", leaves.size(), leafBytes,
+      roots.size(), rootBytes, seconds);
+  }
+  {
+    // A budget for the roots and the first n leaves: loading stops at leaf n.
+    const std::size_t n = leaves.size() / 3;
+    std::size_t budget = rootBytes;
+    for (std::size_t i = 0; i < n; ++i)
+      budget += sizes[leaves[i]];
+    budget += sizes[leaves[n]] / 2;
+    RegionCache cache(file, nullptr, budget);
+    cache.Request(leaves);
+    CHECK(cache.WaitIdle(seconds(10)) && !cache.Pending());
+    CHECK(cache.ResidentBytes() <= std::max(budget, rootBytes));
+    CHECK(cache.ResidentCount() == roots.size() + n);
+    for (std::size_t i = 0; i < leaves.size(); ++i)
+      CHECK(cache.IsResident(leaves[i]) == (i < n));
+    // Raised: the rest loads; lowered: what is wanted stays, then a new request evicts.
+    cache.SetBudget(SIZE_MAX);
+    CHECK(cache.WaitIdle(seconds(10)) && cache.ResidentCount() == roots.size() + leaves.size());
+    cache.SetBudget(budget);
+    CHECK(cache.ResidentCount() == roots.size() + leaves.size());
+    cache.Request({ leaves[0] });
+    CHECK(cache.WaitIdle(seconds(10)));
+    cache.SetBudget(budget - 1);
+    CHECK(cache.ResidentBytes() <= budget - 1 && cache.IsResident(leaves[0]));
+    // Budget below the roots: roots only.
+    RegionCache tiny(file, nullptr, 1);
+    tiny.Request(leaves);
+    CHECK(tiny.WaitIdle(seconds(10)) && tiny.ResidentCount() == roots.size() && tiny.ResidentBytes() == rootBytes);
+  }
+  {
+    // LRU: A, B, C fill the budget; D evicts A (the least recently requested); after B is
+    // requested again and the budget is cut to what is resident, E evicts C.
+    std::vector<std::size_t> bySize = leaves;
+    std::sort(bySize.begin(), bySize.end(), [&](std::size_t a, std::size_t b) { return sizes[a] > sizes[b]; });
+    const std::size_t A = bySize[0], B = bySize[1], C = bySize[2], D = bySize[3], E = bySize[4];
+    RegionCache cache(file, nullptr, rootBytes + sizes[A] + sizes[B] + sizes[C]);
+    CHECK(cache.WaitIdle(seconds(10)));
+    uint64_t generation = cache.Generation();
+    for (std::size_t r : { A, B, C })
+    {
+      cache.Request({ r });
+      CHECK(cache.WaitIdle(seconds(10)) && cache.IsResident(r));
+      CHECK(cache.Generation() == ++generation);
+    }
+    cache.Request({ D });
+    CHECK(cache.WaitIdle(seconds(10)));
+    CHECK(!cache.IsResident(A) && cache.IsResident(B) && cache.IsResident(C) && cache.IsResident(D));
+    CHECK(cache.Generation() == generation + 2);
+    cache.Request({ B });
+    CHECK(cache.WaitIdle(seconds(10)));
+    cache.SetBudget(cache.ResidentBytes());
+    cache.Request({ E });
+    CHECK(cache.WaitIdle(seconds(10)));
+    CHECK(!cache.IsResident(C) && cache.IsResident(B) && cache.IsResident(D) && cache.IsResident(E));
+    CHECK(cache.ResidentBytes() <= cache.Budget());
+  }
+  {
+    // Destroyed while loading everything: returns at once.
+    std::vector<std::size_t> all(file->Regions().size());
+    for (std::size_t r = 0; r < all.size(); ++r)
+      all[r] = r;
+    const auto start = steady_clock::now();
+    std::size_t loaded = 0;
+    {
+      RegionCache cache(file, nullptr, SIZE_MAX);
+      cache.Request(all);
+      std::this_thread::sleep_for(milliseconds(2));
+      loaded = cache.ResidentCount();
+    }
+    const double ms = duration<double, std::milli>(steady_clock::now() - start).count();
+    std::printf("  cache destroyed after %.1f ms with %zu of %zu regions loaded\n", ms, loaded, all.size());
+    CHECK(ms < 500);
+  }
+}
+
+void TestDamagedChunk(const std::string& path)
+{
+  using namespace std::chrono;
+  const std::string damaged = Temp + "/damaged.resmr";
+  std::size_t victim = 0;
+  {
+    const MultiresolutionFile file(path);
+    const Model model(path);
+    victim = model.Leaves()[model.Leaves().size() / 2];
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const ChunkRef& chunk = file.Regions()[victim].chunks[RegionRecord::Side];
+    for (uint32_t b = 0; b < std::min<uint32_t>(chunk.stored, 8); ++b)
+      bytes[chunk.offset + chunk.stored / 2 + b] ^= 0x5a;
+    std::ofstream(damaged, std::ios::binary) << bytes;
+  }
+  const auto file = std::make_shared<const MultiresolutionFile>(damaged);
+  const auto& record = file->Regions()[victim];
+  const Model model(path);
+  RegionCache cache(file, nullptr, SIZE_MAX);
+  cache.Request(model.Leaves());
+  CHECK(cache.WaitIdle(seconds(10)));
+  const std::string error = cache.LastError();
+  std::printf("  damaged chunk: %s\n", error.c_str());
+  CHECK(error.find("damaged.resmr") != std::string::npos);
+  CHECK(error.find("level " + std::to_string(record.level) + ", index " + std::to_string(record.index)) != std::string::npos);
+  CHECK(!cache.IsResident(victim) && !cache.Pending());
+  CHECK(cache.ResidentCount() == model.selector->Roots().size() + model.Leaves().size() - 1);
+}
+
+/// Bit-equal float arrays (NaN where a slot has no value).
+bool Same(const std::vector<float>& a, const std::vector<float>& b)
+{
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * 4) == 0;
+}
+
+void TestProperties()
+{
+  using namespace std::chrono;
+  const std::string egrid = Data + "/spe9/opmflow2022_run_of_opm-data_SPE9_CP/SPE9_CP.EGRID";
+  const std::string geometry = Build(egrid, "spe9");
+  const std::string propertyPath = Temp + "/spe9.resmrp";
+  std::remove(propertyPath.c_str());
+  CHECK(Run(Tool + " add-properties '" + geometry + "' '" + egrid + "' > /dev/null 2>&1") == 0);
+  const auto file = std::make_shared<const MultiresolutionFile>(geometry);
+  const auto properties = std::make_shared<const PropertyFile>(propertyPath);
+  RegionCache cache(file, properties, SIZE_MAX);
+  CHECK(cache.Property() == nullptr);
+  cache.RequestProperty("PRESSURE", 0);
+  CHECK(cache.WaitIdle(seconds(10)));
+  const auto first = cache.Property();
+  CHECK(first && first->name == "PRESSURE" && first->step == 0);
+  CHECK(first && Same(first->values, properties->ReadPacked(static_cast<std::size_t>(properties->Find("PRESSURE", 0)))));
+  cache.RequestProperty("PRESSURE", 1);
+  const auto meanwhile = cache.Property(); // the previous table or the new one, never none
+  CHECK(meanwhile && meanwhile->name == "PRESSURE");
+  CHECK(cache.WaitIdle(seconds(10)));
+  const auto second = cache.Property();
+  CHECK(second && second->step == 1 &&
+    Same(second->values, properties->ReadPacked(static_cast<std::size_t>(properties->Find("PRESSURE", 1)))));
+  CHECK(first->step == 0); // the old table is untouched for whoever still holds it
+  cache.RequestProperty("NOSUCH", 3);
+  CHECK(cache.WaitIdle(seconds(10)));
+  CHECK(cache.Property() == nullptr);
+  CHECK(cache.LastError().find("NOSUCH") != std::string::npos && cache.LastError().find("3") != std::string::npos);
+  std::printf("  properties: PRESSURE steps 0 and 1 (%zu slots); missing: %s\n", second ? second->values.size() : 0,
+    cache.LastError().c_str());
+}
+} // namespace
+
+int main(int argc, char** argv)
+{
+  if (argc < 4)
+  {
+    std::fprintf(stderr, "usage: TestViewSelection RESMR DATA_DIR TEMP_DIR\n");
+    return 2;
+  }
+  Tool = argv[1];
+  Data = argv[2];
+  Temp = argv[3];
+  mkdir(Temp.c_str(), 0755);
+  const auto start = std::chrono::steady_clock::now();
+  const std::string reek = Build(Data + "/reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID", "reek");
+  const std::string reek64 = Build(Data + "/reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID", "reek64", "--cmax 64");
+  const std::string brugge = Build(Data + "/brugge/Real0/BRUGGE_0000.EGRID", "brugge");
+  const std::string synth = Build("synth:96x80x10:5", "synth", "--cmax 96");
+  const std::string left = Build(Data + "/format_variants/xtgeo_etc/sixcells_lefthanded_hdr1.grdecl", "left");
+  const std::string right = Build(Data + "/format_variants/xtgeo_etc/sixcells2_rhand_hdr1.grdecl", "right");
+  std::vector<std::unique_ptr<Model>> models;
+  for (const auto& path : { reek64, brugge, synth })
+    models.emplace_back(new Model(path));
+  const bool ok = resmr_testing::RunNamedTests({
+    { "Extremes",
+      [&] {
+        for (const auto& m : models)
+          TestExtremes(*m);
+      } },
+    { "Conformity",
+      [&] {
+        for (const auto& m : models)
+          TestConformity(*m);
+      } },
+    { "Frustum",
+      [&] {
+        for (const auto& m : models)
+          TestFrustum(*m);
+      } },
+    { "NormalCones",
+      [&] {
+        for (const auto& m : models)
+          TestNormalCones(*m);
+      } },
+    { "Fallback",
+      [&] {
+        for (const auto& m : models)
+          TestFallback(*m);
+      } },
+    { "Prediction", [&] { TestPrediction(); } },
+    { "DrawBuffers",
+      [&] {
+        TestDrawBuffers(reek, 0);
+        TestDrawBuffers(brugge, 0);
+        TestDrawBuffers(synth, 0);
+        const int l = TopologyHandedness(MultiresolutionFile(left));
+        const int r = TopologyHandedness(MultiresolutionFile(right));
+        CHECK(l == -r);
+        TestDrawBuffers(left, l);
+        TestDrawBuffers(right, r);
+      } },
+    { "Cache", [&] { TestCache(reek64); } },
+    { "DamagedChunk", [&] { TestDamagedChunk(reek); } },
+    { "Properties", [&] { TestProperties(); } },
+  });
+  std::printf("total %.2f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  if (!ok)
+  {
+    std::fprintf(stderr, "%d checks failed\n", resmr_testing::Failures);
+    return 1;
+  }
+  return 0;
+}
