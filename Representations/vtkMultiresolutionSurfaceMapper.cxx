@@ -306,6 +306,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   vtkDataObject* input = this->GetInputDataObject(0, 0);
   std::string filePath, propertyPath;
   int32_t step = 0;
+  if (getenv("RESMR_DEBUG")) fprintf(stderr, "Render input %p %s\n", (void*)input, input ? input->GetClassName() : "");
   if (!ReadSource(input, filePath, propertyPath, step))
   {
     return; // an empty piece (another rank) or no file yet

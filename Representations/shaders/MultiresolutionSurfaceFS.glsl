@@ -39,7 +39,10 @@ ivec3 HashSlot(ivec3 cell)
 
 vec3 DecodeNormal(uint code)
 {
-  vec2 e = max(vec2(bitfieldExtract(int(code), 0, 8), bitfieldExtract(int(code), 8, 8)) / 127.0, vec2(-1.0));
+  // Two signed bytes (GLSL 1.50 has no bitfieldExtract).
+  ivec2 bytes = ivec2(int(code & 255u), int((code >> 8u) & 255u));
+  bytes -= ivec2(greaterThanEqual(bytes, ivec2(128))) * 256;
+  vec2 e = max(vec2(bytes) / 127.0, vec2(-1.0));
   vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
   float t = max(-n.z, 0.0);
   n.xy -= t * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);

@@ -118,7 +118,8 @@ for name, grid_path in models():
         run("build", grid_path, "-o", resmr_path, "--quiet")
         if name == "reek":
             run("add-properties", resmr_path, grid_path)
-    stock_reader = simple.EGRIDReader(FileName=grid_path)
+    # resmr build keeps the grid's own coordinates (MAPAXES not applied yet): compare there.
+    stock_reader = simple.EGRIDReader(FileName=grid_path, ApplyMapAxes=0)
     stock_reader.UpdatePipeline()
     grid = servermanager.Fetch(stock_reader)
     i = vtk_to_numpy(grid.GetCellData().GetArray("I"))
@@ -136,7 +137,7 @@ for name, grid_path in models():
     ours = simple.Show(reader, view)
     if ours.GetXMLName() != "ResMRRepresentation" or ours.Representation != "Multiresolution Surface":
         rt.fail(f"{name}: .resmr shown as {ours.GetXMLName()} / {ours.Representation}")
-    ours.ColorMode = "Cell Id"
+    ours.PaintBy = "Cell Id"
     ours.GridLines = 0
     ours.WaitForDetailMs = 120000
     unlit(ours)
@@ -156,6 +157,8 @@ for name, grid_path in models():
             simple.Show(reader, view)
             simple.Render(view)
             got = cell_ids(capture(view, f"{name}-{camera_name}-{tolerance:g}px.png"))
+            if os.environ.get("RESMR_SAVE_DIFF"):
+                np.save(os.path.join(temp, f"{name}-{camera_name}-{tolerance:g}px.npy"), np.stack([expected, got]))
             both = (expected > 0) & (got > 0)
             agree = float(np.mean(expected[both] == got[both])) if both.any() else 0.0
             inside = erode(expected > 0, int(np.ceil(tolerance)) + 1)
@@ -190,7 +193,7 @@ for name, grid_path in models():
         expected = capture(view, "reek-poro-stock.png")
         simple.Hide(stock_reader, view)
         simple.Show(reader, view)
-        ours.ColorMode = "Property"
+        ours.PaintBy = "Property"
         ours.PixelTolerance = 0
         simple.ColorBy(ours, ("CELLS", "PORO"))
         simple.Render(view)
