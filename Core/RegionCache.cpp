@@ -259,6 +259,26 @@ int TopologyHandedness(const MultiresolutionFile& file)
   return 1;
 }
 
+void UseOriginalSideFaces(RegionMesh& mesh)
+{
+  ExtractSurfaces(mesh);
+  mesh.sideTriangles.clear();
+  mesh.sideTriangles.reserve(mesh.side.quads.size() * 2);
+  for (const auto& quad : mesh.side.quads)
+  {
+    mesh.sideTriangles.push_back({ quad[0], quad[1], quad[2] });
+    mesh.sideTriangles.push_back({ quad[0], quad[2], quad[3] });
+  }
+}
+
+RegionDrawBuffers LoadRegionDrawBuffers(
+  const MultiresolutionFile& file, std::size_t region, const std::array<double, 3>& origin, int handedness)
+{
+  RegionMesh mesh = file.ReadRegion(region); // not ReadRegionSurfaces: the buffers need positions
+  UseOriginalSideFaces(mesh);
+  return PrepareRegionDrawBuffers(mesh, origin, handedness);
+}
+
 RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin, int handedness)
 {
   RegionDrawBuffers out;
@@ -699,8 +719,7 @@ void RegionCache::Run()
     try
     {
       // ReadRegion, not ReadRegionSurfaces: the buffers need the positions.
-      const RegionMesh mesh = this->File->ReadRegion(region);
-      buffers = std::make_shared<RegionDrawBuffers>(PrepareRegionDrawBuffers(mesh, this->ModelOrigin, handedness));
+      buffers = std::make_shared<RegionDrawBuffers>(LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin, handedness));
     }
     catch (const std::exception& e)
     {

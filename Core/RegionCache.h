@@ -10,7 +10,8 @@
 //   constant axis: floor(c) at any point of a face is the 0-based (i, j, k) of the cell the
 //   face belongs to, and c is an integer + 0.5 on that axis). Triangles: the top surface,
 //   then the bottom, then the side (the file's simplified side triangles), counter-clockwise
-//   seen from outside in the z-up frame.
+//   seen from outside in the z-up frame. The side is the region mesh's side faces, not the
+//   file's simplified side (UseOriginalSideFaces says why).
 // - Resident bytes (the buffers' sizes) stay within the budget, except that the roots and
 //   the regions requested by the newest frame are never evicted to load others: when the
 //   wanted set outgrows the budget, loading stops there (the selection then draws ancestors).
@@ -60,9 +61,21 @@ struct RegionDrawBuffers
 /// which tells which side of a side face its cell lies on. From the first cell found.
 int TopologyHandedness(const MultiresolutionFile& file);
 
+/// Replaces the file's simplified side triangles (Sec. 4.3) by the side faces of the region's
+/// own column mesh, two triangles a quad. The simplified side keeps the geometry within the
+/// region's error but not the layer boundaries its topological coordinates interpolate: on
+/// Reek they move by up to 4 layers, which paints side faces with the wrong cells (2% of the
+/// pixels of a side view at 1 px). Column collapse keeps every layer interface, so the
+/// mesh's side faces carry exact k; what they cost is triangles.
+void UseOriginalSideFaces(RegionMesh& mesh);
+
 /// Draw buffers of a decoded region (surfaces and topological coordinates are enough).
 RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin,
   int handedness);
+
+/// What the cache loads for a region: its mesh read and checked, its own side faces, buffers.
+RegionDrawBuffers LoadRegionDrawBuffers(
+  const MultiresolutionFile& file, std::size_t region, const std::array<double, 3>& origin, int handedness);
 
 struct PropertyTableData
 {

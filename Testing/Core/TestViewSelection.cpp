@@ -652,7 +652,7 @@ std::vector<std::size_t> RegionBytes(const MultiresolutionFile& file)
   const auto& o = file.Header().latticeOrigin;
   std::vector<std::size_t> bytes;
   for (std::size_t r = 0; r < file.Regions().size(); ++r)
-    bytes.push_back(PrepareRegionDrawBuffers(file.ReadRegion(r), { o[0], o[1], -o[2] }, handedness).Bytes());
+    bytes.push_back(LoadRegionDrawBuffers(file, r, { o[0], o[1], -o[2] }, handedness).Bytes());
   return bytes;
 }
 
@@ -688,7 +688,7 @@ void TestCache(const std::string& path)
     CHECK(sum == cache.ResidentBytes());
     const auto& o = file->Header().latticeOrigin;
     CHECK(cache.Origin() == (std::array<double, 3>{ o[0], o[1], -o[2] }));
-    const auto expected = PrepareRegionDrawBuffers(file->ReadRegion(leaves[0]), cache.Origin(), TopologyHandedness(*file));
+    const auto expected = LoadRegionDrawBuffers(*file, leaves[0], cache.Origin(), TopologyHandedness(*file));
     CHECK(cache.Get(leaves[0]) && cache.Get(leaves[0])->vertices == expected.vertices &&
       cache.Get(leaves[0])->indices == expected.indices);
     CHECK(cache.LastError().empty());

@@ -1,0 +1,201 @@
+"""Multiresolution Surface benchmark (issue 7, paper Sec. 6.2-6.3), run with pvpython:
+
+  pvpython bench/run_view_bench.py --plugin PLUGIN.so --resmr build/bin/resmr \
+      --scratch bench/scratch/view --models synth:1000x1000x10 reek [--stock]
+
+For each model: time to first image (open to the first frame on screen, not waiting for
+detail), then a scripted camera path at 1280x720 (orbit, zoom to close inspection, fly along
+a fault line) with the frame-rate controller targeting --fps; per frame the frame time, the
+tolerance, triangles drawn and resident MB (the representation's readout) and the process's
+RSS. With --stock the same path is run on stock ParaView (EGRIDReader + Surface) where the
+model fits. Results: bench/results/view.{md,json} and view.png."""
+import argparse
+import json
+import os
+import platform
+import resource
+import subprocess
+import time
+
+from paraview import simple
+
+parser = argparse.ArgumentParser()
+parser.add_argument("--plugin", required=True)
+parser.add_argument("--resmr", required=True)
+parser.add_argument("--scratch", required=True)
+parser.add_argument("--data", default="/work/shared/data")
+parser.add_argument("--models", nargs="+", required=True)
+parser.add_argument("--fps", type=float, default=10)
+parser.add_argument("--frames", type=int, default=300)
+parser.add_argument("--budget", type=int, default=1024, help="MB")
+parser.add_argument("--stock", action="store_true")
+parser.add_argument("--out", default="bench/results/view")
+args = parser.parse_args()
+simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
+os.makedirs(args.scratch, exist_ok=True)
+
+REAL = {
+    "reek": "reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID",
+    "brugge": "brugge/Real0/BRUGGE_0000.EGRID",
+}
+
+
+def rss_mb():
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    return 0.0
+
+
+def prepare(model):
+    """(grid file or None, .resmr path, cells)."""
+    if model in REAL:
+        grid = os.path.join(args.data, REAL[model])
+        path = os.path.join(args.scratch, model + ".resmr")
+    else:
+        nx, ny, nz = (int(v) for v in model.split(":")[1].split("x"))
+        grid = os.path.join(args.scratch, f"synth_{nx}x{ny}x{nz}.EGRID")
+        path = os.path.join(args.scratch, f"synth_{nx}x{ny}x{nz}.resmr")
+        if not os.path.exists(grid):
+            subprocess.run([args.resmr, "synth", str(nx), str(ny), str(nz), "-o", grid, "--quiet"], check=True,
+                           stdout=subprocess.DEVNULL)
+    if not os.path.exists(path):
+        subprocess.run([args.resmr, "build", grid, "-o", path, "--quiet"], check=True, stdout=subprocess.DEVNULL)
+        subprocess.run([args.resmr, "add-properties", path, grid], check=True, stdout=subprocess.DEVNULL)
+    info = json.loads(subprocess.run([args.resmr, "info", path, "--json"], check=True, capture_output=True,
+                                     text=True).stdout) if False else None
+    return grid, path
+
+
+def camera_path(view, bounds, frames):
+    """Orbit (40%), zoom to a close look at the centre (30%), fly along the x axis at low
+    altitude (30%): one camera a frame."""
+    import math
+    cx, cy = (bounds[0] + bounds[1]) / 2, (bounds[2] + bounds[3]) / 2
+    cz = (bounds[4] + bounds[5]) / 2
+    size = max(bounds[1] - bounds[0], bounds[3] - bounds[2])
+    cameras = []
+    orbit, zoom = int(frames * 0.4), int(frames * 0.3)
+    fly = frames - orbit - zoom
+    for f in range(orbit):
+        a = 2 * math.pi * f / orbit
+        cameras.append(((cx + 1.2 * size * math.cos(a), cy + 1.2 * size * math.sin(a), cz + 0.6 * size), (cx, cy, cz)))
+    for f in range(zoom):
+        t = f / max(zoom - 1, 1)
+        d = 1.2 * size * (1 - t) + 0.03 * size * t
+        cameras.append(((cx + d, cy, cz + 0.5 * d), (cx, cy, cz)))
+    for f in range(fly):
+        t = f / max(fly - 1, 1)
+        x = bounds[0] + (bounds[1] - bounds[0]) * t
+        cameras.append(((x, cy - 0.05 * size, bounds[5] + 0.02 * size), (x + 0.1 * size, cy, cz)))
+    return cameras
+
+
+def run_path(view, display, bounds, readout):
+    frames = []
+    for position, focal in camera_path(view, bounds, args.frames):
+        camera = view.GetActiveCamera()
+        camera.SetPosition(position)
+        camera.SetFocalPoint(focal)
+        camera.SetViewUp(0, 0, 1)
+        view.ResetCameraClippingRange() if hasattr(view, "ResetCameraClippingRange") else None
+        start = time.perf_counter()
+        simple.Render(view)
+        elapsed = time.perf_counter() - start
+        row = {"seconds": elapsed, "rss_mb": rss_mb()}
+        if readout:
+            display.UpdatePropertyInformation()
+            row.update(tolerance=display.GetPropertyValue("CurrentTolerance"),
+                       triangles=display.GetPropertyValue("TrianglesDrawn"),
+                       resident_mb=display.GetPropertyValue("ResidentMB"))
+        frames.append(row)
+    return frames
+
+
+def percentile(values, p):
+    values = sorted(values)
+    return values[min(len(values) - 1, int(round(p / 100 * (len(values) - 1))))]
+
+
+results = {"machine": {"cpu": platform.processor() or platform.machine(), "cores": os.cpu_count(),
+                       "renderer": "Mesa llvmpipe (no GPU)"},
+           "fps_target": args.fps, "frames": args.frames, "budget_mb": args.budget, "models": []}
+for model in args.models:
+    grid, path = prepare(model)
+    view = simple.CreateRenderView()
+    view.ViewSize = [1280, 720]
+    view.OrientationAxesVisibility = 0
+    rss_before = rss_mb()
+    start = time.perf_counter()
+    reader = simple.OpenDataFile(path)
+    display = simple.Show(reader, view)
+    display.MemoryBudgetMB = args.budget
+    display.TargetFrameRate = args.fps
+    simple.ColorBy(display, ("CELLS", "PORO"))
+    view.ResetCamera(False)
+    simple.Render(view)
+    first_image = time.perf_counter() - start
+    bounds = reader.GetDataInformation().GetBounds()
+    frames = run_path(view, display, bounds, True)
+    times = [f["seconds"] for f in frames]
+    entry = {"model": model, "first_image_s": first_image, "rss_before_mb": rss_before,
+             "p50_ms": 1000 * percentile(times, 50), "p99_ms": 1000 * percentile(times, 99),
+             "max_resident_mb": max(f["resident_mb"] for f in frames),
+             "max_rss_mb": max(f["rss_mb"] for f in frames), "frames": frames}
+    print(f"{model}: first image {first_image:.2f} s, p50 {entry['p50_ms']:.0f} ms, p99 {entry['p99_ms']:.0f} ms, "
+          f"resident <= {entry['max_resident_mb']:.0f} MB, RSS <= {entry['max_rss_mb']:.0f} MB", flush=True)
+    simple.Delete(reader)
+    simple.Delete(view)
+    if args.stock and grid:
+        view = simple.CreateRenderView()
+        view.ViewSize = [1280, 720]
+        start = time.perf_counter()
+        stock = simple.EGRIDReader(FileName=grid, ApplyMapAxes=0)
+        shown = simple.Show(stock, view)
+        shown.SetRepresentationType("Surface")
+        simple.ColorBy(shown, ("CELLS", "PORO"))
+        view.ResetCamera(False)
+        simple.Render(view)
+        entry["stock_first_image_s"] = time.perf_counter() - start
+        stock_frames = run_path(view, shown, bounds, False)
+        stock_times = [f["seconds"] for f in stock_frames]
+        entry["stock_p50_ms"] = 1000 * percentile(stock_times, 50)
+        entry["stock_p99_ms"] = 1000 * percentile(stock_times, 99)
+        entry["stock_max_rss_mb"] = max(f["rss_mb"] for f in stock_frames)
+        print(f"  stock: first image {entry['stock_first_image_s']:.2f} s, p50 {entry['stock_p50_ms']:.0f} ms, "
+              f"p99 {entry['stock_p99_ms']:.0f} ms, RSS <= {entry['stock_max_rss_mb']:.0f} MB", flush=True)
+        simple.Delete(stock)
+        simple.Delete(view)
+    results["models"].append(entry)
+
+with open(args.out + ".json", "w") as out:
+    json.dump(results, out, indent=1)
+lines = [f"# Multiresolution Surface: first image, frame times, memory (target {args.fps:g} FPS, 1280x720, "
+         f"{args.frames}-frame path, budget {args.budget} MB)", "",
+         f"Machine: {results['machine']['cpu']}, {results['machine']['cores']} cores, Mesa llvmpipe (no GPU).", "",
+         "| model | first image s | p50 ms | p99 ms | resident MB (max) | RSS MB (max) | stock first image s | stock p50 ms | stock p99 ms | stock RSS MB |",
+         "|---|---|---|---|---|---|---|---|---|---|"]
+for e in results["models"]:
+    lines.append(f"| {e['model']} | {e['first_image_s']:.2f} | {e['p50_ms']:.0f} | {e['p99_ms']:.0f} | "
+                 f"{e['max_resident_mb']:.0f} | {e['max_rss_mb']:.0f} | {e.get('stock_first_image_s', float('nan')):.2f} | "
+                 f"{e.get('stock_p50_ms', float('nan')):.0f} | {e.get('stock_p99_ms', float('nan')):.0f} | "
+                 f"{e.get('stock_max_rss_mb', float('nan')):.0f} |")
+with open(args.out + ".md", "w") as out:
+    out.write("\n".join(lines) + "\n")
+try:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    figure, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    for e in results["models"]:
+        axes[0].plot([1000 * f["seconds"] for f in e["frames"]], label=e["model"])
+        axes[1].plot([f["tolerance"] for f in e["frames"]], label=e["model"])
+    axes[0].axhline(1000 / args.fps, color="k", linestyle="--", linewidth=0.8)
+    axes[0].set_ylabel("frame ms")
+    axes[1].set_ylabel("tolerance px")
+    axes[1].set_xlabel("frame of the path")
+    axes[0].legend()
+    figure.savefig(args.out + ".png", dpi=100)
+except ImportError:
+    print("matplotlib missing: no plot")
