@@ -10,6 +10,7 @@
 #include "vtkCamera.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
+#include "vtkLogger.h"
 #include "vtkMath.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
@@ -40,6 +41,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <thread>
 
 vtkStandardNewMacro(vtkMultiresolutionSurfaceMapper);
 
@@ -306,7 +308,6 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   vtkDataObject* input = this->GetInputDataObject(0, 0);
   std::string filePath, propertyPath;
   int32_t step = 0;
-  if (getenv("RESMR_DEBUG")) fprintf(stderr, "Render input %p %s\n", (void*)input, input ? input->GetClassName() : "");
   if (!ReadSource(input, filePath, propertyPath, step))
   {
     return; // an empty piece (another rank) or no file yet
@@ -427,6 +428,29 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     predicted = in.Selector->Select(resmr::PredictNextView(in.PreviousView, view), all).wanted;
   }
   cache.Request(selection.wanted, predicted);
+  // The roots are the stand-in of last resort: the first frame waits for them (they are the
+  // smallest meshes and load first), so no frame shows a hole where the model is.
+  {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    const auto missingRoot = [&]() {
+      for (std::size_t root : in.Selector->Roots())
+      {
+        if (!cache.IsResident(root) && cache.LastError().empty())
+        {
+          return true;
+        }
+      }
+      return false;
+    };
+    if (missingRoot())
+    {
+      while (missingRoot() && std::chrono::steady_clock::now() < deadline)
+      {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+      selection = in.Selector->Select(view, resident);
+    }
+  }
   if (this->WaitForDetailMs > 0)
   {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(this->WaitForDetailMs);
@@ -715,6 +739,8 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   vtkOpenGLCheckErrorMacro("after drawing the multiresolution surface");
 
   in.Pending = cache.Pending();
+  vtkLogF(TRACE, "multiresolution surface: %d regions, %lld triangles at %.2f px", in.Drawn,
+    static_cast<long long>(in.Triangles), in.Tolerance);
   const double cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   in.FrameMs = cpuMs + in.GpuMs;
   if (this->TargetFrameRate > 0)

@@ -13,7 +13,6 @@ import argparse
 import json
 import os
 import platform
-import resource
 import subprocess
 import time
 
@@ -63,8 +62,6 @@ def prepare(model):
     if not os.path.exists(path):
         subprocess.run([args.resmr, "build", grid, "-o", path, "--quiet"], check=True, stdout=subprocess.DEVNULL)
         subprocess.run([args.resmr, "add-properties", path, grid], check=True, stdout=subprocess.DEVNULL)
-    info = json.loads(subprocess.run([args.resmr, "info", path, "--json"], check=True, capture_output=True,
-                                     text=True).stdout) if False else None
     return grid, path
 
 
@@ -99,7 +96,6 @@ def run_path(view, display, bounds, readout):
         camera.SetPosition(position)
         camera.SetFocalPoint(focal)
         camera.SetViewUp(0, 0, 1)
-        view.ResetCameraClippingRange() if hasattr(view, "ResetCameraClippingRange") else None
         start = time.perf_counter()
         simple.Render(view)
         elapsed = time.perf_counter() - start
