@@ -99,6 +99,25 @@ out.GetCellData().AddArray(array)
     return simple.ProgrammableFilter(Input=grid_reader, Script=script, OutputDataSetType="Same as Input")
 
 
+def render_both(stock, ours, bounds, direction, zoom, tag, tolerance):
+    """Cell ids of stock ParaView's image and ours from the same camera."""
+    simple.Hide(ours, view)
+    simple.Show(stock, view)
+    view.ResetCamera(False)
+    rt.place_camera(view, bounds, 1.0, direction, zoom)
+    expected = cell_ids(capture(view, f"{tag}-stock.png"))
+    simple.Hide(stock, view)
+    simple.Show(ours, view)
+    simple.Render(view)
+    return expected, cell_ids(capture(view, f"{tag}-{tolerance:g}px.png"))
+
+
+def count_holes(expected, got, tolerance):
+    """Background pixels of ours deeper than the tolerance inside stock's silhouette."""
+    inside = erode(expected > 0, int(np.ceil(tolerance)) + 1)
+    return int(np.sum(inside & (got == 0)))
+
+
 def unlit(display):
     display.Ambient = 1.0
     display.Diffuse = 0.0
@@ -152,21 +171,12 @@ for name, grid_path in models():
         ours.PixelTolerance = tolerance
         same = covered = 0
         for camera_name, direction, zoom in cameras:
-            simple.Hide(reader, view)
-            simple.Show(ids, view)
-            view.ResetCamera(False)
-            rt.place_camera(view, bounds, 1.0, direction, zoom)
-            expected = cell_ids(capture(view, f"{name}-{camera_name}-stock.png"))
-            simple.Hide(ids, view)
-            simple.Show(reader, view)
-            simple.Render(view)
-            got = cell_ids(capture(view, f"{name}-{camera_name}-{tolerance:g}px.png"))
+            expected, got = render_both(ids, reader, bounds, direction, zoom, f"{name}-{camera_name}", tolerance)
             if os.environ.get("RESMR_SAVE_DIFF"):
                 np.save(os.path.join(temp, f"{name}-{camera_name}-{tolerance:g}px.npy"), np.stack([expected, got]))
             both = (expected > 0) & (got > 0)
             agree = float(np.mean(expected[both] == got[both])) if both.any() else 0.0
-            inside = erode(expected > 0, int(np.ceil(tolerance)) + 1)
-            holes = int(np.sum(inside & (got == 0)))
+            holes = count_holes(expected, got, tolerance)
             ours.UpdatePropertyInformation()
             readout = (f"tolerance {ours.GetPropertyValue('CurrentTolerance'):.2f} px, "
                        f"{int(ours.GetPropertyValue('TrianglesDrawn'))} triangles, "
@@ -196,16 +206,8 @@ for name, grid_path in models():
                 angle = 2 * math.pi * step / 8
                 direction = [math.cos(angle), math.sin(angle), 0.6 - 0.15 * step]
                 zoom = 1.0 + 0.25 * step
-                simple.Hide(reader, view)
-                simple.Show(ids, view)
-                rt.place_camera(view, bounds, 1.0, direction, zoom)
-                expected = cell_ids(capture(view, f"path-{step}-stock.png"))
-                simple.Hide(ids, view)
-                simple.Show(reader, view)
-                simple.Render(view)
-                got = cell_ids(capture(view, f"path-{step}-{tolerance:g}px.png"))
-                inside = erode(expected > 0, int(np.ceil(tolerance)) + 1)
-                holes = int(np.sum(inside & (got == 0)))
+                expected, got = render_both(ids, reader, bounds, direction, zoom, f"path-{step}", tolerance)
+                holes = count_holes(expected, got, tolerance)
                 worst = holes if holes > worst else worst
                 if holes > 0:
                     failures.append(f"camera path step {step} at {tolerance:g} px: {holes} background pixels inside")
