@@ -316,8 +316,18 @@ ViewSelection ViewSelector::Select(const ViewParameters& view, const std::functi
 
   ViewSelection selection;
   selection.largestProjectedError = actual.largest;
+  // Front to back: nearer regions fill the depth buffer first, so the hidden fragments of
+  // farther ones fail the early depth test before the (costly) fragment shader runs.
+  std::vector<std::pair<double, std::size_t>> nearFirst;
+  nearFirst.reserve(actual.shown.size());
   for (std::size_t r : actual.shown)
   {
+    nearFirst.emplace_back(Nearness(regions[r], Corners(regions[r]), view), r);
+  }
+  std::sort(nearFirst.begin(), nearFirst.end());
+  for (const auto& entry : nearFirst)
+  {
+    const std::size_t r = entry.second;
     const RegionRecord& record = regions[r];
     const Box corners = Corners(record);
     DrawnRegion drawn;

@@ -17,6 +17,7 @@
 //   boxes enclose every descendant, so projected errors never grow down the tree and the cut
 //   of an all-resident hierarchy is the ideal one.
 // - A root region that is not resident is not drawn (the caller loads the roots first).
+// - `drawn` is ordered nearest first, so early depth rejection spares hidden fragments.
 // - `wanted` lists the regions of the ideal cut (as if everything were resident) and the
 //   ancestors leading to them, coarse before fine and near before far: the loading order.
 #pragma once
@@ -53,7 +54,7 @@ struct DrawnRegion
 
 struct ViewSelection
 {
-  std::vector<DrawnRegion> drawn;  ///< what to draw this frame (resident regions only)
+  std::vector<DrawnRegion> drawn;  ///< what to draw this frame (resident regions only), nearest first
   std::vector<std::size_t> wanted; ///< the loading order (see the contract)
   /// Largest projected error (pixels) of a drawn region's diamond; what the tolerance holds
   /// once everything wanted is resident.

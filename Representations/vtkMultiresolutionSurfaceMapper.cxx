@@ -198,7 +198,7 @@ double vtkMultiresolutionSurfaceMapper::GetCurrentTolerance() const
 double vtkMultiresolutionSurfaceMapper::GetResidentMB() const
 {
   const std::size_t bytes = this->Internal->Cache ? this->Internal->Cache->ResidentBytes() : 0;
-  return double(bytes) / (1 << 20);
+  return double(bytes + this->Internal->GpuBytes) / (1 << 20);
 }
 vtkIdType vtkMultiresolutionSurfaceMapper::GetTrianglesDrawn() const
 {
@@ -282,6 +282,13 @@ bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties
   return true;
 }
 
+/// The loader's share of the mesh budget: the GPU mirrors at most what is resident, so half
+/// each keeps both together within the budget.
+std::size_t MainMemoryShare(int budgetMB)
+{
+  return (std::size_t(budgetMB) << 20) / 2;
+}
+
 void UploadInteger3D(vtkTextureObject* texture, vtkOpenGLRenderWindow* window, const std::array<uint32_t, 3>& sides,
   int components, unsigned int internalFormat, unsigned int format, const void* data)
 {
@@ -339,7 +346,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
         in.Properties = properties;
       }
       in.Selector.reset(new resmr::ViewSelector(*in.File));
-      in.Cache.reset(new resmr::RegionCache(in.File, in.Properties, std::size_t(this->MemoryBudgetMB) << 20));
+      in.Cache.reset(new resmr::RegionCache(in.File, in.Properties, MainMemoryShare(this->MemoryBudgetMB)));
       in.FilePath = filePath;
       in.PropertyPath = propertyPath;
     }
@@ -361,7 +368,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     return; // the files failed to open; the error was reported once
   }
   resmr::RegionCache& cache = *in.Cache;
-  cache.SetBudget(std::size_t(this->MemoryBudgetMB) << 20);
+  cache.SetBudget(MainMemoryShare(this->MemoryBudgetMB));
   const resmr::MultiresolutionHeader& header = in.File->Header();
 
   // Property table wanted this frame.

@@ -55,7 +55,9 @@ public:
   vtkSetClampMacro(TargetFrameRate, double, 0.0, 1000.0);
   vtkGetMacro(TargetFrameRate, double);
 
-  /// Memory budget of resident meshes, MB (CPU, and the same again at most on the GPU).
+  /// Memory budget of resident meshes, MB, CPU and GPU together: the loader keeps at most half
+  /// in main memory and the GPU mirrors at most what is resident (the other half). The
+  /// model's tables (hash, normals, one property) are outside it: a fixed cost per file.
   vtkSetClampMacro(MemoryBudgetMB, int, 16, 1 << 20);
   vtkGetMacro(MemoryBudgetMB, int);
 
@@ -75,6 +77,7 @@ public:
   ///@{
   /// Live readout, updated each render.
   double GetCurrentTolerance() const;
+  /// Mesh memory now: main memory plus GPU buffers, MB (within MemoryBudgetMB, see there).
   double GetResidentMB() const;
   vtkIdType GetTrianglesDrawn() const;
   int GetRegionsDrawn() const;
