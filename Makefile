@@ -46,17 +46,26 @@ configure: deps $(BUILD_DIR)/build.ninja
 build: configure
 	cmake --build $(BUILD_DIR)
 
-# The main job: open the demo model; with a display, in the ParaView GUI; without one,
-# screenshots in $(DEMO_OUTPUT)/ of the demo deck and of a generated 540k-cell model.
+# The main job: a generated faulted model of 3 million cells (with 3 report steps), its
+# multiresolution hierarchy (.resmr + .resmrp), opened with the Multiresolution Surface
+# representation: with a display, in the ParaView GUI to fly through; without one, the demo
+# deck's screenshots and a scripted fly-through of the generated model in $(DEMO_OUTPUT)/.
+DEMO_MODEL := $(DEMO_OUTPUT)/FAULTED
 demo: build
+	@mkdir -p $(DEMO_OUTPUT)
+	@if [ ! -s $(DEMO_MODEL).resmrp ]; then \
+	  echo "demo: generating a faulted 400x300x25 model and its hierarchy in $(DEMO_OUTPUT)/" && \
+	  $(BUILD_DIR)/bin/resmr synth 400 300 25 --steps 3 --quiet -o $(DEMO_MODEL).EGRID >/dev/null && \
+	  $(BUILD_DIR)/bin/resmr build $(DEMO_MODEL).EGRID -o $(DEMO_MODEL).resmr --quiet && \
+	  $(BUILD_DIR)/bin/resmr add-properties $(DEMO_MODEL).resmr $(DEMO_MODEL).EGRID >/dev/null; \
+	fi
 	@if [ -n "$$DISPLAY" ]; then \
-	  echo "Opening $(DEMO_DECK) in ParaView (plugin from $(PLUGIN_DIR))"; \
-	  PV_PLUGIN_PATH=$(abspath $(PLUGIN_DIR)) paraview --data=$(DEMO_DECK); \
+	  echo "Opening $(DEMO_MODEL).resmr in ParaView (plugin from $(PLUGIN_DIR))"; \
+	  PV_PLUGIN_PATH=$(abspath $(PLUGIN_DIR)) RESMR_DEMO_FILE=$(abspath $(DEMO_MODEL).resmr) \
+	    paraview --script=scripts/demo_view.py; \
 	else \
 	  $(XVFB) pvpython --force-offscreen-rendering scripts/demo.py $(PLUGIN) $(DEMO_DECK) $(DEMO_OUTPUT) && \
-	  mkdir -p $(DEMO_OUTPUT) && \
-	  $(BUILD_DIR)/bin/resmr synth 150 120 30 --steps 5 --quiet -o $(DEMO_OUTPUT)/SYNTHETIC.EGRID && \
-	  $(XVFB) pvpython --force-offscreen-rendering scripts/demo.py $(PLUGIN) $(DEMO_OUTPUT)/SYNTHETIC.EGRID $(DEMO_OUTPUT); \
+	  $(XVFB) pvpython --force-offscreen-rendering scripts/demo_view.py $(PLUGIN) $(DEMO_MODEL).resmr $(DEMO_OUTPUT); \
 	fi
 
 test: build

@@ -53,6 +53,70 @@ std::vector<uint8_t> HeaderOf(
   return std::move(head.Bytes);
 }
 
+/// The cell whose value each hash slot holds: its own cell when active, else the nearest
+/// active cell of the same layer (fewest i/j steps; ~0 if the layer has none). Coarse levels'
+/// faces reach over inactive cells (Sec. 4.1 simplifies them with the rest); padding their
+/// slots the way texture atlases pad charts paints them like their surroundings instead of in
+/// the NaN colour. Finest-level faces belong to active cells only, so exact views are unchanged.
+std::vector<uint64_t> NearestActiveSources(const std::vector<uint64_t>& slotCells,
+  const std::vector<std::vector<uint8_t>>& active, const std::array<int64_t, 3>& dims)
+{
+  const uint64_t nx = static_cast<uint64_t>(dims[0]), ny = static_cast<uint64_t>(dims[1]);
+  const uint64_t layer = nx * ny;
+  std::vector<uint64_t> sources = slotCells;
+  std::vector<std::vector<std::size_t>> inactiveSlotsByLayer(active.size());
+  for (std::size_t s = 0; s < slotCells.size(); ++s)
+  {
+    const uint64_t cell = slotCells[s];
+    if (cell != ~uint64_t(0) && !active[cell / layer][cell % layer])
+    {
+      inactiveSlotsByLayer[cell / layer].push_back(s);
+    }
+  }
+  std::vector<uint32_t> nearest;
+  std::vector<uint32_t> queue;
+  for (std::size_t k = 0; k < active.size(); ++k)
+  {
+    if (inactiveSlotsByLayer[k].empty())
+    {
+      continue;
+    }
+    // Breadth-first from every active column at once: each column learns its nearest one.
+    const uint32_t unknown = ~uint32_t(0);
+    nearest.assign(layer, unknown);
+    queue.clear();
+    for (uint64_t c = 0; c < layer; ++c)
+    {
+      if (active[k][c])
+      {
+        nearest[c] = static_cast<uint32_t>(c);
+        queue.push_back(static_cast<uint32_t>(c));
+      }
+    }
+    for (std::size_t head = 0; head < queue.size(); ++head)
+    {
+      const uint32_t c = queue[head];
+      const uint64_t i = c % nx, j = c / nx;
+      const uint64_t next[4] = { i > 0 ? c - 1 : layer, i + 1 < nx ? c + 1 : layer, j > 0 ? c - nx : layer,
+        j + 1 < ny ? c + nx : layer };
+      for (uint64_t n : next)
+      {
+        if (n < layer && nearest[n] == unknown)
+        {
+          nearest[n] = nearest[c];
+          queue.push_back(static_cast<uint32_t>(n));
+        }
+      }
+    }
+    for (std::size_t s : inactiveSlotsByLayer[k])
+    {
+      const uint32_t source = nearest[slotCells[s] % layer];
+      sources[s] = source == unknown ? ~uint64_t(0) : k * layer + source;
+    }
+  }
+  return sources;
+}
+
 std::string TableName(const PropertyTable& t)
 {
   return t.step < 0 ? t.name : t.name + " of step " + std::to_string(t.step) + " (report " + std::to_string(t.reportNumber) + ")";
@@ -227,6 +291,7 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
   {
     this->Active.push_back(geometry.ReadActiveLayer(k));
   }
+  this->SlotSources = NearestActiveSources(this->SlotCells, this->Active, this->Dims);
   // The table count is patched in at Commit.
   const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, 0);
   this->Write(head.data(), head.size(), "header");
@@ -307,7 +372,7 @@ void PropertyFileWriter::Add(PropertyTable table, const std::vector<float>& cell
   raw.assign(this->SlotCells.size() * 4, 0);
   for (std::size_t s = 0; s < this->SlotCells.size(); ++s)
   {
-    const float v = this->SlotCells[s] == ~uint64_t(0) ? none : value(this->SlotCells[s]);
+    const float v = this->SlotSources[s] == ~uint64_t(0) ? none : value(this->SlotSources[s]);
     std::memcpy(&raw[s * 4], &v, 4);
   }
   table.packed = this->PutChunk(raw, TableName(table) + " packed table");

@@ -85,7 +85,9 @@ public:
   ~PropertyFileWriter();
 
   /// Adds a table from one value a cell (nx ny nz, ECLIPSE order; NaN: no value); cells
-  /// inactive in the geometry get NaN. Replaces an earlier table of the same name and step.
+  /// inactive in the geometry get NaN in the layer tables, and in the packed table the value
+  /// of the nearest active cell of their layer (coarse faces reach over them). Replaces an
+  /// earlier table of the same name and step.
   void Add(PropertyTable table, const std::vector<float>& cellValues);
   /// Copies every table of `older` (same geometry) that this writer does not hold yet.
   void CopyFrom(const PropertyFile& older);
@@ -103,6 +105,7 @@ private:
   std::array<int64_t, 3> Dims{};
   std::array<uint32_t, 3> TableSides{};
   std::vector<uint64_t> SlotCells;         ///< from the geometry
+  std::vector<uint64_t> SlotSources;       ///< the cell whose value a slot holds (see Add)
   std::vector<std::vector<uint8_t>> Active; ///< per layer
   std::vector<PropertyTable> Entries;
 };
