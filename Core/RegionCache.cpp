@@ -7,6 +7,8 @@
 #include <exception>
 #include <limits>
 #include <map>
+#include <stdexcept>
+#include <string>
 
 namespace resmr
 {
@@ -271,23 +273,32 @@ void UseOriginalSideFaces(RegionMesh& mesh)
   }
 }
 
-RegionDrawBuffers LoadRegionDrawBuffers(
-  const MultiresolutionFile& file, std::size_t region, const std::array<double, 3>& origin, int handedness)
+RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
+  const std::array<double, 3>& origin, int handedness, int32_t layer)
 {
   RegionMesh mesh = file.ReadRegion(region); // not ReadRegionSurfaces: the buffers need positions
+  if (layer >= 0)
+  {
+    return PrepareLayerDrawBuffers(mesh, layer, origin, handedness);
+  }
   UseOriginalSideFaces(mesh);
   return PrepareRegionDrawBuffers(mesh, origin, handedness);
 }
 
-RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin, int handedness)
+namespace
+{
+RegionDrawBuffers PrepareDrawBuffers(const RegionMesh& mesh, const RegionSurface& top, const RegionSurface& bottom,
+  const std::vector<std::array<uint32_t, 3>>& sideTriangles, const std::array<double, 3>& origin, int handedness)
 {
   RegionDrawBuffers out;
+  out.topCone = top.cone;
+  out.bottomCone = bottom.cone;
   std::vector<uint32_t> map(static_cast<std::size_t>(mesh.VertexCount()), Unused);
   // A top face lies on its cell's upper interface k: the cell is at k + 0.5; a bottom face on
   // the lower interface k + 1: the cell is at (k + 1) - 0.5.
-  AddQuads(mesh, mesh.top, 0.5, origin, map, out);
+  AddQuads(mesh, top, 0.5, origin, map, out);
   out.topIndices = static_cast<uint32_t>(out.indices.size());
-  AddQuads(mesh, mesh.bottom, -0.5, origin, map, out);
+  AddQuads(mesh, bottom, -0.5, origin, map, out);
   out.bottomIndices = static_cast<uint32_t>(out.indices.size()) - out.topIndices;
   // Side triangles: the face's constant axis is the largest component of its normal in
   // topological space n_T; the physical outward normal is det(A) A^-T n_T (A = d(x, y, z) /
@@ -295,7 +306,7 @@ RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::ar
   // handedness * n_T[axis] and the cell lies on the other side. Each triangle has its own
   // vertices, since the offset belongs to the triangle.
   const auto columns = ColumnsByCell(mesh);
-  for (const auto& t : mesh.sideTriangles)
+  for (const auto& t : sideTriangles)
   {
     const Vector t0 = Topological(mesh, t[0]), t1 = Topological(mesh, t[1]), t2 = Topological(mesh, t[2]);
     const Vector n = Cross(Minus(t1, t0), Minus(t2, t0));
@@ -328,6 +339,36 @@ RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::ar
   out.sideIndices = static_cast<uint32_t>(out.indices.size()) - out.topIndices - out.bottomIndices;
   return out;
 }
+} // namespace
+
+RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin, int handedness)
+{
+  return PrepareDrawBuffers(mesh, mesh.top, mesh.bottom, mesh.sideTriangles, origin, handedness);
+}
+
+RegionDrawBuffers PrepareLayerDrawBuffers(
+  const RegionMesh& mesh, int32_t layer, const std::array<double, 3>& origin, int handedness)
+{
+  if (layer < 0 || layer >= mesh.layers)
+  {
+    throw std::out_of_range("layer " + std::to_string(layer) + " of a region mesh of " + std::to_string(mesh.layers) +
+      " layers");
+  }
+  RegionSurface top, bottom, side;
+  ExtractLayerSurfaces(mesh, layer, top, bottom, side);
+  // Side quads as two triangles each, turning as the quads: the whole model's side is
+  // triangles too, so both views share the offset rules (the layer's k is exact either way).
+  std::vector<std::array<uint32_t, 3>> triangles;
+  triangles.reserve(side.quads.size() * 2);
+  for (const auto& quad : side.quads)
+  {
+    triangles.push_back({ quad[0], quad[1], quad[2] });
+    triangles.push_back({ quad[0], quad[2], quad[3] });
+  }
+  RegionDrawBuffers out = PrepareDrawBuffers(mesh, top, bottom, triangles, origin, handedness);
+  out.layer = layer;
+  return out;
+}
 
 RegionCache::RegionCache(std::shared_ptr<const MultiresolutionFile> file, std::shared_ptr<const PropertyFile> properties,
   std::size_t budgetBytes)
@@ -337,16 +378,16 @@ RegionCache::RegionCache(std::shared_ptr<const MultiresolutionFile> file, std::s
 {
   const auto& origin = this->File->Header().latticeOrigin;
   this->ModelOrigin = { origin[0], origin[1], -origin[2] };
+  this->LayerSlots = static_cast<uint64_t>(std::max<int64_t>(this->File->Header().dims[2], 0)) + 1;
   const std::size_t count = this->File->Regions().size();
-  this->InWanted.assign(count, 0);
-  this->InPredicted.assign(count, 0);
-  this->IsPinned.assign(count, 0);
+  this->IsRoot.assign(count, 0);
   for (std::size_t r = 0; r < count; ++r)
   {
     if (this->File->Regions()[r].level == 0)
     {
-      this->Pinned.push_back(r);
-      this->IsPinned[r] = 1;
+      this->Roots.push_back(r);
+      this->IsRoot[r] = 1;
+      this->Pinned.push_back(this->KeyOf(r, this->CurrentLayer));
     }
   }
   this->Loader = std::thread([this] { this->Run(); });
@@ -363,10 +404,57 @@ RegionCache::~RegionCache()
   this->Loader.join();
 }
 
+bool RegionCache::SetLayer(int32_t layer)
+{
+  if (layer < -1 || static_cast<uint64_t>(layer + 1) >= this->LayerSlots)
+  {
+    return false;
+  }
+  {
+    std::lock_guard<std::mutex> lock(this->Lock);
+    if (layer == this->CurrentLayer)
+    {
+      return true;
+    }
+    this->CurrentLayer = layer;
+    this->Pinned.clear();
+    for (std::size_t r : this->Roots)
+    {
+      this->Pinned.push_back(this->KeyOf(r, layer));
+    }
+    // The old layer's request is void: its regions become evictable, and none loads now.
+    this->Wanted.clear();
+    this->Predicted.clear();
+    this->InWanted.clear();
+    this->InPredicted.clear();
+    this->WantedBlocked = this->PredictedBlocked = false;
+    ++this->Changes; // what Get returns has changed
+  }
+  this->Wake.notify_all();
+  return true;
+}
+
+int32_t RegionCache::Layer() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->CurrentLayer;
+}
+
 std::shared_ptr<const RegionDrawBuffers> RegionCache::Get(std::size_t region) const
 {
   std::lock_guard<std::mutex> lock(this->Lock);
-  const auto found = this->Entries.find(region);
+  const auto found = this->Entries.find(this->KeyOf(region, this->CurrentLayer));
+  return found == this->Entries.end() ? nullptr : found->second.buffers;
+}
+
+std::shared_ptr<const RegionDrawBuffers> RegionCache::Get(std::size_t region, int32_t layer) const
+{
+  if (layer < -1 || static_cast<uint64_t>(layer + 1) >= this->LayerSlots)
+  {
+    return nullptr;
+  }
+  std::lock_guard<std::mutex> lock(this->Lock);
+  const auto found = this->Entries.find(this->KeyOf(region, layer));
   return found == this->Entries.end() ? nullptr : found->second.buffers;
 }
 
@@ -379,36 +467,45 @@ void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vec
 {
   {
     std::lock_guard<std::mutex> lock(this->Lock);
-    for (std::size_t r : this->Wanted)
-    {
-      this->InWanted[r] = 0;
-    }
-    for (std::size_t r : this->Predicted)
-    {
-      this->InPredicted[r] = 0;
-    }
     this->Wanted.clear();
     this->Predicted.clear();
+    this->InWanted.clear();
+    this->InPredicted.clear();
     // Wanted regions get the newest time, predicted ones just under it: among regions of one
     // request, predicted ones are evicted first.
     this->Clock += 2;
-    const std::size_t count = this->InWanted.size();
+    const std::size_t count = this->IsRoot.size();
+    const int32_t layer = this->CurrentLayer;
     for (std::size_t r : wanted)
     {
-      if (r < count && !this->InWanted[r])
+      const Key key = this->KeyOf(r, layer);
+      if (r < count && this->InWanted.insert(key).second)
       {
-        this->InWanted[r] = 1;
-        this->Wanted.push_back(r);
-        this->Entries[r].lastRequested = this->Clock;
+        this->Wanted.push_back(key);
+        this->Entries[key].lastRequested = this->Clock;
       }
     }
+    const auto predict = [&](std::size_t r, int32_t l) {
+      const Key key = this->KeyOf(r, l);
+      if (r < count && !this->InWanted.count(key) && this->InPredicted.insert(key).second)
+      {
+        this->Predicted.push_back(key);
+        this->Entries[key].lastRequested = this->Clock - 1;
+      }
+    };
     for (std::size_t r : predicted)
     {
-      if (r < count && !this->InWanted[r] && !this->InPredicted[r])
+      predict(r, layer);
+    }
+    // The next layer switch is probably to a neighbour: its roots, so that it need not wait.
+    for (const int32_t next : { layer + 1, layer - 1 })
+    {
+      if (layer >= 0 && next >= 0 && static_cast<uint64_t>(next + 1) < this->LayerSlots)
       {
-        this->InPredicted[r] = 1;
-        this->Predicted.push_back(r);
-        this->Entries[r].lastRequested = this->Clock - 1;
+        for (std::size_t r : this->Roots)
+        {
+          predict(r, next);
+        }
       }
     }
     this->WantedBlocked = this->PredictedBlocked = false;
@@ -416,14 +513,15 @@ void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vec
   this->Wake.notify_all();
 }
 
-void RegionCache::RequestProperty(const std::string& name, int32_t step)
+void RegionCache::RequestProperty(const std::string& name, int32_t step, int32_t layer)
 {
   {
     std::lock_guard<std::mutex> lock(this->Lock);
     this->PropertyName = name;
     this->PropertyStep = step;
-    this->PropertyWanted =
-      !(this->CurrentProperty && this->CurrentProperty->name == name && this->CurrentProperty->step == step);
+    this->PropertyLayer = layer;
+    this->PropertyWanted = !(this->CurrentProperty && this->CurrentProperty->name == name &&
+      this->CurrentProperty->step == step && this->CurrentProperty->layer == layer);
   }
   this->Wake.notify_all();
 }
@@ -440,8 +538,8 @@ bool RegionCache::PendingLocked() const
   {
     return true;
   }
-  const auto missing = [&](std::size_t r) {
-    const auto found = this->Entries.find(r);
+  const auto missing = [&](Key key) {
+    const auto found = this->Entries.find(key);
     return found == this->Entries.end() || (!found->second.buffers && !found->second.failed);
   };
   if (std::any_of(this->Pinned.begin(), this->Pinned.end(), missing))
@@ -474,13 +572,13 @@ void RegionCache::SetBudget(std::size_t bytes)
     std::lock_guard<std::mutex> lock(this->Lock);
     this->BudgetBytes = bytes;
     // Evict at once what may go (neither a root nor wanted by the newest frame).
-    for (std::size_t r : this->EvictableLocked(std::numeric_limits<std::size_t>::max()))
+    for (Key key : this->EvictableLocked(std::numeric_limits<Key>::max()))
     {
       if (this->Bytes <= this->BudgetBytes)
       {
         break;
       }
-      this->EvictLocked(r);
+      this->EvictLocked(key);
     }
     this->WantedBlocked = this->PredictedBlocked = false;
   }
@@ -518,33 +616,39 @@ std::string RegionCache::LastError() const
   return this->Error;
 }
 
-std::vector<std::size_t> RegionCache::EvictableLocked(std::size_t region) const
+bool RegionCache::IsPinnedLocked(Key key) const
+{
+  return this->IsRoot[this->RegionOf(key)] && this->LayerOf(key) == this->CurrentLayer;
+}
+
+std::vector<RegionCache::Key> RegionCache::EvictableLocked(Key key) const
 {
   // Loading a wanted region may evict predicted ones; loading anything else may not evict
   // what the newest frame wants or predicts. Roots never go.
-  const bool wanted = region < this->InWanted.size() && this->InWanted[region];
-  std::vector<std::pair<uint64_t, std::size_t>> order;
+  const bool wanted = this->InWanted.count(key) != 0;
+  std::vector<std::pair<uint64_t, Key>> order;
   for (const auto& entry : this->Entries)
   {
-    const std::size_t r = entry.first;
-    if (entry.second.buffers && r != region && !this->IsPinned[r] && !this->InWanted[r] &&
-      (wanted || !this->InPredicted[r]))
+    const Key k = entry.first;
+    if (entry.second.buffers && k != key && !this->IsPinnedLocked(k) && !this->InWanted.count(k) &&
+      (wanted || !this->InPredicted.count(k)))
     {
-      order.emplace_back(entry.second.lastRequested, r);
+      order.emplace_back(entry.second.lastRequested, k);
     }
   }
   std::sort(order.begin(), order.end());
-  std::vector<std::size_t> regions;
+  std::vector<Key> keys;
+  keys.reserve(order.size());
   for (const auto& o : order)
   {
-    regions.push_back(o.second);
+    keys.push_back(o.second);
   }
-  return regions;
+  return keys;
 }
 
-void RegionCache::EvictLocked(std::size_t region)
+void RegionCache::EvictLocked(Key key)
 {
-  Entry& entry = this->Entries[region];
+  Entry& entry = this->Entries[key];
   if (entry.buffers)
   {
     this->Bytes -= entry.buffers->Bytes();
@@ -556,15 +660,15 @@ void RegionCache::EvictLocked(std::size_t region)
 
 int64_t RegionCache::NextRegionLocked()
 {
-  const auto missing = [&](std::size_t r) {
-    const auto found = this->Entries.find(r);
+  const auto missing = [&](Key key) {
+    const auto found = this->Entries.find(key);
     return found == this->Entries.end() || (!found->second.buffers && !found->second.failed);
   };
-  for (std::size_t r : this->Pinned)
+  for (Key key : this->Pinned)
   {
-    if (missing(r))
+    if (missing(key))
     {
-      return static_cast<int64_t>(r);
+      return static_cast<int64_t>(key);
     }
   }
   for (int list = 0; list < 2; ++list)
@@ -574,18 +678,18 @@ int64_t RegionCache::NextRegionLocked()
     {
       return -1;
     }
-    for (std::size_t r : wanted ? this->Wanted : this->Predicted)
+    for (Key key : wanted ? this->Wanted : this->Predicted)
     {
-      if (!missing(r))
+      if (!missing(key))
       {
         continue;
       }
-      // A region refused earlier for the budget is not decoded again while it cannot fit.
-      const std::size_t known = this->Entries[r].bytes;
+      // An entry refused earlier for the budget is not decoded again while it cannot fit.
+      const std::size_t known = this->Entries[key].bytes;
       if (known > 0)
       {
         std::size_t freeable = 0;
-        for (std::size_t e : this->EvictableLocked(r))
+        for (Key e : this->EvictableLocked(key))
         {
           freeable += this->Entries[e].buffers->Bytes();
         }
@@ -595,41 +699,40 @@ int64_t RegionCache::NextRegionLocked()
           break;
         }
       }
-      return static_cast<int64_t>(r);
+      return static_cast<int64_t>(key);
     }
   }
   return -1;
 }
 
-void RegionCache::InsertLocked(std::size_t region, std::shared_ptr<const RegionDrawBuffers> buffers)
+void RegionCache::InsertLocked(Key key, std::shared_ptr<const RegionDrawBuffers> buffers)
 {
-  Entry& entry = this->Entries[region];
+  Entry& entry = this->Entries[key];
   const std::size_t need = buffers->Bytes();
   entry.bytes = need;
-  if (!this->IsPinned[region] && this->Bytes + need > this->BudgetBytes)
+  if (!this->IsPinnedLocked(key) && this->Bytes + need > this->BudgetBytes)
   {
-    const bool requested = this->InWanted[region] || this->InPredicted[region];
-    const std::vector<std::size_t> evictable =
-      requested ? this->EvictableLocked(region) : std::vector<std::size_t>();
+    const bool inWanted = this->InWanted.count(key) != 0, inPredicted = this->InPredicted.count(key) != 0;
+    const std::vector<Key> evictable = inWanted || inPredicted ? this->EvictableLocked(key) : std::vector<Key>();
     std::size_t freeable = 0;
-    for (std::size_t e : evictable)
+    for (Key e : evictable)
     {
       freeable += this->Entries[e].buffers->Bytes();
     }
     if (this->Bytes - freeable + need > this->BudgetBytes)
     {
       // Loading stops here: the selection draws ancestors instead.
-      if (this->InWanted[region])
+      if (inWanted)
       {
         this->WantedBlocked = true;
       }
-      else if (this->InPredicted[region])
+      else if (inPredicted)
       {
         this->PredictedBlocked = true;
       }
       return;
     }
-    for (std::size_t e : evictable)
+    for (Key e : evictable)
     {
       if (this->Bytes + need <= this->BudgetBytes)
       {
@@ -638,7 +741,7 @@ void RegionCache::InsertLocked(std::size_t region, std::shared_ptr<const RegionD
       this->EvictLocked(e);
     }
   }
-  this->Entries[region].buffers = std::move(buffers);
+  this->Entries[key].buffers = std::move(buffers);
   this->Bytes += need;
   ++this->Resident;
   ++this->Changes;
@@ -669,6 +772,7 @@ void RegionCache::Run()
     {
       const std::string name = this->PropertyName;
       const int32_t step = this->PropertyStep;
+      const int32_t layer = this->PropertyLayer;
       lock.unlock();
       std::shared_ptr<PropertyTableData> table;
       std::string error;
@@ -685,16 +789,19 @@ void RegionCache::Run()
           table = std::make_shared<PropertyTableData>();
           table->name = name;
           table->step = step;
-          table->values = this->Properties->ReadPacked(static_cast<std::size_t>(index));
+          table->layer = layer;
+          table->values = layer < 0 ? this->Properties->ReadPacked(static_cast<std::size_t>(index))
+                                    : this->Properties->ReadLayer(static_cast<std::size_t>(index), layer);
         }
       }
       catch (const std::exception& e)
       {
         table.reset();
-        error = "property " + name + " step " + std::to_string(step) + ": " + e.what();
+        error = "property " + name + " step " + std::to_string(step) +
+          (layer >= 0 ? " layer " + std::to_string(layer + 1) : std::string()) + ": " + e.what();
       }
       lock.lock();
-      if (name == this->PropertyName && step == this->PropertyStep)
+      if (name == this->PropertyName && step == this->PropertyStep && layer == this->PropertyLayer)
       {
         this->PropertyWanted = false;
         this->CurrentProperty = table; // null when the table could not be read
@@ -712,14 +819,17 @@ void RegionCache::Run()
       this->Wake.wait(lock);
       continue;
     }
-    const std::size_t region = static_cast<std::size_t>(next);
+    const Key key = static_cast<Key>(next);
+    const std::size_t region = this->RegionOf(key);
+    const int32_t layer = this->LayerOf(key);
     lock.unlock();
     std::shared_ptr<RegionDrawBuffers> buffers;
     std::string error;
     try
     {
       // ReadRegion, not ReadRegionSurfaces: the buffers need the positions.
-      buffers = std::make_shared<RegionDrawBuffers>(LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin, handedness));
+      buffers = std::make_shared<RegionDrawBuffers>(
+        LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin, handedness, layer));
     }
     catch (const std::exception& e)
     {
@@ -732,12 +842,12 @@ void RegionCache::Run()
     }
     if (!error.empty())
     {
-      this->Entries[region].failed = true;
+      this->Entries[key].failed = true;
       this->Error = error;
     }
     else
     {
-      this->InsertLocked(region, std::move(buffers));
+      this->InsertLocked(key, std::move(buffers));
     }
     this->Idle.notify_all();
   }

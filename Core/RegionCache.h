@@ -12,6 +12,10 @@
 //   then the bottom, then the side (the file's simplified side triangles), counter-clockwise
 //   seen from outside in the z-up frame. The side is the region mesh's side faces, not the
 //   file's simplified side (UseOriginalSideFaces says why).
+// - Single-layer view (Sec. 4.1, 6.1): every column keeps all nk layers, so the buffers of
+//   layer k come from the same decoded mesh (PrepareLayerDrawBuffers). SetLayer picks the
+//   layer that Get, IsResident and Request deal in; buffers are cached per (region, layer)
+//   under the one budget, and the current layer's roots take the roots' place below.
 // - Resident bytes (the buffers' sizes) stay within the budget, except that the roots and
 //   the regions requested by the newest frame are never evicted to load others: when the
 //   wanted set outgrows the budget, loading stops there (the selection then draws ancestors).
@@ -44,6 +48,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <unordered_set>
 #include <vector>
 
 namespace resmr
@@ -54,6 +59,10 @@ struct RegionDrawBuffers
   std::vector<float> vertices;   ///< per vertex: x, y, z, ci, cj, ck
   std::vector<uint32_t> indices; ///< triangles: top, bottom, side
   uint32_t topIndices = 0, bottomIndices = 0, sideIndices = 0; ///< index counts of each part
+  int32_t layer = -1; ///< the layer drawn (0-based), -1: the whole model
+  /// Normal cones of the top and bottom parts (RegionSurface::cone). A layer's faces are not
+  /// the region's stored surfaces, so their culling needs their own cones.
+  std::array<float, 4> topCone{ 0.f, 0.f, 1.f, -2.f }, bottomCone{ 0.f, 0.f, 1.f, -2.f };
   std::size_t Bytes() const { return this->vertices.size() * 4 + this->indices.size() * 4; }
 };
 
@@ -73,15 +82,25 @@ void UseOriginalSideFaces(RegionMesh& mesh);
 RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin,
   int handedness);
 
-/// What the cache loads for a region: its mesh read and checked, its own side faces, buffers.
-RegionDrawBuffers LoadRegionDrawBuffers(
-  const MultiresolutionFile& file, std::size_t region, const std::array<double, 3>& origin, int handedness);
+/// Draw buffers of layer `layer` (0-based) of a decoded region, laid out as the whole model's:
+/// the top and bottom faces of the layer's active cells and their side faces open in that
+/// layer (no active cell across in the same layer, a fault, the model's limit;
+/// ExtractLayerSurfaces). Cell coordinates lie in the layer: k + 0.5 on top and bottom faces,
+/// k to k + 1 (its interfaces) on side faces.
+RegionDrawBuffers PrepareLayerDrawBuffers(
+  const RegionMesh& mesh, int32_t layer, const std::array<double, 3>& origin, int handedness);
+
+/// What the cache loads for a region: its mesh read and checked, its own side faces, buffers;
+/// of one layer (0-based) when `layer` >= 0.
+RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
+  const std::array<double, 3>& origin, int handedness, int32_t layer = -1);
 
 struct PropertyTableData
 {
   std::string name;
   int32_t step = -1;
-  std::vector<float> values; ///< one a hash slot
+  int32_t layer = -1;        ///< -1: the packed table; else that layer's 2D table
+  std::vector<float> values; ///< one a hash slot (packed), or nx ny values (a layer, i fastest)
 };
 
 class RegionCache
@@ -97,15 +116,28 @@ public:
   /// World position of the vertices' origin: (latticeOrigin x, y, -depth).
   std::array<double, 3> Origin() const { return this->ModelOrigin; }
 
-  /// The buffers of a resident region, or null. Never blocks on loading.
+  /// The layer shown: 0-based, or -1 (the default) for the whole model. Get, IsResident and
+  /// Request then deal in that layer's buffers, and its roots are the ones loaded whatever the
+  /// budget. Other layers' buffers stay resident until evicted (least recently requested
+  /// first); the previous request is dropped, so nothing of the old layer is loaded any more.
+  /// In a layer, each Request also asks for the roots of the layers above and below, after
+  /// the predicted regions: stepping through the layers finds its first meshes ready. Returns
+  /// false, changing nothing, for a layer the model does not have. Never blocks on loading.
+  bool SetLayer(int32_t layer);
+  int32_t Layer() const;
+
+  /// The buffers of a resident region (of the current layer, or of `layer`), or null. Never
+  /// blocks on loading.
   std::shared_ptr<const RegionDrawBuffers> Get(std::size_t region) const;
+  std::shared_ptr<const RegionDrawBuffers> Get(std::size_t region, int32_t layer) const;
   bool IsResident(std::size_t region) const;
 
   /// The frame's wanted regions in loading order (replaces the previous request), then regions
   /// wanted by predicted frames, loaded after and evicted first.
   void Request(const std::vector<std::size_t>& wanted, const std::vector<std::size_t>& predicted = {});
-  /// Asks for a property table (name, step); Property() keeps the previous one until it loads.
-  void RequestProperty(const std::string& name, int32_t step);
+  /// Asks for a property table (name, step): the packed table, or the 2D table of `layer`
+  /// (0-based); Property() keeps the previous one until it loads.
+  void RequestProperty(const std::string& name, int32_t step, int32_t layer = -1);
   std::shared_ptr<const PropertyTableData> Property() const;
 
   /// True while a requested region or property table is not loaded yet and can still be
@@ -123,21 +155,35 @@ public:
   std::string LastError() const;
 
 private:
+  /// Entries are keyed by (region, layer): region * (nk + 1) + layer + 1.
+  using Key = uint64_t;
+  Key KeyOf(std::size_t region, int32_t layer) const
+  {
+    return static_cast<Key>(region) * this->LayerSlots + static_cast<Key>(layer + 1);
+  }
+  std::size_t RegionOf(Key key) const { return static_cast<std::size_t>(key / this->LayerSlots); }
+  int32_t LayerOf(Key key) const { return static_cast<int32_t>(key % this->LayerSlots) - 1; }
   void Run();
-  /// The next region to load (roots, then wanted, then predicted), or -1; may mark loading
-  /// blocked when a region whose size is known cannot fit. Lock held.
+  /// The next entry to load (roots, then wanted, then predicted), or -1; may mark loading
+  /// blocked when an entry whose size is known cannot fit. Lock held.
   int64_t NextRegionLocked();
   bool PendingLocked() const;
-  /// Resident regions that may be evicted to load `region`, least recently requested first.
-  std::vector<std::size_t> EvictableLocked(std::size_t region) const;
+  /// The current layer's roots are pinned. Lock held.
+  bool IsPinnedLocked(Key key) const;
+  /// Resident entries that may be evicted to load `key`, least recently requested first.
+  std::vector<Key> EvictableLocked(Key key) const;
   /// Makes room and inserts, or refuses (blocking the rest of the request). Lock held.
-  void InsertLocked(std::size_t region, std::shared_ptr<const RegionDrawBuffers> buffers);
-  void EvictLocked(std::size_t region);
+  void InsertLocked(Key key, std::shared_ptr<const RegionDrawBuffers> buffers);
+  void EvictLocked(Key key);
   // (members are the implementation's)
   std::shared_ptr<const MultiresolutionFile> File;
   std::shared_ptr<const PropertyFile> Properties;
   std::array<double, 3> ModelOrigin{};
   int Handedness = 1;
+  uint64_t LayerSlots = 1; ///< nk + 1
+  int32_t CurrentLayer = -1;
+  std::vector<std::size_t> Roots;
+  std::vector<uint8_t> IsRoot; ///< per region
   mutable std::mutex Lock;
   mutable std::condition_variable Wake, Idle;
   std::thread Loader;
@@ -153,15 +199,16 @@ private:
     std::size_t bytes = 0; ///< known once prepared (also for a region refused for the budget)
     bool failed = false;
   };
-  std::map<std::size_t, Entry> Entries;
-  std::vector<std::size_t> Wanted, Predicted;
-  std::vector<uint8_t> InWanted, InPredicted, IsPinned; ///< per region
+  std::map<Key, Entry> Entries;
+  std::vector<Key> Wanted, Predicted;
+  std::unordered_set<Key> InWanted, InPredicted;
   bool WantedBlocked = false, PredictedBlocked = false; ///< loading stopped for the budget
   std::size_t Resident = 0;
-  std::vector<std::size_t> Pinned;
+  std::vector<Key> Pinned; ///< the current layer's roots
   std::string Error;
   std::string PropertyName;
   int32_t PropertyStep = -1;
+  int32_t PropertyLayer = -1;
   bool PropertyWanted = false;
   std::shared_ptr<const PropertyTableData> CurrentProperty;
 };

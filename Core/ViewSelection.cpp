@@ -308,6 +308,11 @@ Traversal Traverse(const MultiresolutionFile& file, const Nodes& nodes, const st
 }
 } // namespace
 
+bool SurfaceCulled(const std::array<float, 4>& cone, const RegionRecord& region, const ViewParameters& view)
+{
+  return !(cone[3] > -1.5f) || BackFacing(cone, Corners(region), view);
+}
+
 ViewSelection ViewSelector::Select(const ViewParameters& view, const std::function<bool(std::size_t)>& resident) const
 {
   const auto& regions = this->File->Regions();

@@ -86,6 +86,12 @@ private:
   std::vector<std::size_t> RootRegions;
 };
 
+/// Whether a surface of `region` whose normals lie in `cone` (RegionSurface::cone; cosine -2:
+/// empty) need not be drawn: empty, or facing away from the eye from every point of the
+/// region's bounding volume. Select culls the stored top and bottom with it; the single-layer
+/// view, whose faces are not those surfaces, culls its layer's top and bottom the same way.
+bool SurfaceCulled(const std::array<float, 4>& cone, const RegionRecord& region, const ViewParameters& view);
+
 /// Where the camera will probably be a frame ahead: the last two views extrapolated linearly
 /// (eye and clip matrix), for loading ahead of need.
 ViewParameters PredictNextView(const ViewParameters& previous, const ViewParameters& current);

@@ -121,12 +121,14 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   std::unique_ptr<resmr::ViewSelector> Selector;
   std::unique_ptr<resmr::RegionCache> Cache;
   std::string Error;
+  std::string LayerError; ///< why Layer cannot be drawn, empty if it can
   double Bounds[6] = { 0, 0, 0, 0, 0, 0 };
 
   // GPU side.
   std::map<std::size_t, std::unique_ptr<GpuRegion>> Gpu;
   std::size_t GpuBytes = 0;
   vtkNew<vtkTextureObject> OffsetTexture, NormalTexture, PropertyTexture, ColorTexture;
+  vtkNew<vtkTextureObject> LayerPropertyTexture; ///< nx x ny R32F: one layer's table
   bool HashUploaded = false;
   std::shared_ptr<const resmr::PropertyTableData> UploadedProperty;
   vtkMTimeType ColorTableTime = 0;
@@ -222,6 +224,10 @@ bool vtkMultiresolutionSurfaceMapper::GetLoadsPending() const
 }
 const char* vtkMultiresolutionSurfaceMapper::GetLastError() const
 {
+  if (this->Internal->Error.empty() && !this->Internal->LayerError.empty())
+  {
+    return this->Internal->LayerError.c_str();
+  }
   if (this->Internal->Error.empty() && this->Internal->Cache)
   {
     static thread_local std::string cacheError;
@@ -252,6 +258,7 @@ void vtkMultiresolutionSurfaceMapper::ReleaseGraphicsResources(vtkWindow* window
   in.OffsetTexture->ReleaseGraphicsResources(window);
   in.NormalTexture->ReleaseGraphicsResources(window);
   in.PropertyTexture->ReleaseGraphicsResources(window);
+  in.LayerPropertyTexture->ReleaseGraphicsResources(window);
   in.ColorTexture->ReleaseGraphicsResources(window);
   if (in.TimerQuery != 0)
   {
@@ -371,6 +378,25 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   cache.SetBudget(MainMemoryShare(this->MemoryBudgetMB));
   const resmr::MultiresolutionHeader& header = in.File->Header();
 
+  // The layer shown (0-based; -1 the whole model). Out of range: nothing is drawn, and
+  // LastError says why, rather than a layer the user did not ask for.
+  if (this->Layer < 0 || this->Layer > header.dims[2])
+  {
+    const std::string message = "Layer " + std::to_string(this->Layer) + " is out of range: " + in.FilePath +
+      " has " + std::to_string(header.dims[2]) + " layers (1 to " + std::to_string(header.dims[2]) +
+      "; 0 draws the whole model)";
+    if (message != in.LayerError)
+    {
+      vtkWarningMacro(<< message);
+      in.LayerError = message;
+    }
+    in.Pending = false;
+    return;
+  }
+  in.LayerError.clear();
+  const int32_t layer = this->Layer - 1;
+  cache.SetLayer(layer);
+
   // Property table wanted this frame.
   // (a static property has one table, step -1, for every step)
   int32_t tableStep = step;
@@ -382,7 +408,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   }
   if (wantProperty)
   {
-    cache.RequestProperty(this->ArrayName, tableStep);
+    cache.RequestProperty(this->ArrayName, tableStep, layer);
   }
 
   // The view, in model coordinates (the actor's matrix folded into the projection).
@@ -481,10 +507,11 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   in.PreviousView = view;
   in.HavePreviousView = true;
 
-  // GPU buffers follow the cache: drop what it evicted, upload what is drawn.
+  // GPU buffers follow the cache: drop what it evicted (or what another layer replaced),
+  // upload what is drawn.
   for (auto entry = in.Gpu.begin(); entry != in.Gpu.end();)
   {
-    if (!cache.IsResident(entry->first))
+    if (cache.Get(entry->first) != entry->second->buffers)
     {
       in.GpuBytes -= entry->second->bytes;
       entry->second->layout->ReleaseGraphicsResources();
@@ -540,16 +567,30 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     float none = std::numeric_limits<float>::quiet_NaN();
     in.PropertyTexture->SetContext(window);
     in.PropertyTexture->Create3DFromRaw(1, 1, 1, 1, VTK_FLOAT, &none);
+    in.LayerPropertyTexture->SetContext(window);
+    in.LayerPropertyTexture->Create2DFromRaw(1, 1, 1, VTK_FLOAT, &none);
     unsigned char white[4] = { 255, 255, 255, 255 };
     in.ColorTexture->SetContext(window);
     in.ColorTexture->Create2DFromRaw(1, 1, 4, VTK_UNSIGNED_CHAR, white);
   }
   std::shared_ptr<const resmr::PropertyTableData> property = wantProperty ? cache.Property() : nullptr;
-  if (property && (property->name != this->ArrayName || property->step != tableStep))
+  if (property && (property->name != this->ArrayName || property->step != tableStep || property->layer != layer))
   {
     property.reset(); // still the previous property: the solid colour until this one loads
   }
-  if (property && property != in.UploadedProperty)
+  if (property && property != in.UploadedProperty && property->layer >= 0)
+  {
+    // A layer's table is a 2D texture of nx x ny, indexed by (i, j): no hash (Sec. 5.4).
+    state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    in.LayerPropertyTexture->SetContext(window);
+    in.LayerPropertyTexture->ResetFormatAndType();
+    in.LayerPropertyTexture->SetMinificationFilter(vtkTextureObject::Nearest);
+    in.LayerPropertyTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    in.LayerPropertyTexture->Create2DFromRaw(static_cast<unsigned int>(header.dims[0]),
+      static_cast<unsigned int>(header.dims[1]), 1, VTK_FLOAT, const_cast<float*>(property->values.data()));
+    in.UploadedProperty = property;
+  }
+  else if (property && property != in.UploadedProperty)
   {
     state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     in.PropertyTexture->SetContext(window);
@@ -655,6 +696,9 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   program->SetUniformi("cellNormals", in.NormalTexture->GetTextureUnit());
   in.PropertyTexture->Activate();
   program->SetUniformi("propertyTable", in.PropertyTexture->GetTextureUnit());
+  in.LayerPropertyTexture->Activate();
+  program->SetUniformi("layerProperty", in.LayerPropertyTexture->GetTextureUnit());
+  program->SetUniformi("layer", layer);
   in.ColorTexture->Activate();
   program->SetUniformi("colorMap", in.ColorTexture->GetTextureUnit());
   if (colorMode == PropertyColors)
@@ -721,13 +765,17 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     }
     gpu.layout->Bind();
     gpu.indices->Bind();
+    // The selection culled the stored top and bottom by their cones; a layer's own top and
+    // bottom have their own cones.
+    const resmr::RegionRecord& record = in.File->Regions()[drawn.region];
+    const bool top = layer < 0 ? drawn.top : !resmr::SurfaceCulled(buffers.topCone, record, view);
+    const bool bottom = layer < 0 ? drawn.bottom : !resmr::SurfaceCulled(buffers.bottomCone, record, view);
     const struct
     {
       bool shown;
       uint32_t first, count;
       int kind;
-    } parts[3] = { { drawn.top, 0, buffers.topIndices, 0 },
-      { drawn.bottom, buffers.topIndices, buffers.bottomIndices, 1 },
+    } parts[3] = { { top, 0, buffers.topIndices, 0 }, { bottom, buffers.topIndices, buffers.bottomIndices, 1 },
       { drawn.side, buffers.topIndices + buffers.bottomIndices, buffers.sideIndices, 2 } };
     for (const auto& part : parts)
     {
@@ -745,6 +793,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   }
   in.Substituted = static_cast<int>(selection.substituted);
   in.PropertyTexture->Deactivate();
+  in.LayerPropertyTexture->Deactivate();
   in.ColorTexture->Deactivate();
   in.OffsetTexture->Deactivate();
   in.NormalTexture->Deactivate();
@@ -780,4 +829,5 @@ void vtkMultiresolutionSurfaceMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MemoryBudgetMB: " << this->MemoryBudgetMB << "\n";
   os << indent << "GridLines: " << this->GridLines << "\n";
   os << indent << "WaitForDetailMs: " << this->WaitForDetailMs << "\n";
+  os << indent << "Layer: " << this->Layer << "\n";
 }

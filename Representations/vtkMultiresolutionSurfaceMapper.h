@@ -9,7 +9,8 @@
  * thread never waits on disk. Fragments find their original cell from the topological
  * coordinate and paint its property through the perfect-hash tables and the lookup table,
  * the original grid lines and the cell's face normal. With a target frame rate the pixel
- * tolerance follows the measured frame times (resmr::FrameRateController).
+ * tolerance follows the measured frame times (resmr::FrameRateController). With Layer set,
+ * the same regions show one layer alone (Sec. 4.1, 5.2, 6.1), painted from its 2D tables.
  *
  * The input is a copy of the descriptor vtkMultiresolutionReader writes (its bounds are the
  * model's) with a string field array (SourceArrayName) naming the .resmr file, the property
@@ -69,6 +70,13 @@ public:
   vtkSetVector3Macro(GridLineColor, double);
   vtkGetVector3Macro(GridLineColor, double);
 
+  /// Single-layer view: 0 (the default) draws the whole model; K in 1..nk (ECLIPSE's K, from 1)
+  /// draws layer K alone: its active cells' top and bottom faces and the side faces bounding
+  /// them within the layer, from the same regions the whole model would use, painted from the
+  /// layer's 2D property table. Any other value draws nothing and GetLastError() says why.
+  vtkSetMacro(Layer, int);
+  vtkGetMacro(Layer, int);
+
   /// Still renders wait (at most this many ms) until every mesh the view wants is loaded:
   /// batch scripts and screenshots; 0 (interactive use) never waits.
   vtkSetClampMacro(WaitForDetailMs, int, 0, 600000);
@@ -117,6 +125,7 @@ private:
   double GridLineWidth = 1.0;
   double GridLineColor[3] = { 0.1, 0.1, 0.1 };
   int WaitForDetailMs = 0;
+  int Layer = 0;
 
   struct Internals;
   std::unique_ptr<Internals> Internal;

@@ -3,6 +3,8 @@
 #include "vtkMultiresolutionReader.h"
 #include "vtkMultiresolutionSurfaceMapper.h"
 
+#include "MultiresolutionFile.h"
+
 #include "vtkActor.h"
 #include "vtkAlgorithmOutput.h"
 #include "vtkFieldData.h"
@@ -17,6 +19,7 @@
 #include "vtkScalarsToColors.h"
 #include "vtkStringArray.h"
 
+#include <exception>
 #include <string>
 
 vtkStandardNewMacro(vtkMultiresolutionSurfaceRepresentation);
@@ -78,6 +81,22 @@ int vtkMultiresolutionSurfaceRepresentation::RequestData(
       source->InsertNextValue(reader->GetResolvedPropertyFileName());
       source->InsertNextValue(std::to_string(step));
       this->Delivered->GetFieldData()->AddArray(source);
+      // The Layer property's range: the header is read once a file (the mapper opens it again
+      // where it draws, which may be another process).
+      const std::string path = reader->GetFileName() ? reader->GetFileName() : "";
+      if (path != this->LayerRangeFile)
+      {
+        this->LayerRangeFile = path;
+        this->LayerRange[1] = 0;
+        try
+        {
+          this->LayerRange[1] = static_cast<int>(resmr::MultiresolutionFile(path).Header().dims[2]);
+        }
+        catch (const std::exception&)
+        {
+          // the reader reports a file it cannot open
+        }
+      }
     }
   }
   return this->Superclass::RequestData(request, inputVector, outputVector);
@@ -228,6 +247,10 @@ void vtkMultiresolutionSurfaceRepresentation::SetWaitForDetailMs(int millisecond
 {
   this->Mapper->SetWaitForDetailMs(milliseconds);
 }
+void vtkMultiresolutionSurfaceRepresentation::SetLayer(int layer)
+{
+  this->Mapper->SetLayer(layer);
+}
 double vtkMultiresolutionSurfaceRepresentation::GetCurrentTolerance()
 {
   return this->Mapper->GetCurrentTolerance();
@@ -265,4 +288,5 @@ void vtkMultiresolutionSurfaceRepresentation::PrintSelf(ostream& os, vtkIndent i
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "Mapper: " << this->Mapper << "\n";
+  os << indent << "LayerRange: " << this->LayerRange[0] << " " << this->LayerRange[1] << "\n";
 }

@@ -76,6 +76,7 @@ public:
   void SetGridLineWidth(double pixels);
   void SetGridLineColor(double r, double g, double b);
   void SetWaitForDetailMs(int milliseconds);
+  void SetLayer(int layer);
   double GetCurrentTolerance();
   double GetResidentMB();
   double GetTrianglesDrawn();
@@ -87,6 +88,11 @@ public:
   ///@}
 
   vtkMultiresolutionSurfaceMapper* GetMapper() { return this->Mapper; }
+
+  /// 0 and the model's layer count nk: the range of Layer (0 the whole model), read from the
+  /// file's header when the input names a file; 0 0 before, and where the representation has
+  /// no input (the client's copy in client/server mode).
+  vtkGetVector2Macro(LayerRange, int);
 
 protected:
   vtkMultiresolutionSurfaceRepresentation();
@@ -105,6 +111,8 @@ private:
   vtkNew<vtkActor> Actor;
   vtkSmartPointer<vtkPolyData> Delivered;
   std::string Error;
+  int LayerRange[2] = { 0, 0 };
+  std::string LayerRangeFile; ///< the file LayerRange was read from
 };
 
 #endif

@@ -4,12 +4,13 @@
 // fragment is floor(cell coordinate); its property and top/bottom normal are found through
 // the perfect spatial hash (two texel fetches); the original grid lines are where the
 // coordinate crosses an integer, drawn a fixed width in pixels and faded out where cells
-// shrink below a few pixels.
+// shrink below a few pixels. In the single-layer view (layer >= 0) the property comes from
+// that layer's 2D table, indexed by (i, j) without the hash.
 
 in vec3 cellCoord;
 in vec3 viewPosition;
 
-uniform int colorMode;    // 0: solid colour, 1: property, 2: cell id (debug), 3: layer k
+uniform int colorMode;    // 0: solid colour, 1: property, 2: cell id (debug)
 uniform int faceKind;     // 0: top, 1: bottom, 2: side
 uniform ivec3 gridDims;   // nx, ny, nz
 uniform ivec3 tableSides; // m
@@ -17,6 +18,8 @@ uniform ivec3 offsetSides; // r
 uniform usampler3D hashOffsets;  // r0 x r1 x r2, RGB16UI
 uniform usampler3D cellNormals;  // m0 x m1 x m2, RG16UI (top, bottom)
 uniform sampler3D propertyTable; // m0 x m1 x m2, R32F
+uniform int layer;               // -1: the whole model; else the one layer drawn (0-based)
+uniform sampler2D layerProperty; // nx x ny, R32F: that layer's table
 uniform sampler2D colorMap;      // N x 1, RGBA8
 uniform vec2 scalarRange;        // lookup table range (log10 of it when logScale)
 uniform int logScale;
@@ -52,18 +55,25 @@ vec3 DecodeNormal(uint code)
 void main()
 {
   ivec3 cell = clamp(ivec3(floor(cellCoord)), ivec3(0), gridDims - 1);
+  if (layer >= 0 && faceKind == 2)
+  {
+    // A layer's side faces span its interfaces, k to k + 1: seen edge-on they are slivers
+    // on screen, where interpolation strays past either interface. Their cell is in the
+    // layer; top and bottom faces keep the k their vertices give.
+    cell.z = layer;
+  }
   if (colorMode == 2)
   {
     int id = cell.x + gridDims.x * (cell.y + gridDims.y * cell.z) + 1;
     gl_FragData[0] = vec4(float(id & 255), float((id >> 8) & 255), float((id >> 16) & 255), 255.0) / 255.0;
     return;
   }
-  ivec3 slot = HashSlot(cell);
+  ivec3 slot = layer < 0 ? HashSlot(cell) : ivec3(0);
 
   vec3 color = solidColor;
   if (colorMode == 1)
   {
-    float value = texelFetch(propertyTable, slot, 0).r;
+    float value = layer < 0 ? texelFetch(propertyTable, slot, 0).r : texelFetch(layerProperty, cell.xy, 0).r;
     if (isnan(value))
     {
       color = nanColor.rgb;
@@ -83,10 +93,12 @@ void main()
   }
 
   // Normal (view space): the original cell's top or bottom face normal (Sec. 5.3), the
-  // facet's own for sides. Lit from the camera (headlight), both sides.
+  // facet's own for sides. Lit from the camera (headlight), both sides. A layer's cells are
+  // mostly inside the model, and the normal table is hashed for the external faces' cells
+  // only: a layer lights every face by its geometric normal, per pixel.
   vec3 facet = normalize(cross(dFdx(viewPosition), dFdy(viewPosition)));
   vec3 normal = facet;
-  if (faceKind < 2)
+  if (faceKind < 2 && layer < 0)
   {
     uvec2 codes = texelFetch(cellNormals, slot, 0).xy;
     normal = normalize(normalToView * DecodeNormal(faceKind == 0 ? codes.x : codes.y));

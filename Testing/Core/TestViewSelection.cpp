@@ -3,7 +3,9 @@
 // a synthetic one: the extremes of the projected error against SelectByError, conformity
 // under random residency, frustum and normal-cone culling, resident ancestors standing in,
 // draw buffers whose cell coordinates land in the right active cell, and the region cache's
-// budget, LRU eviction, damaged chunks, prompt shutdown and property tables.
+// budget, LRU eviction, damaged chunks, prompt shutdown and property tables; single-layer
+// buffers (exactly the layer's active cells and the faces bounding them) and the cache's
+// layers (switching never waits, buffers kept per layer under the one budget).
 #include "CoreTesting.h"
 
 #include "ConformalCut.h"
@@ -26,6 +28,7 @@
 #include <set>
 #include <string>
 #include <sys/stat.h>
+#include <tuple>
 #include <unistd.h>
 
 using namespace resmr;
@@ -830,12 +833,208 @@ void TestProperties()
   CHECK(second && second->step == 1 &&
     Same(second->values, properties->ReadPacked(static_cast<std::size_t>(properties->Find("PRESSURE", 1)))));
   CHECK(first->step == 0); // the old table is untouched for whoever still holds it
+  // A layer's 2D table for the single-layer view.
+  cache.RequestProperty("PRESSURE", 1, 2);
+  CHECK(cache.WaitIdle(seconds(10)));
+  const auto layer = cache.Property();
+  const auto& dims = file->Header().dims;
+  CHECK(layer && layer->layer == 2 && layer->step == 1 && layer->values.size() == std::size_t(dims[0] * dims[1]) &&
+    Same(layer->values, properties->ReadLayer(static_cast<std::size_t>(properties->Find("PRESSURE", 1)), 2)));
   cache.RequestProperty("NOSUCH", 3);
   CHECK(cache.WaitIdle(seconds(10)));
   CHECK(cache.Property() == nullptr);
   CHECK(cache.LastError().find("NOSUCH") != std::string::npos && cache.LastError().find("3") != std::string::npos);
   std::printf("  properties: PRESSURE steps 0 and 1 (%zu slots); missing: %s\n", second ? second->values.size() : 0,
     cache.LastError().c_str());
+}
+/// Single-layer buffers (Sec. 4.1, 6.1) of every leaf region for the first, a middle and the
+/// last layer: every cell coordinate lies in the layer (k + 0.5 on top and bottom faces, k to
+/// k + 1 on side faces); over the leaves, the top and bottom
+/// faces name each active cell of the layer exactly once (two triangles each) and nothing
+/// else; every side triangle names an active cell of the layer whose side on the triangle's
+/// plane is open; every side of an active cell with no active cell across in the layer (or
+/// the model's limit across) is drawn.
+void TestLayerBuffers(const std::string& path)
+{
+  const MultiresolutionFile file(path);
+  const int handedness = TopologyHandedness(file);
+  const auto& dims = file.Header().dims;
+  const auto& o = file.Header().latticeOrigin;
+  const std::array<double, 3> origin{ o[0], o[1], -o[2] };
+  const double w[3] = { 1.0 / 3 + std::sqrt(2.0) * 1e-3, 1.0 / 3 + std::sqrt(3.0) * 1e-3, 0 };
+  const double w2 = 1 - w[0] - w[1];
+  std::vector<std::size_t> leaves;
+  for (std::size_t r = 0; r < file.Regions().size(); ++r)
+    if (file.Regions()[r].level == file.Header().leafLevel)
+      leaves.push_back(r);
+  for (const int64_t k : { int64_t(0), dims[2] / 2, dims[2] - 1 })
+  {
+    const std::vector<uint8_t> active = file.ReadActiveLayer(k);
+    const auto isActive = [&](int64_t i, int64_t j) {
+      return i >= 0 && j >= 0 && i < dims[0] && j < dims[1] && active[std::size_t(i + dims[0] * j)] != 0;
+    };
+    std::vector<int> tops(std::size_t(dims[0] * dims[1]), 0), bottoms(tops.size(), 0);
+    std::set<std::tuple<int64_t, int64_t, int, int>> sides; // i, j, axis, low (0) or high (1) side
+    std::size_t bad = 0, triangles = 0, outside = 0;
+    for (std::size_t r : leaves)
+    {
+      const RegionMesh mesh = file.ReadRegion(r);
+      const RegionDrawBuffers buffers = PrepareLayerDrawBuffers(mesh, int32_t(k), origin, handedness);
+      RegionSurface top, bottom, side;
+      ExtractLayerSurfaces(mesh, int32_t(k), top, bottom, side);
+      CHECK(buffers.layer == k && buffers.sideIndices == 6 * side.quads.size());
+      CHECK(buffers.topIndices == 6 * top.quads.size() && buffers.bottomIndices == 6 * bottom.quads.size());
+      // Top and bottom vertices sit half a layer in; side vertices on the layer's interfaces.
+      for (std::size_t t = 0; t < buffers.indices.size(); ++t)
+      {
+        const float ck = buffers.vertices[buffers.indices[t] * 6 + 5];
+        outside += t < buffers.topIndices + buffers.bottomIndices ? ck != float(k + 0.5) : ck < k || ck > k + 1;
+      }
+      for (std::size_t t = 0; t < buffers.indices.size(); t += 3)
+      {
+        ++triangles;
+        double point[3] = { 0, 0, 0 };
+        for (int v = 0; v < 3; ++v)
+          for (int a = 0; a < 3; ++a)
+            point[a] += (v == 2 ? w2 : w[v]) * buffers.vertices[buffers.indices[t + v] * 6 + 3 + a];
+        const int64_t i = int64_t(std::floor(point[0])), j = int64_t(std::floor(point[1]));
+        bool ok = int64_t(std::floor(point[2])) == k && isActive(i, j);
+        if (ok && t < buffers.topIndices)
+          ++tops[std::size_t(i + dims[0] * j)];
+        else if (ok && t < buffers.topIndices + buffers.bottomIndices)
+          ++bottoms[std::size_t(i + dims[0] * j)];
+        else if (ok)
+        {
+          // The quad's plane (from its first vertex) must be the cell's low or high side on
+          // the axis along which the quad's nodes share their topological coordinate.
+          const std::size_t s = (t - buffers.topIndices - buffers.bottomIndices) / 6;
+          const auto& quad = side.quads[s];
+          const uint32_t perNode = uint32_t(mesh.layers + 1);
+          const auto& a = mesh.topology[quad[0] / perNode];
+          const auto& b = mesh.topology[quad[3] / perNode];
+          const int axis = a[0] == b[0] ? 0 : a[1] == b[1] ? 1 : -1;
+          const int64_t low = axis == 0 ? i : j;
+          ok = axis >= 0 && (a[axis] == double(low) || a[axis] == double(low + 1));
+          if (ok)
+            sides.insert({ i, j, axis, a[axis] == double(low) ? 0 : 1 });
+        }
+        bad += !ok;
+      }
+    }
+    std::size_t cells = 0, wrongTop = 0, missingSides = 0, faultSides = 0;
+    for (int64_t j = 0; j < dims[1]; ++j)
+      for (int64_t i = 0; i < dims[0]; ++i)
+      {
+        const std::size_t c = std::size_t(i + dims[0] * j);
+        cells += isActive(i, j);
+        wrongTop += isActive(i, j) ? (tops[c] != 2) + (bottoms[c] != 2) : (tops[c] != 0) + (bottoms[c] != 0);
+        if (!isActive(i, j))
+          continue;
+        const int64_t across[4][2] = { { i - 1, j }, { i + 1, j }, { i, j - 1 }, { i, j + 1 } };
+        for (int n = 0; n < 4; ++n)
+        {
+          const bool drawn = sides.count({ i, j, n / 2, n % 2 }) != 0;
+          missingSides += !isActive(across[n][0], across[n][1]) && !drawn;
+          faultSides += isActive(across[n][0], across[n][1]) && drawn;
+        }
+      }
+    std::printf("  layer %lld of %s: %zu active cells, %zu triangles, %zu misplaced, %zu cells without exactly one "
+      "top and bottom, %zu open sides missing, %zu sides against an active cell (faults), %zu vertices off the layer\n",
+      static_cast<long long>(k + 1), path.c_str(), cells, triangles, bad, wrongTop, missingSides, faultSides, outside);
+    CHECK(cells > 0 && bad == 0 && wrongTop == 0 && missingSides == 0 && outside == 0);
+  }
+}
+
+/// The cache's layers: out-of-range layers refused; a switch returns at once and keeps the
+/// whole model's buffers; the new layer's roots load first, its requested regions as asked
+/// (equal to LoadRegionDrawBuffers of that layer), the roots of the layers around it after;
+/// resident bytes are every (region, layer) held; a budget that holds the whole model's leaves
+/// evicts them, least recently requested first, for the layer's.
+void TestLayerCache(const std::string& path)
+{
+  using namespace std::chrono;
+  const auto file = std::make_shared<const MultiresolutionFile>(path);
+  const Model model(path);
+  const auto leaves = model.Leaves();
+  const auto roots = model.selector->Roots();
+  const int32_t nk = int32_t(file->Header().dims[2]);
+  const int32_t k = nk / 2;
+  const int handedness = TopologyHandedness(*file);
+  RegionCache cache(file, nullptr, SIZE_MAX);
+  CHECK(cache.WaitIdle(seconds(10)) && cache.Layer() == -1);
+  CHECK(!cache.SetLayer(nk) && !cache.SetLayer(-2) && cache.Layer() == -1);
+  cache.Request(leaves);
+  CHECK(cache.WaitIdle(seconds(10)));
+  const uint64_t generation = cache.Generation();
+  const auto start = steady_clock::now();
+  CHECK(cache.SetLayer(k) && cache.Layer() == k);
+  const double switchMs = duration<double, std::milli>(steady_clock::now() - start).count();
+  CHECK(cache.Generation() > generation);
+  CHECK(cache.Get(leaves[0], -1) != nullptr); // the whole model's stay
+  CHECK(cache.WaitIdle(seconds(10)));
+  for (std::size_t r : roots)
+  {
+    const auto buffers = cache.Get(r);
+    const auto expected = LoadRegionDrawBuffers(*file, r, cache.Origin(), handedness, k);
+    CHECK(buffers && buffers == cache.Get(r, k) && buffers->layer == k && buffers->vertices == expected.vertices &&
+      buffers->indices == expected.indices);
+  }
+  CHECK(!cache.IsResident(leaves[0])); // nothing of the layer asked for yet but its roots
+  const auto loadStart = steady_clock::now();
+  cache.Request(leaves);
+  CHECK(cache.WaitIdle(seconds(30)));
+  const double loadMs = duration<double, std::milli>(steady_clock::now() - loadStart).count();
+  std::size_t held = 0;
+  for (std::size_t r : leaves)
+  {
+    const auto buffers = cache.Get(r);
+    CHECK(buffers && buffers->layer == k);
+  }
+  const auto expected = LoadRegionDrawBuffers(*file, leaves.back(), cache.Origin(), handedness, k);
+  const auto last = cache.Get(leaves.back());
+  CHECK(last->vertices == expected.vertices && last->indices == expected.indices);
+  for (std::size_t r : roots)
+    for (const int32_t l : { k - 1, k + 1 })
+      CHECK(l < 0 || l >= nk || cache.Get(r, l) != nullptr);
+  for (std::size_t r = 0; r < file->Regions().size(); ++r)
+    for (int32_t l = -1; l < nk; ++l)
+      if (const auto buffers = cache.Get(r, l))
+        held += buffers->Bytes();
+  CHECK(held == cache.ResidentBytes());
+  CHECK(cache.LastError().empty());
+  // Back to the whole model: everything it wanted is still there.
+  CHECK(cache.SetLayer(-1) && !cache.Pending() && cache.IsResident(leaves[0]));
+  std::printf("  layer cache %s: switch to layer %d in %.3f ms, its %zu leaves loaded in %.1f ms, %zu bytes held over "
+    "3 layers and the whole model\n", path.c_str(), k + 1, switchMs, leaves.size(), loadMs, held);
+  CHECK(switchMs < 50);
+
+  // A budget for the roots and the larger of the two sets of leaves (the whole model's, the
+  // layer's), not both: the layer's leaves evict the whole model's.
+  std::size_t wholeBytes = 0, layerBytes = 0, rootBytes = 0;
+  for (std::size_t r : leaves)
+  {
+    wholeBytes += cache.Get(r, -1)->Bytes();
+    layerBytes += cache.Get(r, k)->Bytes();
+  }
+  for (std::size_t r : roots)
+    rootBytes += cache.Get(r, -1)->Bytes() + cache.Get(r, k)->Bytes();
+  const std::size_t budget = std::max(wholeBytes, layerBytes) + rootBytes;
+  RegionCache small(file, nullptr, budget);
+  small.Request(leaves);
+  CHECK(small.WaitIdle(seconds(10)));
+  CHECK(std::all_of(leaves.begin(), leaves.end(), [&](std::size_t r) { return small.IsResident(r); }));
+  CHECK(small.SetLayer(k));
+  small.Request(leaves);
+  CHECK(small.WaitIdle(seconds(30)));
+  std::size_t wholeLeft = 0, layerLeaves = 0;
+  for (std::size_t r : leaves)
+  {
+    wholeLeft += small.Get(r, -1) != nullptr;
+    layerLeaves += small.Get(r, k) != nullptr;
+  }
+  std::printf("  layer cache under %zu bytes: %zu of %zu whole-model leaves left, %zu layer leaves, %zu bytes "
+    "resident\n", budget, wholeLeft, leaves.size(), layerLeaves, small.ResidentBytes());
+  CHECK(layerLeaves == leaves.size() && wholeLeft < leaves.size() && small.ResidentBytes() <= budget);
 }
 } // namespace
 
@@ -901,6 +1100,13 @@ int main(int argc, char** argv)
     { "Cache", [&] { TestCache(reek64); } },
     { "DamagedChunk", [&] { TestDamagedChunk(reek); } },
     { "Properties", [&] { TestProperties(); } },
+    { "LayerBuffers",
+      [&] {
+        TestLayerBuffers(reek);
+        TestLayerBuffers(brugge);
+        TestLayerBuffers(synth);
+      } },
+    { "LayerCache", [&] { TestLayerCache(reek64); } },
   });
   std::printf("total %.2f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   if (!ok)

@@ -124,6 +124,65 @@ def compare_image(render_view, baseline_dir, name, temp_dir, threshold=0.05, max
                              f"{100 * moved:.2f}% of pixels changed); see {produced}")
 
 
+def capture_rgb(view, path, width, height):
+    """Saves the view (opaque background) and returns its pixels, (height, width, 3) int64."""
+    from paraview import simple
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOImage import vtkPNGReader
+    simple.SaveScreenshot(path, view, ImageResolution=[width, height], TransparentBackground=0)
+    reader = vtkPNGReader()
+    reader.SetFileName(path)
+    reader.Update()
+    pixels = vtk_to_numpy(reader.GetOutput().GetPointData().GetScalars())[:, :3].astype(np.int64)
+    return pixels.reshape(height, width, 3)
+
+
+def cell_ids(pixels):
+    """The cell-id colouring decoded: 0 for background, else 1 + i + nx (j + ny k)."""
+    return pixels[..., 0] + 256 * pixels[..., 1] + 65536 * pixels[..., 2]
+
+
+def erode(mask, steps, corners=False):
+    """The mask shrunk by `steps` pixels (4-neighbourhood, or 8 with `corners`)."""
+    out = mask.copy()
+    for _ in range(steps):
+        shrunk = out.copy()
+        shrunk[1:, :] &= out[:-1, :]
+        shrunk[:-1, :] &= out[1:, :]
+        shrunk[:, 1:] &= out[:, :-1]
+        shrunk[:, :-1] &= out[:, 1:]
+        if corners:
+            shrunk[1:, 1:] &= out[:-1, :-1]
+            shrunk[1:, :-1] &= out[:-1, 1:]
+            shrunk[:-1, 1:] &= out[1:, :-1]
+            shrunk[:-1, :-1] &= out[1:, 1:]
+        out = shrunk
+    return out
+
+
+def stock_cell_id_filter(grid_reader, dims):
+    """A ProgrammableFilter adding cell array CellIdColor: the RGB of 1 + i + nx (j + ny k),
+    the Multiresolution Surface's Cell Id colouring, from the reader's I, J, K arrays."""
+    from paraview import simple
+    script = f"""
+import numpy as np
+from vtkmodules.util.numpy_support import vtk_to_numpy, numpy_to_vtk
+data = self.GetInputDataObject(0, 0)
+out = self.GetOutputDataObject(0)
+out.ShallowCopy(data)
+cd = data.GetCellData()
+i = vtk_to_numpy(cd.GetArray('I')).astype(np.int64) - 1
+j = vtk_to_numpy(cd.GetArray('J')).astype(np.int64) - 1
+k = vtk_to_numpy(cd.GetArray('K')).astype(np.int64) - 1
+ids = i + {dims[0]} * (j + {dims[1]} * k) + 1
+rgb = np.stack([ids & 255, (ids >> 8) & 255, (ids >> 16) & 255], axis=1).astype(np.uint8)
+array = numpy_to_vtk(rgb, deep=1)
+array.SetName('CellIdColor')
+out.GetCellData().AddArray(array)
+"""
+    return simple.ProgrammableFilter(Input=grid_reader, Script=script, OutputDataSetType="Same as Input")
+
+
 def fail(message):
     print("FAIL", message)
     sys.exit(1)
