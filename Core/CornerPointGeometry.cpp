@@ -133,12 +133,8 @@ CornerPointGeometry CornerPointGeometry::FromDeck(GrdeclDeck& deck, bool applyMa
   {
     BuildCartesian(deck, geometry.CoordValues, geometry.ZcornValues);
   }
-  geometry.MapAxesAvailable = deck.hasMapAxes && !deck.gridUnitIsMap;
   CheckMapAxes(deck);
-  if (geometry.MapAxesAvailable)
-  {
-    MapTransformOf(deck.mapAxes, geometry.MapTransform);
-  }
+  geometry.MapAxesAvailable = PlacementTransform(deck.Placement(), geometry.MapTransform);
   geometry.SetMapAxesApplied(applyMapAxes);
   return geometry;
 }
@@ -167,6 +163,11 @@ bool CornerPointGeometry::MapTransformOf(const MapAxes& axes, std::array<double,
   return true;
 }
 
+bool CornerPointGeometry::PlacementTransform(const MapPlacement& placement, std::array<double, 6>& transform)
+{
+  return placement.hasMapAxes && !placement.gridUnitIsMap && MapTransformOf(placement.mapAxes, transform);
+}
+
 void CornerPointGeometry::SetMapAxesApplied(bool apply)
 {
   this->MapAxesApplied = apply && this->MapAxesAvailable;
@@ -176,14 +177,9 @@ void CornerPointGeometry::SetMapAxesApplied(bool apply)
 void CornerPointGeometry::PillarPoint(int64_t pillar, double depth, double xyz[3]) const
 {
   PointOnPillar(&this->CoordValues[static_cast<std::size_t>(6 * pillar)], depth, xyz);
-  const double x = xyz[0], y = xyz[1];
   if (this->MapAxesApplied)
   {
-    const auto& m = this->MapTransform;
-    const double mx = m[0] + x * m[2] + y * m[4];
-    const double my = m[1] + x * m[3] + y * m[5];
-    xyz[0] = mx;
-    xyz[1] = my;
+    ApplyMapTransform(this->MapTransform, xyz[0], xyz[1]);
   }
 }
 
@@ -207,9 +203,7 @@ void CornerPointGeometry::DetectHandedness()
     out[1] = p[1];
     if (this->MapAxesApplied)
     {
-      const auto& m = this->MapTransform;
-      out[0] = m[0] + p[0] * m[2] + p[1] * m[4];
-      out[1] = m[1] + p[0] * m[3] + p[1] * m[5];
+      ApplyMapTransform(this->MapTransform, out[0], out[1]);
     }
   };
   double turn = 0.0;

@@ -70,6 +70,15 @@ public:
   const std::vector<double>& Coord() const { return this->CoordValues; }
   /// Origin and unit axes from MAPAXES; false if an axis point coincides with the origin.
   static bool MapTransformOf(const MapAxes& axes, std::array<double, 6>& transform);
+  /// The transform FromDeck applies: MAPAXES given and usable, grid not already in map units.
+  static bool PlacementTransform(const MapPlacement& placement, std::array<double, 6>& transform);
+  /// Grid (x, y) to map coordinates with a MapTransformOf transform.
+  static void ApplyMapTransform(const std::array<double, 6>& m, double& x, double& y)
+  {
+    const double mx = m[0] + x * m[2] + y * m[4];
+    y = m[1] + x * m[3] + y * m[5];
+    x = mx;
+  }
   /// Throws the GrdeclError FromDeck throws for MAPAXES the deck cannot use (axis points on
   /// the origin), whether or not the transform is applied.
   static void CheckMapAxes(const GrdeclDeck& deck);

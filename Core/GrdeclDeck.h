@@ -49,6 +49,16 @@ struct MapAxes
   std::array<double, 2> xAxisPoint{};
 };
 
+/// Where the grid lies on the map: MAPAXES, MAPUNITS and GRIDUNIT as the input gives them.
+struct MapPlacement
+{
+  bool hasMapAxes = false;
+  MapAxes mapAxes;
+  std::string mapUnits;
+  std::string gridUnit;
+  bool gridUnitIsMap = false; ///< GRIDUNIT 'METRES' 'MAP': COORD already in map coordinates
+};
+
 struct GrdeclDeck
 {
   std::array<int64_t, 3> dims{ 0, 0, 0 }; ///< nx, ny, nz (0 until SPECGRID/DIMENS)
@@ -77,6 +87,10 @@ struct GrdeclDeck
   std::vector<std::string> warnings; ///< problems that did not stop the parse
 
   int64_t CellCount() const { return this->dims[0] * this->dims[1] * this->dims[2]; }
+  MapPlacement Placement() const
+  {
+    return { this->hasMapAxes, this->mapAxes, this->mapUnits, this->gridUnit, this->gridUnitIsMap };
+  }
   const CellArray* FindArray(const std::string& name) const;
   CellArray* FindArray(const std::string& name);
   bool HasCornerPointGeometry() const

@@ -1490,6 +1490,7 @@ HierarchyReport Builder::Run()
         modelParts.push_back({ 0, m });
       }
       report.regions = static_cast<int64_t>(regions.size());
+      header.map = this->Source.Placement(); // recorded only: positions stay in grid coordinates
       this->Report("writing", 0.99);
       AssembleMultiresolutionFile(this->Output, header, paths, regions, modelParts);
       struct stat info;

@@ -25,6 +25,8 @@
 //   a manifest a level); a build killed after its leaf level resumes from the last finished
 //   level when run again with the same input and options. The scratch folder is removed
 //   when the file is in place; after a failure it stays for resuming.
+// - The input's MAPAXES, MAPUNITS and GRIDUNIT go to the file's header; meshes, errors and
+//   bounds stay in grid coordinates (viewers place them on the map).
 // - Deterministic: the same input and Cmax give the same region meshes whatever the thread
 //   count (chunks may lie in another order in the file).
 #pragma once

@@ -54,10 +54,11 @@ bool SyntheticLayerSource::Next(std::vector<float>& zcorn, std::vector<uint8_t>&
 }
 
 CornerPointLayerSource::CornerPointLayerSource(
-  const CornerPointGeometry& geometry, const std::vector<bool>& active, std::string name)
+  const CornerPointGeometry& geometry, const std::vector<bool>& active, std::string name, MapPlacement placement)
   : Geometry(geometry)
   , Active(active)
   , Label(std::move(name))
+  , Map(std::move(placement))
 {
 }
 
@@ -172,6 +173,7 @@ public:
   std::array<int64_t, 3> Dims() const override { return this->Layout.deck.dims; }
   const std::vector<double>& Coord() const override { return this->CoordValues; }
   std::string Name() const override { return this->File.Path(); }
+  MapPlacement Placement() const override { return this->Layout.deck.Placement(); }
 
   bool Next(std::vector<float>& zcorn, std::vector<uint8_t>& active) override
   {
@@ -279,6 +281,7 @@ public:
   std::array<int64_t, 3> Dims() const override { return this->Deck.dims; }
   const std::vector<double>& Coord() const override { return this->CoordValues; }
   std::string Name() const override { return this->Label; }
+  MapPlacement Placement() const override { return this->Deck.Placement(); }
 
   bool Next(std::vector<float>& zcorn, std::vector<uint8_t>& active) override
   {

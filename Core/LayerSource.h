@@ -3,11 +3,13 @@
 //
 // Contract:
 // - Coord(): COORD as the grid defines it, 6 values a pillar (top x y depth, bottom x y depth),
-//   MAPAXES not applied (grid coordinates).
+//   MAPAXES not applied (grid coordinates); Placement() gives MAPAXES, MAPUNITS and GRIDUNIT.
 // - Next() gives layers k = 0, 1, ... nk - 1 in order: ZCORN of the layer (8 nx ny values: the
 //   2nx x 2ny top-face block then the bottom-face block, ECLIPSE order) and one active flag a
 //   cell (i fastest); false after the last layer.
 #pragma once
+
+#include "GrdeclDeck.h"
 
 #include <array>
 #include <cstdint>
@@ -19,7 +21,6 @@ namespace resmr
 {
 
 class CornerPointGeometry;
-struct GrdeclDeck;
 class SyntheticReservoir;
 class SyntheticLayerStream;
 struct SyntheticParameters;
@@ -33,6 +34,8 @@ public:
   virtual bool Next(std::vector<float>& zcorn, std::vector<uint8_t>& active) = 0;
   /// What the model is, for messages ("synth:100x100x10:1", a file name).
   virtual std::string Name() const = 0;
+  /// The input's MAPAXES, MAPUNITS and GRIDUNIT (none for generated models).
+  virtual MapPlacement Placement() const { return {}; }
 };
 
 /// Layers generated on the fly (SyntheticReservoir), never all in memory.
@@ -57,17 +60,21 @@ private:
 class CornerPointLayerSource : public LayerSource
 {
 public:
-  /// `geometry` and `active` (one flag a cell, ECLIPSE order) must outlive the source.
-  CornerPointLayerSource(const CornerPointGeometry& geometry, const std::vector<bool>& active, std::string name);
+  /// `geometry` and `active` (one flag a cell, ECLIPSE order) must outlive the source;
+  /// `placement`: the deck's (GrdeclDeck::Placement()).
+  CornerPointLayerSource(const CornerPointGeometry& geometry, const std::vector<bool>& active, std::string name,
+    MapPlacement placement = {});
   std::array<int64_t, 3> Dims() const override;
   const std::vector<double>& Coord() const override;
   bool Next(std::vector<float>& zcorn, std::vector<uint8_t>& active) override;
   std::string Name() const override { return this->Label; }
+  MapPlacement Placement() const override { return this->Map; }
 
 private:
   const CornerPointGeometry& Geometry;
   const std::vector<bool>& Active;
   std::string Label;
+  MapPlacement Map;
   int64_t K = 0;
 };
 
@@ -83,7 +90,7 @@ void ReadCornerPointModel(const std::string& path, GrdeclDeck& deck, std::vector
 /// - a GRDECL/DATA deck: parsed once with ParseGrdeclGrid, ZCORN and ACTNUM (DX, DY, DZ, TOPS
 ///   for Cartesian decks) spooled to unlinked temporary files in `spoolFolder` (created if
 ///   missing; the system temporary folder when empty), freed with the source.
-/// Memory: COORD and O(nx ny) a layer. Layers, Coord() and Dims() are exactly those of a
+/// Memory: COORD and O(nx ny) a layer. Layers, Coord(), Dims() and Placement() are exactly those of a
 /// CornerPointLayerSource over ReadCornerPointModel and CornerPointGeometry::FromDeck(deck,
 /// false). Throws GrdeclError naming the file and place, std::invalid_argument for a
 /// malformed synth: spec.

@@ -2,6 +2,7 @@
 #include "MultiresolutionFile.h"
 
 #include "AtomicOutputFile.h"
+#include "CornerPointGeometry.h"
 
 #include <lzo/lzo1x.h>
 
@@ -26,6 +27,9 @@ constexpr char TrailerMagic[8] = { 'R', 'E', 'S', 'M', 'R', 'I', 'D', 'X' };
 constexpr std::size_t HeaderBytes = 256;
 constexpr std::size_t RecordBytes = 192;
 constexpr std::size_t ModelRecordBytes = 32;
+constexpr uint32_t MapAxesFlag = 1;   // header: MAPAXES given
+constexpr uint32_t GridInMapFlag = 2; // header: GRIDUNIT says COORD is in map coordinates
+constexpr std::size_t UnitBytes = 8;  // header: MAPUNITS, GRIDUNIT
 constexpr uint32_t MeshMagic = 0x4853454d;    // "MESH"
 constexpr uint32_t SurfaceMagic = 0x46525553; // "SURF"
 constexpr uint32_t TrianglesMagic = 0x53495254; // "TRIS"
@@ -319,6 +323,20 @@ void PutHeader(ByteWriter& out, const MultiresolutionHeader& h)
   out.Put(h.hashOffsetSides);
   out.Put(h.hashedCells);
   out.Put(h.geometryId);
+  out.Put(static_cast<uint32_t>((h.map.hasMapAxes ? MapAxesFlag : 0) | (h.map.gridUnitIsMap ? GridInMapFlag : 0)));
+  out.Put(h.map.mapAxes.yAxisPoint);
+  out.Put(h.map.mapAxes.origin);
+  out.Put(h.map.mapAxes.xAxisPoint);
+  for (const std::string* unit : { &h.map.mapUnits, &h.map.gridUnit })
+  {
+    char text[UnitBytes] = {}; // printable ASCII, NUL-padded (other characters become '?')
+    for (std::size_t c = 0; c < std::min(unit->size(), UnitBytes); ++c)
+    {
+      const char u = (*unit)[c];
+      text[c] = u >= 0x20 && u <= 0x7e ? u : '?';
+    }
+    out.PutBytes(text, UnitBytes);
+  }
   out.Bytes.resize(HeaderBytes - 4, 0);
   out.Put(Crc32(out.Bytes.data(), out.Bytes.size()));
 }
@@ -782,16 +800,18 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
     uint8_t magic[8];
     head.GetBytes(magic, 8);
     const uint32_t version = head.Get<uint32_t>();
-    if (version != MultiresolutionHeader::Version)
+    if (version < MultiresolutionHeader::OldestVersion || version > MultiresolutionHeader::Version)
     {
-      throw MultiresolutionFileError(path + ": format version " + std::to_string(version) + "; this build reads version " +
-        std::to_string(MultiresolutionHeader::Version));
+      throw MultiresolutionFileError(path + ": format version " + std::to_string(version) + " at byte 8; this build reads versions " +
+        std::to_string(MultiresolutionHeader::OldestVersion) + " to " + std::to_string(MultiresolutionHeader::Version) +
+        (version < MultiresolutionHeader::OldestVersion ? " (build the file again with resmr build)" : " (a newer build wrote it)"));
     }
+    this->Head.version = version;
     uint32_t storedCrc;
     std::memcpy(&storedCrc, this->Data + HeaderBytes - 4, 4);
     if (Crc32(this->Data, HeaderBytes - 4) != storedCrc)
     {
-      throw MultiresolutionFileError(path + ": header checksum mismatch (bytes 0-159 are corrupt)");
+      throw MultiresolutionFileError(path + ": header checksum mismatch (bytes 0-" + std::to_string(HeaderBytes - 5) + " are corrupt)");
     }
     head.Get<uint32_t>();
     head.Get(this->Head.dims);
@@ -806,6 +826,10 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
     head.Get(this->Head.hashOffsetSides);
     this->Head.hashedCells = head.Get<uint64_t>();
     this->Head.geometryId = head.Get<uint64_t>();
+    if (version >= 4)
+    {
+      this->ReadMapPlacement(head);
+    }
     const auto& d = this->Head.dims;
     const auto& m = this->Head.hashTableSides;
     const auto& r = this->Head.hashOffsetSides;
@@ -878,6 +902,49 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
   {
     UnmapFile(this->Data, this->Size);
     throw;
+  }
+}
+
+void MultiresolutionFile::ReadMapPlacement(ByteReader& head)
+{
+  MapPlacement& map = this->Head.map;
+  const std::size_t at = HeaderBytes - 4 - 4 - 6 * 8 - 2 * UnitBytes;
+  const uint32_t flags = head.Get<uint32_t>();
+  head.Get(map.mapAxes.yAxisPoint);
+  head.Get(map.mapAxes.origin);
+  head.Get(map.mapAxes.xAxisPoint);
+  char text[2][UnitBytes];
+  head.GetBytes(text[0], UnitBytes);
+  head.GetBytes(text[1], UnitBytes);
+  const auto fail = [&](const std::string& what) {
+    throw MultiresolutionFileError(this->FilePath + ": header bytes " + std::to_string(at) + "-" +
+      std::to_string(HeaderBytes - 5) + " (map placement): " + what + " (corrupt)");
+  };
+  if (flags > (MapAxesFlag | GridInMapFlag))
+  {
+    fail("unknown flags " + std::to_string(flags));
+  }
+  map.hasMapAxes = (flags & MapAxesFlag) != 0;
+  map.gridUnitIsMap = (flags & GridInMapFlag) != 0;
+  std::array<double, 6> transform;
+  if (map.hasMapAxes && !map.gridUnitIsMap && !CornerPointGeometry::MapTransformOf(map.mapAxes, transform))
+  {
+    fail("MAPAXES axis points coincide with the origin or are not finite");
+  }
+  std::string* units[2] = { &map.mapUnits, &map.gridUnit };
+  for (int u = 0; u < 2; ++u)
+  {
+    const std::size_t length = std::find(text[u], text[u] + UnitBytes, '\0') - text[u];
+    units[u]->assign(text[u], length);
+    if (std::any_of(units[u]->begin(), units[u]->end(), [](char c) { return c < 0x20 || c > 0x7e; }) ||
+      std::any_of(text[u] + length, text[u] + UnitBytes, [](char c) { return c != '\0'; }))
+    {
+      fail(std::string(u == 0 ? "MAPUNITS" : "GRIDUNIT") + " is not text");
+    }
+    while (!units[u]->empty() && units[u]->back() == ' ')
+    {
+      units[u]->pop_back();
+    }
   }
 }
 

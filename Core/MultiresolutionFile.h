@@ -2,10 +2,11 @@
 // LZO-compressed one chunk each and concatenated, with an index of offsets, sizes, bounding
 // volumes, errors and normal cones, laid out for memory mapping.
 //
-// Layout (little-endian), version 2:
+// Layout (little-endian), version 4:
 //   header (256 bytes, CRC-32 at its end): magic, version, grid dimensions, hierarchy box,
 //     position lattice, leaf level, Cmax, region and model-chunk counts, perfect-hash sizes,
-//     geometry id
+//     geometry id, then the input's map placement (flags, MAPAXES' 6 values, MAPUNITS and
+//     GRIDUNIT in 8 characters each; version 3 has none and reads as no MAPAXES)
 //   chunks, in any order: LZO1X-1 compressed, CRC-32 of the stored bytes in the index
 //   index: one 192-byte record a region, then one 32-byte record a model chunk
 //   trailer (32 bytes): index offset and size, CRC-32 of the index, magic "RESMRIDX"
@@ -24,10 +25,12 @@
 // stored as floats: integers are exact and rounding never carries a value across one, so no
 // coordinate moves into another cell.
 //
-// Positions keep depth down (Core's convention); the viewer shows z = -depth.
+// Positions keep depth down (Core's convention); the viewer shows z = -depth. They stay in
+// grid coordinates: MAPAXES is only recorded, for viewers to apply as the grid readers do.
 #pragma once
 
 #include "ByteStream.h"
+#include "GrdeclDeck.h"
 #include "PerfectSpatialHash.h"
 #include "RegionMesh.h"
 
@@ -44,7 +47,9 @@ namespace resmr
 
 struct MultiresolutionHeader
 {
-  static constexpr uint32_t Version = 3;
+  static constexpr uint32_t Version = 4;
+  static constexpr uint32_t OldestVersion = 3; ///< older files are refused
+  uint32_t version = Version;                  ///< the file's, when read
   std::array<int64_t, 3> dims{};
   std::array<double, 4> box{};          ///< hierarchy box: xmin, ymin, xmax, ymax
   std::array<double, 3> latticeOrigin{}; ///< x, y, depth
@@ -60,6 +65,9 @@ struct MultiresolutionHeader
   uint64_t hashedCells = 0;    ///< cells the extracted faces touch (filled slots)
   /// Identifies the geometry (a digest of every chunk's checksum): property files name it.
   uint64_t geometryId = 0;
+  /// The input's MAPAXES, MAPUNITS and GRIDUNIT (units: 8 characters at most); apply with
+  /// CornerPointGeometry::PlacementTransform.
+  MapPlacement map;
 };
 
 /// Where one compressed chunk lies.
@@ -215,6 +223,7 @@ public:
   const RegionRecord* Find(int32_t level, int64_t index) const;
 
 private:
+  void ReadMapPlacement(ByteReader& head);
   std::vector<uint8_t> ReadChunk(const RegionRecord& record, int chunk) const;
   std::vector<uint8_t> ReadChunk(const ChunkRef& ref, const std::string& place) const;
   std::string FilePath;

@@ -1,5 +1,6 @@
 #include "vtkMultiresolutionReader.h"
 
+#include "CornerPointGeometry.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
 
@@ -14,6 +15,7 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -145,11 +147,21 @@ int vtkMultiresolutionReader::RequestData(
     {
       return this->Fail(this->FileName + ": no root region in the file");
     }
+    // The box's corners in map coordinates (MAPAXES), as the grid readers place the grid.
+    std::array<double, 6> transform;
+    const bool mapAxes =
+      this->ApplyMapAxes && resmr::CornerPointGeometry::PlacementTransform(geometry.Header().map, transform);
     vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
     for (int corner = 0; corner < 8; ++corner)
     {
       const double depth = (corner & 4) ? high[2] : low[2];
-      points->InsertNextPoint((corner & 1) ? high[0] : low[0], (corner & 2) ? high[1] : low[1], -depth);
+      double x = (corner & 1) ? high[0] : low[0], y = (corner & 2) ? high[1] : low[1];
+      if (mapAxes)
+      {
+        resmr::CornerPointGeometry::ApplyMapTransform(transform, x, y);
+      }
+      points->InsertNextPoint(x, y, -depth);
     }
     vtkNew<vtkCellArray> edges;
     for (int a = 0; a < 8; ++a)
@@ -234,4 +246,5 @@ void vtkMultiresolutionReader::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "FileName: " << this->FileName << "\n";
   os << indent << "PropertyFileName: " << this->PropertyFileName << "\n";
+  os << indent << "ApplyMapAxes: " << this->ApplyMapAxes << "\n";
 }

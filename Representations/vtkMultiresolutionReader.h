@@ -9,7 +9,8 @@
  * holding that property's minimum and maximum at the requested time step, so Color By lists
  * the properties and Rescale finds their ranges. The property file's report steps (in days)
  * are the time steps. A damaged file, or a property file of another geometry, is an error
- * naming the file.
+ * naming the file. With ApplyMapAxes (the default) the box is placed by the file's MAPAXES,
+ * as the grid readers place the grid; the representation draws the surface there too.
  */
 #ifndef vtkMultiresolutionReader_h
 #define vtkMultiresolutionReader_h
@@ -34,6 +35,12 @@ public:
   /// The property file; empty (the default): FILE.resmrp beside the .resmr, if it exists.
   vtkSetStdStringFromCharMacro(PropertyFileName);
   vtkGetCharFromStdStringMacro(PropertyFileName);
+
+  /// Place the model in map coordinates given by the input's MAPAXES (x, y rotated, scaled
+  /// and shifted as the grid readers do; z unchanged). On by default.
+  vtkSetMacro(ApplyMapAxes, bool);
+  vtkGetMacro(ApplyMapAxes, bool);
+  vtkBooleanMacro(ApplyMapAxes, bool);
 
   /// The property file actually used after the last update (empty if none).
   const std::string& GetResolvedPropertyFileName() const { return this->ResolvedPropertyFile; }
@@ -61,6 +68,7 @@ private:
 
   std::string FileName;
   std::string PropertyFileName;
+  bool ApplyMapAxes = true;
   std::string ResolvedPropertyFile;
   std::string LastError;
   std::string InformationFailed; ///< why RequestInformation failed (the file did not open)

@@ -1,5 +1,6 @@
 #include "vtkMultiresolutionSurfaceMapper.h"
 
+#include "CornerPointGeometry.h"
 #include "FrameRateController.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
@@ -272,8 +273,8 @@ void vtkMultiresolutionSurfaceMapper::ReleaseGraphicsResources(vtkWindow* window
 
 namespace
 {
-/// (.resmr path, .resmrp path, step) from the descriptor; false if it has none.
-bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties, int32_t& step)
+/// (.resmr path, .resmrp path, step, map axes) from the descriptor; false if it has none.
+bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties, int32_t& step, bool& mapAxes)
 {
   vtkFieldData* fields = input ? input->GetFieldData() : nullptr;
   vtkStringArray* source =
@@ -286,6 +287,7 @@ bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties
   file = source->GetValue(0);
   properties = source->GetValue(1);
   step = static_cast<int32_t>(std::stol(source->GetValue(2)));
+  mapAxes = source->GetNumberOfValues() > 3 && source->GetValue(3) == "1";
   return true;
 }
 
@@ -332,7 +334,8 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   vtkDataObject* input = this->GetInputDataObject(0, 0);
   std::string filePath, propertyPath;
   int32_t step = 0;
-  if (!ReadSource(input, filePath, propertyPath, step))
+  bool applyMapAxes = false;
+  if (!ReadSource(input, filePath, propertyPath, step, applyMapAxes))
   {
     return; // an empty piece (another rank) or no file yet
   }
@@ -411,7 +414,14 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     cache.RequestProperty(this->ArrayName, tableStep, layer);
   }
 
-  // The view, in model coordinates (the actor's matrix folded into the projection).
+  // The view, in model coordinates (the actor's matrix and MAPAXES folded into the projection,
+  // in double: map coordinates are large).
+  Matrix mapAxes{ 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
+  std::array<double, 6> map;
+  if (applyMapAxes && resmr::CornerPointGeometry::PlacementTransform(header.map, map))
+  {
+    mapAxes = { map[2], map[4], 0, map[0], map[3], map[5], 0, map[1], 0, 0, 1, 0, 0, 0, 0, 1 };
+  }
   vtkOpenGLRenderWindow* window = vtkOpenGLRenderWindow::SafeDownCast(renderer->GetRenderWindow());
   if (in.Window != window)
   {
@@ -425,7 +435,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   camera->GetKeyMatrices(renderer, worldToView, normalMatrix, viewToClip, worldToClip);
   vtkNew<vtkMatrix4x4> actorMatrix;
   actor->GetMatrix(actorMatrix);
-  const Matrix modelToWorld = FromRowMajor(actorMatrix);
+  const Matrix modelToWorld = Multiply(FromRowMajor(actorMatrix), mapAxes);
   const Matrix modelToClip = Multiply(FromTransposed(worldToClip), modelToWorld);
   const Matrix modelToView = Multiply(FromTransposed(worldToView), modelToWorld);
   int width = 0, height = 0, x0 = 0, y0 = 0;
@@ -434,15 +444,17 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   view.worldToClip = modelToClip;
   {
     vtkNew<vtkMatrix4x4> inverse;
-    inverse->DeepCopy(actorMatrix);
+    inverse->DeepCopy(modelToWorld.data());
     inverse->Invert();
     double eye[4] = { 0, 0, 0, 1 }, position[4];
     camera->GetPosition(eye);
     inverse->MultiplyPoint(eye, position);
     view.eye = { position[0], position[1], position[2] };
-    double direction[3];
+    double direction[4] = { 0, 0, 0, 0 }, modelDirection[4];
     camera->GetDirectionOfProjection(direction);
-    view.direction = { direction[0], direction[1], direction[2] };
+    inverse->MultiplyPoint(direction, modelDirection);
+    vtkMath::Normalize(modelDirection);
+    view.direction = { modelDirection[0], modelDirection[1], modelDirection[2] };
   }
   view.parallel = camera->GetParallelProjection() != 0;
   view.pixelsPerUnit = view.parallel

@@ -33,7 +33,8 @@ public:
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   /// The input's field array naming the files and step: .resmr path, .resmrp path (or
-  /// empty), step number (decimal).
+  /// empty), step number (decimal), then "1" to place the model by the file's MAPAXES (as
+  /// the descriptor is) or "0" (absent: "0").
   static const char* SourceArrayName() { return "ResMR Source"; }
 
   enum ColorModes

@@ -10,6 +10,7 @@
 #include "MultiresolutionFile.h"
 #include "SyntheticReservoir.h"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -217,7 +218,7 @@ int MultiresolutionInfo(const char* path, bool listRegions)
   const double cells = double(h.dims[0]) * double(h.dims[1]) * double(h.dims[2]);
   std::printf("{\"file\": \"%s\", \"kind\": \"resmr\", \"version\": %u, \"bytes\": %llu, \"dims\": [%lld, %lld, %lld], "
               "\"cells\": %.0f, \"bytes_per_cell\": %.3f, \"leaf_level\": %d, \"cmax\": %d, \"regions\": %llu, \"levels\": [",
-    path, resmr::MultiresolutionHeader::Version, static_cast<unsigned long long>(file.FileSize()),
+    path, h.version, static_cast<unsigned long long>(file.FileSize()),
     static_cast<long long>(h.dims[0]), static_cast<long long>(h.dims[1]), static_cast<long long>(h.dims[2]), cells,
     double(file.FileSize()) / cells, h.leafLevel, h.cmax, static_cast<unsigned long long>(h.regionCount));
   bool first = true;
@@ -251,6 +252,24 @@ int MultiresolutionInfo(const char* path, bool listRegions)
     static_cast<unsigned long long>(h.hashedCells), m[0], m[1], m[2], r[0], r[1], r[2], slots, offsets,
     slots > 0 ? double(h.hashedCells) / slots : 0.0, h.hashedCells ? slots / double(h.hashedCells) : 0.0,
     h.hashedCells ? (slots * 4 + offsets * 6) / (double(h.hashedCells) * 4) : 0.0, (slots * 4 + offsets * 6) / (cells * 4));
+  // MAPAXES as the input gave it; viewers apply it when "applies" (as the grid readers do).
+  const resmr::MapPlacement& map = h.map;
+  std::array<double, 6> transform;
+  if (map.hasMapAxes || !map.mapUnits.empty() || !map.gridUnit.empty())
+  {
+    const auto& a = map.mapAxes;
+    std::printf(",\n \"map_axes\": {\"given\": %s, \"applies\": %s, \"y_axis_point\": [%.17g, %.17g], "
+                "\"origin\": [%.17g, %.17g], \"x_axis_point\": [%.17g, %.17g], \"map_units\": %s, \"grid_unit\": %s, "
+                "\"grid_in_map_units\": %s}",
+      map.hasMapAxes ? "true" : "false",
+      resmr::CornerPointGeometry::PlacementTransform(map, transform) ? "true" : "false", a.yAxisPoint[0],
+      a.yAxisPoint[1], a.origin[0], a.origin[1], a.xAxisPoint[0], a.xAxisPoint[1], JsonString(map.mapUnits).c_str(),
+      JsonString(map.gridUnit).c_str(), map.gridUnitIsMap ? "true" : "false");
+  }
+  else
+  {
+    std::printf(",\n \"map_axes\": null");
+  }
   if (listRegions)
   {
     std::printf(",\n \"region_list\": [");

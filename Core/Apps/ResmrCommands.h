@@ -3,9 +3,35 @@
 
 #include "GrdeclDeck.h"
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+/// `text` as a JSON string literal, quotes included.
+inline std::string JsonString(const std::string& text)
+{
+  std::string out = "\"";
+  for (char c : text)
+  {
+    if (c == '"' || c == '\\')
+    {
+      out += '\\';
+      out += c;
+    }
+    else if (static_cast<unsigned char>(c) < 32)
+    {
+      char escaped[8];
+      std::snprintf(escaped, sizeof(escaped), "\\u%04x", c);
+      out += escaped;
+    }
+    else
+    {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
 
 /// The value after option argv[a] (advancing a); throws std::invalid_argument if missing.
 inline const char* OptionValue(int& a, int argc, char** argv)

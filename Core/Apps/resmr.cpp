@@ -34,30 +34,6 @@
 
 namespace
 {
-std::string JsonString(const std::string& text)
-{
-  std::string out = "\"";
-  for (char c : text)
-  {
-    if (c == '"' || c == '\\')
-    {
-      out += '\\';
-      out += c;
-    }
-    else if (static_cast<unsigned char>(c) < 32)
-    {
-      char escaped[8];
-      std::snprintf(escaped, sizeof(escaped), "\\u%04x", c);
-      out += escaped;
-    }
-    else
-    {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
 std::string JsonNames(const std::vector<resmr::EclipseResultArray>& arrays)
 {
   std::string out = "[";

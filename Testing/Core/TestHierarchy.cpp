@@ -1,7 +1,8 @@
 // Tests of the multiresolution hierarchy and its file (paper Sec. 4.2, 4.3, 6.1, 6.2): the
 // diamond tree, exact coverage of the original external faces at the finest level, crack-free
-// conformal cuts, monotone errors and bounding volumes, thread-count independence, and
-// rejection of corrupt and truncated files.
+// conformal cuts, monotone errors and bounding volumes, thread-count independence,
+// rejection of corrupt and truncated files, and MAPAXES carried in the header (older versions
+// read as none, unknown ones refused).
 #include "CoreTesting.h"
 
 #include "ColumnMesh.h"
@@ -16,9 +17,11 @@
 #include "SyntheticReservoir.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -614,6 +617,152 @@ void TestHierarchyFile()
   std::remove(path.c_str());
 }
 
+/// A small Cartesian deck with `placement` (MAPUNITS, MAPAXES, GRIDUNIT records) written at `path`.
+void WriteMapDeck(const std::string& path, const std::string& placement)
+{
+  std::ofstream out(path);
+  out << "RUNSPEC\nDIMENS\n 12 10 3 /\nGRID\n" << placement
+      << "DX\n 360*50 /\nDY\n 360*40 /\nDZ\n 360*5 /\nTOPS\n 120*1500 /\nACTNUM\n 300*1 60*0 /\n";
+}
+
+/// Bytes of `bytes` with the header's CRC made right again.
+std::string WithHeaderCrc(std::string bytes)
+{
+  const uint32_t crc = Crc32(bytes.data(), 252);
+  std::memcpy(&bytes[252], &crc, 4);
+  return bytes;
+}
+
+void TestMapAxesInFile()
+{
+  // MAPAXES (a 30 degree turn), MAPUNITS and GRIDUNIT of a deck go to the header, exactly.
+  const std::string deckPath = TempPath("map.GRDECL");
+  WriteMapDeck(deckPath,
+    "MAPUNITS\n 'METRES' /\nMAPAXES\n 455000.25 6781866.525404 455500.25 6781000.5 456366.275404 6781500.5 /\n"
+    "GRIDUNIT\n 'METRES' ' ' /\n");
+  const std::string path = TempPath("map.resmr");
+  HierarchyOptions options;
+  options.cmax = 64;
+  options.threads = 1;
+  {
+    auto source = OpenLayerSource(deckPath, TempPath("map-spool"));
+    BuildHierarchy(*source, path, options);
+  }
+  GrdeclDeck deck;
+  std::vector<bool> active;
+  ReadCornerPointModel(deckPath, deck, active);
+  const MultiresolutionFile file(path);
+  const MapPlacement& map = file.Header().map;
+  CHECK(file.Header().version == MultiresolutionHeader::Version);
+  CHECK(map.hasMapAxes && !map.gridUnitIsMap && map.mapUnits == "METRES" && map.gridUnit == "METRES");
+  CHECK(map.mapAxes.yAxisPoint == deck.mapAxes.yAxisPoint && map.mapAxes.origin == deck.mapAxes.origin &&
+    map.mapAxes.xAxisPoint == deck.mapAxes.xAxisPoint);
+
+  // The header's transform places every corner where the grid readers put it (FromDeck with
+  // MAPAXES applied), bit for bit.
+  std::array<double, 6> transform;
+  CHECK(CornerPointGeometry::PlacementTransform(map, transform));
+  CHECK(std::abs(transform[2] - std::sqrt(0.75)) < 1e-6 && std::abs(transform[3] - 0.5) < 1e-6);
+  GrdeclDeck mapDeck = deck;
+  const CornerPointGeometry grid = CornerPointGeometry::FromDeck(deck, false);
+  const CornerPointGeometry placed = CornerPointGeometry::FromDeck(mapDeck, true);
+  int64_t same = 0, corners = 0;
+  for (int64_t c = 0; c < grid.CellCount(); ++c)
+  {
+    const int64_t i = c % 12, j = c / 12 % 10, k = c / 120;
+    double a[8][3], b[8][3];
+    grid.CellCorners(i, j, k, a);
+    placed.CellCorners(i, j, k, b);
+    for (int v = 0; v < 8; ++v, ++corners)
+    {
+      CornerPointGeometry::ApplyMapTransform(transform, a[v][0], a[v][1]);
+      same += a[v][0] == b[v][0] && a[v][1] == b[v][1] && a[v][2] == b[v][2] ? 1 : 0;
+    }
+  }
+  CHECK(same == corners);
+  std::printf("map axes: %lld of %lld corners placed by the header's MAPAXES as FromDeck places them\n",
+    static_cast<long long>(same), static_cast<long long>(corners));
+
+  // Geometry stays in grid coordinates: the hierarchy box is the grid's.
+  CHECK(file.Header().box[0] >= -1 && file.Header().box[2] <= 12 * 50 + 1 && file.Header().box[3] <= 10 * 40 + 1);
+
+  // GRIDUNIT ... 'MAP': COORD is already in map coordinates, nothing to apply.
+  const std::string inMapPath = TempPath("inmap.GRDECL");
+  WriteMapDeck(inMapPath, "MAPAXES\n 0 1 0 0 1 0 /\nGRIDUNIT\n 'METRES' 'MAP' /\n");
+  const std::string inMap = TempPath("inmap.resmr");
+  {
+    auto source = OpenLayerSource(inMapPath, TempPath("map-spool"));
+    BuildHierarchy(*source, inMap, options);
+  }
+  {
+    const MultiresolutionFile f(inMap);
+    CHECK(f.Header().map.hasMapAxes && f.Header().map.gridUnitIsMap);
+    CHECK(!CornerPointGeometry::PlacementTransform(f.Header().map, transform));
+  }
+
+  // Version 3 (no map placement) still reads, as grid coordinates.
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string damaged = TempPath("map-damaged.resmr");
+  const auto writeBytes = [&](const std::string& content) {
+    std::ofstream out(damaged, std::ios::binary | std::ios::trunc);
+    out.write(content.data(), static_cast<std::streamsize>(content.size()));
+  };
+  const auto withVersion = [&](uint32_t version) {
+    std::string b = bytes;
+    std::memcpy(&b[8], &version, 4);
+    std::fill(b.begin() + 184, b.begin() + 252, '\0');
+    return WithHeaderCrc(b);
+  };
+  writeBytes(withVersion(3));
+  {
+    const MultiresolutionFile old(damaged);
+    CHECK(old.Header().version == 3 && !old.Header().map.hasMapAxes && old.Header().map.mapUnits.empty());
+    CHECK(!CornerPointGeometry::PlacementTransform(old.Header().map, transform));
+    CHECK(old.Regions().size() == file.Regions().size() && old.Header().geometryId == file.Header().geometryId);
+  }
+  // Versions this build does not know are refused by number.
+  writeBytes(withVersion(2));
+  resmr_testing::ExpectError<MultiresolutionFileError>("version 2", [&] { MultiresolutionFile f(damaged); },
+    { damaged, "format version 2", "versions 3 to 4", "resmr build" });
+  writeBytes(withVersion(5));
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "version 5", [&] { MultiresolutionFile f(damaged); }, { damaged, "format version 5", "newer" });
+  // A placement that cannot be right, under a good checksum, is named; a flipped byte there
+  // fails the checksum.
+  std::string broken = bytes;
+  broken[184] = 7;
+  writeBytes(WithHeaderCrc(broken));
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "flags", [&] { MultiresolutionFile f(damaged); }, { damaged, "map placement", "unknown flags" });
+  broken = bytes;
+  std::memcpy(&broken[188 + 32], &broken[188 + 16], 16); // x axis point onto the origin
+  writeBytes(WithHeaderCrc(broken));
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "axes", [&] { MultiresolutionFile f(damaged); }, { damaged, "MAPAXES", "coincide" });
+  broken = bytes;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::memcpy(&broken[188], &nan, 8);
+  writeBytes(WithHeaderCrc(broken));
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "nan", [&] { MultiresolutionFile f(damaged); }, { damaged, "MAPAXES", "not finite" });
+  broken = bytes;
+  broken[240] = '\x01';
+  writeBytes(WithHeaderCrc(broken));
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "units", [&] { MultiresolutionFile f(damaged); }, { damaged, "MAPUNITS", "not text" });
+  broken = bytes;
+  broken[200] ^= 0x04;
+  writeBytes(broken);
+  resmr_testing::ExpectError<MultiresolutionFileError>(
+    "flipped placement", [&] { MultiresolutionFile f(damaged); }, { damaged, "header checksum" });
+  for (const std::string& p : { deckPath, path, inMapPath, inMap, damaged })
+  {
+    std::remove(p.c_str());
+  }
+  rmdir(TempPath("map-spool").c_str());
+}
+
 void TestFailedBuildLeavesNothing()
 {
   // An existing file of the output's name survives a failed build untouched.
@@ -640,6 +789,7 @@ int main()
 {
   TestDiamondTree();
   TestHierarchyFile();
+  TestMapAxesInFile();
   TestFailedBuildLeavesNothing();
   if (resmr_testing::Failures)
   {

@@ -1,7 +1,7 @@
 // Streaming grid input of the hierarchy builder (paper Sec. 4.2: the model is read layer by
 // layer, never held whole): OpenLayerSource on every real EGRID/FEGRID and deck of the shared
-// data gives exactly the layers of the in-memory path (ReadCornerPointModel, FromDeck,
-// CornerPointLayerSource); decks with ACTNUM/DZ edits match too; corrupt files and the
+// data gives exactly the layers and map placement (MAPAXES, units) of the in-memory path
+// (ReadCornerPointModel, FromDeck, CornerPointLayerSource); decks with ACTNUM/DZ edits match too; corrupt files and the
 // refused COPY into a spooled array fail with GrdeclError naming file and keyword; spool files
 // never show in the folder.
 #include "CoreTesting.h"
@@ -43,6 +43,8 @@ int EntriesIn(const std::string& folder)
   return count;
 }
 
+int MapAxesModels = 0; ///< models whose streamed source gives MAPAXES
+
 bool SameBits(const void* a, const void* b, std::size_t bytes)
 {
   return bytes == 0 || std::memcmp(a, b, bytes) == 0;
@@ -61,7 +63,7 @@ bool CompareWithInMemory(const std::string& path)
   {
     resmr::ReadCornerPointModel(path, deck, flags);
     geometry.reset(new resmr::CornerPointGeometry(resmr::CornerPointGeometry::FromDeck(deck, false)));
-    memory.reset(new resmr::CornerPointLayerSource(*geometry, flags, path));
+    memory.reset(new resmr::CornerPointLayerSource(*geometry, flags, path, deck.Placement()));
   }
   catch (const resmr::GrdeclError& error)
   {
@@ -78,6 +80,11 @@ bool CompareWithInMemory(const std::string& path)
       CHECK(stream->Name() == path);
       CHECK(stream->Coord().size() == memory->Coord().size() &&
         SameBits(stream->Coord().data(), memory->Coord().data(), 8 * memory->Coord().size()));
+      const resmr::MapPlacement a = stream->Placement(), b = memory->Placement();
+      CHECK(a.hasMapAxes == b.hasMapAxes && a.gridUnitIsMap == b.gridUnitIsMap && a.mapUnits == b.mapUnits &&
+        a.gridUnit == b.gridUnit && a.mapAxes.origin == b.mapAxes.origin &&
+        a.mapAxes.xAxisPoint == b.mapAxes.xAxisPoint && a.mapAxes.yAxisPoint == b.mapAxes.yAxisPoint);
+      MapAxesModels += a.hasMapAxes ? 1 : 0;
     }
     std::vector<float> z1, z2;
     std::vector<uint8_t> a1, a2;
@@ -165,8 +172,10 @@ void TestRealModels(const std::string& data)
     }
     (CompareWithInMemory(data + "/" + file) ? compared : rejected)++;
   }
-  std::printf("  %d real models identical layer by layer, %d rejected by both paths\n", compared, rejected);
+  std::printf("  %d real models identical layer by layer (%d with MAPAXES), %d rejected by both paths\n", compared,
+    MapAxesModels, rejected);
   CHECK(compared >= 60);
+  CHECK(MapAxesModels >= 5);
 }
 
 std::string ReadAll(const std::string& path)

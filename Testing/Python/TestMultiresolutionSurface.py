@@ -14,7 +14,11 @@ mode (the cell each fragment's topological coordinate names, same encoding). Che
   is covered deeper than the tolerance inside its silhouette;
 - property colours (Reek PORO, ParaView's lookup table, unlit) at tolerance 0: >= 99% of the
   pixels both cover agree within 3 levels a channel;
-- the readout (tolerance, triangles, resident MB) is reported to pvpython.
+- the readout (tolerance, triangles, resident MB) is reported to pvpython;
+- the comparisons above use grid coordinates (ApplyMapAxes=0 on both sides); with default
+  settings (MAPAXES applied by both) Reek's descriptor bounds equal EGRIDReader's within 1e-6
+  of the extent and two views name the same cells on >= 99.5% of the pixels at 0 px; the
+  same two views of the demo deck with MAPAXES turned 30 degrees and mirrored (GRDECLReader).
 Images of failures are left in the temporary folder."""
 import os
 import subprocess
@@ -140,7 +144,7 @@ for name, grid_path in models():
         run("build", grid_path, "-o", resmr_path, "--quiet")
         if name == "reek":
             run("add-properties", resmr_path, grid_path)
-    # resmr build keeps the grid's own coordinates (MAPAXES not applied yet): compare there.
+    # Grid coordinates on both sides (ApplyMapAxes=0); map coordinates are checked on Reek below.
     stock_reader = simple.EGRIDReader(FileName=grid_path, ApplyMapAxes=0)
     stock_reader.UpdatePipeline()
     grid = servermanager.Fetch(stock_reader)
@@ -156,6 +160,7 @@ for name, grid_path in models():
     unlit(stock)
 
     reader = simple.OpenDataFile(resmr_path)
+    reader.ApplyMapAxes = 0
     ours = simple.Show(reader, view)
     if ours.GetXMLName() != "ResMRRepresentation" or ours.Representation != "Multiresolution Surface":
         rt.fail(f"{name}: .resmr shown as {ours.GetXMLName()} / {ours.Representation}")
@@ -243,6 +248,119 @@ for name, grid_path in models():
         simple.Hide(reader, view)
     for proxy in (ids, reader, stock_reader):
         simple.Delete(proxy)
+
+# Map coordinates: Reek's .resmr and its EGRID with default settings (both apply MAPAXES) lie
+# in the same place: the same box, and the same cells from the same cameras.
+grid_path = dict(models())["reek"]
+stock_reader = simple.EGRIDReader(FileName=grid_path)
+stock_reader.UpdatePipeline()
+grid = servermanager.Fetch(stock_reader)
+if int(stock_reader.ApplyMapAxes) != 1:
+    rt.fail("EGRIDReader does not apply map axes by default")
+dims = tuple(int(vtk_to_numpy(grid.GetCellData().GetArray(a)).max()) for a in ("I", "J", "K"))
+ids = stock_cell_ids(stock_reader, dims)
+stock = simple.Show(ids, view)
+stock.SetRepresentationType("Surface")
+simple.ColorBy(stock, ("CELLS", "CellIdColor"))
+stock.MapScalars = 0
+unlit(stock)
+reader = simple.OpenDataFile(os.path.join(temp, "reek.resmr"))
+reader.UpdatePipeline()
+expected_bounds = stock_reader.GetDataInformation().GetBounds()
+got_bounds = reader.GetDataInformation().GetBounds()
+grid_bounds = simple.EGRIDReader(FileName=grid_path, ApplyMapAxes=0)
+grid_bounds.UpdatePipeline()
+shift = grid_bounds.GetDataInformation().GetBounds()
+print(f"reek in map coordinates: descriptor bounds {got_bounds}, EGRIDReader's {expected_bounds}")
+if np.abs(expected_bounds[0] - shift[0]) < 1000:
+    failures.append(f"reek: EGRIDReader bounds {expected_bounds} are not shifted by MAPAXES from {shift}")
+extent = np.max([expected_bounds[1] - expected_bounds[0], expected_bounds[3] - expected_bounds[2]])
+worst = float(np.max(np.abs(np.subtract(got_bounds, expected_bounds)))) / extent
+print(f"reek map bounds: largest difference {worst:.2e} of the extent")
+if worst > 1e-6:
+    failures.append(f"reek map bounds {got_bounds} differ from EGRIDReader's {expected_bounds} ({worst:.2e} of the extent)")
+simple.Delete(grid_bounds)
+ours = simple.Show(reader, view)
+ours.PaintBy = "Cell Id"
+ours.GridLines = 0
+ours.WaitForDetailMs = 120000
+ours.PixelTolerance = 0
+unlit(ours)
+for camera_name, direction, zoom in (("above", [0.3, -0.5, 0.8], 1.0), ("side", [1.0, -0.3, 0.25], 1.3)):
+    expected, got = render_both(ids, reader, expected_bounds, direction, zoom, f"reek-map-{camera_name}", 0.0)
+    both = (expected > 0) & (got > 0)
+    agree = float(np.mean(expected[both] == got[both])) if both.any() else 0.0
+    holes = count_holes(expected, got, 0.0)
+    print(f"reek map coordinates {camera_name} at 0 px: {100 * agree:.2f}% of {int(both.sum())} pixels name the "
+          f"same cell; {holes} holes")
+    if agree < 0.995:
+        failures.append(f"reek map coordinates {camera_name}: {100 * agree:.2f}% < 99.5%")
+    if holes > 0:
+        failures.append(f"reek map coordinates {camera_name}: {holes} background pixels inside")
+    if not both.any() or both.sum() < 0.05 * WIDTH * HEIGHT:
+        failures.append(f"reek map coordinates {camera_name}: model covers too few pixels ({int(both.sum())})")
+for proxy in (ids, reader, stock_reader):
+    simple.Delete(proxy)
+
+# A turned and mirrored MAPAXES (30 degrees, y axis reversed; the demo deck otherwise), read by
+# GRDECLReader with default settings: the same cells from the same cameras, and a descriptor
+# box (the grid box turned) around the grid.
+demo = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Data", "demo_faulted_dome.grdecl")
+deck = os.path.join(temp, "turned.grdecl")
+with open(demo) as source, open(deck, "w") as out:
+    text = source.read()
+    original = "MAPAXES\n 451000.0 6781000.0  451000.0 6780000.0  452000.0 6780000.0 /"
+    if original not in text:
+        rt.fail(f"{demo}: MAPAXES record not found")
+    out.write(text.replace(original, "MAPAXES\n 451500.0 6779133.974596216  451000.0 6780000.0  "
+                                     "451866.0254037844 6780500.0 /"))
+turned = os.path.join(temp, "turned.resmr")
+run("build", deck, "-o", turned, "--quiet")
+stock_reader = simple.GRDECLReader(FileName=deck)
+stock_reader.UpdatePipeline()
+grid = servermanager.Fetch(stock_reader, arg1=None, arg2=None, idx=0)
+dims = tuple(int(vtk_to_numpy(grid.GetCellData().GetArray(a)).max()) for a in ("I", "J", "K"))
+ids = stock_cell_ids(stock_reader, dims)
+stock = simple.Show(ids, view)
+stock.SetRepresentationType("Surface")
+simple.ColorBy(stock, ("CELLS", "CellIdColor"))
+stock.MapScalars = 0
+unlit(stock)
+reader = simple.OpenDataFile(turned)
+reader.UpdatePipeline()
+expected_bounds = stock_reader.GetDataInformation().GetBounds()
+got_bounds = reader.GetDataInformation().GetBounds()
+points, cells = rt.points_and_cells(grid)
+used = points[cells[rt.cell_array(grid, "ACTNUM") > 0].ravel()]  # the hierarchy holds active cells
+active_bounds = np.ravel(np.column_stack([used.min(axis=0), used.max(axis=0)]))
+print(f"turned MAPAXES: descriptor bounds {got_bounds}, GRDECLReader's active cells' {tuple(active_bounds)}")
+slack = 1e-6 * (active_bounds[1] - active_bounds[0] + active_bounds[3] - active_bounds[2])
+box = np.array(got_bounds)
+holds = (np.all(box[[0, 2]] <= active_bounds[[0, 2]] + slack) and np.all(box[[1, 3]] >= active_bounds[[1, 3]] - slack)
+         and np.all(np.abs(box[4:] - active_bounds[4:]) <= slack))
+if not holds:
+    failures.append(f"turned MAPAXES: descriptor bounds {got_bounds} do not hold the active cells' {active_bounds}")
+ours = simple.Show(reader, view)
+ours.PaintBy = "Cell Id"
+ours.GridLines = 0
+ours.WaitForDetailMs = 120000
+ours.PixelTolerance = 0
+unlit(ours)
+for camera_name, direction, zoom in (("above", [0.3, -0.5, 0.8], 1.0), ("side", [1.0, -0.3, 0.25], 1.3)):
+    expected, got = render_both(ids, reader, expected_bounds, direction, zoom, f"turned-{camera_name}", 0.0)
+    both = (expected > 0) & (got > 0)
+    agree = float(np.mean(expected[both] == got[both])) if both.any() else 0.0
+    holes = count_holes(expected, got, 0.0)
+    print(f"turned MAPAXES {camera_name} at 0 px: {100 * agree:.2f}% of {int(both.sum())} pixels name the "
+          f"same cell; {holes} holes")
+    if agree < 0.995:
+        failures.append(f"turned MAPAXES {camera_name}: {100 * agree:.2f}% < 99.5%")
+    if holes > 0:
+        failures.append(f"turned MAPAXES {camera_name}: {holes} background pixels inside")
+    if not both.any() or both.sum() < 0.05 * WIDTH * HEIGHT:
+        failures.append(f"turned MAPAXES {camera_name}: model covers too few pixels ({int(both.sum())})")
+for proxy in (ids, reader, stock_reader):
+    simple.Delete(proxy)
 
 if failures:
     rt.fail("; ".join(failures))
