@@ -179,7 +179,7 @@ for model in args.models:
         view = simple.CreateRenderView()
         view.ViewSize = [1280, 720]
         start = time.perf_counter()
-        stock = simple.EGRIDReader(FileName=grid, ApplyMapAxes=0)
+        stock = simple.EGRIDReader(FileName=grid)
         shown = simple.Show(stock, view)
         shown.SetRepresentationType("Surface")
         simple.ColorBy(shown, ("CELLS", "PORO"))

@@ -88,7 +88,7 @@ for name, grid_path in models():
         run("build", grid_path, "-o", resmr_path, "--quiet")
         if name == "reek":
             run("add-properties", resmr_path, grid_path)
-    stock_reader = simple.EGRIDReader(FileName=grid_path, ApplyMapAxes=0)
+    stock_reader = simple.EGRIDReader(FileName=grid_path)
     stock_reader.UpdatePipeline()
     grid = servermanager.Fetch(stock_reader)
     dims = tuple(int(vtk_to_numpy(grid.GetCellData().GetArray(a)).max()) for a in ("I", "J", "K"))
