@@ -532,9 +532,15 @@ std::shared_ptr<const PropertyTableData> RegionCache::Property() const
   return this->CurrentProperty;
 }
 
+std::shared_ptr<const ModelTables> RegionCache::Tables() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->LoadedTables;
+}
+
 bool RegionCache::PendingLocked() const
 {
-  if (this->PropertyWanted)
+  if (this->PropertyWanted || !this->TablesTried)
   {
     return true;
   }
@@ -767,8 +773,47 @@ void RegionCache::Run()
   }
   while (!this->Stopping)
   {
-    const int64_t next = this->PropertyWanted ? -1 : this->NextRegionLocked();
-    if (this->PropertyWanted)
+    // The roots first (the first image), then the model's tables and the property (colour),
+    // then the regions the view wants.
+    const auto rootMissing = [&]() {
+      for (Key key : this->Pinned)
+      {
+        const auto found = this->Entries.find(key);
+        if (found == this->Entries.end() || (!found->second.buffers && !found->second.failed))
+        {
+          return true;
+        }
+      }
+      return false;
+    };
+    if (!this->TablesTried && !rootMissing())
+    {
+      lock.unlock();
+      std::shared_ptr<ModelTables> tables = std::make_shared<ModelTables>();
+      std::string error;
+      try
+      {
+        tables->hash = this->File->ReadHash();
+        tables->normals = this->File->ReadModelArray(ModelChunk::CellNormals);
+      }
+      catch (const std::exception& e)
+      {
+        tables.reset();
+        error = e.what();
+      }
+      lock.lock();
+      this->TablesTried = true;
+      this->LoadedTables = tables;
+      if (!error.empty())
+      {
+        this->Error = error;
+      }
+      this->Idle.notify_all();
+      continue;
+    }
+    const bool propertyNow = this->PropertyWanted && this->TablesTried;
+    const int64_t next = propertyNow ? -1 : this->NextRegionLocked();
+    if (propertyNow)
     {
       const std::string name = this->PropertyName;
       const int32_t step = this->PropertyStep;

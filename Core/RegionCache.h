@@ -103,6 +103,13 @@ struct PropertyTableData
   std::vector<float> values; ///< one a hash slot (packed), or nx ny values (a layer, i fastest)
 };
 
+/// The model's lookup tables for painting (Sec. 5.3-5.4): the hash and each slot's normals.
+struct ModelTables
+{
+  PerfectSpatialHash hash;
+  std::vector<uint8_t> normals; ///< 4 bytes a hash slot (top, bottom); empty in older files
+};
+
 class RegionCache
 {
 public:
@@ -139,6 +146,9 @@ public:
   /// (0-based); Property() keeps the previous one until it loads.
   void RequestProperty(const std::string& name, int32_t step, int32_t layer = -1);
   std::shared_ptr<const PropertyTableData> Property() const;
+  /// The hash and normal tables, or null until the loader has read them (right after the
+  /// roots: on a large model they are tens of MB to decompress, never the render thread's job).
+  std::shared_ptr<const ModelTables> Tables() const;
 
   /// True while a requested region or property table is not loaded yet and can still be
   /// (not over budget, no error).
@@ -211,6 +221,8 @@ private:
   int32_t PropertyLayer = -1;
   bool PropertyWanted = false;
   std::shared_ptr<const PropertyTableData> CurrentProperty;
+  std::shared_ptr<const ModelTables> LoadedTables;
+  bool TablesTried = false; ///< read once, loaded or failed
 };
 
 } // namespace resmr

@@ -554,24 +554,37 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     glUniform3i(glGetUniformLocation(handle, name), a, b, c);
   };
 
-  // Model tables: the hash's offsets and the cells' normals (once a file), the property
-  // table when another is current, the colour map when the lookup table changes.
+  // Model tables: the hash's offsets and the cells' normals (once a file, when the loader has
+  // read them), the property table when another is current, the colour map when the lookup
+  // table changes. Until the hash is in, the whole model is drawn in the solid colour, lit by
+  // facet normals, with 1-texel stand-ins for the samplers.
   if (!in.HashUploaded)
   {
     state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    const resmr::PerfectSpatialHash hash = in.File->ReadHash();
-    UploadInteger3D(in.OffsetTexture, window, hash.offsetSides, 3, GL_RGB16UI, GL_RGB_INTEGER, hash.offsets.data());
-    const std::vector<uint8_t> normals = in.File->ReadModelArray(resmr::ModelChunk::CellNormals);
-    if (normals.size() == hash.TableSize() * 4)
+    const std::shared_ptr<const resmr::ModelTables> tables = cache.Tables();
+    if (tables)
     {
-      UploadInteger3D(in.NormalTexture, window, hash.tableSides, 2, GL_RG16UI, GL_RG_INTEGER, normals.data());
+      const resmr::PerfectSpatialHash& hash = tables->hash;
+      UploadInteger3D(in.OffsetTexture, window, hash.offsetSides, 3, GL_RGB16UI, GL_RGB_INTEGER, hash.offsets.data());
+      if (tables->normals.size() == hash.TableSize() * 4)
+      {
+        UploadInteger3D(
+          in.NormalTexture, window, hash.tableSides, 2, GL_RG16UI, GL_RG_INTEGER, tables->normals.data());
+      }
+      else
+      {
+        const std::vector<uint16_t> up(hash.TableSize() * 2, 0); // code 0 is +z
+        UploadInteger3D(in.NormalTexture, window, hash.tableSides, 2, GL_RG16UI, GL_RG_INTEGER, up.data());
+      }
+      in.HashUploaded = true;
     }
-    else
+    else if (in.OffsetTexture->GetHandle() == 0)
     {
-      const std::vector<uint16_t> up(hash.TableSize() * 2, 0); // code 0 is +z
-      UploadInteger3D(in.NormalTexture, window, hash.tableSides, 2, GL_RG16UI, GL_RG_INTEGER, up.data());
+      const std::array<uint32_t, 3> one{ 1, 1, 1 };
+      const uint16_t zeros[3] = { 0, 0, 0 };
+      UploadInteger3D(in.OffsetTexture, window, one, 3, GL_RGB16UI, GL_RGB_INTEGER, zeros);
+      UploadInteger3D(in.NormalTexture, window, one, 2, GL_RG16UI, GL_RG_INTEGER, zeros);
     }
-    in.HashUploaded = true;
   }
   if (in.PropertyTexture->GetHandle() == 0)
   {
@@ -643,7 +656,9 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     in.ColorTable = table;
     in.ColorTableTime = table->GetMTime();
   }
-  const int colorMode = this->ColorMode == PropertyColors && !property ? SolidColor : this->ColorMode;
+  const bool hashReady = in.HashUploaded || layer >= 0; // a layer's 2D table needs no hash
+  const int colorMode =
+    this->ColorMode == PropertyColors && (!property || !hashReady) ? SolidColor : this->ColorMode;
 
   // GPU time of an earlier frame, when the driver has it (never waits).
   if (in.TimerQuery != 0 && in.TimerPending)
@@ -699,9 +714,18 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   }
   program->SetUniformi("colorMode", colorMode);
   uniform3i("gridDims", int(header.dims[0]), int(header.dims[1]), int(header.dims[2]));
-  uniform3i("tableSides", int(header.hashTableSides[0]), int(header.hashTableSides[1]), int(header.hashTableSides[2]));
-  uniform3i(
-    "offsetSides", int(header.hashOffsetSides[0]), int(header.hashOffsetSides[1]), int(header.hashOffsetSides[2]));
+  if (in.HashUploaded)
+  {
+    uniform3i("tableSides", int(header.hashTableSides[0]), int(header.hashTableSides[1]), int(header.hashTableSides[2]));
+    uniform3i(
+      "offsetSides", int(header.hashOffsetSides[0]), int(header.hashOffsetSides[1]), int(header.hashOffsetSides[2]));
+  }
+  else
+  {
+    uniform3i("tableSides", 1, 1, 1);
+    uniform3i("offsetSides", 1, 1, 1);
+  }
+  program->SetUniformi("cellTables", in.HashUploaded ? 1 : 0);
   in.OffsetTexture->Activate();
   program->SetUniformi("hashOffsets", in.OffsetTexture->GetTextureUnit());
   in.NormalTexture->Activate();

@@ -18,6 +18,7 @@ uniform ivec3 offsetSides; // r
 uniform usampler3D hashOffsets;  // r0 x r1 x r2, RGB16UI
 uniform usampler3D cellNormals;  // m0 x m1 x m2, RG16UI (top, bottom)
 uniform sampler3D propertyTable; // m0 x m1 x m2, R32F
+uniform int cellTables;          // 0 until the hash and normal tables are loaded
 uniform int layer;               // -1: the whole model; else the one layer drawn (0-based)
 uniform sampler2D layerProperty; // nx x ny, R32F: that layer's table
 uniform sampler2D colorMap;      // N x 1, RGBA8
@@ -98,7 +99,7 @@ void main()
   // only: a layer lights every face by its geometric normal, per pixel.
   vec3 facet = normalize(cross(dFdx(viewPosition), dFdy(viewPosition)));
   vec3 normal = facet;
-  if (faceKind < 2 && layer < 0)
+  if (faceKind < 2 && layer < 0 && cellTables == 1)
   {
     uvec2 codes = texelFetch(cellNormals, slot, 0).xy;
     normal = normalize(normalToView * DecodeNormal(faceKind == 0 ? codes.x : codes.y));
