@@ -709,6 +709,10 @@ void TestCache(const std::string& path)
     cache.Request(leaves);
     CHECK(cache.WaitIdle(seconds(10)) && !cache.Pending());
     CHECK(cache.ResidentBytes() <= std::max(budget, rootBytes));
+    // The hash and normal tables come from the loader too, equal to the file's.
+    const auto tables = cache.Tables();
+    CHECK(tables && tables->hash.offsets == file->ReadHash().offsets &&
+      tables->normals == file->ReadModelArray(ModelChunk::CellNormals));
     CHECK(cache.ResidentCount() == roots.size() + n);
     for (std::size_t i = 0; i < leaves.size(); ++i)
       CHECK(cache.IsResident(leaves[i]) == (i < n));
