@@ -2,7 +2,10 @@
 .resmr opened on the server renders there (remote rendering) and the client receives the
 same image builtin mode makes: >= 99.9% of the pixels name the same cell in the cell-id
 colouring, and the server's log (TRACE) shows it drew as many triangles as builtin mode.
-(The pvpython readout properties are the client's object: 0 in remote rendering.)"""
+The readout pulled in pvpython is the server's (vtkSMMultiresolutionSurfaceRepresentationProxy):
+triangles and regions equal the server's TRACE log of the same frame, resident MB > 0, and the
+tolerance is the one set (fixed, no target frame rate), at 0 px and at 12 px; LayerRange is
+the model's (0 to nk = 8)."""
 import re
 import os
 import socket
@@ -52,20 +55,31 @@ def render(name):
     simple.Render(view)
     image = os.path.join(temp, name + ".png")
     simple.SaveScreenshot(image, view, ImageResolution=[480, 360], TransparentBackground=0)
-    display.UpdatePropertyInformation()
-    triangles = display.GetPropertyValue("TrianglesDrawn")
-    error = display.GetPropertyValue("LastError")
+    readouts = [readout(display)]
+    # A coarser frame (fewer triangles): the readout must follow the frame just drawn.
+    display.PixelTolerance = 12
+    simple.Render(view)
+    readouts.append(readout(display))
+    error = readouts[0]["LastError"]
     reader_png = vtkPNGReader()
     reader_png.SetFileName(image)
     reader_png.Update()
     pixels = vtk_to_numpy(reader_png.GetOutput().GetPointData().GetScalars())[:, :3].astype(np.int64)
     simple.Delete(reader)
     simple.Delete(view)
-    return pixels[:, 0] + 256 * pixels[:, 1] + 65536 * pixels[:, 2], triangles, error
+    return pixels[:, 0] + 256 * pixels[:, 1] + 65536 * pixels[:, 2], readouts, error
+
+
+def readout(display):
+    display.UpdatePropertyInformation()
+    return {name: display.GetPropertyValue(name) for name in
+            ("CurrentTolerance", "ResidentMB", "TrianglesDrawn", "RegionsDrawn", "RegionsSubstituted",
+             "LastFrameMs", "LoadsPending", "LastError", "LayerRange")}
 
 
 simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
-builtin, builtin_triangles, _ = render("builtin")
+builtin, builtin_readouts, _ = render("builtin")
+builtin_triangles = builtin_readouts[0]["TrianglesDrawn"]
 print(f"builtin: {int(np.sum(builtin > 0))} pixels covered, {builtin_triangles:.0f} triangles")
 
 with socket.socket() as probe:
@@ -94,7 +108,7 @@ try:
     simple.Connect("localhost", port)
     simple.LoadPlugin(args.plugin, remote=True, ns=vars(simple))
     simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
-    remote, _, error = render("server")
+    remote, remote_readouts, error = render("server")
     simple.Disconnect()
 finally:
     server.terminate()
@@ -102,9 +116,15 @@ finally:
         server.wait(timeout=20)
     except subprocess.TimeoutExpired:
         server.kill()
-drawn = [int(m.group(1)) for m in (re.search(r"multiresolution surface: \d+ regions, (\d+) triangles", line)
-                                   for line in server_lines()) if m]
-remote_triangles = drawn[-1] if drawn else 0
+# The server's frames: (regions, triangles, tolerance); the last at each tolerance is the one
+# the readout after it describes (WaitForDetailMs: the still render's final frame).
+frames = [(int(m.group(1)), int(m.group(2)), float(m.group(3))) for m in
+          (re.search(r"multiresolution surface: (\d+) regions, (\d+) triangles at ([\d.]+) px", line)
+           for line in server_lines()) if m]
+last_at = {}
+for frame in frames:
+    last_at[frame[2]] = frame
+remote_triangles = last_at[0.0][1] if 0.0 in last_at else 0
 
 both = (builtin > 0) & (remote > 0)
 share = float(np.mean(builtin[both] == remote[both])) if both.any() else 0.0
@@ -115,4 +135,21 @@ if error:
 if both.sum() < 0.05 * builtin.size or share < 0.999 or remote_triangles != builtin_triangles:
     rt.fail(f"client/server image differs from builtin ({100 * share:.2f}%, {remote_triangles} vs "
             f"{builtin_triangles} triangles)")
-print("Multiresolution Surface renders through pvserver")
+for set_tolerance, values in zip((0.0, 12.0), remote_readouts):
+    logged = last_at.get(set_tolerance, (0, 0, 0))
+    print(f"server readout at {set_tolerance} px: {values}; server log: {logged[0]} regions, "
+          f"{logged[1]} triangles")
+    if values["TrianglesDrawn"] != logged[1] or values["RegionsDrawn"] != logged[0] or logged[1] == 0:
+        rt.fail(f"readout at {set_tolerance} px is not the server's frame: {values['TrianglesDrawn']:.0f} "
+                f"triangles, {values['RegionsDrawn']} regions vs {logged[1]}, {logged[0]} in its log")
+    if abs(values["CurrentTolerance"] - set_tolerance) > 1e-9 or not values["ResidentMB"] > 0 \
+            or values["LoadsPending"] != 0 or values["LastFrameMs"] <= 0:
+        rt.fail(f"readout at {set_tolerance} px: {values}")
+if list(remote_readouts[0]["LayerRange"]) != [0, 8]:
+    rt.fail(f"LayerRange through pvserver: {remote_readouts[0]['LayerRange']}, not [0, 8]")
+if not remote_readouts[1]["TrianglesDrawn"] < remote_readouts[0]["TrianglesDrawn"]:
+    rt.fail("12 px drew no fewer triangles than 0 px")
+for a, b in zip(builtin_readouts, remote_readouts):
+    if a["TrianglesDrawn"] != b["TrianglesDrawn"] or a["RegionsDrawn"] != b["RegionsDrawn"]:
+        rt.fail(f"server readout {b} differs from builtin {a}")
+print("Multiresolution Surface renders through pvserver; its readout is the server's")

@@ -1,0 +1,136 @@
+#include "pqMultiresolutionReadoutDock.h"
+
+#include "pqMultiresolutionReadout.h"
+
+#include "pqActiveObjects.h"
+#include "pqDataRepresentation.h"
+#include "pqPipelineSource.h"
+#include "pqView.h"
+#include "vtkLogger.h"
+
+#include <QFormLayout>
+#include <QLabel>
+#include <QLocale>
+#include <QVBoxLayout>
+
+pqMultiresolutionReadoutDock::pqMultiresolutionReadoutDock(QWidget* parent)
+  : Superclass(parent)
+{
+  this->setWindowTitle(tr("Multiresolution Readout"));
+  auto* body = new QWidget(this);
+  auto* layout = new QVBoxLayout(body);
+  this->Source = new QLabel(body);
+  this->Source->setWordWrap(true);
+  layout->addWidget(this->Source);
+
+  this->Values = new QWidget(body);
+  auto* form = new QFormLayout(this->Values);
+  form->setContentsMargins(0, 0, 0, 0);
+  const auto row = [&](const QString& name, const QString& help) {
+    auto* value = new QLabel(this->Values);
+    value->setTextInteractionFlags(Qt::TextSelectableByMouse);
+    value->setToolTip(help);
+    form->addRow(name, value);
+    return value;
+  };
+  this->Tolerance = row(tr("Tolerance"), tr("Projected error tolerance of the last frame, pixels"));
+  this->Resident = row(tr("Resident"), tr("Memory held by loaded meshes, of the memory budget"));
+  this->Triangles = row(tr("Triangles drawn"), tr("Triangles drawn in the last frame"));
+  this->Regions = row(tr("Regions drawn"),
+    tr("Region meshes drawn in the last frame; in brackets, those standing in for finer ones still loading"));
+  this->Frame = row(tr("Last frame"), tr("Time the last frame took"));
+  this->Loads = row(tr("Loads"), tr("Whether meshes the view wants are still loading"));
+  layout->addWidget(this->Values);
+
+  this->Error = new QLabel(body);
+  this->Error->setWordWrap(true);
+  this->Error->setStyleSheet("color: #c0392b;");
+  this->Error->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  layout->addWidget(this->Error);
+  layout->addStretch(1);
+  this->setWidget(body);
+
+  // Zero-delay single shot: runs once the render and the other handlers of its signal are
+  // done, and once for any number of requests made meanwhile.
+  this->Update.setSingleShot(true);
+  this->Update.setInterval(0);
+  QObject::connect(&this->Update, &QTimer::timeout, this, &pqMultiresolutionReadoutDock::updateReadout);
+  const auto request = [this]() { this->Update.start(); };
+  pqActiveObjects& active = pqActiveObjects::instance();
+  QObject::connect(&active, &pqActiveObjects::viewChanged, this, &pqMultiresolutionReadoutDock::setView);
+  QObject::connect(&active, QOverload<pqDataRepresentation*>::of(&pqActiveObjects::representationChanged), this,
+    request);
+  QObject::connect(this, &QDockWidget::visibilityChanged, this, request);
+  this->setView(active.activeView());
+}
+
+pqMultiresolutionReadoutDock::~pqMultiresolutionReadoutDock() = default;
+
+void pqMultiresolutionReadoutDock::setView(pqView* view)
+{
+  if (this->View)
+  {
+    QObject::disconnect(this->View, nullptr, this, nullptr);
+  }
+  this->View = view;
+  if (view)
+  {
+    const auto request = [this]() { this->Update.start(); };
+    QObject::connect(view, &pqView::endRender, this, request);
+    QObject::connect(view, &pqView::representationVisibilityChanged, this, request);
+  }
+  this->Update.start();
+}
+
+void pqMultiresolutionReadoutDock::updateReadout()
+{
+  if (!this->isVisible())
+  {
+    return;
+  }
+  // The active source's surface, else the first one shown in the active view.
+  pqRepresentation* chosen = nullptr;
+  pqDataRepresentation* activeRepresentation = pqActiveObjects::instance().activeRepresentation();
+  if (this->View && activeRepresentation && activeRepresentation->getView() == this->View &&
+    pqMultiresolutionReadout::Surface(activeRepresentation, false))
+  {
+    chosen = activeRepresentation;
+  }
+  for (int i = 0; this->View && !chosen && i < this->View->getNumberOfRepresentations(); ++i)
+  {
+    pqRepresentation* representation = this->View->getRepresentation(i);
+    if (pqMultiresolutionReadout::Surface(representation, true))
+    {
+      chosen = representation;
+    }
+  }
+  vtkSMProxy* surface = pqMultiresolutionReadout::Surface(chosen, false);
+  if (!surface)
+  {
+    this->Source->setText(tr("No Multiresolution Surface in the active view."));
+    this->Values->setVisible(false);
+    this->Error->setVisible(false);
+    return;
+  }
+
+  const pqMultiresolutionReadout readout = pqMultiresolutionReadout::Pull(surface);
+  const QLocale locale(QLocale::English);
+  auto* data = qobject_cast<pqDataRepresentation*>(chosen);
+  pqPipelineSource* input = data ? data->getInput() : nullptr;
+  this->Source->setText(input ? input->getSMName() : tr("Multiresolution Surface"));
+  this->Tolerance->setText(tr("%1 px (%2)")
+                             .arg(readout.Tolerance, 0, 'f', 2)
+                             .arg(readout.TargetFrameRate > 0 ? tr("holding %1 fps").arg(readout.TargetFrameRate)
+                                                              : tr("fixed")));
+  this->Resident->setText(tr("%1 MB of %2 MB").arg(readout.ResidentMB, 0, 'f', 1).arg(readout.BudgetMB));
+  this->Triangles->setText(locale.toString(static_cast<qlonglong>(readout.Triangles)));
+  this->Regions->setText(tr("%1 (%2 standing in)").arg(readout.Regions).arg(readout.Substituted));
+  this->Frame->setText(tr("%1 ms").arg(readout.FrameMs, 0, 'f', 1));
+  this->Loads->setText(readout.LoadsPending ? tr("pending") : tr("idle"));
+  this->Error->setText(readout.Error);
+  this->Values->setVisible(true);
+  this->Error->setVisible(!readout.Error.isEmpty());
+  vtkLogF(TRACE, "multiresolution readout: %.2f px, %.1f MB, %.0f triangles, %d regions, %d substituted, %s",
+    readout.Tolerance, readout.ResidentMB, readout.Triangles, readout.Regions, readout.Substituted,
+    readout.LoadsPending ? "pending" : "idle");
+}

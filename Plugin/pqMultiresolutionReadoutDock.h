@@ -1,0 +1,42 @@
+// Dock window "Multiresolution Readout" (issue 7, point 4): the live readout of the
+// Multiresolution Surface in the active view (the active source's, else the first visible
+// one), refreshed after each render of that view.
+#ifndef pqMultiresolutionReadoutDock_h
+#define pqMultiresolutionReadoutDock_h
+
+#include <QDockWidget>
+#include <QPointer>
+#include <QTimer>
+
+class QLabel;
+class pqView;
+
+class pqMultiresolutionReadoutDock : public QDockWidget
+{
+  Q_OBJECT
+  typedef QDockWidget Superclass;
+
+public:
+  pqMultiresolutionReadoutDock(QWidget* parent = nullptr);
+  ~pqMultiresolutionReadoutDock() override;
+
+private Q_SLOTS:
+  void setView(pqView* view);
+  void updateReadout();
+
+private:
+  Q_DISABLE_COPY(pqMultiresolutionReadoutDock)
+  QPointer<pqView> View;
+  QTimer Update; ///< coalesces the signals that ask for an update into one pull
+  QLabel* Source;
+  QLabel* Tolerance;
+  QLabel* Resident;
+  QLabel* Triangles;
+  QLabel* Regions;
+  QLabel* Frame;
+  QLabel* Loads;
+  QLabel* Error;
+  QWidget* Values;
+};
+
+#endif
