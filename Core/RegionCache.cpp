@@ -281,31 +281,26 @@ RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::si
   {
     return PrepareLayerDrawBuffers(mesh, layer, origin, handedness);
   }
+  const std::vector<std::array<uint32_t, 3>> simplifiedSide = mesh.sideTriangles;
   UseOriginalSideFaces(mesh);
-  return PrepareRegionDrawBuffers(mesh, origin, handedness);
+  RegionDrawBuffers out = PrepareRegionDrawBuffers(mesh, origin, handedness);
+  AddCoarseSide(mesh, simplifiedSide, origin, handedness, out);
+  return out;
 }
 
 namespace
 {
-RegionDrawBuffers PrepareDrawBuffers(const RegionMesh& mesh, const RegionSurface& top, const RegionSurface& bottom,
-  const std::vector<std::array<uint32_t, 3>>& sideTriangles, const std::array<double, 3>& origin, int handedness)
+/// Appends side triangles, each with its own vertices (the cell offset belongs to the
+/// triangle); `checkCells` moves each one's offset to the cell that owns an exact side face.
+void AddSideTriangles(const RegionMesh& mesh, const std::vector<std::array<uint32_t, 3>>& sideTriangles,
+  const std::array<double, 3>& origin, int handedness, bool checkCells, RegionDrawBuffers& out)
 {
-  RegionDrawBuffers out;
-  out.topCone = top.cone;
-  out.bottomCone = bottom.cone;
-  std::vector<uint32_t> map(static_cast<std::size_t>(mesh.VertexCount()), Unused);
-  // A top face lies on its cell's upper interface k: the cell is at k + 0.5; a bottom face on
-  // the lower interface k + 1: the cell is at (k + 1) - 0.5.
-  AddQuads(mesh, top, 0.5, origin, map, out);
-  out.topIndices = static_cast<uint32_t>(out.indices.size());
-  AddQuads(mesh, bottom, -0.5, origin, map, out);
-  out.bottomIndices = static_cast<uint32_t>(out.indices.size()) - out.topIndices;
   // Side triangles: the face's constant axis is the largest component of its normal in
   // topological space n_T; the physical outward normal is det(A) A^-T n_T (A = d(x, y, z) /
   // d(i, j, k)), so the outward direction along that axis has the sign of
   // handedness * n_T[axis] and the cell lies on the other side. Each triangle has its own
   // vertices, since the offset belongs to the triangle.
-  const auto columns = ColumnsByCell(mesh);
+  const auto columns = checkCells ? ColumnsByCell(mesh) : std::map<std::pair<int64_t, int64_t>, std::size_t>{};
   for (const auto& t : sideTriangles)
   {
     const Vector t0 = Topological(mesh, t[0]), t1 = Topological(mesh, t[1]), t2 = Topological(mesh, t[2]);
@@ -336,10 +331,34 @@ RegionDrawBuffers PrepareDrawBuffers(const RegionMesh& mesh, const RegionSurface
     }
     out.indices.insert(out.indices.end(), { first, first + 1, first + 2 });
   }
+}
+
+RegionDrawBuffers PrepareDrawBuffers(const RegionMesh& mesh, const RegionSurface& top, const RegionSurface& bottom,
+  const std::vector<std::array<uint32_t, 3>>& sideTriangles, const std::array<double, 3>& origin, int handedness)
+{
+  RegionDrawBuffers out;
+  out.topCone = top.cone;
+  out.bottomCone = bottom.cone;
+  std::vector<uint32_t> map(static_cast<std::size_t>(mesh.VertexCount()), Unused);
+  // A top face lies on its cell's upper interface k: the cell is at k + 0.5; a bottom face on
+  // the lower interface k + 1: the cell is at (k + 1) - 0.5.
+  AddQuads(mesh, top, 0.5, origin, map, out);
+  out.topIndices = static_cast<uint32_t>(out.indices.size());
+  AddQuads(mesh, bottom, -0.5, origin, map, out);
+  out.bottomIndices = static_cast<uint32_t>(out.indices.size()) - out.topIndices;
+  AddSideTriangles(mesh, sideTriangles, origin, handedness, true, out);
   out.sideIndices = static_cast<uint32_t>(out.indices.size()) - out.topIndices - out.bottomIndices;
   return out;
 }
 } // namespace
+
+void AddCoarseSide(const RegionMesh& mesh, const std::vector<std::array<uint32_t, 3>>& simplifiedSide,
+  const std::array<double, 3>& origin, int handedness, RegionDrawBuffers& out)
+{
+  const std::size_t before = out.indices.size();
+  AddSideTriangles(mesh, simplifiedSide, origin, handedness, false, out);
+  out.coarseSideIndices = static_cast<uint32_t>(out.indices.size() - before);
+}
 
 RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin, int handedness)
 {

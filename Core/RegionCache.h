@@ -57,8 +57,13 @@ namespace resmr
 struct RegionDrawBuffers
 {
   std::vector<float> vertices;   ///< per vertex: x, y, z, ci, cj, ck
-  std::vector<uint32_t> indices; ///< triangles: top, bottom, side
+  std::vector<uint32_t> indices; ///< triangles: top, bottom, side, coarse side
   uint32_t topIndices = 0, bottomIndices = 0, sideIndices = 0; ///< index counts of each part
+  /// The file's simplified side (Sec. 4.3), after the exact one: far fewer triangles on models
+  /// of many layers, within the region's error, but its layer boundaries are interpolated
+  /// (see UseOriginalSideFaces); for regions whose error projects to a few pixels or more.
+  /// 0 when absent (a layer's buffers).
+  uint32_t coarseSideIndices = 0;
   int32_t layer = -1; ///< the layer drawn (0-based), -1: the whole model
   /// Normal cones of the top and bottom parts (RegionSurface::cone). A layer's faces are not
   /// the region's stored surfaces, so their culling needs their own cones.
@@ -77,6 +82,11 @@ int TopologyHandedness(const MultiresolutionFile& file);
 /// pixels of a side view at 1 px). Column collapse keeps every layer interface, so the
 /// mesh's side faces carry exact k; what they cost is triangles.
 void UseOriginalSideFaces(RegionMesh& mesh);
+
+/// Appends `simplifiedSide` (the file's side triangles of the region, before
+/// UseOriginalSideFaces) as the coarse side of `out`.
+void AddCoarseSide(const RegionMesh& mesh, const std::vector<std::array<uint32_t, 3>>& simplifiedSide,
+  const std::array<double, 3>& origin, int handedness, RegionDrawBuffers& out);
 
 /// Draw buffers of a decoded region (surfaces and topological coordinates are enough).
 RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin,

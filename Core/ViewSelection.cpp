@@ -337,6 +337,7 @@ ViewSelection ViewSelector::Select(const ViewParameters& view, const std::functi
     const Box corners = Corners(record);
     DrawnRegion drawn;
     drawn.region = r;
+    drawn.projectedError = ProjectedError(record, view);
     drawn.top = record.topCone[3] > -1.5f && !BackFacing(record.topCone, corners, view);
     drawn.bottom = record.bottomCone[3] > -1.5f && !BackFacing(record.bottomCone, corners, view);
     selection.drawn.push_back(drawn);

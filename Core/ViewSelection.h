@@ -50,6 +50,7 @@ struct DrawnRegion
 {
   std::size_t region = 0; ///< index into MultiresolutionFile::Regions()
   bool top = true, bottom = true, side = true; ///< surfaces not culled by their normal cones
+  double projectedError = 0; ///< the region's error in pixels this frame (Lindstrom's bound)
 };
 
 struct ViewSelection

@@ -291,6 +291,9 @@ bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties
   return true;
 }
 
+/// Projected error (pixels) past which a region's simplified side replaces its exact one.
+constexpr double CoarseSidePixels = 2.0;
+
 /// The loader's share of the mesh budget: the GPU mirrors at most what is resident, so half
 /// each keeps both together within the budget.
 std::size_t MainMemoryShare(int budgetMB)
@@ -806,13 +809,20 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     const resmr::RegionRecord& record = in.File->Regions()[drawn.region];
     const bool top = layer < 0 ? drawn.top : !resmr::SurfaceCulled(buffers.topCone, record, view);
     const bool bottom = layer < 0 ? drawn.bottom : !resmr::SurfaceCulled(buffers.bottomCone, record, view);
-    const struct
+    // Where the region's error already shows (a few pixels), its side is drawn simplified
+    // (Sec. 4.3): on models of many layers that is most of the triangles, and the geometry is
+    // no closer than that error anyway. Exact sides keep k exact for close and 1 px views.
+    const bool coarseSide = buffers.coarseSideIndices > 0 && drawn.projectedError > CoarseSidePixels;
+    struct Part
     {
       bool shown;
       uint32_t first, count;
       int kind;
-    } parts[3] = { { top, 0, buffers.topIndices, 0 }, { bottom, buffers.topIndices, buffers.bottomIndices, 1 },
-      { drawn.side, buffers.topIndices + buffers.bottomIndices, buffers.sideIndices, 2 } };
+    };
+    const Part parts[3] = { { top, 0, buffers.topIndices, 0 }, { bottom, buffers.topIndices, buffers.bottomIndices, 1 },
+      coarseSide ? Part{ drawn.side, buffers.topIndices + buffers.bottomIndices + buffers.sideIndices,
+                     buffers.coarseSideIndices, 2 }
+                 : Part{ drawn.side, buffers.topIndices + buffers.bottomIndices, buffers.sideIndices, 2 } };
     for (const auto& part : parts)
     {
       if (part.shown && part.count > 0)

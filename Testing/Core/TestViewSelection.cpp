@@ -659,6 +659,37 @@ std::vector<std::size_t> RegionBytes(const MultiresolutionFile& file)
   return bytes;
 }
 
+/// Every region's buffers hold the exact side (its mesh's side quads) and, after it, the
+/// file's simplified side as the coarse side; coarse levels' simplified sides are smaller.
+void TestCoarseSides(const std::string& path)
+{
+  const MultiresolutionFile file(path);
+  const int handedness = TopologyHandedness(file);
+  const auto& o = file.Header().latticeOrigin;
+  std::size_t exact = 0, coarse = 0;
+  for (std::size_t r = 0; r < file.Regions().size(); ++r)
+  {
+    const RegionDrawBuffers buffers = LoadRegionDrawBuffers(file, r, { o[0], o[1], -o[2] }, handedness);
+    RegionMesh mesh = file.ReadRegion(r);
+    const std::size_t simplified = mesh.sideTriangles.size();
+    UseOriginalSideFaces(mesh);
+    CHECK(buffers.sideIndices == 3 * mesh.sideTriangles.size());
+    CHECK(buffers.coarseSideIndices == 3 * simplified);
+    CHECK(buffers.topIndices + buffers.bottomIndices + buffers.sideIndices + buffers.coarseSideIndices ==
+      buffers.indices.size());
+    const std::size_t vertexCount = buffers.vertices.size() / 6;
+    for (std::size_t i = buffers.indices.size() - buffers.coarseSideIndices; i < buffers.indices.size(); ++i)
+      CHECK(buffers.indices[i] < vertexCount);
+    if (file.Regions()[r].level < file.Header().leafLevel)
+    {
+      exact += buffers.sideIndices;
+      coarse += buffers.coarseSideIndices;
+    }
+  }
+  std::printf("%s: coarse levels' sides %zu triangles exact, %zu simplified\n", path.c_str(), exact / 3, coarse / 3);
+  CHECK(coarse > 0 && coarse < exact);
+}
+
 void TestCache(const std::string& path)
 {
   using namespace std::chrono;
@@ -1100,6 +1131,11 @@ int main(int argc, char** argv)
         CHECK(l == -r);
         TestDrawBuffers(left, l);
         TestDrawBuffers(right, r);
+      } },
+    { "CoarseSides",
+      [&] {
+        TestCoarseSides(reek);
+        TestCoarseSides(synth);
       } },
     { "Cache", [&] { TestCache(reek64); } },
     { "DamagedChunk", [&] { TestDamagedChunk(reek); } },
