@@ -462,9 +462,13 @@ std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const C
   return Decompress(data, size, ref, place);
 }
 
-const uint8_t* MapReadOnlyFile(const std::string& path, uint64_t& size)
+const uint8_t* MapReadOnlyFile(const std::string& path, uint64_t& size, int* keep)
 {
-  const int descriptor = open(path.c_str(), O_RDONLY);
+  if (keep)
+  {
+    *keep = -1;
+  }
+  const int descriptor = open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (descriptor < 0)
   {
     throw MultiresolutionFileError(path + ": cannot open: " + std::strerror(errno));
@@ -482,12 +486,39 @@ const uint8_t* MapReadOnlyFile(const std::string& path, uint64_t& size)
     return nullptr;
   }
   void* map = mmap(nullptr, size, PROT_READ, MAP_SHARED, descriptor, 0);
-  close(descriptor);
+  const int mapError = errno;
+  if (map == MAP_FAILED || !keep)
+  {
+    close(descriptor);
+  }
   if (map == MAP_FAILED)
   {
-    throw MultiresolutionFileError(path + ": cannot map: " + std::strerror(errno));
+    throw MultiresolutionFileError(path + ": cannot map: " + std::strerror(mapError));
+  }
+  if (keep)
+  {
+    *keep = descriptor;
   }
   return static_cast<const uint8_t*>(map);
+}
+
+void CheckMappedSize(int descriptor, uint64_t size, const std::string& path)
+{
+  struct stat info;
+  if (descriptor >= 0 && fstat(descriptor, &info) == 0 && static_cast<uint64_t>(info.st_size) < size)
+  {
+    throw MultiresolutionFileError(path + ": the file is now " + std::to_string(info.st_size) + " bytes, " +
+      std::to_string(size) + " when it was opened (cut or rewritten in place while open)");
+  }
+}
+
+void CloseDescriptor(int& descriptor)
+{
+  if (descriptor >= 0)
+  {
+    close(descriptor);
+    descriptor = -1;
+  }
 }
 
 void UnmapFile(const uint8_t* data, uint64_t size)
@@ -783,10 +814,11 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
   : FilePath(path)
 {
   InitialiseLzo();
-  this->Data = MapReadOnlyFile(path, this->Size);
+  this->Data = MapReadOnlyFile(path, this->Size, &this->Descriptor);
   if (this->Size < HeaderBytes + IndexTrailerBytes)
   {
     UnmapFile(this->Data, this->Size);
+    CloseDescriptor(this->Descriptor);
     throw MultiresolutionFileError(path + ": " + std::to_string(this->Size) +
       " bytes, too short for a multiresolution file (truncated?)");
   }
@@ -901,6 +933,7 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
   catch (...)
   {
     UnmapFile(this->Data, this->Size);
+    CloseDescriptor(this->Descriptor);
     throw;
   }
 }
@@ -951,6 +984,7 @@ void MultiresolutionFile::ReadMapPlacement(ByteReader& head)
 MultiresolutionFile::~MultiresolutionFile()
 {
   UnmapFile(this->Data, this->Size);
+  CloseDescriptor(this->Descriptor);
 }
 
 const RegionRecord* MultiresolutionFile::Find(int32_t level, int64_t index) const
@@ -974,6 +1008,7 @@ std::vector<uint8_t> MultiresolutionFile::ReadChunk(const RegionRecord& record, 
 
 std::vector<uint8_t> MultiresolutionFile::ReadChunk(const ChunkRef& ref, const std::string& place) const
 {
+  CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
   return Decompress(this->Data, this->Size, ref, place);
 }
 
@@ -1038,10 +1073,13 @@ std::vector<uint8_t> MultiresolutionFile::ReadModelArray(uint32_t kind) const
   }
   std::sort(pieces.begin(), pieces.end(), [](const ModelChunk* a, const ModelChunk* b) { return a->part < b->part; });
   std::vector<uint8_t> out;
+  const char* const names[] = { "model array", "active flags", "hash offset table", "hash cell table",
+    "cell normal table" };
+  const std::string name = names[kind <= ModelChunk::CellNormals ? kind : 0];
   for (std::size_t p = 0; p < pieces.size(); ++p)
   {
-    const std::string place = this->FilePath + ": model array " + std::to_string(kind) + " piece " + std::to_string(p) +
-      " at byte " + std::to_string(pieces[p]->chunk.offset);
+    const std::string place = this->FilePath + ": " + name + " (model chunk kind " + std::to_string(kind) +
+      ") piece " + std::to_string(p) + " at byte " + std::to_string(pieces[p]->chunk.offset);
     if (pieces[p]->part != p || (p + 1 < pieces.size() && pieces[p]->chunk.raw != ModelPieceBytes))
     {
       throw MultiresolutionFileError(place + ": pieces missing or out of order");
@@ -1059,6 +1097,7 @@ RegionMesh MultiresolutionFile::ReadRegion(std::size_t i) const
   {
     throw std::out_of_range("multiresolution file: no region " + std::to_string(i));
   }
+  CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
   return DecodeRegion(this->Data, this->Size, this->FilePath, this->Records[i], this->Head);
 }
 

@@ -229,6 +229,7 @@ private:
   std::string FilePath;
   const uint8_t* Data = nullptr;
   uint64_t Size = 0;
+  int Descriptor = -1; ///< kept open to notice a file cut while mapped
   MultiresolutionHeader Head;
   std::vector<RegionRecord> Records;
   std::vector<ModelChunk> Model;
@@ -241,9 +242,16 @@ std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw);
 std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place);
 
 /// Maps a whole regular file read-only (nullptr for an empty one); throws
-/// MultiresolutionFileError naming the file. Release with UnmapFile.
-const uint8_t* MapReadOnlyFile(const std::string& path, uint64_t& size);
+/// MultiresolutionFileError naming the file. Release with UnmapFile. With `keep`, the file
+/// stays open and its descriptor is stored there (-1 if none; release with CloseDescriptor),
+/// for CheckMappedSize.
+const uint8_t* MapReadOnlyFile(const std::string& path, uint64_t& size, int* keep = nullptr);
 void UnmapFile(const uint8_t* data, uint64_t size);
+void CloseDescriptor(int& descriptor);
+/// Throws MultiresolutionFileError naming the file if the open file is now shorter than the
+/// `size` bytes mapped: reading a page past its end would kill the process (SIGBUS). Called
+/// before each read of a chunk; a file cut during that read still can.
+void CheckMappedSize(int descriptor, uint64_t size, const std::string& path);
 
 /// CRC-32 (IEEE 802.3) of a byte range, continuing from `crc`.
 uint32_t Crc32(const void* data, std::size_t size, uint32_t crc = 0);

@@ -126,10 +126,11 @@ std::string TableName(const PropertyTable& t)
 PropertyFile::PropertyFile(const std::string& path)
   : FilePath(path)
 {
-  this->Data = MapReadOnlyFile(path, this->Size);
+  this->Data = MapReadOnlyFile(path, this->Size, &this->Descriptor);
   if (this->Size < HeaderBytes + IndexTrailerBytes)
   {
     UnmapFile(this->Data, this->Size);
+    CloseDescriptor(this->Descriptor);
     throw MultiresolutionFileError(path + ": " + std::to_string(this->Size) + " bytes, too short for a property file (truncated?)");
   }
   try
@@ -202,6 +203,7 @@ PropertyFile::PropertyFile(const std::string& path)
   catch (...)
   {
     UnmapFile(this->Data, this->Size);
+    CloseDescriptor(this->Descriptor);
     throw;
   }
 }
@@ -209,6 +211,7 @@ PropertyFile::PropertyFile(const std::string& path)
 PropertyFile::~PropertyFile()
 {
   UnmapFile(this->Data, this->Size);
+  CloseDescriptor(this->Descriptor);
 }
 
 int PropertyFile::Find(const std::string& name, int32_t step) const
@@ -235,6 +238,7 @@ void PropertyFile::CheckGeometry(const MultiresolutionFile& geometry) const
 
 std::vector<float> PropertyFile::ReadValues(const ChunkRef& ref, uint64_t count, const std::string& place) const
 {
+  CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
   const auto raw = DecompressChunk(this->Data, this->Size, ref, place);
   if (raw.size() != count * 4)
   {
@@ -249,7 +253,8 @@ std::vector<float> PropertyFile::ReadPacked(std::size_t table) const
 {
   const PropertyTable& t = this->Entries.at(table);
   const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
-  return this->ReadValues(t.packed, slots, this->FilePath + ": packed table of " + TableName(t));
+  return this->ReadValues(t.packed, slots, this->FilePath + ": packed table of " + TableName(t) + " at byte " +
+    std::to_string(t.packed.offset));
 }
 
 std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
@@ -260,7 +265,8 @@ std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
     throw std::out_of_range(this->FilePath + ": no layer " + std::to_string(k + 1));
   }
   return this->ReadValues(t.layers[static_cast<std::size_t>(k)], static_cast<uint64_t>(this->Dims[0] * this->Dims[1]),
-    this->FilePath + ": layer " + std::to_string(k + 1) + " of " + TableName(t));
+    this->FilePath + ": layer " + std::to_string(k + 1) + " of " + TableName(t) + " at byte " +
+      std::to_string(t.layers[static_cast<std::size_t>(k)].offset));
 }
 
 PropertyFileWriter::PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry)

@@ -71,6 +71,7 @@ private:
   std::string FilePath;
   const uint8_t* Data = nullptr;
   uint64_t Size = 0;
+  int Descriptor = -1; ///< kept open to notice a file cut while mapped
   uint64_t Geometry = 0;
   std::array<int64_t, 3> Dims{};
   std::array<uint32_t, 3> TableSides{};

@@ -123,6 +123,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   std::unique_ptr<resmr::RegionCache> Cache;
   std::string Error;
   std::string LayerError; ///< why Layer cannot be drawn, empty if it can
+  std::string Reported; ///< the last error sent to vtkErrorMacro (each failure once)
   double Bounds[6] = { 0, 0, 0, 0, 0, 0 };
 
   // GPU side.
@@ -343,6 +344,20 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     return; // an empty piece (another rank) or no file yet
   }
 
+  // A file that cannot be drawn is closed, with its error (reported once while it stays the
+  // same); the next frame tries again, so a mended file draws.
+  const auto fail = [&](const std::string& message) {
+    in.Close();
+    in.FilePath = filePath;
+    in.PropertyPath = propertyPath;
+    in.Error = message;
+    if (message != in.Reported)
+    {
+      in.Reported = message;
+      vtkErrorMacro(<< message);
+    }
+  };
+
   // (Re)open the files when the descriptor names others.
   if (filePath != in.FilePath || propertyPath != in.PropertyPath || !in.Cache)
   {
@@ -362,23 +377,17 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
       in.Cache.reset(new resmr::RegionCache(in.File, in.Properties, MainMemoryShare(this->MemoryBudgetMB)));
       in.FilePath = filePath;
       in.PropertyPath = propertyPath;
+      in.Reported.clear();
     }
     catch (const std::exception& error)
     {
-      in.Close();
-      in.FilePath = filePath;
-      in.PropertyPath = propertyPath;
-      if (in.Error != error.what())
-      {
-        in.Error = error.what();
-        vtkErrorMacro(<< in.Error);
-      }
+      fail(error.what());
       return;
     }
   }
   if (!in.Cache)
   {
-    return; // the files failed to open; the error was reported once
+    return;
   }
   resmr::RegionCache& cache = *in.Cache;
   cache.SetBudget(MainMemoryShare(this->MemoryBudgetMB));
@@ -851,6 +860,14 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   vtkOpenGLCheckErrorMacro("after drawing the multiresolution surface");
 
   in.Pending = cache.Pending();
+  // The loader thread's errors (a damaged region or property table: the frame draws what it
+  // can) go to the output window too, each once, not only to the LastError readout.
+  const std::string loadError = cache.LastError();
+  if (!loadError.empty() && loadError != in.Reported)
+  {
+    in.Reported = loadError;
+    vtkErrorMacro(<< loadError);
+  }
   vtkLogF(TRACE, "multiresolution surface: %d regions, %lld triangles at %.2f px", in.Drawn,
     static_cast<long long>(in.Triangles), in.Tolerance);
   const double cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
