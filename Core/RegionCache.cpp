@@ -2,6 +2,12 @@
 // coordinates, and the loader thread with its least-recently-used memory budget.
 #include "RegionCache.h"
 
+#ifdef __linux__
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -774,6 +780,11 @@ void RegionCache::InsertLocked(Key key, std::shared_ptr<const RegionDrawBuffers>
 
 void RegionCache::Run()
 {
+#ifdef __linux__
+  // Below the render thread: decompression must not take the cores a frame (or a software
+  // rasterizer's threads) needs; it uses what the frames leave.
+  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+#endif
   int handedness = 1;
   std::string failure;
   try

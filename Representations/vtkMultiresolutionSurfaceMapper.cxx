@@ -110,6 +110,25 @@ struct GpuRegion
   std::size_t bytes = 0;
   bool ready = false;
 };
+
+/// A region's draw buffers copied into GL buffer objects.
+std::unique_ptr<GpuRegion> UploadRegion(
+  std::shared_ptr<const resmr::RegionDrawBuffers> buffers, vtkShaderProgram* program)
+{
+  auto gpu = std::make_unique<GpuRegion>();
+  gpu->buffers = buffers;
+  if (!buffers->indices.empty())
+  {
+    gpu->layout->Bind();
+    gpu->vertices->Upload(buffers->vertices, vtkOpenGLBufferObject::ArrayBuffer);
+    gpu->indices->Upload(buffers->indices, vtkOpenGLBufferObject::ElementArrayBuffer);
+    gpu->layout->AddAttributeArray(program, gpu->vertices, "vertexPosition", 0, 24, VTK_FLOAT, 3, false);
+    gpu->layout->AddAttributeArray(program, gpu->vertices, "cellCoordinate", 12, 24, VTK_FLOAT, 3, false);
+    gpu->layout->Release();
+  }
+  gpu->bytes = buffers->Bytes();
+  return gpu;
+}
 } // namespace
 
 struct vtkMultiresolutionSurfaceMapper::Internals
@@ -143,6 +162,8 @@ struct vtkMultiresolutionSurfaceMapper::Internals
 
   // View state and readout.
   resmr::FrameRateController Controller;
+  bool ControllerRunning = false; ///< holding a frame rate since the file opened
+  bool UploadsDeferred = false;   ///< loaded meshes wait for the next frame's upload
   bool HavePreviousView = false;
   resmr::ViewParameters PreviousView;
   double Tolerance = 1;
@@ -155,6 +176,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
 
   void Close()
   {
+    this->ControllerRunning = false;
     this->Cache.reset();
     this->Selector.reset();
     this->Properties.reset();
@@ -291,6 +313,12 @@ bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties
   mapAxes = source->GetNumberOfValues() > 3 && source->GetValue(3) == "1";
   return true;
 }
+
+/// Most bytes of meshes copied to the GPU in one interactive frame (see Render).
+constexpr std::size_t UploadBytesPerFrame = std::size_t(16) << 20;
+
+/// Tolerance (pixels) the frame-rate controller starts from.
+constexpr double ControllerStartPixels = 8.0;
 
 /// Projected error (pixels) past which a region's simplified side replaces its exact one.
 constexpr double CoarseSidePixels = 2.0;
@@ -474,6 +502,13 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     : height / (2.0 * std::tan(vtkMath::RadiansFromDegrees(camera->GetViewAngle()) / 2));
   if (this->TargetFrameRate > 0)
   {
+    if (!in.ControllerRunning)
+    {
+      // Start coarse and refine a step a frame: starting fine, the first frames after the
+      // roots would draw whatever detail has loaded before the controller can catch up.
+      in.Controller.Reset(std::max(this->PixelTolerance, ControllerStartPixels));
+      in.ControllerRunning = true;
+    }
     in.Controller.SetTargetFramesPerSecond(this->TargetFrameRate);
     in.Tolerance = in.Controller.Tolerance();
   }
@@ -481,6 +516,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   {
     in.Tolerance = this->PixelTolerance;
     in.Controller.Reset(std::max(this->PixelTolerance, 1.0));
+    in.ControllerRunning = false;
   }
   view.tolerancePixels = in.Tolerance;
 
@@ -560,6 +596,41 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
       vtkErrorMacro(<< in.Error);
     }
     return;
+  }
+  // Uploads, a bounded amount a frame while interacting (the roots and still renders whatever
+  // it takes): a burst of loaded meshes copied in one frame stalled it (76 MB took 100 ms on
+  // llvmpipe). The frame then draws what is on the GPU, ancestors standing in for the rest.
+  {
+    const bool bounded = this->WaitForDetailMs == 0;
+    std::size_t uploaded = 0;
+    in.UploadsDeferred = false;
+    std::vector<std::size_t> order = in.Selector->Roots();
+    order.insert(order.end(), selection.wanted.begin(), selection.wanted.end());
+    const std::size_t roots = in.Selector->Roots().size();
+    for (std::size_t n = 0; n < order.size(); ++n)
+    {
+      const std::size_t region = order[n];
+      if (in.Gpu.count(region))
+      {
+        continue;
+      }
+      std::shared_ptr<const resmr::RegionDrawBuffers> buffers = cache.Get(region);
+      if (!buffers)
+      {
+        continue;
+      }
+      if (bounded && n >= roots && uploaded > 0 && uploaded + buffers->Bytes() > UploadBytesPerFrame)
+      {
+        in.UploadsDeferred = true;
+        break;
+      }
+      auto gpu = UploadRegion(buffers, program);
+      uploaded += gpu->bytes;
+      in.GpuBytes += gpu->bytes;
+      in.Gpu.emplace(region, std::move(gpu));
+    }
+    const auto onGpu = [&in](std::size_t region) { return in.Gpu.count(region) > 0; };
+    selection = in.Selector->Select(view, onGpu);
   }
   const GLuint handle = static_cast<GLuint>(program->GetHandle());
   const auto uniform3i = [handle](const char* name, int a, int b, int c) {
@@ -790,18 +861,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
       {
         continue; // evicted since the selection: its ancestor is not drawn either this frame
       }
-      auto gpu = std::make_unique<GpuRegion>();
-      gpu->buffers = buffers;
-      if (!buffers->indices.empty())
-      {
-        gpu->layout->Bind();
-        gpu->vertices->Upload(buffers->vertices, vtkOpenGLBufferObject::ArrayBuffer);
-        gpu->indices->Upload(buffers->indices, vtkOpenGLBufferObject::ElementArrayBuffer);
-        gpu->layout->AddAttributeArray(program, gpu->vertices, "vertexPosition", 0, 24, VTK_FLOAT, 3, false);
-        gpu->layout->AddAttributeArray(program, gpu->vertices, "cellCoordinate", 12, 24, VTK_FLOAT, 3, false);
-        gpu->layout->Release();
-      }
-      gpu->bytes = buffers->Bytes();
+      auto gpu = UploadRegion(buffers, program);
       in.GpuBytes += gpu->bytes;
       found = in.Gpu.emplace(drawn.region, std::move(gpu)).first;
     }
@@ -859,7 +919,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   }
   vtkOpenGLCheckErrorMacro("after drawing the multiresolution surface");
 
-  in.Pending = cache.Pending();
+  in.Pending = cache.Pending() || in.UploadsDeferred;
   // The loader thread's errors (a damaged region or property table: the frame draws what it
   // can) go to the output window too, each once, not only to the LastError readout.
   const std::string loadError = cache.LastError();
