@@ -26,7 +26,6 @@ import subprocess
 import numpy as np
 from paraview import servermanager, simple
 from vtkmodules.util.numpy_support import vtk_to_numpy
-from vtkmodules.vtkIOImage import vtkPNGReader
 
 import resmr_testing as rt
 
@@ -55,52 +54,12 @@ def models():
 
 
 def capture(view, name):
-    path = os.path.join(temp, name)
-    simple.SaveScreenshot(path, view, ImageResolution=[WIDTH, HEIGHT], TransparentBackground=0)
-    reader = vtkPNGReader()
-    reader.SetFileName(path)
-    reader.Update()
-    image = reader.GetOutput()
-    pixels = vtk_to_numpy(image.GetPointData().GetScalars())[:, :3].astype(np.int64)
-    return pixels.reshape(HEIGHT, WIDTH, 3)
+    return rt.capture_rgb(view, os.path.join(temp, name), WIDTH, HEIGHT)
 
 
-def cell_ids(pixels):
-    """0 for background, else the natural index + 1 the colour encodes."""
-    return pixels[..., 0] + 256 * pixels[..., 1] + 65536 * pixels[..., 2]
-
-
-def erode(mask, steps):
-    out = mask.copy()
-    for _ in range(steps):
-        shrunk = out.copy()
-        shrunk[1:, :] &= out[:-1, :]
-        shrunk[:-1, :] &= out[1:, :]
-        shrunk[:, 1:] &= out[:, :-1]
-        shrunk[:, :-1] &= out[:, 1:]
-        out = shrunk
-    return out
-
-
-def stock_cell_ids(grid_reader, dims):
-    """A ProgrammableFilter giving each cell the RGB of 1 + its natural index."""
-    script = f"""
-import numpy as np
-from vtkmodules.util.numpy_support import vtk_to_numpy, numpy_to_vtk
-data = self.GetInputDataObject(0, 0)
-out = self.GetOutputDataObject(0)
-out.ShallowCopy(data)
-cd = data.GetCellData()
-i = vtk_to_numpy(cd.GetArray('I')).astype(np.int64) - 1
-j = vtk_to_numpy(cd.GetArray('J')).astype(np.int64) - 1
-k = vtk_to_numpy(cd.GetArray('K')).astype(np.int64) - 1
-ids = i + {dims[0]} * (j + {dims[1]} * k) + 1
-rgb = np.stack([ids & 255, (ids >> 8) & 255, (ids >> 16) & 255], axis=1).astype(np.uint8)
-array = numpy_to_vtk(rgb, deep=1)
-array.SetName('CellIdColor')
-out.GetCellData().AddArray(array)
-"""
-    return simple.ProgrammableFilter(Input=grid_reader, Script=script, OutputDataSetType="Same as Input")
+cell_ids = rt.cell_ids
+erode = rt.erode
+stock_cell_ids = rt.stock_cell_id_filter
 
 
 def render_both(stock, ours, bounds, direction, zoom, tag, tolerance):
@@ -120,6 +79,29 @@ def count_holes(expected, got, tolerance):
     """Background pixels of ours deeper than the tolerance inside stock's silhouette."""
     inside = erode(expected > 0, int(np.ceil(tolerance)) + 1)
     return int(np.sum(inside & (got == 0)))
+
+
+def compare_at_zero(reader, ids, expected_bounds, label, tag):
+    """Ours at 0 px in cell ids against stock's `ids`, from above and the side (>= 99.5%, no holes)."""
+    ours = simple.Show(reader, view)
+    ours.PaintBy = "Cell Id"
+    ours.GridLines = 0
+    ours.WaitForDetailMs = 120000
+    ours.PixelTolerance = 0
+    unlit(ours)
+    for camera_name, direction, zoom in (("above", [0.3, -0.5, 0.8], 1.0), ("side", [1.0, -0.3, 0.25], 1.3)):
+        expected, got = render_both(ids, reader, expected_bounds, direction, zoom, f"{tag}-{camera_name}", 0.0)
+        both = (expected > 0) & (got > 0)
+        agree = float(np.mean(expected[both] == got[both])) if both.any() else 0.0
+        holes = count_holes(expected, got, 0.0)
+        print(f"{label} {camera_name} at 0 px: {100 * agree:.2f}% of {int(both.sum())} pixels name the "
+              f"same cell; {holes} holes")
+        if agree < 0.995:
+            failures.append(f"{label} {camera_name}: {100 * agree:.2f}% < 99.5%")
+        if holes > 0:
+            failures.append(f"{label} {camera_name}: {holes} background pixels inside")
+        if not both.any() or both.sum() < 0.05 * WIDTH * HEIGHT:
+            failures.append(f"{label} {camera_name}: model covers too few pixels ({int(both.sum())})")
 
 
 def unlit(display):
@@ -280,25 +262,7 @@ print(f"reek map bounds: largest difference {worst:.2e} of the extent")
 if worst > 1e-6:
     failures.append(f"reek map bounds {got_bounds} differ from EGRIDReader's {expected_bounds} ({worst:.2e} of the extent)")
 simple.Delete(grid_bounds)
-ours = simple.Show(reader, view)
-ours.PaintBy = "Cell Id"
-ours.GridLines = 0
-ours.WaitForDetailMs = 120000
-ours.PixelTolerance = 0
-unlit(ours)
-for camera_name, direction, zoom in (("above", [0.3, -0.5, 0.8], 1.0), ("side", [1.0, -0.3, 0.25], 1.3)):
-    expected, got = render_both(ids, reader, expected_bounds, direction, zoom, f"reek-map-{camera_name}", 0.0)
-    both = (expected > 0) & (got > 0)
-    agree = float(np.mean(expected[both] == got[both])) if both.any() else 0.0
-    holes = count_holes(expected, got, 0.0)
-    print(f"reek map coordinates {camera_name} at 0 px: {100 * agree:.2f}% of {int(both.sum())} pixels name the "
-          f"same cell; {holes} holes")
-    if agree < 0.995:
-        failures.append(f"reek map coordinates {camera_name}: {100 * agree:.2f}% < 99.5%")
-    if holes > 0:
-        failures.append(f"reek map coordinates {camera_name}: {holes} background pixels inside")
-    if not both.any() or both.sum() < 0.05 * WIDTH * HEIGHT:
-        failures.append(f"reek map coordinates {camera_name}: model covers too few pixels ({int(both.sum())})")
+compare_at_zero(reader, ids, expected_bounds, "reek map coordinates", "reek-map")
 for proxy in (ids, reader, stock_reader):
     simple.Delete(proxy)
 
@@ -340,25 +304,7 @@ holds = (np.all(box[[0, 2]] <= active_bounds[[0, 2]] + slack) and np.all(box[[1,
          and np.all(np.abs(box[4:] - active_bounds[4:]) <= slack))
 if not holds:
     failures.append(f"turned MAPAXES: descriptor bounds {got_bounds} do not hold the active cells' {active_bounds}")
-ours = simple.Show(reader, view)
-ours.PaintBy = "Cell Id"
-ours.GridLines = 0
-ours.WaitForDetailMs = 120000
-ours.PixelTolerance = 0
-unlit(ours)
-for camera_name, direction, zoom in (("above", [0.3, -0.5, 0.8], 1.0), ("side", [1.0, -0.3, 0.25], 1.3)):
-    expected, got = render_both(ids, reader, expected_bounds, direction, zoom, f"turned-{camera_name}", 0.0)
-    both = (expected > 0) & (got > 0)
-    agree = float(np.mean(expected[both] == got[both])) if both.any() else 0.0
-    holes = count_holes(expected, got, 0.0)
-    print(f"turned MAPAXES {camera_name} at 0 px: {100 * agree:.2f}% of {int(both.sum())} pixels name the "
-          f"same cell; {holes} holes")
-    if agree < 0.995:
-        failures.append(f"turned MAPAXES {camera_name}: {100 * agree:.2f}% < 99.5%")
-    if holes > 0:
-        failures.append(f"turned MAPAXES {camera_name}: {holes} background pixels inside")
-    if not both.any() or both.sum() < 0.05 * WIDTH * HEIGHT:
-        failures.append(f"turned MAPAXES {camera_name}: model covers too few pixels ({int(both.sum())})")
+compare_at_zero(reader, ids, expected_bounds, "turned MAPAXES", "turned")
 for proxy in (ids, reader, stock_reader):
     simple.Delete(proxy)
 
