@@ -32,14 +32,12 @@ os.makedirs(temp, exist_ok=True)
 WIDTH, HEIGHT = 640, 480
 
 
-def run(*command):
-    subprocess.run([resmr, *command], capture_output=True, text=True, check=True)
+run = rt.run_resmr
+unlit = rt.unlit
 
 
 def models():
-    synthetic = os.path.join(temp, "faulted.EGRID")
-    if not os.path.exists(synthetic):
-        run("synth", "90", "70", "12", "-o", synthetic, "--faults", "6", "--throw", "0.4", "--quiet")
+    synthetic = rt.faulted_synthetic(temp)
     return [
         ("reek", os.path.join(args.data, "reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID")),
         ("faulted", synthetic),
@@ -49,11 +47,6 @@ def models():
 def capture(name):
     return rt.capture_rgb(view, os.path.join(temp, name), WIDTH, HEIGHT)
 
-
-def unlit(display):
-    display.Ambient = 1.0
-    display.Diffuse = 0.0
-    display.Specular = 0.0
 
 
 def stock_layer(source, layer):

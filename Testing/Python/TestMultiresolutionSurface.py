@@ -38,14 +38,12 @@ WIDTH, HEIGHT = 640, 480
 BACKGROUND = [0.0, 0.0, 0.0]
 
 
-def run(*command):
-    subprocess.run([resmr, *command], capture_output=True, text=True, check=True)
+run = rt.run_resmr
+unlit = rt.unlit
 
 
 def models():
-    synthetic = os.path.join(temp, "faulted.EGRID")
-    if not os.path.exists(synthetic):
-        run("synth", "90", "70", "12", "-o", synthetic, "--faults", "6", "--throw", "0.4", "--quiet")
+    synthetic = rt.faulted_synthetic(temp)
     return [
         ("reek", os.path.join(args.data, "reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID")),
         ("brugge", os.path.join(args.data, "brugge/Real0/BRUGGE_0000.EGRID")),
@@ -81,6 +79,20 @@ def count_holes(expected, got, tolerance):
     return int(np.sum(inside & (got == 0)))
 
 
+def show_stock_cell_ids(stock_reader):
+    """Stock ParaView's surface of the reader's grid in the cell-id colouring, unlit, in the
+    view: (the grid fetched, the colouring filter)."""
+    grid = servermanager.Fetch(stock_reader, arg1=None, arg2=None, idx=0)
+    dims = tuple(int(vtk_to_numpy(grid.GetCellData().GetArray(a)).max()) for a in ("I", "J", "K"))
+    ids = stock_cell_ids(stock_reader, dims)
+    stock = simple.Show(ids, view)
+    stock.SetRepresentationType("Surface")
+    simple.ColorBy(stock, ("CELLS", "CellIdColor"))
+    stock.MapScalars = 0
+    unlit(stock)
+    return grid, ids
+
+
 def compare_at_zero(reader, ids, expected_bounds, label, tag):
     """Ours at 0 px in cell ids against stock's `ids`, from above and the side (>= 99.5%, no holes)."""
     ours = simple.Show(reader, view)
@@ -103,11 +115,6 @@ def compare_at_zero(reader, ids, expected_bounds, label, tag):
         if not both.any() or both.sum() < 0.05 * WIDTH * HEIGHT:
             failures.append(f"{label} {camera_name}: model covers too few pixels ({int(both.sum())})")
 
-
-def unlit(display):
-    display.Ambient = 1.0
-    display.Diffuse = 0.0
-    display.Specular = 0.0
 
 
 view = simple.CreateRenderView()
@@ -236,16 +243,9 @@ for name, grid_path in models():
 grid_path = dict(models())["reek"]
 stock_reader = simple.EGRIDReader(FileName=grid_path)
 stock_reader.UpdatePipeline()
-grid = servermanager.Fetch(stock_reader)
 if int(stock_reader.ApplyMapAxes) != 1:
     rt.fail("EGRIDReader does not apply map axes by default")
-dims = tuple(int(vtk_to_numpy(grid.GetCellData().GetArray(a)).max()) for a in ("I", "J", "K"))
-ids = stock_cell_ids(stock_reader, dims)
-stock = simple.Show(ids, view)
-stock.SetRepresentationType("Surface")
-simple.ColorBy(stock, ("CELLS", "CellIdColor"))
-stock.MapScalars = 0
-unlit(stock)
+grid, ids = show_stock_cell_ids(stock_reader)
 reader = simple.OpenDataFile(os.path.join(temp, "reek.resmr"))
 reader.UpdatePipeline()
 expected_bounds = stock_reader.GetDataInformation().GetBounds()
@@ -282,14 +282,7 @@ turned = os.path.join(temp, "turned.resmr")
 run("build", deck, "-o", turned, "--quiet")
 stock_reader = simple.GRDECLReader(FileName=deck)
 stock_reader.UpdatePipeline()
-grid = servermanager.Fetch(stock_reader, arg1=None, arg2=None, idx=0)
-dims = tuple(int(vtk_to_numpy(grid.GetCellData().GetArray(a)).max()) for a in ("I", "J", "K"))
-ids = stock_cell_ids(stock_reader, dims)
-stock = simple.Show(ids, view)
-stock.SetRepresentationType("Surface")
-simple.ColorBy(stock, ("CELLS", "CellIdColor"))
-stock.MapScalars = 0
-unlit(stock)
+grid, ids = show_stock_cell_ids(stock_reader)
 reader = simple.OpenDataFile(turned)
 reader.UpdatePipeline()
 expected_bounds = stock_reader.GetDataInformation().GetBounds()

@@ -186,3 +186,24 @@ out.GetCellData().AddArray(array)
 def fail(message):
     print("FAIL", message)
     sys.exit(1)
+
+
+def run_resmr(*command):
+    """Runs the resmr tool (RESMR_EXECUTABLE) and fails on a non-zero exit."""
+    import subprocess
+    subprocess.run([os.environ["RESMR_EXECUTABLE"], *command], capture_output=True, text=True, check=True)
+
+
+def faulted_synthetic(temp):
+    """The faulted 90 x 70 x 12 synthetic model the image tests share (generated once)."""
+    path = os.path.join(temp, "faulted.EGRID")
+    if not os.path.exists(path):
+        run_resmr("synth", "90", "70", "12", "-o", path, "--faults", "6", "--throw", "0.4", "--quiet")
+    return path
+
+
+def unlit(display):
+    """Ambient light only: colours come out as the lookup table or cell-id colouring gives them."""
+    display.Ambient = 1.0
+    display.Diffuse = 0.0
+    display.Specular = 0.0
