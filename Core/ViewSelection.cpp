@@ -154,8 +154,18 @@ ViewSelector::ViewSelector(const MultiresolutionFile& file)
   this->Nodes.resize(regions.size());
   std::map<std::pair<int32_t, int64_t>, std::size_t> byName;
   int deepest = 0;
+  const double infinity = std::numeric_limits<double>::infinity();
+  this->ModelBox = { infinity, -infinity, infinity, -infinity, infinity, -infinity };
   for (std::size_t r = 0; r < regions.size(); ++r)
   {
+    const auto& b = regions[r].bounds;
+    const double low[3] = { b[0], b[1], -static_cast<double>(b[5]) };
+    const double high[3] = { b[3], b[4], -static_cast<double>(b[2]) };
+    for (int a = 0; a < 3; ++a)
+    {
+      this->ModelBox[2 * a] = std::min(this->ModelBox[2 * a], low[a]);
+      this->ModelBox[2 * a + 1] = std::max(this->ModelBox[2 * a + 1], high[a]);
+    }
     byName[{ regions[r].level, regions[r].index }] = r;
     deepest = std::max(deepest, static_cast<int>(regions[r].level));
     if (regions[r].level == 0)
@@ -321,6 +331,20 @@ ViewSelection ViewSelector::Select(const ViewParameters& view, const std::functi
 
   ViewSelection selection;
   selection.largestProjectedError = actual.largest;
+  if (!view.parallel && !regions.empty())
+  {
+    const auto& box = this->ModelBox;
+    double squared = 0;
+    for (int a = 0; a < 3; ++a)
+    {
+      const double d = std::max({ box[2 * a] - view.eye[a], 0.0, view.eye[a] - box[2 * a + 1] });
+      squared += d * d;
+    }
+    // A margin of a millionth of the box: float bounds, double eye.
+    const double margin =
+      1e-6 * std::max({ box[1] - box[0], box[3] - box[2], box[5] - box[4], std::abs(box[0]), std::abs(box[2]) });
+    selection.backFacesHidden = std::sqrt(squared) > 2 * std::max(view.nearDistance, 0.0) + margin;
+  }
   // Front to back: nearer regions fill the depth buffer first, so the hidden fragments of
   // farther ones fail the early depth test before the (costly) fragment shader runs.
   std::vector<std::pair<double, std::size_t>> nearFirst;

@@ -44,6 +44,7 @@ struct ViewParameters
   /// or anywhere (parallel: viewport height / (2 parallel scale)).
   double pixelsPerUnit = 1;
   double tolerancePixels = 1;
+  double nearDistance = 0; ///< near clipping plane's distance from the eye (world units)
 };
 
 struct DrawnRegion
@@ -62,6 +63,12 @@ struct ViewSelection
   double largestProjectedError = 0;
   /// Drawn regions standing in for wanted descendants that are not resident.
   std::size_t substituted = 0;
+  /// The model's surface is closed and faces outward, so seen from outside its back faces are
+  /// hidden and the renderer may cull them: true when the eye (perspective) is farther from the
+  /// box of every region than twice the near plane (which then cuts no part of the model at
+  /// a field of view below 120 degrees). Seen from inside, or through a near plane cutting the
+  /// model, the back faces are what shows. Parallel projections are never culled.
+  bool backFacesHidden = false;
 };
 
 /// The diamond tree of one file, built once: children and diamond partners of every region.
@@ -85,6 +92,7 @@ private:
   const MultiresolutionFile* File = nullptr;
   std::vector<Node> Nodes;
   std::vector<std::size_t> RootRegions;
+  std::array<double, 6> ModelBox{}; ///< every region's box: xmin, xmax, ymin, ymax, zmin, zmax (z up)
 };
 
 /// Whether a surface of `region` whose normals lie in `cone` (RegionSurface::cone; cosine -2:

@@ -493,6 +493,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     double direction[4] = { 0, 0, 0, 0 }, modelDirection[4];
     camera->GetDirectionOfProjection(direction);
     inverse->MultiplyPoint(direction, modelDirection);
+    view.nearDistance = camera->GetClippingRange()[0] * vtkMath::Norm(modelDirection); // in model units
     vtkMath::Normalize(modelDirection);
     view.direction = { modelDirection[0], modelDirection[1], modelDirection[2] };
   }
@@ -847,7 +848,20 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
 
   state->vtkglEnable(GL_DEPTH_TEST);
   state->vtkglDepthMask(GL_TRUE);
-  state->vtkglDisable(GL_CULL_FACE);
+  // Back faces of the closed surface, hidden from outside, are culled (the bottom seen from
+  // above is about a third of the triangles); a mirroring transform turns the winding.
+  if (selection.backFacesHidden && layer < 0)
+  {
+    const double determinant = vtkMath::Determinant3x3(modelToWorld[0], modelToWorld[1], modelToWorld[2], modelToWorld[4],
+      modelToWorld[5], modelToWorld[6], modelToWorld[8], modelToWorld[9], modelToWorld[10]);
+    state->vtkglEnable(GL_CULL_FACE);
+    state->vtkglCullFace(GL_BACK);
+    glFrontFace(determinant < 0 ? GL_CW : GL_CCW); // restored after drawing (not in vtkOpenGLState)
+  }
+  else
+  {
+    state->vtkglDisable(GL_CULL_FACE);
+  }
   state->vtkglDisable(GL_BLEND);
 
   // Draw.
@@ -906,6 +920,8 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     gpu.layout->Release();
     ++in.Drawn;
   }
+  glFrontFace(GL_CCW);
+  state->vtkglDisable(GL_CULL_FACE);
   in.Substituted = static_cast<int>(selection.substituted);
   in.PropertyTexture->Deactivate();
   in.LayerPropertyTexture->Deactivate();

@@ -35,10 +35,21 @@ uniform float specular;
 uniform float specularPower;
 uniform mat3 normalToView;
 
+// a mod m for 0 <= a < 2^24: the quotient in float, corrected by one either way (a divide
+// may be a reciprocal and a multiply). Integer division has no vector instruction on CPUs
+// (llvmpipe runs it lane by lane) and is slow on GPUs too.
+ivec3 Modulo(ivec3 a, ivec3 m)
+{
+  ivec3 r = a - m * ivec3(floor(vec3(a) / vec3(m)));
+  r += m * ivec3(lessThan(r, ivec3(0)));
+  return r - m * ivec3(greaterThanEqual(r, m));
+}
+
 ivec3 HashSlot(ivec3 cell)
 {
-  ivec3 offset = ivec3(texelFetch(hashOffsets, cell % offsetSides, 0).xyz);
-  return (cell % tableSides + offset) % tableSides;
+  ivec3 offset = ivec3(texelFetch(hashOffsets, Modulo(cell, offsetSides), 0).xyz);
+  ivec3 slot = Modulo(cell, tableSides) + offset; // offsets are below the sides
+  return slot - tableSides * ivec3(greaterThanEqual(slot, tableSides));
 }
 
 vec3 DecodeNormal(uint code)
