@@ -426,21 +426,9 @@ private:
 
 std::unique_ptr<LayerSource> OpenLayerSource(const std::string& input, const std::string& spoolFolder)
 {
-  if (input.rfind("synth:", 0) == 0)
+  if (IsSyntheticSpec(input))
   {
-    SyntheticParameters p;
-    long long nx = 0, ny = 0, nz = 0;
-    unsigned long long seed = 1;
-    if (std::sscanf(input.c_str() + 6, "%lldx%lldx%lld:%llu", &nx, &ny, &nz, &seed) < 3)
-    {
-      throw std::invalid_argument(input + ": expected synth:NIxNJxNK[:SEED]");
-    }
-    p.nx = nx;
-    p.ny = ny;
-    p.nz = nz;
-    p.seed = seed;
-    p.Validate();
-    return std::unique_ptr<LayerSource>(new SyntheticLayerSource(p, input));
+    return std::unique_ptr<LayerSource>(new SyntheticLayerSource(ParseSyntheticSpec(input), input));
   }
   if (LooksLikeEclipseGridFile(input))
   {

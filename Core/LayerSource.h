@@ -83,7 +83,7 @@ private:
 void ReadCornerPointModel(const std::string& path, GrdeclDeck& deck, std::vector<bool>& active);
 
 /// The layers of `input`, streamed whatever the model's size:
-/// - "synth:NIxNJxNK[:SEED]": from the generator;
+/// - "synth:NIxNJxNK[:SEED[:STEPS]]": from the generator (ParseSyntheticSpec);
 /// - an EGRID/FEGRID: COORD read whole, then each layer's ZCORN and ACTNUM read from the file
 ///   as Next() asks for it (EclipseRecordCursor). Checked as ReadEclipseGrid checks; the
 ///   checks of ZCORN's values happen layer by layer;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 
 namespace resmr
 {
@@ -275,17 +276,20 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
   , Dims(geometry.Header().dims)
   , TableSides(geometry.Header().hashTableSides)
 {
-  const auto cells = geometry.ReadModelArray(ModelChunk::HashCells);
   const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
-  if (cells.size() != slots * 8)
+  std::vector<uint64_t> slotCells;
   {
-    throw MultiresolutionFileError(geometry.Path() + ": hash cells hold " + std::to_string(cells.size()) +
-      " bytes for a table of " + std::to_string(slots) + " slots");
+    const auto cells = geometry.ReadModelArray(ModelChunk::HashCells);
+    if (cells.size() != slots * 8)
+    {
+      throw MultiresolutionFileError(geometry.Path() + ": hash cells hold " + std::to_string(cells.size()) +
+        " bytes for a table of " + std::to_string(slots) + " slots");
+    }
+    slotCells.resize(cells.size() / 8);
+    std::memcpy(slotCells.data(), cells.data(), cells.size());
   }
-  this->SlotCells.resize(cells.size() / 8);
-  std::memcpy(this->SlotCells.data(), cells.data(), cells.size());
   const uint64_t total = static_cast<uint64_t>(this->Dims[0] * this->Dims[1] * this->Dims[2]);
-  for (uint64_t cell : this->SlotCells)
+  for (uint64_t cell : slotCells)
   {
     if (cell != ~uint64_t(0) && cell >= total)
     {
@@ -297,7 +301,31 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
   {
     this->Active.push_back(geometry.ReadActiveLayer(k));
   }
-  this->SlotSources = NearestActiveSources(this->SlotCells, this->Active, this->Dims);
+  this->SlotSources = NearestActiveSources(slotCells, this->Active, this->Dims);
+  slotCells = std::vector<uint64_t>();
+  // The slots each layer fills (those whose source lies in it), for tables given by layers.
+  const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
+  this->LayerSlotStart.assign(static_cast<std::size_t>(this->Dims[2]) + 1, 0);
+  for (uint64_t source : this->SlotSources)
+  {
+    if (source != ~uint64_t(0))
+    {
+      ++this->LayerSlotStart[source / layer + 1];
+    }
+  }
+  for (std::size_t k = 1; k < this->LayerSlotStart.size(); ++k)
+  {
+    this->LayerSlotStart[k] += this->LayerSlotStart[k - 1];
+  }
+  this->SlotsByLayer.resize(this->LayerSlotStart.back());
+  std::vector<uint64_t> next(this->LayerSlotStart.begin(), this->LayerSlotStart.end() - 1);
+  for (uint64_t s = 0; s < this->SlotSources.size(); ++s)
+  {
+    if (this->SlotSources[s] != ~uint64_t(0))
+    {
+      this->SlotsByLayer[next[this->SlotSources[s] / layer]++] = s;
+    }
+  }
   // The table count is patched in at Commit.
   const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, 0);
   this->Write(head.data(), head.size(), "header");
@@ -341,47 +369,109 @@ ChunkRef PropertyFileWriter::CopyChunk(const PropertyFile& from, const ChunkRef&
 
 void PropertyFileWriter::Add(PropertyTable table, const std::vector<float>& cellValues)
 {
-  const int64_t nx = this->Dims[0], ny = this->Dims[1], nz = this->Dims[2];
-  if (static_cast<int64_t>(cellValues.size()) != nx * ny * nz)
+  const int64_t layer = this->Dims[0] * this->Dims[1];
+  if (static_cast<int64_t>(cellValues.size()) != layer * this->Dims[2])
   {
     throw std::invalid_argument(this->Output->Path() + ": " + TableName(table) + " has " + std::to_string(cellValues.size()) +
-      " values for " + std::to_string(nx * ny * nz) + " cells");
+      " values for " + std::to_string(layer * this->Dims[2]) + " cells");
   }
+  const std::size_t handle = this->BeginTable(std::move(table));
+  for (int64_t k = 0; k < this->Dims[2]; ++k)
+  {
+    this->AddLayer(handle, cellValues.data() + k * layer);
+  }
+  this->EndTable(handle);
+}
+
+std::size_t PropertyFileWriter::BeginTable(PropertyTable table)
+{
   if (table.name.empty() || table.name.size() >= NameBytes)
   {
     throw std::invalid_argument(this->Output->Path() + ": property name '" + table.name + "' must hold 1 to 31 bytes");
   }
+  OpenTable opened;
+  opened.table = std::move(table);
+  opened.table.layers.clear();
+  opened.low = std::numeric_limits<float>::infinity();
+  opened.high = -opened.low;
+  // Slots without a source (empty, or inactive in a layer with no active cell) stay NaN.
   const float none = std::numeric_limits<float>::quiet_NaN();
-  const auto value = [&](uint64_t cell) {
-    const uint64_t layer = static_cast<uint64_t>(nx * ny);
-    return this->Active[cell / layer][cell % layer] ? cellValues[cell] : none;
-  };
-  float low = std::numeric_limits<float>::infinity(), high = -low;
-  std::vector<uint8_t> raw(static_cast<std::size_t>(nx * ny) * 4);
-  table.layers.clear();
-  for (int64_t k = 0; k < nz; ++k)
+  opened.packed.resize(this->SlotSources.size() * 4);
+  for (std::size_t s = 0; s < this->SlotSources.size(); ++s)
   {
-    for (int64_t c = 0; c < nx * ny; ++c)
+    std::memcpy(&opened.packed[s * 4], &none, 4);
+  }
+  opened.open = true;
+  for (std::size_t handle = 0; handle < this->Open.size(); ++handle)
+  {
+    if (!this->Open[handle].open)
     {
-      const float v = value(static_cast<uint64_t>(k * nx * ny + c));
-      if (!std::isnan(v))
-      {
-        low = std::min(low, v);
-        high = std::max(high, v);
-      }
-      std::memcpy(&raw[static_cast<std::size_t>(c) * 4], &v, 4);
+      this->Open[handle] = std::move(opened);
+      return handle;
     }
-    table.layers.push_back(this->PutChunk(raw, TableName(table) + " layer " + std::to_string(k + 1)));
   }
-  table.minimum = low <= high ? low : none;
-  table.maximum = low <= high ? high : none;
-  raw.assign(this->SlotCells.size() * 4, 0);
-  for (std::size_t s = 0; s < this->SlotCells.size(); ++s)
+  this->Open.push_back(std::move(opened));
+  return this->Open.size() - 1;
+}
+
+PropertyFileWriter::OpenTable& PropertyFileWriter::Opened(std::size_t handle)
+{
+  if (handle >= this->Open.size() || !this->Open[handle].open)
   {
-    const float v = this->SlotSources[s] == ~uint64_t(0) ? none : value(this->SlotSources[s]);
-    std::memcpy(&raw[s * 4], &v, 4);
+    throw std::invalid_argument(this->Output->Path() + ": no open table " + std::to_string(handle));
   }
-  table.packed = this->PutChunk(raw, TableName(table) + " packed table");
+  return this->Open[handle];
+}
+
+void PropertyFileWriter::AddLayer(std::size_t handle, const float* layerValues)
+{
+  OpenTable& t = this->Opened(handle);
+  const int64_t k = static_cast<int64_t>(t.table.layers.size());
+  if (k >= this->Dims[2])
+  {
+    throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) + " given more than its " +
+      std::to_string(this->Dims[2]) + " layers");
+  }
+  const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
+  const std::vector<uint8_t>& active = this->Active[static_cast<std::size_t>(k)];
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  std::vector<uint8_t> raw(static_cast<std::size_t>(layer) * 4);
+  for (uint64_t c = 0; c < layer; ++c)
+  {
+    const float v = active[c] ? layerValues[c] : none;
+    if (!std::isnan(v))
+    {
+      t.low = std::min(t.low, v);
+      t.high = std::max(t.high, v);
+    }
+    std::memcpy(&raw[static_cast<std::size_t>(c) * 4], &v, 4);
+  }
+  t.table.layers.push_back(this->PutChunk(raw, TableName(t.table) + " layer " + std::to_string(k + 1)));
+  for (uint64_t at = this->LayerSlotStart[static_cast<std::size_t>(k)];
+       at < this->LayerSlotStart[static_cast<std::size_t>(k) + 1]; ++at)
+  {
+    const uint64_t s = this->SlotsByLayer[at];
+    const uint64_t c = this->SlotSources[s] % layer;
+    const float v = active[c] ? layerValues[c] : none;
+    std::memcpy(&t.packed[s * 4], &v, 4);
+  }
+}
+
+void PropertyFileWriter::EndTable(std::size_t handle)
+{
+  OpenTable& t = this->Opened(handle);
+  if (static_cast<int64_t>(t.table.layers.size()) != this->Dims[2])
+  {
+    throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) + " ended after " +
+      std::to_string(t.table.layers.size()) + " of its " + std::to_string(this->Dims[2]) + " layers");
+  }
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  PropertyTable table = std::move(t.table);
+  table.minimum = t.low <= t.high ? t.low : none;
+  table.maximum = t.low <= t.high ? t.high : none;
+  table.packed = this->PutChunk(t.packed, TableName(table) + " packed table");
+  t.packed = std::vector<uint8_t>();
+  t.open = false;
   for (auto& old : this->Entries)
   {
     if (old.name == table.name && old.step == table.step)
@@ -419,6 +509,13 @@ void PropertyFileWriter::CopyFrom(const PropertyFile& older)
 
 void PropertyFileWriter::Commit()
 {
+  for (const OpenTable& t : this->Open)
+  {
+    if (t.open)
+    {
+      throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) + " was never ended");
+    }
+  }
   ByteWriter index;
   for (const PropertyTable& t : this->Entries)
   {

@@ -90,6 +90,15 @@ public:
   /// of the nearest active cell of their layer (coarse faces reach over them). Replaces an
   /// earlier table of the same name and step.
   void Add(PropertyTable table, const std::vector<float>& cellValues);
+  /// The same for values that come a layer at a time (a generator's stream), so that no
+  /// whole array is held: BeginTable, then AddLayer for k = 0 .. nz-1 in order, then EndTable
+  /// stores what Add would store from the same values. Several tables may be open at once
+  /// (their layer chunks interleave in the file); each holds its packed table (m0 m1 m2
+  /// values, 4 bytes each) until EndTable. BeginTable returns the table's handle.
+  std::size_t BeginTable(PropertyTable table);
+  /// The next layer of open table `handle`: nx ny values, i fastest.
+  void AddLayer(std::size_t handle, const float* layerValues);
+  void EndTable(std::size_t handle);
   /// Copies every table of `older` (same geometry) that this writer does not hold yet.
   void CopyFrom(const PropertyFile& older);
   /// Writes the index and trailer and renames the file into place.
@@ -97,6 +106,14 @@ public:
   std::size_t TableCount() const { return this->Entries.size(); }
 
 private:
+  struct OpenTable
+  {
+    PropertyTable table;
+    std::vector<uint8_t> packed; ///< m0 m1 m2 floats, filled as the layers come
+    float low = 0, high = 0;     ///< value range so far
+    bool open = false;
+  };
+  OpenTable& Opened(std::size_t handle);
   ChunkRef PutChunk(const std::vector<uint8_t>& raw, const std::string& what);
   ChunkRef CopyChunk(const PropertyFile& from, const ChunkRef& ref);
   void Write(const void* data, std::size_t size, const std::string& what);
@@ -105,9 +122,11 @@ private:
   uint64_t Geometry = 0;
   std::array<int64_t, 3> Dims{};
   std::array<uint32_t, 3> TableSides{};
-  std::vector<uint64_t> SlotCells;         ///< from the geometry
   std::vector<uint64_t> SlotSources;       ///< the cell whose value a slot holds (see Add)
   std::vector<std::vector<uint8_t>> Active; ///< per layer
+  std::vector<uint64_t> LayerSlotStart;    ///< nz + 1: where each layer's slots start below
+  std::vector<uint64_t> SlotsByLayer;      ///< slots with a source, by their source's layer
+  std::vector<OpenTable> Open;
   std::vector<PropertyTable> Entries;
 };
 

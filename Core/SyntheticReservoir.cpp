@@ -7,6 +7,7 @@
 #include "CivilCalendar.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -197,6 +198,68 @@ void SyntheticParameters::Validate() const
   {
     fail("steps must be 0 to 10000 (got " + std::to_string(this->steps) + ")");
   }
+}
+
+bool IsSyntheticSpec(const std::string& text)
+{
+  return text.rfind("synth:", 0) == 0;
+}
+
+SyntheticParameters ParseSyntheticSpec(const std::string& spec)
+{
+  const auto malformed = [&]() {
+    return std::invalid_argument(spec + ": expected synth:NIxNJxNK[:SEED[:STEPS]]");
+  };
+  if (!IsSyntheticSpec(spec))
+  {
+    throw malformed();
+  }
+  const char* at = spec.c_str() + 6;
+  const char* const end = spec.c_str() + spec.size();
+  const auto number = [&](auto& value) {
+    const auto result = std::from_chars(at, end, value);
+    if (result.ec != std::errc() || result.ptr == at)
+    {
+      throw malformed();
+    }
+    at = result.ptr;
+  };
+  const auto expect = [&](char separator) {
+    if (at == end || *at != separator)
+    {
+      throw malformed();
+    }
+    ++at;
+  };
+  SyntheticParameters p;
+  number(p.nx);
+  expect('x');
+  number(p.ny);
+  expect('x');
+  number(p.nz);
+  if (at != end)
+  {
+    expect(':');
+    number(p.seed);
+  }
+  if (at != end)
+  {
+    expect(':');
+    number(p.steps);
+  }
+  if (at != end)
+  {
+    throw malformed();
+  }
+  try
+  {
+    p.Validate();
+  }
+  catch (const std::invalid_argument& error)
+  {
+    throw std::invalid_argument(spec + ": " + error.what());
+  }
+  return p;
 }
 
 void SyntheticStatistics::Add(const SyntheticStatistics& other)

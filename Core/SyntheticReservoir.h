@@ -45,6 +45,15 @@ struct SyntheticParameters
   int64_t CellCount() const { return this->nx * this->ny * this->nz; }
 };
 
+/// Whether `text` names a generated model: "synth:NIxNJxNK[:SEED[:STEPS]]", the input of
+/// resmr build, simplify and add-properties that needs no file.
+bool IsSyntheticSpec(const std::string& text);
+
+/// The parameters a synth: spec names, validated: NI NJ NK cells, SEED (default 1) and STEPS
+/// report steps (default 0; only properties depend on them, never the grid), the rest at their
+/// defaults (those of resmr synth). Throws std::invalid_argument naming the spec if malformed.
+SyntheticParameters ParseSyntheticSpec(const std::string& spec);
+
 /// Why a cell is inactive (or not).
 enum class SyntheticCellState : uint8_t
 {

@@ -5,12 +5,14 @@
 #include "EclipseKeywordWriter.h"
 #include "GrdeclError.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <stdexcept>
 #include <sys/stat.h>
 
 namespace resmr
@@ -58,7 +60,7 @@ SyntheticStatistics EachLayer(const SyntheticReservoir& model, PassCounter& coun
   return stream.Statistics();
 }
 
-std::vector<float> ActiveValues(const SyntheticLayer& layer, const std::vector<float>& values, float scale = 1)
+std::vector<float> ActiveValues(const SyntheticLayer& layer, const std::vector<float>& values)
 {
   std::vector<float> active;
   active.reserve(static_cast<std::size_t>(layer.activeCells));
@@ -66,7 +68,7 @@ std::vector<float> ActiveValues(const SyntheticLayer& layer, const std::vector<f
   {
     if (layer.state[c] == SyntheticCellState::Active)
     {
-      active.push_back(values[c] * scale);
+      active.push_back(values[c]);
     }
   }
   return active;
@@ -126,6 +128,41 @@ void WriteHeaders(EclipseKeywordWriter& out, const SyntheticReservoir& model, in
 }
 } // namespace
 
+const std::vector<SyntheticInitArray>& SyntheticInitArrays()
+{
+  static const std::vector<SyntheticInitArray> arrays = { { "PORV", true }, { "DEPTH", false },
+    { "DX", false }, { "DY", false }, { "DZ", false }, { "PORO", false }, { "PERMX", false },
+    { "PERMY", false }, { "PERMZ", false }, { "NTG", false } };
+  return arrays;
+}
+
+void FillSyntheticInitArray(
+  const SyntheticReservoir& model, std::size_t index, const SyntheticLayer& layer, float* values)
+{
+  const std::size_t cells = layer.state.size();
+  const auto copy = [&](const std::vector<float>& from, float scale) {
+    for (std::size_t c = 0; c < cells; ++c)
+    {
+      values[c] = from[c] * scale;
+    }
+  };
+  const auto fill = [&](double size) { std::fill(values, values + cells, static_cast<float>(size)); };
+  switch (index)
+  {
+    case 0: copy(layer.poreVolume, 1); break;
+    case 1: copy(layer.depth, 1); break;
+    case 2: fill(model.CellSizeX()); break;
+    case 3: fill(model.CellSizeY()); break;
+    case 4: copy(layer.thickness, 1); break;
+    case 5: copy(layer.poro, 1); break;
+    case 6: copy(layer.permx, 1); break;
+    case 7: copy(layer.permx, 1); break; // isotropic in the bedding plane
+    case 8: copy(layer.permx, 0.1f); break;
+    case 9: copy(layer.ntg, 1); break;
+    default: throw std::out_of_range("no synthetic INIT array " + std::to_string(index));
+  }
+}
+
 SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model, const std::string& egridPath,
   const SyntheticProgress& progress)
 {
@@ -142,7 +179,7 @@ SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model, const std
       "), or write GRDECL for an ASCII deck");
   }
   const int64_t nz = p.nz;
-  const int passes = 2 + 10 + 2 * p.steps;
+  const int passes = 2 + static_cast<int>(SyntheticInitArrays().size()) + 2 * p.steps;
   PassCounter counter(progress, passes, nz);
   SyntheticOutput output;
 
@@ -183,34 +220,22 @@ SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model, const std
   const std::string initPath = CompanionPath(egridPath, "INIT");
   EclipseKeywordWriter init(initPath);
   WriteHeaders(init, model, active, SyntheticReservoir::StartDate(), 0.0);
-  init.Begin("PORV", "REAL", p.CellCount());
-  EachLayer(model, counter, [&](const SyntheticLayer& layer) {
-    init.Append(layer.poreVolume.data(), static_cast<int64_t>(layer.poreVolume.size()));
-  });
-  struct ActiveArray
+  std::vector<float> values;
+  for (std::size_t a = 0; a < SyntheticInitArrays().size(); ++a)
   {
-    const char* name;
-    std::vector<float> SyntheticLayer::*values;
-    float scale;
-  };
-  const ActiveArray arrays[] = { { "DEPTH", &SyntheticLayer::depth, 1 }, { "DX", nullptr, 0 },
-    { "DY", nullptr, 1 }, { "DZ", &SyntheticLayer::thickness, 1 }, { "PORO", &SyntheticLayer::poro, 1 },
-    { "PERMX", &SyntheticLayer::permx, 1 }, { "PERMY", &SyntheticLayer::permx, 1 },
-    { "PERMZ", &SyntheticLayer::permx, 0.1f }, { "NTG", &SyntheticLayer::ntg, 1 } };
-  for (const ActiveArray& array : arrays)
-  {
-    init.Begin(array.name, "REAL", active);
+    const SyntheticInitArray& array = SyntheticInitArrays()[a];
+    init.Begin(array.name, "REAL", array.everyCell ? p.CellCount() : active);
     EachLayer(model, counter, [&](const SyntheticLayer& layer) {
-      if (array.values)
+      values.resize(layer.state.size());
+      FillSyntheticInitArray(model, a, layer, values.data());
+      if (array.everyCell)
       {
-        const std::vector<float> values = ActiveValues(layer, layer.*(array.values), array.scale);
         init.Append(values.data(), static_cast<int64_t>(values.size()));
       }
       else
       {
-        const float size = static_cast<float>(array.scale == 0 ? model.CellSizeX() : model.CellSizeY());
-        const std::vector<float> values(static_cast<std::size_t>(layer.activeCells), size);
-        init.Append(values.data(), static_cast<int64_t>(values.size()));
+        const std::vector<float> written = ActiveValues(layer, values);
+        init.Append(written.data(), static_cast<int64_t>(written.size()));
       }
     });
   }

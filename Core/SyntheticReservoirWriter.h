@@ -33,6 +33,22 @@ struct SyntheticOutput
   int64_t bytes = 0;
 };
 
+/// One cell array of the INIT WriteSyntheticEclipse writes.
+struct SyntheticInitArray
+{
+  const char* name;
+  bool everyCell; ///< written for every cell (PORV); the others for active cells only
+};
+
+/// The INIT's cell arrays in file order: PORV, DEPTH, DX, DY, DZ, PORO, PERMX, PERMY, PERMZ,
+/// NTG.
+const std::vector<SyntheticInitArray>& SyntheticInitArrays();
+
+/// Array `index` of SyntheticInitArrays() for every cell of `layer` (nx ny values, i fastest,
+/// inactive cells included): the values the INIT holds for its active cells, bit for bit.
+void FillSyntheticInitArray(
+  const SyntheticReservoir& model, std::size_t index, const SyntheticLayer& layer, float* values);
+
 /// Called with the fraction done, 0 to 1.
 using SyntheticProgress = std::function<void(double)>;
 

@@ -1,5 +1,6 @@
-// resmr add-properties: simulation properties of every step into a property file beside the
-// geometry (paper Sec. 5.5: one hierarchy serves every simulation of the same grid).
+// resmr add-properties: simulation properties of every step (or a generated model's) into a
+// property file beside the geometry (paper Sec. 5.5: one hierarchy serves every simulation of
+// the same grid).
 #include "ResmrCommands.h"
 
 #include "EclipseGrid.h"
@@ -7,9 +8,13 @@
 #include "GrdeclParser.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
+#include "SyntheticReservoir.h"
+#include "SyntheticReservoirWriter.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -22,8 +27,11 @@ const char* AddPropertiesUsage =
   "usage: resmr add-properties FILE.resmr RESULTS... [-o FILE.resmrp]\n"
   "  RESULTS: an EGRID (its INIT and restart companions are found by name: every INIT\n"
   "           array and every array of every report step), an INIT or a UNRST/restart file\n"
-  "           beside its EGRID (only that file's arrays), or a GRDECL/DATA deck (its cell\n"
-  "           arrays other than geometry)\n"
+  "           beside its EGRID (only that file's arrays), a GRDECL/DATA deck (its cell\n"
+  "           arrays other than geometry), or synth:NIxNJxNK[:SEED[:STEPS]]: the arrays of\n"
+  "           the INIT (and, with STEPS, the UNRST of that many report steps) that\n"
+  "           resmr synth NI NJ NK --seed SEED --steps STEPS would write, streamed from the\n"
+  "           generator layer by layer (no file; any size, beyond an EGRID's 268M cells)\n"
   "  -o FILE  property file (default: FILE.resmrp beside FILE.resmr); tables it already\n"
   "           holds are kept unless replaced (same name and step). The .resmr file is only\n"
   "           read, never written.\n";
@@ -63,6 +71,118 @@ std::string GridBeside(const std::string& path)
     }
   }
   throw std::invalid_argument(path + ": no EGRID beside it (" + stem + ".EGRID): its active cells are needed to place the values");
+}
+
+/// The properties of the generated model `spec` names, as the INIT (and UNRST) resmr synth
+/// writes for it hold them (the same SyntheticInitArrays and FillStep), streamed: each pass of
+/// the generator gives a group of tables layer by layer. A table held open keeps its packed
+/// table (4 bytes a hash slot) until its last layer, so a group holds as many tables as fit
+/// in one whole array (4 bytes a cell; at least one): memory never exceeds what a file input
+/// needs, and no whole array is held. Every layer's active cells must be the geometry's.
+/// Returns the generator passes made.
+int AddSyntheticProperties(const std::string& spec, const resmr::MultiresolutionFile& geometry,
+  resmr::PropertyFileWriter& writer, const std::function<void(const resmr::PropertyTable&)>& added)
+{
+  const resmr::SyntheticParameters parameters = resmr::ParseSyntheticSpec(spec);
+  const auto& h = geometry.Header();
+  if (parameters.nx != h.dims[0] || parameters.ny != h.dims[1] || parameters.nz != h.dims[2])
+  {
+    throw std::invalid_argument(spec + ": grid " + std::to_string(parameters.nx) + "x" + std::to_string(parameters.ny) +
+      "x" + std::to_string(parameters.nz) + " is not the grid of " + geometry.Path());
+  }
+  const resmr::SyntheticReservoir model(parameters);
+  const auto& arrays = resmr::SyntheticInitArrays();
+  // Every table, in the order of an add-properties of the files: the INIT's arrays, then
+  // PRESSURE and SWAT of each step (array -1).
+  struct Job
+  {
+    int array = -1;
+    int step = 0;
+    bool pressure = false;
+  };
+  std::vector<Job> jobs;
+  for (std::size_t a = 0; a < arrays.size(); ++a)
+  {
+    jobs.push_back({ static_cast<int>(a), 0, false });
+  }
+  for (int step = 1; step <= parameters.steps; ++step)
+  {
+    jobs.push_back({ -1, step, true });
+    jobs.push_back({ -1, step, false });
+  }
+  const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
+  const uint64_t cells = static_cast<uint64_t>(parameters.CellCount());
+  const std::size_t group = static_cast<std::size_t>(std::max<uint64_t>(1, slots > 0 ? cells / slots : jobs.size()));
+
+  std::vector<float> values, pressure, swat;
+  int passes = 0;
+  for (std::size_t first = 0; first < jobs.size(); first += group)
+  {
+    const std::size_t last = std::min(jobs.size(), first + group);
+    std::vector<resmr::PropertyTable> tables;
+    std::vector<std::size_t> handles;
+    for (std::size_t j = first; j < last; ++j)
+    {
+      resmr::PropertyTable table;
+      if (jobs[j].array >= 0)
+      {
+        table.name = arrays[static_cast<std::size_t>(jobs[j].array)].name;
+      }
+      else
+      {
+        table.name = jobs[j].pressure ? "PRESSURE" : "SWAT";
+        table.step = jobs[j].step - 1;
+        table.reportNumber = jobs[j].step;
+        table.days = model.StepDays(jobs[j].step);
+      }
+      tables.push_back(table);
+      handles.push_back(writer.BeginTable(std::move(table)));
+    }
+    resmr::SyntheticLayerStream stream(model);
+    resmr::SyntheticLayer layer;
+    while (stream.Next(layer))
+    {
+      if (passes == 0)
+      {
+        const std::vector<uint8_t> active = geometry.ReadActiveLayer(layer.k);
+        for (std::size_t c = 0; c < layer.state.size(); ++c)
+        {
+          if ((layer.state[c] == resmr::SyntheticCellState::Active) != (c < active.size() && active[c] != 0))
+          {
+            throw std::invalid_argument(spec + ": the active cells of layer " + std::to_string(layer.k + 1) +
+              " differ from those of " + geometry.Path() + ": another model (seed?)");
+          }
+        }
+      }
+      values.resize(layer.state.size());
+      pressure.resize(layer.state.size());
+      swat.resize(layer.state.size());
+      int filledStep = 0; // the step whose PRESSURE and SWAT this layer's buffers hold
+      for (std::size_t j = first; j < last; ++j)
+      {
+        const Job& job = jobs[j];
+        if (job.array >= 0)
+        {
+          resmr::FillSyntheticInitArray(model, static_cast<std::size_t>(job.array), layer, values.data());
+          writer.AddLayer(handles[j - first], values.data());
+          continue;
+        }
+        if (filledStep != job.step)
+        {
+          model.FillStep(job.step, layer, pressure.data(), swat.data());
+          filledStep = job.step;
+        }
+        writer.AddLayer(handles[j - first], job.pressure ? pressure.data() : swat.data());
+      }
+    }
+    ++passes;
+    for (std::size_t t = 0; t < handles.size(); ++t)
+    {
+      writer.EndTable(handles[t]);
+      added(tables[t]);
+    }
+  }
+  return passes;
 }
 
 /// The geometry's active cells per layer, to check that results belong to this grid.
@@ -131,17 +251,27 @@ int AddPropertiesCommand(int argc, char** argv)
       older->CheckGeometry(geometry);
     }
     resmr::PropertyFileWriter writer(output, geometry);
-    std::vector<float> values(static_cast<std::size_t>(cells));
+    std::vector<float> values; // one whole array, for file inputs only
     const float none = std::numeric_limits<float>::quiet_NaN();
     int64_t added = 0;
-    const auto add = [&](resmr::PropertyTable table) {
-      writer.Add(table, values);
+    int generatorPasses = 0;
+    const auto report = [&](const resmr::PropertyTable& table) {
       ++added;
       std::fprintf(stderr, "resmr add-properties: %s%s\n", table.name.c_str(),
         table.step < 0 ? "" : (" step " + std::to_string(table.step) + " (report " + std::to_string(table.reportNumber) + ")").c_str());
     };
+    const auto add = [&](resmr::PropertyTable table) {
+      writer.Add(table, values);
+      report(table);
+    };
     for (const std::string& input : inputs)
     {
+      if (resmr::IsSyntheticSpec(input))
+      {
+        generatorPasses += AddSyntheticProperties(input, geometry, writer, report);
+        continue;
+      }
+      values.resize(static_cast<std::size_t>(cells));
       const std::string ext = Extension(input);
       const bool isInit = ext == "INIT" || ext == "FINIT";
       const bool isRestart = ext == "UNRST" || ext == "FUNRST" || (ext.size() == 5 && (ext[0] == 'X' || ext[0] == 'F') &&
@@ -231,8 +361,9 @@ int AddPropertiesCommand(int argc, char** argv)
       writer.CopyFrom(*older);
     }
     writer.Commit();
-    std::printf("{\"geometry\": \"%s\", \"properties\": \"%s\", \"tables_added\": %lld, \"tables\": %zu}\n",
-      geometryPath.c_str(), output.c_str(), static_cast<long long>(added), writer.TableCount());
+    std::printf("{\"geometry\": \"%s\", \"properties\": \"%s\", \"tables_added\": %lld, \"tables\": %zu, "
+                "\"generator_passes\": %d}\n",
+      geometryPath.c_str(), output.c_str(), static_cast<long long>(added), writer.TableCount(), generatorPasses);
     return 0;
   }
   catch (const std::exception& error)

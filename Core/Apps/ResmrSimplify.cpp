@@ -27,7 +27,7 @@ namespace
 {
 const char* SimplifyUsage =
   "usage: resmr simplify MODEL [--fraction F | --columns N | --uniform B] [--seed S] [--no-hausdorff]\n"
-  "  MODEL: an EGRID, a GRDECL/DATA deck, or synth:NXxNYxNZ[:SEED] (generated in memory)\n"
+  "  MODEL: an EGRID, a GRDECL/DATA deck, or synth:NIxNJxNK[:SEED] (generated in memory)\n"
   "  --fraction F   keep this fraction of the columns (default 0.1)\n"
   "  --columns N    keep N columns\n"
   "  --candidates N random candidates weighed per collapse (default 8, as the paper)\n"
@@ -47,20 +47,9 @@ struct Model
 Model Load(const std::string& source)
 {
   Model model;
-  if (source.rfind("synth:", 0) == 0)
+  if (resmr::IsSyntheticSpec(source))
   {
-    resmr::SyntheticParameters p;
-    unsigned long long seed = 1;
-    long long nx = 0, ny = 0, nz = 0;
-    const int read = std::sscanf(source.c_str() + 6, "%lldx%lldx%lld:%llu", &nx, &ny, &nz, &seed);
-    if (read < 3)
-    {
-      throw std::invalid_argument(source + ": expected synth:NXxNYxNZ[:SEED]");
-    }
-    p.nx = nx;
-    p.ny = ny;
-    p.nz = nz;
-    p.seed = seed;
+    const resmr::SyntheticParameters p = resmr::ParseSyntheticSpec(source);
     const resmr::SyntheticReservoir reservoir(p);
     model.deck.dims = { p.nx, p.ny, p.nz };
     model.deck.coord = reservoir.Coord();
