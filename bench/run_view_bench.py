@@ -49,6 +49,9 @@ def rss_mb():
     return 0.0
 
 
+EGRID_MAX_CELLS = 268435455  # ZCORN's 8 values a cell must fit an ECLIPSE keyword's 32-bit count
+
+
 def prepare(model):
     """(grid file or None, .resmr path, cells)."""
     if model in REAL:
@@ -58,12 +61,19 @@ def prepare(model):
         nx, ny, nz = (int(v) for v in model.split(":")[1].split("x"))
         grid = os.path.join(args.scratch, f"synth_{nx}x{ny}x{nz}.EGRID")
         path = os.path.join(args.scratch, f"synth_{nx}x{ny}x{nz}.resmr")
-        if not os.path.exists(grid):
+        if nx * ny * nz > EGRID_MAX_CELLS:
+            # Too large for an EGRID: the generator streams straight into the builder and the
+            # property file (seed 1, as resmr synth's default).
+            grid = None
+            source = f"synth:{nx}x{ny}x{nz}:1"
+        elif not os.path.exists(grid):
             subprocess.run([args.resmr, "synth", str(nx), str(ny), str(nz), "-o", grid, "--quiet"], check=True,
                            stdout=subprocess.DEVNULL)
     if not os.path.exists(path):
-        subprocess.run([args.resmr, "build", grid, "-o", path, "--quiet"], check=True, stdout=subprocess.DEVNULL)
-        subprocess.run([args.resmr, "add-properties", path, grid], check=True, stdout=subprocess.DEVNULL)
+        subprocess.run([args.resmr, "build", grid or source, "-o", path, "--quiet"], check=True,
+                       stdout=subprocess.DEVNULL)
+    if not os.path.exists(path + "p"):
+        subprocess.run([args.resmr, "add-properties", path, grid or source], check=True, stdout=subprocess.DEVNULL)
     return grid, path
 
 
@@ -190,7 +200,7 @@ for model in args.models:
     simple.Delete(reader)
     simple.Delete(view)
     cells = cell_count(model)
-    if args.stock and grid and cells is not None and cells > args.stock_max_cells:
+    if args.stock and cells is not None and cells > args.stock_max_cells:
         entry["stock_skipped"] = (f"{cells / 1e6:.0f}M cells need about {cells * 330 / 2**30:.0f} GB in stock "
                                   f"ParaView; this machine has {results['machine']['memory_gb']} GB")
         print("  stock: " + entry["stock_skipped"], flush=True)
