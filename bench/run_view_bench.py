@@ -152,40 +152,38 @@ def cell_count(model):
 results = {"machine": {"cpu": cpu_name(), "cores": os.cpu_count(), "memory_gb": memory_gb(),
                        "renderer": "Mesa llvmpipe (no GPU)"},
            "fps_target": args.fps, "frames": args.frames, "budget_mb": args.budget, "models": []}
-# ParaView's own cost of a frame at this size (a 64-triangle sphere): what a frame costs
-# before any model is drawn.
+
+
+def sphere_frame_ms(view, theta, phi, zoom=None):
+    """Median time of 50 frames of stock ParaView showing a sphere of 2 theta (phi - 2)
+    triangles, turning a degree a frame."""
+    sphere = simple.Sphere(ThetaResolution=theta, PhiResolution=phi)
+    simple.Show(sphere, view)
+    if zoom:
+        view.ResetCamera(False)
+        view.GetActiveCamera().Zoom(zoom)
+    simple.Render(view)
+    times = []
+    for _ in range(50):
+        view.GetActiveCamera().Azimuth(1)
+        start = time.perf_counter()
+        simple.Render(view)
+        times.append(time.perf_counter() - start)
+    simple.Delete(sphere)
+    return 1000 * percentile(times, 50)
+
+
+# ParaView's own cost of a frame at this size: with a 64-triangle sphere, what a frame costs
+# before any model is drawn; with a 118,800-triangle sphere filling most of the view, what this
+# renderer takes for about as many triangles as the multiresolution model's coarsest views.
 view = simple.CreateRenderView()
 view.ViewSize = [1280, 720]
 view.OrientationAxesVisibility = 0
-sphere = simple.Sphere(ThetaResolution=8, PhiResolution=8)
-simple.Show(sphere, view)
-simple.Render(view)
-empty_times = []
-for _ in range(50):
-    view.GetActiveCamera().Azimuth(1)
-    start = time.perf_counter()
-    simple.Render(view)
-    empty_times.append(time.perf_counter() - start)
-results["empty_frame_ms"] = 1000 * percentile(empty_times, 50)
+results["empty_frame_ms"] = sphere_frame_ms(view, 8, 8)
 print(f"ParaView's frame with a 64-triangle sphere at 1280x720: {results['empty_frame_ms']:.0f} ms", flush=True)
-simple.Delete(sphere)
-# And with a 119k-triangle sphere filling most of the view, stock Surface: what this renderer
-# takes for about as many triangles as the multiresolution model's coarsest views.
-sphere = simple.Sphere(ThetaResolution=300, PhiResolution=200)
-simple.Show(sphere, view)
-view.ResetCamera(False)
-view.GetActiveCamera().Zoom(1.5)
-simple.Render(view)
-dense_times = []
-for _ in range(50):
-    view.GetActiveCamera().Azimuth(1)
-    start = time.perf_counter()
-    simple.Render(view)
-    dense_times.append(time.perf_counter() - start)
-results["dense_sphere_frame_ms"] = 1000 * percentile(dense_times, 50)
+results["dense_sphere_frame_ms"] = sphere_frame_ms(view, 300, 200, zoom=1.5)
 print(f"ParaView's frame with a 118,800-triangle sphere at 1280x720: {results['dense_sphere_frame_ms']:.0f} ms",
       flush=True)
-simple.Delete(sphere)
 simple.Delete(view)
 
 for model in args.models:
