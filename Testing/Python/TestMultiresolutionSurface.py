@@ -136,17 +136,7 @@ for name, grid_path in models():
     # Grid coordinates on both sides (ApplyMapAxes=0); map coordinates are checked on Reek below.
     stock_reader = simple.EGRIDReader(FileName=grid_path, ApplyMapAxes=0)
     stock_reader.UpdatePipeline()
-    grid = servermanager.Fetch(stock_reader)
-    i = vtk_to_numpy(grid.GetCellData().GetArray("I"))
-    j = vtk_to_numpy(grid.GetCellData().GetArray("J"))
-    k = vtk_to_numpy(grid.GetCellData().GetArray("K"))
-    dims = (int(i.max()), int(j.max()), int(k.max()))
-    ids = stock_cell_ids(stock_reader, dims)
-    stock = simple.Show(ids, view)
-    stock.SetRepresentationType("Surface")
-    simple.ColorBy(stock, ("CELLS", "CellIdColor"))
-    stock.MapScalars = 0
-    unlit(stock)
+    grid, ids = show_stock_cell_ids(stock_reader)
 
     reader = simple.OpenDataFile(resmr_path)
     reader.ApplyMapAxes = 0
