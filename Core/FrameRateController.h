@@ -8,7 +8,10 @@
 //   proportion (the 99th percentile matters more than the mean); faster ones lower it
 //   gently, and only while the frame time leaves a margin (below 80% of the target), so the
 //   tolerance does not oscillate around the target.
-// - The tolerance stays within [MinimumPixels, MaximumPixels].
+// - The tolerance stays within [MinimumPixels, MaximumPixels]. The maximum is far above any
+//   picture one wants: the bound projects each region's largest error at its box's point
+//   nearest the eye, so in a low flight the roots' bound is thousands of pixels, and a
+//   smaller cap (256 px once) left the controller stuck with a million triangles in view.
 // - Tolerance grows as frame time to the power 1/2: triangles drawn go as about 1 / tol^2
 //   for surfaces (screen-space error bounds a linear size).
 #pragma once
@@ -20,7 +23,7 @@ class FrameRateController
 {
 public:
   static constexpr double MinimumPixels = 0.5;
-  static constexpr double MaximumPixels = 256;
+  static constexpr double MaximumPixels = 65536;
 
   void SetTargetFramesPerSecond(double fps) { this->TargetSeconds = fps > 0 ? 1.0 / fps : 0.1; }
   double TargetFramesPerSecond() const { return 1.0 / this->TargetSeconds; }

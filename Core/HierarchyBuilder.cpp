@@ -184,11 +184,15 @@ std::vector<uint8_t> KeptCells(const std::vector<uint8_t>& perCell, const std::v
   return out;
 }
 
-RegionMesh ToRegionMesh(const ScratchRegion& region, double sideError)
+RegionMesh ToRegionMesh(
+  const ScratchRegion& region, const MultiresolutionHeader& header, float ownError, double sideError)
 {
   RegionMesh out;
   out.layers = region.mesh.layers;
   out.positions = region.mesh.positions;
+  // What readers will decode: pinch-outs are sealed by thickness, and a run the builder seals
+  // must be the one every reader seals.
+  RoundToLattice(out.positions, header);
   out.topology.resize(region.mesh.topology.size());
   for (std::size_t n = 0; n < out.topology.size(); ++n)
   {
@@ -205,6 +209,7 @@ RegionMesh ToRegionMesh(const ScratchRegion& region, double sideError)
   out.active = region.mesh.activeCells;
   out.cutEdges = region.cutEdges;
   out.openSides = region.openSides;
+  out.sealedPinchThickness = ownError;
   ExtractSurfaces(out);
   // Sec. 4.3: side faces simplified up to the error of the hexahedral mesh they bound.
   out.sideTriangles = SimplifySideSurface(out, sideError);
@@ -444,6 +449,10 @@ void MarkTouchedCells(const RegionMesh& mesh, const std::array<int64_t, 3>& dims
   {
     mark(t.data(), 3, 2);
   }
+  for (const auto& q : mesh.side.quads)
+  {
+    mark(q.data(), 4, 2);
+  }
 }
 
 class Builder
@@ -591,7 +600,8 @@ void Builder::Emit(int level, int64_t index, const ScratchRegion& region, bool k
   record.ownError = static_cast<float>(ownError);
   // The file rounds positions to its lattice after simplification: allow one step more.
   const auto& step = this->Header.latticeStep;
-  const RegionMesh mesh = ToRegionMesh(region, ownError + std::sqrt(step[0] * step[0] + step[1] * step[1] + step[2] * step[2]));
+  const RegionMesh mesh = ToRegionMesh(region, this->Header, level == this->Header.leafLevel ? 0.f : record.ownError,
+    ownError + std::sqrt(step[0] * step[0] + step[1] * step[1] + step[2] * step[2]));
   this->Chunks->AddRegion(mesh, this->Header, record);
   std::lock_guard<std::mutex> guard(this->RecordLock);
   this->Records[{ level, index }] = record;
@@ -1135,7 +1145,8 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
   this->Phase = "property side";
   ParallelFor(static_cast<int64_t>(keys.size()), threads, [&](int64_t n) {
     const auto& key = keys[static_cast<std::size_t>(n)];
-    const RegionMesh mesh = parts[static_cast<std::size_t>(this->Parts[key])]->ReadRegion(this->Records[key], header);
+    RegionMesh mesh = parts[static_cast<std::size_t>(this->Parts[key])]->ReadRegion(this->Records[key], header);
+    ExtractSurfaces(mesh); // the exact side faces, which views draw for regions of small error
     MarkTouchedCells(mesh, dims, touched);
     this->Report(this->Phase, 0.95 + 0.03 * static_cast<double>(n + 1) / static_cast<double>(keys.size()));
   });

@@ -67,6 +67,22 @@ int32_t Quantise(double value, double origin, double step)
   return static_cast<int32_t>(q);
 }
 
+} // namespace
+
+void RoundToLattice(std::vector<double>& positions, const MultiresolutionHeader& header)
+{
+  for (std::size_t i = 0; i < positions.size(); ++i)
+  {
+    const int axis = static_cast<int>(i % 3);
+    // As the decoder computes it, so the builder sees the bits every reader sees.
+    positions[i] = header.latticeOrigin[axis] +
+      Quantise(positions[i], header.latticeOrigin[axis], header.latticeStep[axis]) * header.latticeStep[axis];
+  }
+}
+
+namespace
+{
+
 /// Positions as lattice integers, each stored as its difference from a prediction: x and y
 /// continue the straight line of the two vertices above (pillars are straight lines, so the
 /// difference is 0 or +-1), depth repeats the one above (the difference is the layer's
@@ -211,6 +227,8 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
       " nodes, " + std::to_string(columns) + " columns disagree with the index");
   }
   mesh.layers = static_cast<int32_t>(layers);
+  // The stored surfaces were extracted with this rule; readers extract them again.
+  mesh.sealedPinchThickness = header.version >= 5 && record.level != header.leafLevel ? record.ownError : 0;
   if (static_cast<uint64_t>(nodes) * 8 > in.Left())
   {
     throw MultiresolutionFileError(in.Where() + ": " + std::to_string(nodes) + " nodes do not fit in the chunk");

@@ -2,7 +2,8 @@
 // LZO-compressed one chunk each and concatenated, with an index of offsets, sizes, bounding
 // volumes, errors and normal cones, laid out for memory mapping.
 //
-// Layout (little-endian), version 4:
+// Layout (little-endian), version 5 (the same as 4; from 5 on, the builder seals pinched-out
+// runs when it extracts surfaces and readers must too, see RegionMesh.h):
 //   header (256 bytes, CRC-32 at its end): magic, version, grid dimensions, hierarchy box,
 //     position lattice, leaf level, Cmax, region and model-chunk counts, perfect-hash sizes,
 //     geometry id, then the input's map placement (flags, MAPAXES' 6 values, MAPUNITS and
@@ -47,7 +48,7 @@ namespace resmr
 
 struct MultiresolutionHeader
 {
-  static constexpr uint32_t Version = 4;
+  static constexpr uint32_t Version = 5;
   static constexpr uint32_t OldestVersion = 3; ///< older files are refused
   uint32_t version = Version;                  ///< the file's, when read
   std::array<int64_t, 3> dims{};
@@ -121,6 +122,10 @@ struct ModelChunk
 
 /// Position lattice for a model of this extent (x, y, depth min and max).
 void ChooseLattice(const std::array<double, 6>& extent, MultiresolutionHeader& header);
+
+/// Positions (x, y, depth triples) moved to the nearest points of the header's lattice, the
+/// very values ReadRegion() gives back for them; throws std::invalid_argument off the lattice.
+void RoundToLattice(std::vector<double>& positions, const MultiresolutionHeader& header);
 
 /// Bytes of one piece of a long model array (HashCells, CellNormals).
 constexpr std::size_t ModelPieceBytes = std::size_t(1) << 28;

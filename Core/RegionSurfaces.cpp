@@ -67,6 +67,57 @@ void AddSide(const RegionMesh& mesh, std::size_t column, int edge, int32_t layer
   surface.quads.push_back({ mesh.Vertex(a, layer), mesh.Vertex(a, layer + 1), mesh.Vertex(b, layer + 1), mesh.Vertex(b, layer) });
 }
 
+/// Cells of the pinched-out runs to seal (see RegionMesh.h), one flag a cell: inactive runs
+/// between two active cells of the column, no thicker than the region's error at any corner,
+/// in columns without a cut edge (so that two regions always agree on the faces between them).
+std::vector<uint8_t> SealedCells(const RegionMesh& mesh)
+{
+  const std::size_t layers = static_cast<std::size_t>(mesh.layers);
+  std::vector<uint8_t> sealed(mesh.corners.size() * layers, 0);
+  if (!(mesh.sealedPinchThickness > 0))
+  {
+    return sealed;
+  }
+  const auto depth = [&](uint32_t node, std::size_t interface) {
+    return mesh.positions[static_cast<std::size_t>(mesh.Vertex(node, static_cast<int32_t>(interface))) * 3 + 2];
+  };
+  for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+  {
+    if (mesh.cutEdges[c])
+    {
+      continue;
+    }
+    const uint8_t* active = &mesh.active[c * layers];
+    for (std::size_t k = 1; k + 1 < layers; ++k)
+    {
+      if (active[k] || !active[k - 1])
+      {
+        continue;
+      }
+      std::size_t end = k; // one past the run
+      while (end < layers && !active[end])
+      {
+        ++end;
+      }
+      if (end < layers)
+      {
+        double thickest = 0;
+        for (const uint32_t node : mesh.corners[c])
+        {
+          const double thickness = depth(node, end) - depth(node, k);
+          thickest = std::isfinite(thickness) ? std::max(thickest, thickness) : HUGE_VAL;
+        }
+        if (thickest <= mesh.sealedPinchThickness)
+        {
+          std::fill(&sealed[c * layers + k], &sealed[c * layers + end], uint8_t(1));
+        }
+      }
+      k = end;
+    }
+  }
+  return sealed;
+}
+
 void ComputeCone(const RegionMesh& mesh, RegionSurface& surface)
 {
   std::vector<glm::dvec3> normals;
@@ -146,26 +197,35 @@ void ExtractSurfaces(RegionMesh& mesh)
   mesh.side = {};
   const int orientation = RegionOrientation(mesh);
   const int32_t layers = mesh.layers;
+  const std::vector<uint8_t> sealed = SealedCells(mesh);
+  const bool sealing = std::find(sealed.begin(), sealed.end(), 1) != sealed.end();
+  const auto across = sealing ? EdgeNeighbours(mesh) : std::vector<std::array<int64_t, 4>>{};
   for (std::size_t c = 0; c < mesh.corners.size(); ++c)
   {
-    const uint8_t* active = &mesh.active[c * static_cast<std::size_t>(layers)];
+    const std::size_t cells = c * static_cast<std::size_t>(layers);
+    const uint8_t* active = &mesh.active[cells];
     for (int32_t k = 0; k < layers; ++k)
     {
-      if (!active[k])
+      if (!active[k] && !sealed[cells + k])
       {
         continue;
       }
-      if (k == 0 || !active[k - 1])
+      if (active[k] && (k == 0 || !(active[k - 1] || sealed[cells + k - 1])))
       {
         AddTopBottom(mesh, c, k, true, orientation, mesh.top);
       }
-      if (k == layers - 1 || !active[k + 1])
+      if (active[k] && (k == layers - 1 || !(active[k + 1] || sealed[cells + k + 1])))
       {
         AddTopBottom(mesh, c, k + 1, false, orientation, mesh.bottom);
       }
       for (int e = 0; e < 4; ++e)
       {
-        if (mesh.openSides[c * static_cast<std::size_t>(layers) + k] & (1u << e))
+        // Solid across (a sealed cell, or for a sealed cell an active one): the face is
+        // inside. No cell next to a cut edge is sealed, on either side of it.
+        const bool open = mesh.openSides[cells + k] & (1u << e);
+        const int64_t other = sealing ? across[c][e] : -1;
+        const bool solidAcross = other >= 0 && sealed[static_cast<std::size_t>(other) * layers + k];
+        if (open && !solidAcross)
         {
           AddSide(mesh, c, e, k, orientation, mesh.side);
         }

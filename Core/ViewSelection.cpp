@@ -66,7 +66,9 @@ double Distance(const RegionRecord& record, const std::array<double, 3>& eye)
 }
 
 /// Lindstrom's bound: the apparent size in pixels of a sphere of radius `error` at the point of
-/// the box nearest the eye. An error of 0 projects to 0 even from inside the box.
+/// the box nearest the eye, but no nearer than the near clipping plane: nothing nearer is
+/// drawn, so a box around the eye (a low flight over a dipping region, a camera inside the
+/// model) need not be refined to its leaves. An error of 0 projects to 0 even from inside.
 double ProjectedError(const RegionRecord& record, const ViewParameters& view)
 {
   const double error = record.error;
@@ -78,7 +80,7 @@ double ProjectedError(const RegionRecord& record, const ViewParameters& view)
   {
     return error * view.pixelsPerUnit;
   }
-  const double d = Distance(record, view.eye);
+  const double d = std::max(Distance(record, view.eye), std::max(view.nearDistance, 0.0));
   return d > 0 ? error * view.pixelsPerUnit / d : std::numeric_limits<double>::infinity();
 }
 

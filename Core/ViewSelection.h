@@ -10,8 +10,8 @@
 // - Projected error of a diamond: its model-space error e (RegionRecord::error, the same for
 //   both triangles, never smaller than a descendant's) seen as a sphere of radius e at the
 //   point of the diamond's bounding box nearest the eye: pixels = e * PixelsPerUnit / d,
-//   d = that distance (perspective; infinite when the eye is inside the box), or
-//   e * PixelsPerUnit (parallel projection).
+//   d = that distance but at least nearDistance, since nothing nearer than the near plane is
+//   drawn (perspective; infinite when both are 0), or e * PixelsPerUnit (parallel).
 // - Conformity: a diamond is split only when every triangle of it is in the cut and all of
 //   their children (absent regions are empty and count as resident) are resident. Bounding
 //   boxes enclose every descendant, so projected errors never grow down the tree and the cut

@@ -724,10 +724,10 @@ void TestMapAxesInFile()
   // Versions this build does not know are refused by number.
   writeBytes(withVersion(2));
   resmr_testing::ExpectError<MultiresolutionFileError>("version 2", [&] { MultiresolutionFile f(damaged); },
-    { damaged, "format version 2", "versions 3 to 4", "resmr build" });
-  writeBytes(withVersion(5));
+    { damaged, "format version 2", "versions 3 to 5", "resmr build" });
+  writeBytes(withVersion(6));
   resmr_testing::ExpectError<MultiresolutionFileError>(
-    "version 5", [&] { MultiresolutionFile f(damaged); }, { damaged, "format version 5", "newer" });
+    "version 6", [&] { MultiresolutionFile f(damaged); }, { damaged, "format version 6", "newer" });
   // A placement that cannot be right, under a good checksum, is named; a flipped byte there
   // fails the checksum.
   std::string broken = bytes;

@@ -434,11 +434,80 @@ void TestHierarchies()
   const Measured& above = levels.at(leaf - 1);
   CHECK(above.output <= 0.6 * above.input);
 }
+
+/// Every edge of the quads used once each way (by position), so the surface is closed.
+bool Closed(const RegionMesh& mesh)
+{
+  std::map<std::pair<std::array<double, 3>, std::array<double, 3>>, int> balance;
+  const auto at = [&](uint32_t v) {
+    const double* p = &mesh.positions[static_cast<std::size_t>(v) * 3];
+    return std::array<double, 3>{ p[0], p[1], p[2] };
+  };
+  for (const RegionSurface* surface : { &mesh.top, &mesh.bottom, &mesh.side })
+  {
+    for (const auto& q : surface->quads)
+    {
+      for (int v = 0; v < 4; ++v)
+      {
+        const auto a = at(q[v]), b = at(q[(v + 1) % 4]);
+        if (a != b)
+        {
+          a < b ? ++balance[{ a, b }] : --balance[{ b, a }];
+        }
+      }
+    }
+  }
+  return std::all_of(balance.begin(), balance.end(), [](const auto& e) { return e.second == 0; });
+}
+
+void TestSealedPinchOuts()
+{
+  // Two columns of three layers; the middle layer is inactive and 5 mm thick (layer 1's
+  // interfaces moved together), the outer ones active.
+  RegionMesh mesh = Block(2, 1, 3, 0, 0);
+  for (std::size_t v = 0; v < mesh.positions.size() / 3; ++v)
+  {
+    const int k = static_cast<int>(v % 4);
+    if (k >= 2)
+    {
+      mesh.positions[v * 3 + 2] -= 3.0 - 0.005;
+    }
+  }
+  for (std::size_t c = 0; c < 2; ++c)
+  {
+    mesh.active[c * 3 + 1] = 0;
+  }
+  ComputeOpenSides(mesh);
+  const auto extract = [&](double thickness, uint8_t cutOfSecond) {
+    mesh.sealedPinchThickness = thickness;
+    mesh.cutEdges = { 0, cutOfSecond };
+    ExtractSurfaces(mesh);
+    return std::array<std::size_t, 3>{ mesh.top.quads.size(), mesh.bottom.quads.size(), mesh.side.quads.size() };
+  };
+  // Unsealed: both active cells of a column show their top and bottom, and 3 open sides each.
+  CHECK((extract(0, 0) == std::array<std::size_t, 3>{ 4, 4, 12 }));
+  CHECK(Closed(mesh));
+  CHECK((extract(0.004, 0) == std::array<std::size_t, 3>{ 4, 4, 12 })); // thicker than allowed
+  // Sealed: one top and one bottom a column; the thin run's own outer sides close the gap.
+  CHECK((extract(0.01, 0) == std::array<std::size_t, 3>{ 2, 2, 18 }));
+  CHECK(Closed(mesh));
+  // A column with a cut edge is never sealed (the region across decides for its cells): the
+  // first column's sealed cell then shows a side to the second's open run.
+  CHECK((extract(0.01, 1) == std::array<std::size_t, 3>{ 3, 3, 16 }));
+  CHECK(Closed(mesh));
+  // A thin run at the top of a column is the model's surface, never sealed: the first
+  // column's top is its third layer's.
+  mesh.active[0] = 0;
+  ComputeOpenSides(mesh);
+  CHECK((extract(0.01, 0) == std::array<std::size_t, 3>{ 2, 2, 3 + 4 + 4 + 3 }));
+  CHECK(Closed(mesh));
+}
 } // namespace
 
 int main()
 {
   TestHandBuilt();
+  TestSealedPinchOuts();
   TestHierarchies();
   if (resmr_testing::Failures)
   {
