@@ -10,6 +10,7 @@
 
 #include "ConformalCut.h"
 #include "DiamondHierarchy.h"
+#include "FrameRateController.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
 #include "RegionCache.h"
@@ -1145,6 +1146,42 @@ void TestLayerCache(const std::string& path)
     "resident\n", budget, wholeLeft, leaves.size(), layerLeaves, small.ResidentBytes());
   CHECK(layerLeaves == leaves.size() && wholeLeft < leaves.size() && small.ResidentBytes() <= budget);
 }
+/// The controller against a modelled renderer whose frame costs fixed + work / tolerance^2
+/// seconds (triangles fall as the square of the tolerance).
+void TestFrameRateController()
+{
+  const auto run = [](double fixed, double work, double startPixels, int frames, double& worst) {
+    FrameRateController controller;
+    controller.SetTargetFramesPerSecond(10);
+    controller.Reset(startPixels);
+    worst = 0;
+    for (int f = 0; f < frames; ++f)
+    {
+      const double pixels = controller.Tolerance();
+      const double seconds = fixed + work / (pixels * pixels);
+      if (f >= 20)
+      {
+        worst = std::max(worst, seconds);
+      }
+      controller.Update(seconds);
+    }
+    return controller.Tolerance();
+  };
+  double worst = 0;
+  // Reachable: after a few frames every frame is within the target, and not far below it.
+  const double settled = run(0.03, 0.5, 1, 200, worst);
+  std::printf("  controller: settled at %.2f px, slowest frame after 20 %.3f s\n", settled, worst);
+  CHECK(worst <= 0.1 && settled < 10);
+  // A view far heavier than the old 256 px cap allowed (a low flight over kilometre errors):
+  // the tolerance keeps rising until the target holds.
+  const double heavy = run(0.03, 2e4, 8, 200, worst);
+  std::printf("  controller, heavy view: %.0f px, slowest frame after 20 %.3f s\n", heavy, worst);
+  CHECK(heavy > 256 && heavy <= FrameRateController::MaximumPixels && worst <= 0.1);
+  // Back to a light view from the heaviest tolerance: down to the minimum within 100 frames.
+  CHECK(run(0.01, 1e-6, FrameRateController::MaximumPixels, 100, worst) == FrameRateController::MinimumPixels);
+  // A renderer slower than the target at any tolerance: the tolerance stops at the maximum.
+  CHECK(run(0.2, 1, 1, 100, worst) == FrameRateController::MaximumPixels);
+}
 } // namespace
 
 int main(int argc, char** argv)
@@ -1200,6 +1237,7 @@ int main(int argc, char** argv)
           TestBackFaces(*m);
       } },
     { "Prediction", [&] { TestPrediction(); } },
+    { "FrameRateController", [&] { TestFrameRateController(); } },
     { "DrawBuffers",
       [&] {
         TestDrawBuffers(reek, 0);
