@@ -1146,6 +1146,7 @@ void TestLayerCache(const std::string& path)
     "resident\n", budget, wholeLeft, leaves.size(), layerLeaves, small.ResidentBytes());
   CHECK(layerLeaves == leaves.size() && wholeLeft < leaves.size() && small.ResidentBytes() <= budget);
 }
+
 /// The controller against a modelled renderer whose frame costs fixed + work / tolerance^2
 /// seconds (triangles fall as the square of the tolerance).
 void TestFrameRateController()
