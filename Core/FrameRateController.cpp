@@ -18,15 +18,17 @@ double FrameRateController::Update(double frameSeconds)
   {
     return this->Pixels;
   }
+  // Frame times jitter by a fifth from frame to frame (loads, uploads, the system), so the
+  // tolerance is held where frames take 60-85% of the target, and the slow tail stays inside it.
   const double ratio = frameSeconds / this->TargetSeconds;
   double factor = 1;
-  if (ratio > 1)
+  if (ratio > HighFraction)
   {
-    factor = std::min(4.0, std::sqrt(ratio) * 1.1); // over budget: back off now, with margin
+    factor = std::min(4.0, std::sqrt(ratio / AimFraction)); // near or over budget: back off now
   }
-  else if (ratio < 0.8)
+  else if (ratio < LowFraction)
   {
-    factor = std::max(0.8, std::sqrt(ratio / 0.8)); // headroom: refine a step at a time
+    factor = std::max(0.8, std::sqrt(ratio / AimFraction)); // headroom: refine a step at a time
   }
   this->Pixels = std::clamp(this->Pixels * factor, MinimumPixels, MaximumPixels);
   return this->Pixels;

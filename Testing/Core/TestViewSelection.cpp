@@ -1169,15 +1169,19 @@ void TestFrameRateController()
     return controller.Tolerance();
   };
   double worst = 0;
-  // Reachable: after a few frames every frame is within the target, and not far below it.
+  // Reachable: after a few frames every frame is within the band's top (85% of the target, a
+  // margin for the jitter a real renderer adds), and not far below it.
+  const double band = FrameRateController::HighFraction * 0.1;
   const double settled = run(0.03, 0.5, 1, 200, worst);
-  std::printf("  controller: settled at %.2f px, slowest frame after 20 %.3f s\n", settled, worst);
-  CHECK(worst <= 0.1 && settled < 10);
+  const double settledSeconds = 0.03 + 0.5 / (settled * settled);
+  std::printf("  controller: settled at %.2f px (%.3f s a frame), slowest frame after 20 %.3f s\n", settled,
+    settledSeconds, worst);
+  CHECK(worst <= band && settledSeconds >= FrameRateController::LowFraction * 0.1);
   // A view far heavier than the old 256 px cap allowed (a low flight over kilometre errors):
   // the tolerance keeps rising until the target holds.
   const double heavy = run(0.03, 2e4, 8, 200, worst);
   std::printf("  controller, heavy view: %.0f px, slowest frame after 20 %.3f s\n", heavy, worst);
-  CHECK(heavy > 256 && heavy <= FrameRateController::MaximumPixels && worst <= 0.1);
+  CHECK(heavy > 256 && heavy <= FrameRateController::MaximumPixels && worst <= band);
   // Back to a light view from the heaviest tolerance: down to the minimum within 100 frames.
   CHECK(run(0.01, 1e-6, FrameRateController::MaximumPixels, 100, worst) == FrameRateController::MinimumPixels);
   // A renderer slower than the target at any tolerance: the tolerance stops at the maximum.
