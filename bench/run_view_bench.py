@@ -294,6 +294,7 @@ try:
     axes[0].axhline(1000 / args.fps, color="k", linestyle="--", linewidth=0.8)
     axes[0].set_ylabel("frame ms")
     axes[1].set_ylabel("tolerance px")
+    axes[1].set_yscale("log")
     axes[1].set_xlabel("frame of the path")
     axes[0].legend()
     figure.savefig(args.out + ".png", dpi=100)
