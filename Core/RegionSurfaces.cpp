@@ -74,7 +74,8 @@ std::vector<uint8_t> SealedCells(const RegionMesh& mesh)
 {
   const std::size_t layers = static_cast<std::size_t>(mesh.layers);
   std::vector<uint8_t> sealed(mesh.corners.size() * layers, 0);
-  if (!(mesh.sealedPinchThickness > 0))
+  if (!(mesh.sealedPinchThickness > 0) || mesh.cutEdges.size() != mesh.corners.size() ||
+    mesh.openSides.size() != sealed.size())
   {
     return sealed;
   }
