@@ -12,7 +12,7 @@ void FrameRateController::Reset(double tolerancePixels)
   this->Pixels = std::clamp(tolerancePixels, MinimumPixels, MaximumPixels);
 }
 
-double FrameRateController::Update(double frameSeconds)
+double FrameRateController::Update(double frameSeconds, bool complete)
 {
   if (!(frameSeconds > 0) || !std::isfinite(frameSeconds))
   {
@@ -26,7 +26,7 @@ double FrameRateController::Update(double frameSeconds)
   {
     factor = std::min(4.0, std::sqrt(ratio / AimFraction)); // near or over budget: back off now
   }
-  else if (ratio < LowFraction)
+  else if (ratio < LowFraction && complete)
   {
     factor = std::max(0.8, std::sqrt(ratio / AimFraction)); // headroom: refine a step at a time
   }

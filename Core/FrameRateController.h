@@ -12,6 +12,10 @@
 //   picture one wants: the bound projects each region's largest error at its box's point
 //   nearest the eye, so in a low flight the roots' bound is thousands of pixels, and a
 //   smaller cap (256 px once) left the controller stuck with a million triangles in view.
+// - A frame that drew ancestors in place of meshes still loading (complete = false) does not
+//   lower the tolerance: its time says nothing of the detail wanted, and refining on it ran the
+//   tolerance down to the minimum while a model's first meshes loaded, then the arriving
+//   meshes slowed a dozen frames past the target. Slow incomplete frames still raise it.
 // - Tolerance grows as frame time to the power 1/2: triangles drawn go as about 1 / tol^2
 //   for surfaces (screen-space error bounds a linear size).
 #pragma once
@@ -32,8 +36,9 @@ public:
   double TargetFramesPerSecond() const { return 1.0 / this->TargetSeconds; }
   void Reset(double tolerancePixels);
   double Tolerance() const { return this->Pixels; }
-  /// The tolerance for the next frame, from the time the last one took.
-  double Update(double frameSeconds);
+  /// The tolerance for the next frame, from the time the last one took and whether it drew
+  /// all the detail the tolerance selected.
+  double Update(double frameSeconds, bool complete = true);
 
 private:
   double TargetSeconds = 0.1;

@@ -28,6 +28,7 @@
 #include "vtkRenderer.h"
 #include "vtkScalarsToColors.h"
 #include "vtkShaderProgram.h"
+#include "vtkSmartPointer.h"
 #include "vtkStringArray.h"
 #include "vtkTextureObject.h"
 #include "vtk_glew.h"
@@ -129,6 +130,99 @@ std::unique_ptr<GpuRegion> UploadRegion(
   gpu->bytes = buffers->Bytes();
   return gpu;
 }
+
+/// A 3D table texture filled a slab of z-slices at a time (glTexSubImage3D) into a texture of
+/// its own, which replaces the one drawn only once complete: copied in one call, a 300M-cell
+/// model's tables (hundreds of MB) stalled a frame for about a second on llvmpipe.
+class SlabUpload
+{
+public:
+  /// Allocates the texture and takes the table (x fastest, then y, then z); `owner` keeps the
+  /// table alive until the copy ends.
+  void Start(vtkOpenGLRenderWindow* window, const std::array<uint32_t, 3>& sides, int components, int vtkType,
+    unsigned int internalFormat, unsigned int format, unsigned int type, std::size_t texelBytes, const void* data,
+    std::shared_ptr<const void> owner)
+  {
+    this->Texture = vtkSmartPointer<vtkTextureObject>::New();
+    this->Texture->SetContext(window);
+    this->Texture->ResetFormatAndType();
+    if (internalFormat != 0)
+    {
+      this->Texture->SetInternalFormat(internalFormat);
+    }
+    this->Texture->SetFormat(format);
+    this->Texture->SetDataType(type);
+    this->Texture->SetMinificationFilter(vtkTextureObject::Nearest);
+    this->Texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    this->Texture->Create3DFromRaw(sides[0], sides[1], sides[2], components, vtkType, nullptr); // storage only
+    this->Sides = sides;
+    this->Format = format;
+    this->Type = type;
+    this->SliceBytes = std::size_t(sides[0]) * sides[1] * texelBytes;
+    this->Data = static_cast<const unsigned char*>(data);
+    this->Keeper = std::move(owner);
+    this->NextSlice = 0;
+  }
+
+  bool Busy() const { return this->Texture != nullptr; }
+  /// The table being copied (null when idle).
+  const void* Source() const { return this->Keeper.get(); }
+
+  /// Copies whole slices while `budget` (bytes, spent here) lasts, at least one if any budget
+  /// is left, or all of them when `unbounded`. True when the texture is complete.
+  bool Continue(vtkOpenGLState* state, std::size_t& budget, bool unbounded)
+  {
+    const uint32_t left = this->Sides[2] - this->NextSlice;
+    if (left == 0 || (!unbounded && budget == 0))
+    {
+      return left == 0;
+    }
+    uint32_t slices = left;
+    if (!unbounded && this->SliceBytes > 0)
+    {
+      slices = static_cast<uint32_t>(std::min<std::size_t>(std::max<std::size_t>(budget / this->SliceBytes, 1), left));
+    }
+    {
+      state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      this->Texture->Activate();
+      glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, static_cast<GLint>(this->NextSlice), static_cast<GLsizei>(this->Sides[0]),
+        static_cast<GLsizei>(this->Sides[1]), static_cast<GLsizei>(slices), this->Format, this->Type,
+        this->Data + this->NextSlice * this->SliceBytes);
+      this->Texture->Deactivate();
+      this->NextSlice += slices;
+      budget -= std::min(budget, slices * this->SliceBytes);
+    }
+    return this->NextSlice == this->Sides[2];
+  }
+
+  /// The complete texture (the upload is then idle).
+  vtkSmartPointer<vtkTextureObject> Take()
+  {
+    vtkSmartPointer<vtkTextureObject> texture = this->Texture;
+    this->Cancel(nullptr);
+    return texture;
+  }
+
+  void Cancel(vtkWindow* window)
+  {
+    if (this->Texture && window)
+    {
+      this->Texture->ReleaseGraphicsResources(window);
+    }
+    this->Texture = nullptr;
+    this->Keeper.reset();
+    this->Data = nullptr;
+  }
+
+private:
+  vtkSmartPointer<vtkTextureObject> Texture;
+  std::array<uint32_t, 3> Sides{};
+  unsigned int Format = 0, Type = 0;
+  std::size_t SliceBytes = 0;
+  const unsigned char* Data = nullptr;
+  std::shared_ptr<const void> Keeper;
+  uint32_t NextSlice = 0;
+};
 } // namespace
 
 struct vtkMultiresolutionSurfaceMapper::Internals
@@ -148,10 +242,15 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   // GPU side.
   std::map<std::size_t, std::unique_ptr<GpuRegion>> Gpu;
   std::size_t GpuBytes = 0;
-  vtkNew<vtkTextureObject> OffsetTexture, NormalTexture, PropertyTexture, ColorTexture;
+  vtkSmartPointer<vtkTextureObject> OffsetTexture = vtkSmartPointer<vtkTextureObject>::New();
+  vtkSmartPointer<vtkTextureObject> NormalTexture = vtkSmartPointer<vtkTextureObject>::New();
+  vtkSmartPointer<vtkTextureObject> PropertyTexture = vtkSmartPointer<vtkTextureObject>::New();
+  vtkNew<vtkTextureObject> ColorTexture;
   vtkNew<vtkTextureObject> LayerPropertyTexture; ///< nx x ny R32F: one layer's table
   bool HashUploaded = false;
   std::shared_ptr<const resmr::PropertyTableData> UploadedProperty;
+  // Tables being copied a slab a frame (see SlabUpload).
+  SlabUpload OffsetUpload, NormalUpload, PropertyUpload;
   vtkMTimeType ColorTableTime = 0;
   vtkScalarsToColors* ColorTable = nullptr;
   double ColorRange[2] = { 0, 1 };
@@ -185,6 +284,14 @@ struct vtkMultiresolutionSurfaceMapper::Internals
     this->PropertyPath.clear();
     this->HashUploaded = false;
     this->UploadedProperty.reset();
+    this->CancelUploads();
+  }
+
+  void CancelUploads()
+  {
+    this->OffsetUpload.Cancel(this->Window);
+    this->NormalUpload.Cancel(this->Window);
+    this->PropertyUpload.Cancel(this->Window);
   }
 
   void ReleaseGpu()
@@ -199,6 +306,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
     this->GpuBytes = 0;
     this->HashUploaded = false;
     this->UploadedProperty.reset();
+    this->CancelUploads();
     this->ColorTableTime = 0;
   }
 };
@@ -314,8 +422,10 @@ bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties
   return true;
 }
 
-/// Most bytes of meshes copied to the GPU in one interactive frame (see Render).
+/// Most bytes copied to the GPU in one interactive frame (see Render), and the part of it the
+/// model's tables may take while they are being copied.
 constexpr std::size_t UploadBytesPerFrame = std::size_t(16) << 20;
+constexpr std::size_t TableBytesPerFrame = std::size_t(8) << 20;
 
 /// Tolerance (pixels) the frame-rate controller starts from.
 constexpr double ControllerStartPixels = 8.0;
@@ -601,9 +711,112 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   // Uploads, a bounded amount a frame while interacting (the roots and still renders whatever
   // it takes): a burst of loaded meshes copied in one frame stalled it (76 MB took 100 ms on
   // llvmpipe). The frame then draws what is on the GPU, ancestors standing in for the rest.
+  // The model's tables go first, a few slabs a frame, so meshes and tables both progress.
+  const bool bounded = this->WaitForDetailMs == 0;
+  std::size_t tableBudget = TableBytesPerFrame;
+
+  // Model tables: the hash's offsets and the cells' normals (once a file, when the loader has
+  // read them), the property table when another is current, the colour map when the lookup
+  // table changes. Until the hash is in, the whole model is drawn in the solid colour, lit by
+  // facet normals, with 1-texel stand-ins for the samplers.
+  if (in.OffsetTexture->GetHandle() == 0)
   {
-    const bool bounded = this->WaitForDetailMs == 0;
-    std::size_t uploaded = 0;
+    state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    const std::array<uint32_t, 3> one{ 1, 1, 1 };
+    const uint16_t zeros[3] = { 0, 0, 0 };
+    UploadInteger3D(in.OffsetTexture, window, one, 3, GL_RGB16UI, GL_RGB_INTEGER, zeros);
+    UploadInteger3D(in.NormalTexture, window, one, 2, GL_RG16UI, GL_RG_INTEGER, zeros);
+  }
+  if (!in.HashUploaded)
+  {
+    const std::shared_ptr<const resmr::ModelTables> tables = cache.Tables();
+    if (tables && !in.OffsetUpload.Busy() && !in.NormalUpload.Busy())
+    {
+      const resmr::PerfectSpatialHash& hash = tables->hash;
+      in.OffsetUpload.Start(window, hash.offsetSides, 3, VTK_UNSIGNED_SHORT, GL_RGB16UI, GL_RGB_INTEGER,
+        GL_UNSIGNED_SHORT, 6, hash.offsets.data(), tables);
+      if (tables->normals.size() == hash.TableSize() * 4)
+      {
+        in.NormalUpload.Start(window, hash.tableSides, 2, VTK_UNSIGNED_SHORT, GL_RG16UI, GL_RG_INTEGER,
+          GL_UNSIGNED_SHORT, 4, tables->normals.data(), tables);
+      }
+      else
+      {
+        auto up = std::make_shared<std::vector<uint16_t>>(hash.TableSize() * 2, 0); // code 0 is +z
+        in.NormalUpload.Start(window, hash.tableSides, 2, VTK_UNSIGNED_SHORT, GL_RG16UI, GL_RG_INTEGER,
+          GL_UNSIGNED_SHORT, 4, up->data(), up);
+      }
+    }
+    if (in.OffsetUpload.Busy() && in.OffsetUpload.Continue(state, tableBudget, !bounded) &&
+      in.NormalUpload.Continue(state, tableBudget, !bounded))
+    {
+      in.OffsetTexture->ReleaseGraphicsResources(window);
+      in.NormalTexture->ReleaseGraphicsResources(window);
+      in.OffsetTexture = in.OffsetUpload.Take();
+      in.NormalTexture = in.NormalUpload.Take();
+      in.HashUploaded = true;
+    }
+  }
+  if (in.PropertyTexture->GetHandle() == 0)
+  {
+    // Until a property loads, every sampler still needs a texture of its type.
+    float none = std::numeric_limits<float>::quiet_NaN();
+    in.PropertyTexture->SetContext(window);
+    in.PropertyTexture->Create3DFromRaw(1, 1, 1, 1, VTK_FLOAT, &none);
+    in.LayerPropertyTexture->SetContext(window);
+    in.LayerPropertyTexture->Create2DFromRaw(1, 1, 1, VTK_FLOAT, &none);
+    unsigned char white[4] = { 255, 255, 255, 255 };
+    in.ColorTexture->SetContext(window);
+    in.ColorTexture->Create2DFromRaw(1, 1, 4, VTK_UNSIGNED_CHAR, white);
+  }
+  std::shared_ptr<const resmr::PropertyTableData> loaded = wantProperty ? cache.Property() : nullptr;
+  if (loaded && (loaded->name != this->ArrayName || loaded->step != tableStep || loaded->layer != layer))
+  {
+    loaded.reset(); // still the previous property
+  }
+  if (!loaded || loaded->layer >= 0 || in.PropertyUpload.Source() != loaded.get())
+  {
+    in.PropertyUpload.Cancel(window); // another table is wanted now
+  }
+  if (loaded && loaded != in.UploadedProperty && loaded->layer >= 0)
+  {
+    // A layer's table is a 2D texture of nx x ny, indexed by (i, j): no hash (Sec. 5.4); at
+    // most a few MB, copied at once.
+    state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    in.LayerPropertyTexture->SetContext(window);
+    in.LayerPropertyTexture->ResetFormatAndType();
+    in.LayerPropertyTexture->SetMinificationFilter(vtkTextureObject::Nearest);
+    in.LayerPropertyTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    in.LayerPropertyTexture->Create2DFromRaw(static_cast<unsigned int>(header.dims[0]),
+      static_cast<unsigned int>(header.dims[1]), 1, VTK_FLOAT, const_cast<float*>(loaded->values.data()));
+    in.UploadedProperty = loaded;
+  }
+  else if (loaded && loaded != in.UploadedProperty)
+  {
+    if (!in.PropertyUpload.Busy())
+    {
+      in.PropertyUpload.Start(window, header.hashTableSides, 1, VTK_FLOAT, 0, GL_RED, GL_FLOAT, sizeof(float),
+        loaded->values.data(), loaded);
+    }
+    if (in.PropertyUpload.Continue(state, tableBudget, !bounded))
+    {
+      in.PropertyTexture->ReleaseGraphicsResources(window);
+      in.PropertyTexture = in.PropertyUpload.Take();
+      in.UploadedProperty = loaded;
+    }
+  }
+  // The table drawn: the wanted one once on the GPU; until then an earlier time step of the
+  // same property and layer stands in (as an ancestor does for a mesh), anything else is
+  // drawn in the solid colour rather than through another property's colour map.
+  std::shared_ptr<const resmr::PropertyTableData> property = in.UploadedProperty;
+  if (!wantProperty || !property || property->name != this->ArrayName || property->layer != layer)
+  {
+    property.reset();
+  }
+
+  // Meshes, with what the tables left of the frame's upload budget.
+  {
+    std::size_t uploaded = TableBytesPerFrame - tableBudget;
     in.UploadsDeferred = false;
     std::vector<std::size_t> order = in.Selector->Roots();
     order.insert(order.end(), selection.wanted.begin(), selection.wanted.end());
@@ -630,6 +843,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
       in.GpuBytes += gpu->bytes;
       in.Gpu.emplace(region, std::move(gpu));
     }
+    in.UploadsDeferred = in.UploadsDeferred || in.OffsetUpload.Busy() || in.PropertyUpload.Busy();
     const auto onGpu = [&in](std::size_t region) { return in.Gpu.count(region) > 0; };
     selection = in.Selector->Select(view, onGpu);
   }
@@ -637,79 +851,6 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   const auto uniform3i = [handle](const char* name, int a, int b, int c) {
     glUniform3i(glGetUniformLocation(handle, name), a, b, c);
   };
-
-  // Model tables: the hash's offsets and the cells' normals (once a file, when the loader has
-  // read them), the property table when another is current, the colour map when the lookup
-  // table changes. Until the hash is in, the whole model is drawn in the solid colour, lit by
-  // facet normals, with 1-texel stand-ins for the samplers.
-  if (!in.HashUploaded)
-  {
-    state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    const std::shared_ptr<const resmr::ModelTables> tables = cache.Tables();
-    if (tables)
-    {
-      const resmr::PerfectSpatialHash& hash = tables->hash;
-      UploadInteger3D(in.OffsetTexture, window, hash.offsetSides, 3, GL_RGB16UI, GL_RGB_INTEGER, hash.offsets.data());
-      if (tables->normals.size() == hash.TableSize() * 4)
-      {
-        UploadInteger3D(
-          in.NormalTexture, window, hash.tableSides, 2, GL_RG16UI, GL_RG_INTEGER, tables->normals.data());
-      }
-      else
-      {
-        const std::vector<uint16_t> up(hash.TableSize() * 2, 0); // code 0 is +z
-        UploadInteger3D(in.NormalTexture, window, hash.tableSides, 2, GL_RG16UI, GL_RG_INTEGER, up.data());
-      }
-      in.HashUploaded = true;
-    }
-    else if (in.OffsetTexture->GetHandle() == 0)
-    {
-      const std::array<uint32_t, 3> one{ 1, 1, 1 };
-      const uint16_t zeros[3] = { 0, 0, 0 };
-      UploadInteger3D(in.OffsetTexture, window, one, 3, GL_RGB16UI, GL_RGB_INTEGER, zeros);
-      UploadInteger3D(in.NormalTexture, window, one, 2, GL_RG16UI, GL_RG_INTEGER, zeros);
-    }
-  }
-  if (in.PropertyTexture->GetHandle() == 0)
-  {
-    // Until a property loads, every sampler still needs a texture of its type.
-    float none = std::numeric_limits<float>::quiet_NaN();
-    in.PropertyTexture->SetContext(window);
-    in.PropertyTexture->Create3DFromRaw(1, 1, 1, 1, VTK_FLOAT, &none);
-    in.LayerPropertyTexture->SetContext(window);
-    in.LayerPropertyTexture->Create2DFromRaw(1, 1, 1, VTK_FLOAT, &none);
-    unsigned char white[4] = { 255, 255, 255, 255 };
-    in.ColorTexture->SetContext(window);
-    in.ColorTexture->Create2DFromRaw(1, 1, 4, VTK_UNSIGNED_CHAR, white);
-  }
-  std::shared_ptr<const resmr::PropertyTableData> property = wantProperty ? cache.Property() : nullptr;
-  if (property && (property->name != this->ArrayName || property->step != tableStep || property->layer != layer))
-  {
-    property.reset(); // still the previous property: the solid colour until this one loads
-  }
-  if (property && property != in.UploadedProperty && property->layer >= 0)
-  {
-    // A layer's table is a 2D texture of nx x ny, indexed by (i, j): no hash (Sec. 5.4).
-    state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    in.LayerPropertyTexture->SetContext(window);
-    in.LayerPropertyTexture->ResetFormatAndType();
-    in.LayerPropertyTexture->SetMinificationFilter(vtkTextureObject::Nearest);
-    in.LayerPropertyTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
-    in.LayerPropertyTexture->Create2DFromRaw(static_cast<unsigned int>(header.dims[0]),
-      static_cast<unsigned int>(header.dims[1]), 1, VTK_FLOAT, const_cast<float*>(property->values.data()));
-    in.UploadedProperty = property;
-  }
-  else if (property && property != in.UploadedProperty)
-  {
-    state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    in.PropertyTexture->SetContext(window);
-    in.PropertyTexture->ResetFormatAndType();
-    in.PropertyTexture->SetMinificationFilter(vtkTextureObject::Nearest);
-    in.PropertyTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
-    in.PropertyTexture->Create3DFromRaw(header.hashTableSides[0], header.hashTableSides[1], header.hashTableSides[2],
-      1, VTK_FLOAT, const_cast<float*>(property->values.data()));
-    in.UploadedProperty = property;
-  }
   vtkScalarsToColors* table = this->GetLookupTable();
   if (property && (table != in.ColorTable || table->GetMTime() != in.ColorTableTime))
   {
@@ -955,7 +1096,9 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     {
       measuredMs = std::max(measuredMs, intervalMs);
     }
-    in.Controller.Update(measuredMs / 1000);
+    // Ancestors drawn for meshes still on their way: not all the detail the tolerance selected.
+    const bool complete = in.Substituted == 0 || !in.Pending;
+    in.Controller.Update(measuredMs / 1000, complete);
   }
 }
 

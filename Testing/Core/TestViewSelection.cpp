@@ -1186,6 +1186,24 @@ void TestFrameRateController()
   CHECK(run(0.01, 1e-6, FrameRateController::MaximumPixels, 100, worst) == FrameRateController::MinimumPixels);
   // A renderer slower than the target at any tolerance: the tolerance stops at the maximum.
   CHECK(run(0.2, 1, 1, 100, worst) == FrameRateController::MaximumPixels);
+
+  // Meshes still loading: frames draw the roots only (fast whatever the tolerance), so they
+  // must not refine it; once all is loaded, the frame at the kept tolerance is within the band
+  // and refinement resumes from there. Slow incomplete frames still coarsen it.
+  FrameRateController loading;
+  loading.SetTargetFramesPerSecond(10);
+  loading.Reset(8);
+  for (int f = 0; f < 50; ++f)
+  {
+    loading.Update(0.01, false);
+  }
+  std::printf("  controller, 50 fast frames while loading: %.2f px\n", loading.Tolerance());
+  CHECK(loading.Tolerance() == 8);
+  loading.Update(0.3, false);
+  CHECK(loading.Tolerance() > 8);
+  const double coarse = loading.Tolerance();
+  loading.Update(0.01, true);
+  CHECK(loading.Tolerance() < coarse);
 }
 } // namespace
 
