@@ -119,7 +119,9 @@ def run_path(view, display, bounds, readout):
             display.UpdatePropertyInformation()
             row.update(tolerance=display.GetPropertyValue("CurrentTolerance"),
                        triangles=display.GetPropertyValue("TrianglesDrawn"),
-                       resident_mb=display.GetPropertyValue("ResidentMB"))
+                       resident_mb=display.GetPropertyValue("ResidentMB"),
+                       substituted=display.GetPropertyValue("RegionsSubstituted"),
+                       pending=display.GetPropertyValue("LoadsPending"))
         frames.append(row)
     return frames
 
