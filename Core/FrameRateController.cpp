@@ -18,9 +18,8 @@ double FrameRateController::Update(double frameSeconds, bool complete)
   {
     return this->Pixels;
   }
-  // Frame times jitter by a fifth to a quarter from frame to frame (loads, uploads, the
-  // system), so the tolerance is held where frames take 55-80% of the target, and the slow
-  // tail stays inside it.
+  // Frame times jitter by a fifth from frame to frame (loads, uploads, the system), so the
+  // tolerance is held where frames take 60-85% of the target, and the slow tail stays inside it.
   const double ratio = frameSeconds / this->TargetSeconds;
   double factor = 1;
   if (ratio > HighFraction)

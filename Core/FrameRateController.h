@@ -7,7 +7,7 @@
 //   for the next frame. Frames over HighFraction of the target raise the tolerance at once in
 //   proportion (the 99th percentile matters more than the mean); frames under LowFraction
 //   lower it gently; in between it stays, so the tolerance does not oscillate and the
-//   frame-to-frame jitter (a fifth to a quarter under llvmpipe) stays within the target.
+//   frame-to-frame jitter (a fifth under llvmpipe) stays within the target.
 // - The tolerance stays within [MinimumPixels, MaximumPixels]. The maximum is far above any
 //   picture one wants: the bound projects each region's largest error at its box's point
 //   nearest the eye, so in a low flight the roots' bound is thousands of pixels, and a
@@ -30,7 +30,7 @@ public:
   static constexpr double MaximumPixels = 65536;
   /// The band of frame times, as fractions of the target, the tolerance is held in, and the
   /// time each correction aims at.
-  static constexpr double LowFraction = 0.55, HighFraction = 0.8, AimFraction = 0.65;
+  static constexpr double LowFraction = 0.6, HighFraction = 0.85, AimFraction = 0.7;
 
   void SetTargetFramesPerSecond(double fps) { this->TargetSeconds = fps > 0 ? 1.0 / fps : 0.1; }
   double TargetFramesPerSecond() const { return 1.0 / this->TargetSeconds; }
