@@ -5,6 +5,7 @@
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
 #include "RegionCache.h"
+#include "UploadPacer.h"
 #include "ViewSelection.h"
 
 #include "vtkActor.h"
@@ -288,6 +289,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   resmr::FrameRateController Controller;
   bool ControllerRunning = false; ///< holding a frame rate since the file opened
   bool UploadsDeferred = false;   ///< loaded meshes wait for the next frame's upload
+  resmr::UploadPacer Pacer;       ///< predicts what mesh copies cost (fresh GPU memory is slow)
   bool Allocated = false;         ///< the frame allocated a table texture (see SlabUpload)
   bool HavePreviousView = false;
   resmr::ViewParameters PreviousView;
@@ -454,10 +456,13 @@ bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties
 }
 
 /// Most bytes copied to the GPU in one interactive frame (see Render), and the part of it the
-/// model's tables may take while they are being copied. llvmpipe spends about 1.5 ms a MB on
-/// new buffers (zeroing, then copying): 16 MB put the frames that took them past the target.
+/// model's tables may take while they are being copied.
 constexpr std::size_t UploadBytesPerFrame = std::size_t(8) << 20;
 constexpr std::size_t TableBytesPerFrame = std::size_t(4) << 20;
+/// The time an interactive frame may spend copying meshes (see resmr::UploadPacer): a tenth of
+/// the target frame time, or this many milliseconds at a fixed tolerance.
+constexpr double UploadShareOfFrame = 0.1;
+constexpr double UploadMsAtFixedTolerance = 10.0;
 
 /// Tolerance (pixels) the frame-rate controller starts from.
 constexpr double ControllerStartPixels = 8.0;
@@ -745,10 +750,13 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   }
   // Uploads, a bounded amount a frame while interacting (the roots and still renders whatever
   // it takes): a burst of loaded meshes copied in one frame stalled it (76 MB took 100 ms on
-  // llvmpipe). The frame then draws what is on the GPU, ancestors standing in for the rest.
-  // The model's tables go first, a few slabs a frame, so meshes and tables both progress.
+  // llvmpipe). The bound is in bytes and in predicted time, since fresh GPU memory costs
+  // fifty times what reused memory does. The frame then draws what is on the GPU, ancestors
+  // standing in for the rest. The model's tables go first, a few slabs a frame, so meshes and
+  // tables both progress.
   const bool bounded = this->WaitForDetailMs == 0;
   std::size_t tableBudget = TableBytesPerFrame;
+  const auto tablesStart = std::chrono::steady_clock::now();
 
   // Model tables: the hash's offsets and the cells' normals (once a file, when the loader has
   // read them), the property table when another is current, the colour map when the lookup
@@ -868,9 +876,15 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     property.reset();
   }
 
-  // Meshes, with what the tables left of the frame's upload budget.
+  // Meshes, with what the tables left of the frame's upload budget, bytes and time.
   {
-    std::size_t uploaded = TableBytesPerFrame - tableBudget;
+    const auto elapsedMs = [](std::chrono::steady_clock::time_point since) {
+      return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
+    };
+    in.Pacer.BeginFrame(
+      this->TargetFrameRate > 0 ? UploadShareOfFrame * 1000 / this->TargetFrameRate : UploadMsAtFixedTolerance,
+      UploadBytesPerFrame);
+    in.Pacer.Spend(TableBytesPerFrame - tableBudget, elapsedMs(tablesStart));
     in.UploadsDeferred = false;
     std::vector<std::size_t> order = in.Selector->Roots();
     order.insert(order.end(), selection.wanted.begin(), selection.wanted.end());
@@ -887,13 +901,14 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
       {
         continue;
       }
-      if (bounded && n >= roots && uploaded > 0 && uploaded + buffers->Bytes() > UploadBytesPerFrame)
+      if (bounded && n >= roots && !in.Pacer.Admit(buffers->Bytes()))
       {
         in.UploadsDeferred = true;
         break;
       }
+      const auto copyStart = std::chrono::steady_clock::now();
       auto gpu = UploadRegion(buffers, program);
-      uploaded += gpu->bytes;
+      in.Pacer.Record(gpu->bytes, elapsedMs(copyStart));
       in.GpuBytes += gpu->bytes;
       in.Gpu.emplace(region, std::move(gpu));
     }

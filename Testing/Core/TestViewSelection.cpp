@@ -11,6 +11,7 @@
 #include "ConformalCut.h"
 #include "DiamondHierarchy.h"
 #include "FrameRateController.h"
+#include "UploadPacer.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
 #include "RegionCache.h"
@@ -1207,6 +1208,49 @@ void TestFrameRateController()
 }
 } // namespace
 
+void TestUploadPacer()
+{
+  UploadPacer pacer;
+  const std::size_t MB = std::size_t(1) << 20;
+  // Before any copy was timed: the first mesh of a frame always goes, however large; the next
+  // only while the initial estimate keeps it within the budget and the bytes within the cap.
+  pacer.BeginFrame(10, 8 * MB);
+  CHECK(pacer.Admit(40 * MB));
+  pacer.Record(2 * MB, 2 * UploadPacer::InitialMsPerMB);
+  CHECK(pacer.Admit(3 * MB) && !pacer.Admit(4 * MB)); // 4 ms spent, 2 ms a MB
+  // Fresh memory (4.4 ms a MB): the estimate rises at once, and the frame takes one such mesh.
+  pacer.BeginFrame(10, 8 * MB);
+  pacer.Record(2 * MB, 8.8);
+  CHECK(std::abs(pacer.MsPerMB() - 4.4) < 1e-9);
+  CHECK(!pacer.Admit(1 * MB) && pacer.Admit(MB / 4));
+  // Reused memory (0.1 ms a MB): one cheap copy does not undo it; many bring it down, and then
+  // the byte cap bounds the frame.
+  pacer.BeginFrame(10, 8 * MB);
+  pacer.Record(1 * MB, 0.1);
+  CHECK(pacer.MsPerMB() > 3.5 && !pacer.Admit(3 * MB));
+  for (int f = 0; f < 60; ++f)
+  {
+    pacer.BeginFrame(10, 8 * MB);
+    pacer.Record(1 * MB, 0.1);
+  }
+  CHECK(pacer.MsPerMB() < 0.2);
+  CHECK(pacer.Admit(7 * MB) && !pacer.Admit(7 * MB + 1));
+  // Work already charged to the frame (the model's tables) counts against both bounds, and a
+  // frame that spent its time admits nothing more; tiny copies and bad timings teach nothing.
+  pacer.BeginFrame(10, 8 * MB);
+  pacer.Spend(4 * MB, 9.95);
+  CHECK(!pacer.Admit(1 * MB) && !pacer.Admit(5 * MB));
+  const double before = pacer.MsPerMB();
+  pacer.Record(1024, 500);
+  pacer.Record(2 * MB, std::numeric_limits<double>::quiet_NaN());
+  pacer.Record(2 * MB, -1);
+  CHECK(pacer.MsPerMB() == before);
+  CHECK(pacer.SpentBytes() == 4 * MB + 1024 + 4 * MB);
+  // A new frame starts a new account: its first mesh goes again.
+  pacer.BeginFrame(10, 8 * MB);
+  CHECK(pacer.SpentBytes() == 0 && pacer.SpentMs() == 0 && pacer.Admit(100 * MB));
+}
+
 int main(int argc, char** argv)
 {
   if (argc < 4)
@@ -1261,6 +1305,7 @@ int main(int argc, char** argv)
       } },
     { "Prediction", [&] { TestPrediction(); } },
     { "FrameRateController", [&] { TestFrameRateController(); } },
+    { "UploadPacer", [&] { TestUploadPacer(); } },
     { "DrawBuffers",
       [&] {
         TestDrawBuffers(reek, 0);
