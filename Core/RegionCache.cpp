@@ -3,7 +3,6 @@
 #include "RegionCache.h"
 
 #ifdef __linux__
-#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -783,17 +782,8 @@ void RegionCache::Run()
 {
 #ifdef __linux__
   // Below the render thread: decompression must not take the cores a frame (or a software
-  // rasterizer's threads) needs; it uses what the frames leave. SCHED_IDLE, so that a waking
-  // render or llvmpipe thread preempts it at once; at nice 10 it still held llvmpipe's two
-  // cores here long enough to put a 100M-cell model's loading frames past the target (14-22
-  // frames of a 1,000-frame path over 100 ms in four runs, against 7 and 13 in two runs with
-  // SCHED_IDLE). It is not starved outright (the scheduler still gives it a small share), and
-  // still renders wait for it with the cores idle.
-  sched_param idle{};
-  if (sched_setscheduler(0, SCHED_IDLE, &idle) != 0) // this thread only (Linux)
-  {
-    setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
-  }
+  // rasterizer's threads) needs; it uses what the frames leave.
+  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
 #endif
   int handedness = 1;
   std::string failure;
