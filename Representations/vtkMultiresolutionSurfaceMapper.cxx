@@ -103,33 +103,140 @@ void ColumnMajor(const Matrix& m, float out[16])
   }
 }
 
-struct GpuRegion
+/// Most bytes of one GPU piece of a region's mesh (the vertices its triangles use and their
+/// indices). A leaf region's mesh reaches 17-26 MB on the 100M-cell model, and llvmpipe in a
+/// VM allocates fresh buffer storage at about 4.4 ms a MB: copied whole, one mesh held a
+/// frame 60-110 ms past its budget. In pieces, the upload pacer admits a frame's copies a
+/// piece at a time, and a region is drawn once all its pieces are on the GPU.
+constexpr std::size_t PieceBytes = std::size_t(1) << 20;
+
+/// Triangles [first, first + count) of a region's indices, with the vertices they use
+/// (vertex numbers rebased to the piece's first), in GL buffers of their own.
+struct GpuPiece
 {
   vtkNew<vtkOpenGLBufferObject> vertices;
   vtkNew<vtkOpenGLBufferObject> indices;
   vtkNew<vtkOpenGLVertexArrayObject> layout;
-  std::shared_ptr<const resmr::RegionDrawBuffers> buffers;
-  std::size_t bytes = 0;
-  bool ready = false;
+  uint32_t first = 0, count = 0;
+
+  void Release()
+  {
+    this->layout->ReleaseGraphicsResources();
+    this->vertices->ReleaseGraphicsResources();
+    this->indices->ReleaseGraphicsResources();
+  }
 };
 
-/// A region's draw buffers copied into GL buffer objects.
-std::unique_ptr<GpuRegion> UploadRegion(
-  std::shared_ptr<const resmr::RegionDrawBuffers> buffers, vtkShaderProgram* program)
+/// A region's draw buffers on their way to the GPU, a piece at a time.
+struct GpuRegion
 {
-  auto gpu = std::make_unique<GpuRegion>();
-  gpu->buffers = buffers;
-  if (!buffers->indices.empty())
+  explicit GpuRegion(std::shared_ptr<const resmr::RegionDrawBuffers> drawBuffers)
+    : buffers(std::move(drawBuffers))
   {
-    gpu->layout->Bind();
-    gpu->vertices->Upload(buffers->vertices, vtkOpenGLBufferObject::ArrayBuffer);
-    gpu->indices->Upload(buffers->indices, vtkOpenGLBufferObject::ElementArrayBuffer);
-    gpu->layout->AddAttributeArray(program, gpu->vertices, "vertexPosition", 0, 24, VTK_FLOAT, 3, false);
-    gpu->layout->AddAttributeArray(program, gpu->vertices, "cellCoordinate", 12, 24, VTK_FLOAT, 3, false);
-    gpu->layout->Release();
   }
-  gpu->bytes = buffers->Bytes();
-  return gpu;
+
+  std::shared_ptr<const resmr::RegionDrawBuffers> buffers;
+  std::vector<std::unique_ptr<GpuPiece>> pieces;
+  std::size_t bytes = 0; ///< copied so far
+
+  bool Ready() const { return this->Copied >= this->buffers->indices.size(); }
+
+  /// Bytes the next piece will copy.
+  std::size_t NextPieceBytes()
+  {
+    this->Measure();
+    return this->Next.bytes;
+  }
+
+  /// Copies the next piece; the bytes copied.
+  std::size_t UploadNextPiece(vtkShaderProgram* program)
+  {
+    this->Measure();
+    const std::vector<float>& vertices = this->buffers->vertices;
+    const std::vector<uint32_t>& indices = this->buffers->indices;
+    auto piece = std::make_unique<GpuPiece>();
+    piece->first = static_cast<uint32_t>(this->Copied);
+    piece->count = static_cast<uint32_t>(this->Next.end - this->Copied);
+    const std::vector<float> pieceVertices(
+      vertices.begin() + std::size_t(this->Next.low) * 6, vertices.begin() + (std::size_t(this->Next.high) + 1) * 6);
+    std::vector<uint32_t> pieceIndices(indices.begin() + this->Copied, indices.begin() + this->Next.end);
+    for (uint32_t& index : pieceIndices)
+    {
+      index -= this->Next.low;
+    }
+    piece->layout->Bind();
+    piece->vertices->Upload(pieceVertices, vtkOpenGLBufferObject::ArrayBuffer);
+    piece->indices->Upload(pieceIndices, vtkOpenGLBufferObject::ElementArrayBuffer);
+    piece->layout->AddAttributeArray(program, piece->vertices, "vertexPosition", 0, 24, VTK_FLOAT, 3, false);
+    piece->layout->AddAttributeArray(program, piece->vertices, "cellCoordinate", 12, 24, VTK_FLOAT, 3, false);
+    piece->layout->Release();
+    this->pieces.push_back(std::move(piece));
+    const std::size_t copied = this->Next.bytes;
+    this->bytes += copied;
+    this->Copied = this->Next.end;
+    this->Next = Extent();
+    return copied;
+  }
+
+  /// Copies whatever is left (a region drawn before the pacer let it finish).
+  void UploadRest(vtkShaderProgram* program)
+  {
+    while (!this->Ready())
+    {
+      this->UploadNextPiece(program);
+    }
+  }
+
+  void Release()
+  {
+    for (auto& piece : this->pieces)
+    {
+      piece->Release();
+    }
+  }
+
+private:
+  struct Extent
+  {
+    std::size_t end = 0; ///< one past the piece's last index; 0 until measured
+    uint32_t low = 0, high = 0;
+    std::size_t bytes = 0;
+  };
+
+  /// Extends the next piece triangle by triangle while its vertex range and indices fit
+  /// PieceBytes (at least one triangle). Top and bottom vertices are numbered as their quads
+  /// come and sides have their own, so a run of triangles uses a compact range.
+  void Measure()
+  {
+    if (this->Next.end > this->Copied || this->Ready())
+    {
+      return;
+    }
+    const std::vector<uint32_t>& indices = this->buffers->indices;
+    Extent extent;
+    extent.low = UINT32_MAX;
+    for (std::size_t n = this->Copied; n + 3 <= indices.size(); n += 3)
+    {
+      const uint32_t low = std::min({ extent.low, indices[n], indices[n + 1], indices[n + 2] });
+      const uint32_t high = std::max({ extent.high, indices[n], indices[n + 1], indices[n + 2] });
+      const std::size_t bytes = (std::size_t(high - low) + 1) * 24 + (n + 3 - this->Copied) * 4;
+      if (n > this->Copied && bytes > PieceBytes)
+      {
+        break;
+      }
+      extent = { n + 3, low, high, bytes };
+    }
+    this->Next = extent;
+  }
+
+  std::size_t Copied = 0; ///< indices copied so far
+  Extent Next;
+};
+
+bool ReadyOnGpu(const std::map<std::size_t, std::unique_ptr<GpuRegion>>& gpu, std::size_t region)
+{
+  const auto found = gpu.find(region);
+  return found != gpu.end() && found->second->Ready();
 }
 
 /// A 3D table texture filled a slab of z-slices at a time (glTexSubImage3D) into a texture of
@@ -331,9 +438,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   {
     for (auto& entry : this->Gpu)
     {
-      entry.second->layout->ReleaseGraphicsResources();
-      entry.second->vertices->ReleaseGraphicsResources();
-      entry.second->indices->ReleaseGraphicsResources();
+      entry.second->Release();
     }
     this->Gpu.clear();
     this->GpuBytes = 0;
@@ -725,9 +830,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     if (cache.Get(entry->first) != entry->second->buffers)
     {
       in.GpuBytes -= entry->second->bytes;
-      entry->second->layout->ReleaseGraphicsResources();
-      entry->second->vertices->ReleaseGraphicsResources();
-      entry->second->indices->ReleaseGraphicsResources();
+      entry->second->Release();
       entry = in.Gpu.erase(entry);
     }
     else
@@ -892,28 +995,32 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     for (std::size_t n = 0; n < order.size(); ++n)
     {
       const std::size_t region = order[n];
-      if (in.Gpu.count(region))
+      auto found = in.Gpu.find(region);
+      if (found == in.Gpu.end())
       {
-        continue;
+        std::shared_ptr<const resmr::RegionDrawBuffers> buffers = cache.Get(region);
+        if (!buffers)
+        {
+          continue;
+        }
+        found = in.Gpu.emplace(region, std::make_unique<GpuRegion>(buffers)).first;
       }
-      std::shared_ptr<const resmr::RegionDrawBuffers> buffers = cache.Get(region);
-      if (!buffers)
+      GpuRegion& gpu = *found->second;
+      while (!gpu.Ready() && !(bounded && n >= roots && !in.Pacer.Admit(gpu.NextPieceBytes())))
       {
-        continue;
+        const auto copyStart = std::chrono::steady_clock::now();
+        const std::size_t bytes = gpu.UploadNextPiece(program);
+        in.Pacer.Record(bytes, elapsedMs(copyStart));
+        in.GpuBytes += bytes;
       }
-      if (bounded && n >= roots && !in.Pacer.Admit(buffers->Bytes()))
+      if (!gpu.Ready())
       {
         in.UploadsDeferred = true;
         break;
       }
-      const auto copyStart = std::chrono::steady_clock::now();
-      auto gpu = UploadRegion(buffers, program);
-      in.Pacer.Record(gpu->bytes, elapsedMs(copyStart));
-      in.GpuBytes += gpu->bytes;
-      in.Gpu.emplace(region, std::move(gpu));
     }
     in.UploadsDeferred = in.UploadsDeferred || in.OffsetUpload.Busy() || in.PropertyUpload.Busy();
-    const auto onGpu = [&in](std::size_t region) { return in.Gpu.count(region) > 0; };
+    const auto onGpu = [&in](std::size_t region) { return ReadyOnGpu(in.Gpu, region); };
     selection = in.Selector->Select(view, onGpu);
   }
   const GLuint handle = static_cast<GLuint>(program->GetHandle());
@@ -1085,18 +1192,20 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
       {
         continue; // evicted since the selection: its ancestor is not drawn either this frame
       }
-      auto gpu = UploadRegion(buffers, program);
-      in.GpuBytes += gpu->bytes;
-      found = in.Gpu.emplace(drawn.region, std::move(gpu)).first;
+      found = in.Gpu.emplace(drawn.region, std::make_unique<GpuRegion>(buffers)).first;
     }
     GpuRegion& gpu = *found->second;
+    if (!gpu.Ready())
+    {
+      const std::size_t before = gpu.bytes;
+      gpu.UploadRest(program);
+      in.GpuBytes += gpu.bytes - before;
+    }
     const resmr::RegionDrawBuffers& buffers = *gpu.buffers;
     if (buffers.indices.empty())
     {
       continue;
     }
-    gpu.layout->Bind();
-    gpu.indices->Bind();
     // The selection culled the stored top and bottom by their cones; a layer's own top and
     // bottom have their own cones.
     const resmr::RegionRecord& record = in.File->Regions()[drawn.region];
@@ -1116,18 +1225,26 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
       coarseSide ? Part{ drawn.side, buffers.topIndices + buffers.bottomIndices + buffers.sideIndices,
                      buffers.coarseSideIndices, 2 }
                  : Part{ drawn.side, buffers.topIndices + buffers.bottomIndices, buffers.sideIndices, 2 } };
-    for (const auto& part : parts)
+    for (const auto& piece : gpu.pieces)
     {
-      if (part.shown && part.count > 0)
+      piece->layout->Bind();
+      piece->indices->Bind();
+      for (const auto& part : parts)
       {
-        program->SetUniformi("faceKind", part.kind);
-        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(part.count), GL_UNSIGNED_INT,
-          reinterpret_cast<const void*>(std::size_t(part.first) * sizeof(uint32_t)));
-        in.Triangles += part.count / 3;
+        // The part's indices that lie in this piece.
+        const uint32_t begin = std::max(part.first, piece->first);
+        const uint32_t end = std::min(part.first + part.count, piece->first + piece->count);
+        if (part.shown && end > begin)
+        {
+          program->SetUniformi("faceKind", part.kind);
+          glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(end - begin), GL_UNSIGNED_INT,
+            reinterpret_cast<const void*>(std::size_t(begin - piece->first) * sizeof(uint32_t)));
+          in.Triangles += (end - begin) / 3;
+        }
       }
+      piece->indices->Release();
+      piece->layout->Release();
     }
-    gpu.indices->Release();
-    gpu.layout->Release();
     ++in.Drawn;
   }
   glFrontFace(GL_CCW);
@@ -1161,7 +1278,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
       return true;
     }
     return std::any_of(selection.wanted.begin(), selection.wanted.end(),
-      [&](std::size_t region) { return !in.Gpu.count(region) && cache.IsResident(region); });
+      [&](std::size_t region) { return !ReadyOnGpu(in.Gpu, region) && cache.IsResident(region); });
   };
   in.Pending = cache.Pending() || in.UploadsDeferred || arrivedLate();
   // The loader thread's errors (a damaged region or property table: the frame draws what it
