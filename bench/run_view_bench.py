@@ -104,6 +104,38 @@ def camera_path(view, bounds, frames):
     return cameras
 
 
+def kernel_reclaim_pids():
+    """Kernel threads that take the cores away from the view at intervals: DAMON's kdamond
+    (this VM runs its pageout scheme every 5 s: bench/results/cpu_gaps.md)."""
+    pids = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/comm") as comm:
+                    if comm.read().startswith("kdamond"):
+                        pids.append(entry)
+            except OSError:
+                pass
+    return pids
+
+
+KERNEL_RECLAIM_PIDS = kernel_reclaim_pids()
+CLOCK_TICK_MS = 1000 / os.sysconf("SC_CLK_TCK")
+
+
+def kernel_reclaim_ms():
+    """CPU time the reclaim threads have used, ms (to 10 ms ticks)."""
+    total = 0
+    for pid in KERNEL_RECLAIM_PIDS:
+        try:
+            with open(f"/proc/{pid}/stat") as stat:
+                fields = stat.read().rsplit(")", 1)[1].split()
+            total += int(fields[11]) + int(fields[12])
+        except (OSError, ValueError, IndexError):
+            pass
+    return total * CLOCK_TICK_MS
+
+
 def run_path(view, display, bounds, readout):
     frames = []
     for position, focal in camera_path(view, bounds, args.frames):
@@ -111,10 +143,11 @@ def run_path(view, display, bounds, readout):
         camera.SetPosition(position)
         camera.SetFocalPoint(focal)
         camera.SetViewUp(0, 0, 1)
+        reclaim = kernel_reclaim_ms()
         start = time.perf_counter()
         simple.Render(view)
         elapsed = time.perf_counter() - start
-        row = {"seconds": elapsed, "rss_mb": rss_mb()}
+        row = {"seconds": elapsed, "rss_mb": rss_mb(), "kernel_reclaim_ms": kernel_reclaim_ms() - reclaim}
         if readout:
             display.UpdatePropertyInformation()
             row.update(tolerance=display.GetPropertyValue("CurrentTolerance"),
@@ -224,8 +257,18 @@ for model in args.models:
              "p50_ms": 1000 * percentile(times, 50), "p99_ms": 1000 * percentile(times, 99),
              "max_resident_mb": max(f["resident_mb"] for f in frames),
              "max_rss_mb": max(f["rss_mb"] for f in frames), "frames": frames}
+    # Attribution, not the target: frames during which the kernel's reclaim thread ran (it
+    # takes 50-60 ms of CPU every ~5.2 s on this VM), and the p99 of the others.
+    quiet = [f["seconds"] for f in frames if f["kernel_reclaim_ms"] == 0]
+    entry["frames_over_target"] = sum(1 for t in times if t > target_s)
+    entry["frames_over_target_during_reclaim"] = sum(
+        1 for f in frames if f["seconds"] > target_s and f["kernel_reclaim_ms"] > 0)
+    entry["frames_during_reclaim"] = len(frames) - len(quiet)
+    entry["p99_ms_outside_reclaim"] = 1000 * percentile(quiet, 99) if quiet else None
     print(f"{model}: first image {first_image:.2f} s, p50 {entry['p50_ms']:.0f} ms, p99 {entry['p99_ms']:.0f} ms, "
-          f"resident <= {entry['max_resident_mb']:.0f} MB, RSS <= {entry['max_rss_mb']:.0f} MB", flush=True)
+          f"resident <= {entry['max_resident_mb']:.0f} MB, RSS <= {entry['max_rss_mb']:.0f} MB; "
+          f"{entry['frames_over_target']} frames over target, {entry['frames_over_target_during_reclaim']} of them "
+          f"while kdamond ran", flush=True)
     simple.Delete(reader)
     simple.Delete(view)
     cells = cell_count(model)
@@ -283,6 +326,18 @@ for e in results["models"]:
 for e in results["models"]:
     if "stock_skipped" in e:
         lines.append(f"\nStock ParaView on {e['model']}: {e['stock_skipped']}.")
+if KERNEL_RECLAIM_PIDS:
+    lines += ["", "Frames over the target and the machine: the kernel's DAMON reclaim thread (kdamond) takes "
+              "the cores for 40-75 ms about every 5.2 s on this VM (bench/results/cpu_gaps.md). Each frame "
+              "records the CPU time kdamond used while it rendered (10 ms ticks). An attribution, not the "
+              "target: the p99 above counts every frame.", "",
+              "| model | frames over target | of them while kdamond ran | frames while kdamond ran | p99 ms of the other frames |",
+              "|---|---|---|---|---|"]
+    for e in results["models"]:
+        if "frames_over_target" in e:
+            quiet = e["p99_ms_outside_reclaim"]
+            lines.append(f"| {e['model']} | {e['frames_over_target']} | {e['frames_over_target_during_reclaim']} | "
+                         f"{e['frames_during_reclaim']} | {'-' if quiet is None else f'{quiet:.0f}'} |")
 with open(args.out + ".md", "w") as out:
     out.write("\n".join(lines) + "\n")
 try:
