@@ -366,6 +366,24 @@ void AddCoarseSide(const RegionMesh& mesh, const std::vector<std::array<uint32_t
   out.coarseSideIndices = static_cast<uint32_t>(out.indices.size() - before);
 }
 
+DrawPiece NextDrawPiece(const RegionDrawBuffers& buffers, std::size_t first, std::size_t maxBytes)
+{
+  const std::vector<uint32_t>& indices = buffers.indices;
+  DrawPiece piece{ first, first, UINT32_MAX, 0, 0 };
+  for (std::size_t n = first; n + 3 <= indices.size(); n += 3)
+  {
+    const uint32_t low = std::min({ piece.lowVertex, indices[n], indices[n + 1], indices[n + 2] });
+    const uint32_t high = std::max({ piece.highVertex, indices[n], indices[n + 1], indices[n + 2] });
+    const std::size_t bytes = (std::size_t(high - low) + 1) * 24 + (n + 3 - first) * 4;
+    if (n > first && bytes > maxBytes)
+    {
+      break;
+    }
+    piece = { first, n + 3, low, high, bytes };
+  }
+  return piece;
+}
+
 RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin, int handedness)
 {
   return PrepareDrawBuffers(mesh, mesh.top, mesh.bottom, mesh.sideTriangles, origin, handedness);

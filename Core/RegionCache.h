@@ -105,6 +105,22 @@ RegionDrawBuffers PrepareLayerDrawBuffers(
 RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
   const std::array<double, 3>& origin, int handedness, int32_t layer = -1);
 
+/// A run of a region's triangles copied to the GPU as one piece: indices [first, end) and
+/// the vertices [lowVertex, highVertex] they use.
+struct DrawPiece
+{
+  std::size_t first = 0, end = 0;
+  uint32_t lowVertex = 0, highVertex = 0;
+  std::size_t bytes = 0; ///< (highVertex - lowVertex + 1) * 24 + (end - first) * 4
+};
+
+/// The piece of `buffers` from index `first` (a multiple of 3, below indices.size()): whole
+/// triangles while the piece's vertex range and indices take at most maxBytes, at least one.
+/// Top and bottom vertices are numbered as their quads come and side triangles have their own,
+/// so a piece's range is compact: pieces of 64 KB or more copy exactly the buffers' bytes on
+/// the Reek, test and 10M-cell models; 4 KB pieces repeat shared vertices (4-16% more).
+DrawPiece NextDrawPiece(const RegionDrawBuffers& buffers, std::size_t first, std::size_t maxBytes);
+
 struct PropertyTableData
 {
   std::string name;

@@ -155,14 +155,14 @@ struct GpuRegion
     const std::vector<float>& vertices = this->buffers->vertices;
     const std::vector<uint32_t>& indices = this->buffers->indices;
     auto piece = std::make_unique<GpuPiece>();
-    piece->first = static_cast<uint32_t>(this->Copied);
-    piece->count = static_cast<uint32_t>(this->Next.end - this->Copied);
-    const std::vector<float> pieceVertices(
-      vertices.begin() + std::size_t(this->Next.low) * 6, vertices.begin() + (std::size_t(this->Next.high) + 1) * 6);
-    std::vector<uint32_t> pieceIndices(indices.begin() + this->Copied, indices.begin() + this->Next.end);
+    piece->first = static_cast<uint32_t>(this->Next.first);
+    piece->count = static_cast<uint32_t>(this->Next.end - this->Next.first);
+    const std::vector<float> pieceVertices(vertices.begin() + std::size_t(this->Next.lowVertex) * 6,
+      vertices.begin() + (std::size_t(this->Next.highVertex) + 1) * 6);
+    std::vector<uint32_t> pieceIndices(indices.begin() + this->Next.first, indices.begin() + this->Next.end);
     for (uint32_t& index : pieceIndices)
     {
-      index -= this->Next.low;
+      index -= this->Next.lowVertex;
     }
     piece->layout->Bind();
     piece->vertices->Upload(pieceVertices, vtkOpenGLBufferObject::ArrayBuffer);
@@ -171,11 +171,9 @@ struct GpuRegion
     piece->layout->AddAttributeArray(program, piece->vertices, "cellCoordinate", 12, 24, VTK_FLOAT, 3, false);
     piece->layout->Release();
     this->pieces.push_back(std::move(piece));
-    const std::size_t copied = this->Next.bytes;
-    this->bytes += copied;
+    this->bytes += this->Next.bytes;
     this->Copied = this->Next.end;
-    this->Next = Extent();
-    return copied;
+    return this->Next.bytes;
   }
 
   /// Copies whatever is left (a region drawn before the pacer let it finish).
@@ -196,41 +194,17 @@ struct GpuRegion
   }
 
 private:
-  struct Extent
-  {
-    std::size_t end = 0; ///< one past the piece's last index; 0 until measured
-    uint32_t low = 0, high = 0;
-    std::size_t bytes = 0;
-  };
-
-  /// Extends the next piece triangle by triangle while its vertex range and indices fit
-  /// PieceBytes (at least one triangle). Top and bottom vertices are numbered as their quads
-  /// come and sides have their own, so a run of triangles uses a compact range.
+  /// The next piece (resmr::NextDrawPiece), measured once.
   void Measure()
   {
-    if (this->Next.end > this->Copied || this->Ready())
+    if (!this->Ready() && this->Next.first != this->Copied)
     {
-      return;
+      this->Next = resmr::NextDrawPiece(*this->buffers, this->Copied, PieceBytes);
     }
-    const std::vector<uint32_t>& indices = this->buffers->indices;
-    Extent extent;
-    extent.low = UINT32_MAX;
-    for (std::size_t n = this->Copied; n + 3 <= indices.size(); n += 3)
-    {
-      const uint32_t low = std::min({ extent.low, indices[n], indices[n + 1], indices[n + 2] });
-      const uint32_t high = std::max({ extent.high, indices[n], indices[n + 1], indices[n + 2] });
-      const std::size_t bytes = (std::size_t(high - low) + 1) * 24 + (n + 3 - this->Copied) * 4;
-      if (n > this->Copied && bytes > PieceBytes)
-      {
-        break;
-      }
-      extent = { n + 3, low, high, bytes };
-    }
-    this->Next = extent;
   }
 
   std::size_t Copied = 0; ///< indices copied so far
-  Extent Next;
+  resmr::DrawPiece Next{ ~std::size_t(0) };
 };
 
 bool ReadyOnGpu(const std::map<std::size_t, std::unique_ptr<GpuRegion>>& gpu, std::size_t region)

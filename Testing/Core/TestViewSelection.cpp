@@ -766,6 +766,52 @@ void TestCoarseSides(const std::string& path)
   CHECK(coarse > 0 && coarse < exact);
 }
 
+/// Pieces a region's buffers go to the GPU in (NextDrawPiece): they cover the indices in
+/// order, whole triangles, each within its byte limit unless one triangle, every index inside
+/// its vertex range. Pieces of 64 KB or more copy exactly the buffers' bytes (consecutive
+/// vertex ranges abut); tiny ones repeat the vertices quads share across their boundaries.
+void TestDrawPieces(const std::string& path)
+{
+  const MultiresolutionFile file(path);
+  const int handedness = TopologyHandedness(file);
+  const auto& o = file.Header().latticeOrigin;
+  for (const std::size_t limit : { std::size_t(4) << 10, std::size_t(64) << 10, std::size_t(1) << 20 })
+  {
+    std::size_t pieces = 0, copied = 0, bytes = 0;
+    for (std::size_t r = 0; r < file.Regions().size(); ++r)
+    {
+      const RegionDrawBuffers buffers = LoadRegionDrawBuffers(file, r, { o[0], o[1], -o[2] }, handedness);
+      bytes += buffers.Bytes();
+      for (std::size_t first = 0; first < buffers.indices.size();)
+      {
+        const DrawPiece piece = NextDrawPiece(buffers, first, limit);
+        CHECK(piece.first == first && piece.end > first && piece.end <= buffers.indices.size());
+        CHECK((piece.end - first) % 3 == 0);
+        CHECK(piece.bytes == (std::size_t(piece.highVertex - piece.lowVertex) + 1) * 24 + (piece.end - first) * 4);
+        CHECK(piece.bytes <= limit || piece.end - first == 3);
+        bool inside = true;
+        for (std::size_t n = first; n < piece.end; ++n)
+        {
+          inside = inside && buffers.indices[n] >= piece.lowVertex && buffers.indices[n] <= piece.highVertex;
+        }
+        CHECK(inside);
+        if (piece.end < buffers.indices.size())
+        {
+          // Adding the next triangle would have passed the limit.
+          const DrawPiece longer = NextDrawPiece(buffers, first, std::size_t(-1));
+          CHECK(longer.end > piece.end);
+        }
+        copied += piece.bytes;
+        ++pieces;
+        first = piece.end;
+      }
+    }
+    std::printf("%s: pieces of at most %zu bytes: %zu, copying %zu bytes of %zu\n", path.c_str(), limit, pieces,
+      copied, bytes);
+    CHECK(limit < (std::size_t(64) << 10) ? copied <= bytes + bytes / 4 : copied == bytes);
+  }
+}
+
 void TestCache(const std::string& path)
 {
   using namespace std::chrono;
@@ -1321,6 +1367,8 @@ int main(int argc, char** argv)
       [&] {
         TestCoarseSides(reek);
         TestCoarseSides(synth);
+        TestDrawPieces(reek);
+        TestDrawPieces(synth);
       } },
     { "Cache", [&] { TestCache(reek64); } },
     { "DamagedChunk", [&] { TestDamagedChunk(reek); } },
