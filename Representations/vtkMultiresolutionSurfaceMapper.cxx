@@ -798,20 +798,24 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   in.HavePreviousView = true;
 
   // GPU buffers follow the cache: drop what it evicted (or what another layer replaced),
-  // upload what is drawn.
-  for (auto entry = in.Gpu.begin(); entry != in.Gpu.end();)
-  {
-    if (cache.Get(entry->first) != entry->second->buffers)
+  // upload what is drawn. The loader thread evicts while a frame runs, so the uploads below
+  // sweep again before passing the GPU's share of the budget.
+  const auto releaseEvicted = [&in, &cache]() {
+    for (auto entry = in.Gpu.begin(); entry != in.Gpu.end();)
     {
-      in.GpuBytes -= entry->second->bytes;
-      entry->second->Release();
-      entry = in.Gpu.erase(entry);
+      if (cache.Get(entry->first) != entry->second->buffers)
+      {
+        in.GpuBytes -= entry->second->bytes;
+        entry->second->Release();
+        entry = in.Gpu.erase(entry);
+      }
+      else
+      {
+        ++entry;
+      }
     }
-    else
-    {
-      ++entry;
-    }
-  }
+  };
+  releaseEvicted();
 
   vtkOpenGLState* state = window->GetState();
   vtkShaderProgram* program =
@@ -966,6 +970,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     std::vector<std::size_t> order = in.Selector->Roots();
     order.insert(order.end(), selection.wanted.begin(), selection.wanted.end());
     const std::size_t roots = in.Selector->Roots().size();
+    const std::size_t gpuShare = (std::size_t(this->MemoryBudgetMB) << 20) - MainMemoryShare(this->MemoryBudgetMB);
     for (std::size_t n = 0; n < order.size(); ++n)
     {
       const std::size_t region = order[n];
@@ -978,6 +983,17 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
           continue;
         }
         found = in.Gpu.emplace(region, std::make_unique<GpuRegion>(buffers)).first;
+      }
+      if (!found->second->Ready() && in.GpuBytes + found->second->NextPieceBytes() > gpuShare)
+      {
+        // The loader may have evicted regions since the sweep above: their copies go before
+        // the GPU passes its share of the budget (it mirrors the cache's, which never does).
+        releaseEvicted();
+        found = in.Gpu.find(region);
+        if (found == in.Gpu.end())
+        {
+          continue; // evicted itself
+        }
       }
       GpuRegion& gpu = *found->second;
       while (!gpu.Ready() && !(bounded && n >= roots && !in.Pacer.Admit(gpu.NextPieceBytes())))
