@@ -3,6 +3,8 @@
 #include "RegionCache.h"
 
 #ifdef __linux__
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -800,8 +802,16 @@ void RegionCache::Run()
 {
 #ifdef __linux__
   // Below the render thread: decompression must not take the cores a frame (or a software
-  // rasterizer's threads) needs; it uses what the frames leave.
-  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+  // rasterizer's threads) needs; it uses what the frames leave. At nice 10 it still took a
+  // whole core in frames of a 2-core machine (the scheduler counts a core running it as busy,
+  // so a waking rasterizer thread queued behind a frame's other work); a SCHED_IDLE core
+  // counts as idle, and the waking thread takes it at once.
+  sched_param none{};
+  if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &none) != 0)
+  {
+    setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+  }
+  pthread_setname_np(pthread_self(), "resmr-loader"); // so profilers and the view bench can tell it apart
 #endif
   int handedness = 1;
   std::string failure;

@@ -136,6 +136,25 @@ def kernel_reclaim_ms():
     return total * CLOCK_TICK_MS
 
 
+def thread_cpu_ms():
+    """CPU time (ms, from schedstat's nanoseconds) this process's threads have used, by role:
+    the render thread, llvmpipe's rasterizer threads, the mesh loader, and the rest."""
+    totals = {"render": 0.0, "rasterizer": 0.0, "loader": 0.0, "other": 0.0}
+    main = str(os.getpid())
+    for tid in os.listdir("/proc/self/task"):
+        try:
+            with open(f"/proc/self/task/{tid}/comm") as comm:
+                name = comm.read().strip()
+            with open(f"/proc/self/task/{tid}/schedstat") as stat:
+                ns = int(stat.read().split()[0])
+        except (OSError, ValueError, IndexError):
+            continue
+        role = ("render" if tid == main else "rasterizer" if name.startswith("llvmpipe") else
+                "loader" if name == "resmr-loader" else "other")
+        totals[role] += ns / 1e6
+    return totals
+
+
 def run_path(view, display, bounds, readout):
     frames = []
     for position, focal in camera_path(view, bounds, args.frames):
@@ -144,10 +163,12 @@ def run_path(view, display, bounds, readout):
         camera.SetFocalPoint(focal)
         camera.SetViewUp(0, 0, 1)
         reclaim = kernel_reclaim_ms()
+        threads = thread_cpu_ms()
         start = time.perf_counter()
         simple.Render(view)
         elapsed = time.perf_counter() - start
         row = {"seconds": elapsed, "rss_mb": rss_mb(), "kernel_reclaim_ms": kernel_reclaim_ms() - reclaim}
+        row.update({f"cpu_{role}_ms": ms - threads[role] for role, ms in thread_cpu_ms().items()})
         if readout:
             display.UpdatePropertyInformation()
             row.update(tolerance=display.GetPropertyValue("CurrentTolerance"),
