@@ -8,11 +8,13 @@ detail), then a scripted camera path at 1280x720 (orbit, zoom to close inspectio
 a fault line) with the frame-rate controller targeting --fps; per frame the frame time, the
 tolerance, triangles drawn and resident MB (the representation's readout) and the process's
 RSS. With --stock the same path is run on stock ParaView (EGRIDReader + Surface) where the
-model fits. Results: bench/results/view.{md,json} and view.png."""
+model fits. Each model, and stock ParaView on it, runs in a fresh pvpython (--one-process: all in
+this one). Results: bench/results/view.{md,json} and view.png."""
 import argparse
 import json
 import os
 import platform
+import shutil
 import subprocess
 import time
 
@@ -34,6 +36,14 @@ parser.add_argument("--out", default="bench/results/view")
 parser.add_argument("--fxaa", action="store_true",
                     help="keep ParaView's FXAA pass on (its default): a full-screen filter that costs llvmpipe "
                          "about 20 ms a frame at 1280x720, the same for stock and multiresolution views")
+parser.add_argument("--one-process", action="store_true",
+                    help="measure every model in this process; by default each model, and stock ParaView on it, "
+                         "runs in a fresh pvpython, as a user opens a model: after the smaller models and stock "
+                         "ParaView's 3 GB run, one process drew the 300M path's frames 10-40%% slower")
+parser.add_argument("--child", choices=("multiresolution", "stock"), help=argparse.SUPPRESS)
+parser.add_argument("--child-out", help=argparse.SUPPRESS)
+parser.add_argument("--report-only", action="store_true",
+                    help="rewrite OUT.md and OUT.png from OUT.json (an earlier run) and stop")
 args = parser.parse_args()
 simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
 os.makedirs(args.scratch, exist_ok=True)
@@ -185,6 +195,88 @@ def percentile(values, p):
     return values[min(len(values) - 1, int(round(p / 100 * (len(values) - 1))))]
 
 
+def stock_cell(e, key, digits):
+    if "stock_skipped" in e:
+        return "does not fit"
+    return f"{e[key]:.{digits}f}" if key in e else "not run"
+
+
+def write_report(results):
+    """OUT.md and OUT.png from the results."""
+    lines = [f"# Multiresolution Surface: first image, frame times, memory (target {results['fps_target']:g} FPS, 1280x720, "
+             f"{results['frames']}-frame path, budget {results['budget_mb']} MB)", "",
+             f"Machine: {results['machine']['cpu']}, {results['machine']['cores']} cores, "
+             f"{results['machine']['memory_gb']} GB, Mesa llvmpipe (no GPU). ParaView's own frame at this size "
+             f"(a 64-triangle sphere) takes {results['empty_frame_ms']:.0f} ms of the {1000 / results['fps_target']:.0f} ms; "
+             f"a 118,800-triangle sphere filling most of the view takes {results['dense_sphere_frame_ms']:.0f} ms. "
+             f"FXAA (a view setting, ParaView's default on) is {'on' if results['fxaa'] else 'off'} for every view here; "
+             f"{'off' if results['fxaa'] else 'on'}, the small sphere's frame takes "
+             f"{results['empty_frame_other_fxaa_ms']:.0f} ms. "
+             + ("Every model ran in one process, one after the other." if results.get("one_process") else
+                "Each model, and stock ParaView on it, ran in a fresh pvpython, as a user opens a model."), "",
+             "| model | first image s | p50 ms | p99 ms | frames within target | resident MB (max) | RSS MB (max) | stock first image s | stock p50 ms | stock p99 ms | stock RSS MB |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+
+    for e in results["models"]:
+        lines.append(f"| {e['model']} | {e['first_image_s']:.2f} | {e['p50_ms']:.0f} | {e['p99_ms']:.0f} | "
+                     f"{100 * e['frames_within_target']:.0f}% | {e['max_resident_mb']:.0f} | {e['max_rss_mb']:.0f} | "
+                     f"{stock_cell(e, 'stock_first_image_s', 2)} | {stock_cell(e, 'stock_p50_ms', 0)} | "
+                     f"{stock_cell(e, 'stock_p99_ms', 0)} | {stock_cell(e, 'stock_max_rss_mb', 0)} |")
+    for e in results["models"]:
+        if "stock_skipped" in e:
+            lines.append(f"\nStock ParaView on {e['model']}: {e['stock_skipped']}.")
+    if any("frames_over_target_during_reclaim" in e for e in results["models"]):
+        lines += ["", "Frames over the target and the machine: the kernel's DAMON reclaim thread (kdamond) takes "
+                  "the cores for 40-75 ms about every 5.2 s on this VM (bench/results/cpu_gaps.md). Each frame "
+                  "records the CPU time kdamond used while it rendered (10 ms ticks). An attribution, not the "
+                  "target: the p99 above counts every frame.", "",
+                  "| model | frames over target | of them while kdamond ran | frames while kdamond ran | p99 ms of the other frames |",
+                  "|---|---|---|---|---|"]
+        for e in results["models"]:
+            if "frames_over_target" in e:
+                quiet = e["p99_ms_outside_reclaim"]
+                lines.append(f"| {e['model']} | {e['frames_over_target']} | {e['frames_over_target_during_reclaim']} | "
+                             f"{e['frames_during_reclaim']} | {'-' if quiet is None else f'{quiet:.0f}'} |")
+    roles = ("render", "rasterizer", "loader")
+    if all("cpu_render_ms" in f for e in results["models"] for f in e["frames"]):
+        lines += ["", "CPU time a frame by thread (ms, schedstat), the median over all frames and over the frames "
+                  "over the target: the render thread (ParaView, the selection, uploads), llvmpipe's rasterizer "
+                  "threads (one a core: at most twice the frame time) and the mesh loader (SCHED_IDLE, so it "
+                  "takes only what the frame leaves idle).", "",
+                  "| model | render | rasterizer | loader | over target: render | rasterizer | loader |",
+                  "|---|---|---|---|---|---|---|"]
+        for e in results["models"]:
+            over = [f for f in e["frames"] if f["seconds"] > 1 / results["fps_target"]]
+            cells = [f"{percentile([f[f'cpu_{r}_ms'] for f in e['frames']], 50):.0f}" for r in roles]
+            cells += [f"{percentile([f[f'cpu_{r}_ms'] for f in over], 50):.0f}" if over else "-" for r in roles]
+            lines.append(f"| {e['model']} | " + " | ".join(cells) + " |")
+    with open(args.out + ".md", "w") as out:
+        out.write("\n".join(lines) + "\n")
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        figure, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+        for e in results["models"]:
+            axes[0].plot([1000 * f["seconds"] for f in e["frames"]], label=e["model"])
+            axes[1].plot([f["tolerance"] for f in e["frames"]], label=e["model"])
+        axes[0].axhline(1000 / results['fps_target'], color="k", linestyle="--", linewidth=0.8)
+        axes[0].set_ylabel("frame ms")
+        axes[1].set_ylabel("tolerance px")
+        axes[1].set_yscale("log")
+        axes[1].set_xlabel("frame of the path")
+        axes[0].legend()
+        figure.savefig(args.out + ".png", dpi=100)
+    except ImportError:
+        print("matplotlib missing: no plot")
+
+
+if args.report_only:
+    with open(args.out + ".json") as saved:
+        write_report(json.load(saved))
+    raise SystemExit
+
+
 def cpu_name():
     try:
         with open("/proc/cpuinfo") as info:
@@ -240,23 +332,8 @@ def sphere_frame_ms(view, theta, phi, zoom=None):
     return 1000 * percentile(times, 50)
 
 
-# ParaView's own cost of a frame at this size: with a 64-triangle sphere, what a frame costs
-# before any model is drawn; with a 118,800-triangle sphere filling most of the view, what this
-# renderer takes for about as many triangles as the multiresolution model's coarsest views.
-results["fxaa"] = bool(args.fxaa)
-view = new_view(args.fxaa)
-results["empty_frame_ms"] = sphere_frame_ms(view, 8, 8)
-print(f"ParaView's frame with a 64-triangle sphere at 1280x720: {results['empty_frame_ms']:.0f} ms", flush=True)
-results["dense_sphere_frame_ms"] = sphere_frame_ms(view, 300, 200, zoom=1.5)
-print(f"ParaView's frame with a 118,800-triangle sphere at 1280x720: {results['dense_sphere_frame_ms']:.0f} ms",
-      flush=True)
-simple.Delete(view)
-view = new_view(not args.fxaa)
-results["empty_frame_other_fxaa_ms"] = sphere_frame_ms(view, 8, 8)
-print(f"The same with FXAA {'off' if args.fxaa else 'on'}: {results['empty_frame_other_fxaa_ms']:.0f} ms", flush=True)
-simple.Delete(view)
-
-for model in args.models:
+def measure_multiresolution(model):
+    """The Multiresolution Surface on `model`'s path: an entry of results["models"]."""
     grid, path = prepare(model)
     view = new_view(args.fxaa)
     rss_before = rss_mb()
@@ -292,12 +369,25 @@ for model in args.models:
           f"while kdamond ran", flush=True)
     simple.Delete(reader)
     simple.Delete(view)
+    entry["bounds"] = list(bounds)
+    return entry
+
+
+def stock_fits(model):
     cells = cell_count(model)
-    if args.stock and cells is not None and cells > args.stock_max_cells:
+    return not (cells is not None and cells > args.stock_max_cells)
+
+
+def measure_stock(model, entry):
+    """Stock ParaView (EGRIDReader + Surface) on the same path, where the model fits: fills `entry`."""
+    grid, _ = prepare(model)
+    bounds = entry["bounds"]
+    cells = cell_count(model)
+    if not stock_fits(model):
         entry["stock_skipped"] = (f"{cells / 1e6:.0f}M cells need about {cells * 330 / 2**30:.0f} GB in stock "
                                   f"ParaView; this machine has {results['machine']['memory_gb']} GB")
         print("  stock: " + entry["stock_skipped"], flush=True)
-    elif args.stock and grid:
+    elif grid:
         view = new_view(args.fxaa)
         start = time.perf_counter()
         stock = simple.EGRIDReader(FileName=grid)
@@ -316,65 +406,65 @@ for model in args.models:
               f"p99 {entry['stock_p99_ms']:.0f} ms, RSS <= {entry['stock_max_rss_mb']:.0f} MB", flush=True)
         simple.Delete(stock)
         simple.Delete(view)
+
+
+def run_child(part, model, entry=None):
+    """Runs `part` of `model`'s measurement in a fresh pvpython; its entry."""
+    out = os.path.join(args.scratch, "view_child.json")
+    if entry is not None:
+        with open(out, "w") as saved:
+            json.dump(entry, saved)
+    command = [shutil.which("pvpython") or "pvpython", os.path.abspath(__file__), "--plugin", args.plugin,
+               "--resmr", args.resmr, "--scratch", args.scratch, "--data", args.data, "--models", model,
+               "--fps", str(args.fps), "--frames", str(args.frames), "--budget", str(args.budget),
+               "--stock-max-cells", str(args.stock_max_cells), "--child", part, "--child-out", out]
+    subprocess.run(command + (["--fxaa"] if args.fxaa else []), check=True)
+    with open(out) as saved:
+        return json.load(saved)
+
+
+if args.child:
+    model = args.models[0]
+    if args.child == "multiresolution":
+        entry = measure_multiresolution(model)
+    else:
+        with open(args.child_out) as saved:
+            entry = json.load(saved)
+        measure_stock(model, entry)
+    with open(args.child_out, "w") as saved:
+        json.dump(entry, saved)
+    raise SystemExit
+
+# ParaView's own cost of a frame at this size: with a 64-triangle sphere, what a frame costs
+# before any model is drawn; with a 118,800-triangle sphere filling most of the view, what this
+# renderer takes for about as many triangles as the multiresolution model's coarsest views.
+results["fxaa"] = bool(args.fxaa)
+results["one_process"] = bool(args.one_process)
+view = new_view(args.fxaa)
+results["empty_frame_ms"] = sphere_frame_ms(view, 8, 8)
+print(f"ParaView's frame with a 64-triangle sphere at 1280x720: {results['empty_frame_ms']:.0f} ms", flush=True)
+results["dense_sphere_frame_ms"] = sphere_frame_ms(view, 300, 200, zoom=1.5)
+print(f"ParaView's frame with a 118,800-triangle sphere at 1280x720: {results['dense_sphere_frame_ms']:.0f} ms",
+      flush=True)
+simple.Delete(view)
+view = new_view(not args.fxaa)
+results["empty_frame_other_fxaa_ms"] = sphere_frame_ms(view, 8, 8)
+print(f"The same with FXAA {'off' if args.fxaa else 'on'}: {results['empty_frame_other_fxaa_ms']:.0f} ms", flush=True)
+simple.Delete(view)
+
+for model in args.models:
+    if args.one_process:
+        entry = measure_multiresolution(model)
+        if args.stock:
+            measure_stock(model, entry)
+    else:
+        entry = run_child("multiresolution", model)
+        if args.stock and stock_fits(model) and prepare(model)[0]:
+            entry = run_child("stock", model, entry)
+        elif args.stock:
+            measure_stock(model, entry)  # records why it does not fit
     results["models"].append(entry)
 
 with open(args.out + ".json", "w") as out:
     json.dump(results, out, indent=1)
-lines = [f"# Multiresolution Surface: first image, frame times, memory (target {args.fps:g} FPS, 1280x720, "
-         f"{args.frames}-frame path, budget {args.budget} MB)", "",
-         f"Machine: {results['machine']['cpu']}, {results['machine']['cores']} cores, "
-         f"{results['machine']['memory_gb']} GB, Mesa llvmpipe (no GPU). ParaView's own frame at this size "
-         f"(a 64-triangle sphere) takes {results['empty_frame_ms']:.0f} ms of the {1000 / args.fps:.0f} ms; "
-         f"a 118,800-triangle sphere filling most of the view takes {results['dense_sphere_frame_ms']:.0f} ms. "
-         f"FXAA (a view setting, ParaView's default on) is {'on' if args.fxaa else 'off'} for every view here; "
-         f"{'off' if args.fxaa else 'on'}, the small sphere's frame takes "
-         f"{results['empty_frame_other_fxaa_ms']:.0f} ms.", "",
-         "| model | first image s | p50 ms | p99 ms | frames within target | resident MB (max) | RSS MB (max) | stock first image s | stock p50 ms | stock p99 ms | stock RSS MB |",
-         "|---|---|---|---|---|---|---|---|---|---|---|"]
-
-
-def stock_cell(e, key, digits):
-    if "stock_skipped" in e:
-        return "does not fit"
-    return f"{e[key]:.{digits}f}" if key in e else "not run"
-
-
-for e in results["models"]:
-    lines.append(f"| {e['model']} | {e['first_image_s']:.2f} | {e['p50_ms']:.0f} | {e['p99_ms']:.0f} | "
-                 f"{100 * e['frames_within_target']:.0f}% | {e['max_resident_mb']:.0f} | {e['max_rss_mb']:.0f} | "
-                 f"{stock_cell(e, 'stock_first_image_s', 2)} | {stock_cell(e, 'stock_p50_ms', 0)} | "
-                 f"{stock_cell(e, 'stock_p99_ms', 0)} | {stock_cell(e, 'stock_max_rss_mb', 0)} |")
-for e in results["models"]:
-    if "stock_skipped" in e:
-        lines.append(f"\nStock ParaView on {e['model']}: {e['stock_skipped']}.")
-if KERNEL_RECLAIM_PIDS:
-    lines += ["", "Frames over the target and the machine: the kernel's DAMON reclaim thread (kdamond) takes "
-              "the cores for 40-75 ms about every 5.2 s on this VM (bench/results/cpu_gaps.md). Each frame "
-              "records the CPU time kdamond used while it rendered (10 ms ticks). An attribution, not the "
-              "target: the p99 above counts every frame.", "",
-              "| model | frames over target | of them while kdamond ran | frames while kdamond ran | p99 ms of the other frames |",
-              "|---|---|---|---|---|"]
-    for e in results["models"]:
-        if "frames_over_target" in e:
-            quiet = e["p99_ms_outside_reclaim"]
-            lines.append(f"| {e['model']} | {e['frames_over_target']} | {e['frames_over_target_during_reclaim']} | "
-                         f"{e['frames_during_reclaim']} | {'-' if quiet is None else f'{quiet:.0f}'} |")
-with open(args.out + ".md", "w") as out:
-    out.write("\n".join(lines) + "\n")
-try:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    figure, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
-    for e in results["models"]:
-        axes[0].plot([1000 * f["seconds"] for f in e["frames"]], label=e["model"])
-        axes[1].plot([f["tolerance"] for f in e["frames"]], label=e["model"])
-    axes[0].axhline(1000 / args.fps, color="k", linestyle="--", linewidth=0.8)
-    axes[0].set_ylabel("frame ms")
-    axes[1].set_ylabel("tolerance px")
-    axes[1].set_yscale("log")
-    axes[1].set_xlabel("frame of the path")
-    axes[0].legend()
-    figure.savefig(args.out + ".png", dpi=100)
-except ImportError:
-    print("matplotlib missing: no plot")
+write_report(results)
