@@ -10,44 +10,13 @@ namespace resmr
 void FrameRateController::Reset(double tolerancePixels)
 {
   this->Pixels = std::clamp(tolerancePixels, MinimumPixels, MaximumPixels);
-  this->LastSeconds = 0;
-  this->LastTriangles = 0;
-  this->FastestSeconds = 0;
 }
 
-double FrameRateController::PredictSeconds(std::size_t triangles) const
-{
-  if (this->LastTriangles == 0)
-  {
-    return 0;
-  }
-  const double fixed = std::min(this->FastestSeconds, this->LastSeconds);
-  return fixed + (this->LastSeconds - fixed) * (double(triangles) / double(this->LastTriangles));
-}
-
-bool FrameRateController::Guard(std::size_t triangles)
-{
-  const double predicted = this->PredictSeconds(triangles);
-  if (!(predicted > HighFraction * this->TargetSeconds) || this->Pixels >= MaximumPixels)
-  {
-    return false;
-  }
-  this->Pixels = std::clamp(
-    this->Pixels * std::min(4.0, std::sqrt(predicted / (AimFraction * this->TargetSeconds))), MinimumPixels, MaximumPixels);
-  return true;
-}
-
-double FrameRateController::Update(double frameSeconds, bool complete, std::size_t triangles)
+double FrameRateController::Update(double frameSeconds, bool complete)
 {
   if (!(frameSeconds > 0) || !std::isfinite(frameSeconds))
   {
     return this->Pixels;
-  }
-  if (triangles > 0)
-  {
-    this->LastSeconds = frameSeconds;
-    this->LastTriangles = triangles;
-    this->FastestSeconds = this->FastestSeconds > 0 ? std::min(this->FastestSeconds, frameSeconds) : frameSeconds;
   }
   // Frame times jitter by a fifth from frame to frame (loads, uploads, the system), so the
   // tolerance is held where frames take 60-85% of the target, and the slow tail stays inside it.

@@ -18,16 +18,7 @@
 //   meshes slowed a dozen frames past the target. Slow incomplete frames still raise it.
 // - Tolerance grows as frame time to the power 1/2: triangles drawn go as about 1 / tol^2
 //   for surfaces (screen-space error bounds a linear size).
-// - Guard(triangles) acts before a frame is drawn, on what the selection is about to draw: a
-//   jump in triangles (the camera cut to a new place, many meshes arriving at once) would
-//   otherwise show as a slow frame first and be corrected only after. It predicts the frame's
-//   time as the fastest frame seen since Reset (what does not grow with triangles) plus the
-//   rest of the last frame's time in proportion to triangles, and when that passes the band's
-//   top (as Update backs off there) raises the tolerance towards the aim; the caller selects
-//   again. Without a measured frame it never raises.
 #pragma once
-
-#include <cstddef>
 
 namespace resmr
 {
@@ -45,21 +36,13 @@ public:
   double TargetFramesPerSecond() const { return 1.0 / this->TargetSeconds; }
   void Reset(double tolerancePixels);
   double Tolerance() const { return this->Pixels; }
-  /// The tolerance for the next frame, from the time the last one took, whether it drew all
-  /// the detail the tolerance selected, and how many triangles it drew (0: not counted).
-  double Update(double frameSeconds, bool complete = true, std::size_t triangles = 0);
-  /// The frame time predicted for drawing `triangles` (seconds; 0 without a measured frame).
-  double PredictSeconds(std::size_t triangles) const;
-  /// Raises the tolerance if `triangles` are predicted to pass HighFraction of the target; true
-  /// if it did.
-  bool Guard(std::size_t triangles);
+  /// The tolerance for the next frame, from the time the last one took and whether it drew
+  /// all the detail the tolerance selected.
+  double Update(double frameSeconds, bool complete = true);
 
 private:
   double TargetSeconds = 0.1;
   double Pixels = 1;
-  double LastSeconds = 0;
-  std::size_t LastTriangles = 0;
-  double FastestSeconds = 0; ///< fastest counted frame since Reset
 };
 
 } // namespace resmr

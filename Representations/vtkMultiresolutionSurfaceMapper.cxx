@@ -217,34 +217,6 @@ bool ReadyOnGpu(const std::map<std::size_t, std::unique_ptr<GpuRegion>>& gpu, st
   return found != gpu.end() && found->second->Ready();
 }
 
-/// Where a region's error already shows (this many pixels), its side is drawn simplified
-/// (Sec. 4.3): on models of many layers that is most of the triangles, and the geometry is no
-/// closer than that error anyway. Exact sides keep k exact for close and 1 px views.
-constexpr double CoarseSidePixels = 2.0;
-
-/// A run of a region's indices drawn as one kind of face (0 top, 1 bottom, 2 side).
-struct DrawPart
-{
-  bool shown;
-  uint32_t first, count;
-  int kind;
-};
-
-/// What a drawn region's buffers draw this frame: top, bottom and side (exact, or simplified
-/// where the region's error shows). The selection culled the stored top and bottom by their
-/// cones; a layer's own top and bottom have their own cones.
-std::array<DrawPart, 3> PartsToDraw(const resmr::RegionDrawBuffers& buffers, const resmr::DrawnRegion& drawn,
-  const resmr::RegionRecord& record, const resmr::ViewParameters& view, int32_t layer)
-{
-  const bool top = layer < 0 ? drawn.top : !resmr::SurfaceCulled(buffers.topCone, record, view);
-  const bool bottom = layer < 0 ? drawn.bottom : !resmr::SurfaceCulled(buffers.bottomCone, record, view);
-  const bool coarseSide = buffers.coarseSideIndices > 0 && drawn.projectedError > CoarseSidePixels;
-  const uint32_t sideFirst = buffers.topIndices + buffers.bottomIndices;
-  return { DrawPart{ top, 0, buffers.topIndices, 0 }, DrawPart{ bottom, buffers.topIndices, buffers.bottomIndices, 1 },
-    coarseSide ? DrawPart{ drawn.side, sideFirst + buffers.sideIndices, buffers.coarseSideIndices, 2 }
-               : DrawPart{ drawn.side, sideFirst, buffers.sideIndices, 2 } };
-}
-
 /// A 3D table texture filled a slab of z-slices at a time (glTexSubImage3D) into a texture of
 /// its own, which replaces the one drawn only once complete: copied in one call, a 300M-cell
 /// model's tables (hundreds of MB) stalled a frame for about a second on llvmpipe.
@@ -578,6 +550,9 @@ constexpr double UploadMsAtFixedTolerance = 10.0;
 
 /// Tolerance (pixels) the frame-rate controller starts from.
 constexpr double ControllerStartPixels = 8.0;
+
+/// Projected error (pixels) past which a region's simplified side replaces its exact one.
+constexpr double CoarseSidePixels = 2.0;
 
 /// The loader's share of the mesh budget: the GPU mirrors at most what is resident, so half
 /// each keeps both together within the budget.
@@ -1070,30 +1045,6 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     in.UploadsDeferred = in.UploadsDeferred || in.OffsetUpload.Busy() || in.PropertyUpload.Busy();
     const auto onGpu = [&in](std::size_t region) { return ReadyOnGpu(in.Gpu, region); };
     selection = in.Selector->Select(view, onGpu);
-    // Before drawing: a jump in triangles (a camera cut, many meshes ready at once) raises the
-    // tolerance now rather than after a slow frame (resmr::FrameRateController::Guard).
-    const auto triangles = [&]() {
-      std::size_t total = 0;
-      for (const resmr::DrawnRegion& drawn : selection.drawn)
-      {
-        const auto found = in.Gpu.find(drawn.region);
-        if (found == in.Gpu.end())
-        {
-          continue;
-        }
-        const resmr::RegionDrawBuffers& buffers = *found->second->buffers;
-        for (const DrawPart& part : PartsToDraw(buffers, drawn, in.File->Regions()[drawn.region], view, layer))
-        {
-          total += part.shown ? part.count / 3 : 0;
-        }
-      }
-      return total;
-    };
-    for (int pass = 0; this->TargetFrameRate > 0 && pass < 4 && in.Controller.Guard(triangles()); ++pass)
-    {
-      in.Tolerance = view.tolerancePixels = in.Controller.Tolerance();
-      selection = in.Selector->Select(view, onGpu);
-    }
   }
   const GLuint handle = static_cast<GLuint>(program->GetHandle());
   const auto uniform3i = [handle](const char* name, int a, int b, int c) {
@@ -1278,8 +1229,25 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     {
       continue;
     }
-    const std::array<DrawPart, 3> parts =
-      PartsToDraw(buffers, drawn, in.File->Regions()[drawn.region], view, layer);
+    // The selection culled the stored top and bottom by their cones; a layer's own top and
+    // bottom have their own cones.
+    const resmr::RegionRecord& record = in.File->Regions()[drawn.region];
+    const bool top = layer < 0 ? drawn.top : !resmr::SurfaceCulled(buffers.topCone, record, view);
+    const bool bottom = layer < 0 ? drawn.bottom : !resmr::SurfaceCulled(buffers.bottomCone, record, view);
+    // Where the region's error already shows (a few pixels), its side is drawn simplified
+    // (Sec. 4.3): on models of many layers that is most of the triangles, and the geometry is
+    // no closer than that error anyway. Exact sides keep k exact for close and 1 px views.
+    const bool coarseSide = buffers.coarseSideIndices > 0 && drawn.projectedError > CoarseSidePixels;
+    struct Part
+    {
+      bool shown;
+      uint32_t first, count;
+      int kind;
+    };
+    const Part parts[3] = { { top, 0, buffers.topIndices, 0 }, { bottom, buffers.topIndices, buffers.bottomIndices, 1 },
+      coarseSide ? Part{ drawn.side, buffers.topIndices + buffers.bottomIndices + buffers.sideIndices,
+                     buffers.coarseSideIndices, 2 }
+                 : Part{ drawn.side, buffers.topIndices + buffers.bottomIndices, buffers.sideIndices, 2 } };
     for (const auto& piece : gpu.pieces)
     {
       piece->layout->Bind();
@@ -1362,7 +1330,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     // tolerance tenfold for a hundred frames.
     if (!in.Allocated)
     {
-      in.Controller.Update(measuredMs / 1000, complete, static_cast<std::size_t>(in.Triangles));
+      in.Controller.Update(measuredMs / 1000, complete);
     }
   }
 }
