@@ -548,8 +548,11 @@ constexpr std::size_t TableBytesPerFrame = std::size_t(4) << 20;
 constexpr double UploadShareOfFrame = 0.1;
 constexpr double UploadMsAtFixedTolerance = 10.0;
 
-/// Tolerance (pixels) the frame-rate controller starts from.
-constexpr double ControllerStartPixels = 8.0;
+/// Tolerance (pixels) the frame-rate controller starts from. From 8 px the first detail of the
+/// 10M and 100M models arrived faster than the controller backed off: 4-6 frames of 100-170 ms
+/// in the first 150 of a path; from 64 px, 2. Reek and Brugge still reach 0.5 px within 25
+/// frames, and 10M and 100M hold 20-500 px later on anyway.
+constexpr double ControllerStartPixels = 64.0;
 
 /// Projected error (pixels) past which a region's simplified side replaces its exact one.
 constexpr double CoarseSidePixels = 2.0;
