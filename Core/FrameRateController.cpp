@@ -12,7 +12,7 @@ void FrameRateController::Reset(double tolerancePixels)
   this->Pixels = std::clamp(tolerancePixels, MinimumPixels, MaximumPixels);
 }
 
-double FrameRateController::Update(double frameSeconds, bool complete)
+double FrameRateController::Update(double frameSeconds, bool complete, const CutRange& same)
 {
   if (!(frameSeconds > 0) || !std::isfinite(frameSeconds))
   {
@@ -30,7 +30,16 @@ double FrameRateController::Update(double frameSeconds, bool complete)
   {
     factor = std::max(0.8, std::sqrt(ratio / AimFraction)); // headroom: refine a step at a time
   }
-  this->Pixels = std::clamp(this->Pixels * factor, MinimumPixels, MaximumPixels);
+  double from = this->Pixels;
+  if (factor > 1 && same.coarsenAt > from && std::isfinite(same.coarsenAt))
+  {
+    from = same.coarsenAt; // every tolerance below it draws this frame again
+  }
+  else if (factor < 1 && same.refineBelow < from && same.refineBelow > 0)
+  {
+    from = same.refineBelow; // every tolerance above it does
+  }
+  this->Pixels = std::clamp(from * factor, MinimumPixels, MaximumPixels);
   return this->Pixels;
 }
 

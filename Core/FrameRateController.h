@@ -18,10 +18,28 @@
 //   meshes slowed a dozen frames past the target. Slow incomplete frames still raise it.
 // - Tolerance grows as frame time to the power 1/2: triangles drawn go as about 1 / tol^2
 //   for surfaces (screen-space error bounds a linear size).
+// - Steps act on the cut, not on a number: the selection reports the range of tolerances
+//   that give the frame's cut (CutRange), and any tolerance in it draws the same thing. A
+//   step to refine starts from the range's low end, one to coarsen from its high end, so
+//   every step changes what is drawn. Without it a tolerance raised far above the view's
+//   errors (a slow frame at the roots, or near leaves of a low flight that no tolerance
+//   short of thousands of pixels coarsens) took dozens of frames to mean anything again:
+//   dozens of frames too coarse, or too slow.
 #pragma once
+
+#include <limits>
 
 namespace resmr
 {
+
+/// The tolerances (pixels) that draw the same cut as the last frame's: a tolerance below
+/// `refineBelow` splits a diamond drawn whole (0: nothing can split now), one at or above
+/// `coarsenAt` merges a split diamond (infinity: nothing is split). The defaults say nothing.
+struct CutRange
+{
+  double refineBelow = std::numeric_limits<double>::infinity();
+  double coarsenAt = 0;
+};
 
 class FrameRateController
 {
@@ -36,9 +54,9 @@ public:
   double TargetFramesPerSecond() const { return 1.0 / this->TargetSeconds; }
   void Reset(double tolerancePixels);
   double Tolerance() const { return this->Pixels; }
-  /// The tolerance for the next frame, from the time the last one took and whether it drew
-  /// all the detail the tolerance selected.
-  double Update(double frameSeconds, bool complete = true);
+  /// The tolerance for the next frame, from the time the last one took, whether it drew all
+  /// the detail the tolerance selected, and the tolerances that draw the same cut.
+  double Update(double frameSeconds, bool complete = true, const CutRange& same = CutRange());
 
 private:
   double TargetSeconds = 0.1;

@@ -145,6 +145,8 @@ struct Traversal
   std::vector<std::vector<std::size_t>> visibleByLevel; ///< every region reached and not culled
   std::vector<uint8_t> split;                           ///< per region
   double largest = 0;
+  double refineBelow = 0; ///< largest error of a diamond that only the tolerance kept whole
+  double coarsenAt = std::numeric_limits<double>::infinity(); ///< smallest error of a split diamond
 };
 } // namespace
 
@@ -291,8 +293,16 @@ Traversal Traverse(const MultiresolutionFile& file, const Nodes& nodes, const st
           }
         }
       }
-      const bool split =
-        depth < leaves && complete && anyVisible && ready && error > view.tolerancePixels;
+      const bool splittable = depth < leaves && complete && anyVisible && ready;
+      const bool split = splittable && error > view.tolerancePixels;
+      if (split)
+      {
+        out.coarsenAt = std::min(out.coarsenAt, error);
+      }
+      else if (splittable)
+      {
+        out.refineBelow = std::max(out.refineBelow, error);
+      }
       for (std::size_t t : diamond)
       {
         if (split)
@@ -333,6 +343,8 @@ ViewSelection ViewSelector::Select(const ViewParameters& view, const std::functi
 
   ViewSelection selection;
   selection.largestProjectedError = actual.largest;
+  selection.refineBelowPixels = actual.refineBelow;
+  selection.coarsenAtPixels = actual.coarsenAt;
   if (!view.parallel && !regions.empty())
   {
     const auto& box = this->ModelBox;

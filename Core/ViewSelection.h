@@ -28,6 +28,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace resmr
@@ -61,6 +62,12 @@ struct ViewSelection
   /// Largest projected error (pixels) of a drawn region's diamond; what the tolerance holds
   /// once everything wanted is resident.
   double largestProjectedError = 0;
+  /// The tolerances between which this frame's cut stays the same, for the frame-rate
+  /// controller: a tolerance below `refineBelowPixels` splits a diamond drawn whole now (0:
+  /// none can split, being leaves or waiting on loads), one at or above `coarsenAtPixels`
+  /// draws a diamond split now whole (infinity: none is split).
+  double refineBelowPixels = 0;
+  double coarsenAtPixels = std::numeric_limits<double>::infinity();
   /// Drawn regions standing in for wanted descendants that are not resident.
   std::size_t substituted = 0;
   /// The model's surface is closed and faces outward, so seen from outside its back faces are

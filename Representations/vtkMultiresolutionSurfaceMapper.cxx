@@ -1333,7 +1333,10 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     // tolerance tenfold for a hundred frames.
     if (!in.Allocated)
     {
-      in.Controller.Update(measuredMs / 1000, complete);
+      resmr::CutRange same;
+      same.refineBelow = selection.refineBelowPixels;
+      same.coarsenAt = selection.coarsenAtPixels;
+      in.Controller.Update(measuredMs / 1000, complete, same);
     }
   }
 }

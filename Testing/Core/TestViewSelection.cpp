@@ -350,6 +350,52 @@ void TestConformity(const Model& model)
   std::printf("  conformity: %d views, up to %zu regions drawn\n", views, mostDrawn);
 }
 
+/// The cut stays the same for any tolerance in [refineBelowPixels, coarsenAtPixels) and
+/// changes at either end: just below the first a diamond splits, at the second one merges.
+void TestToleranceInterval(const Model& model)
+{
+  std::mt19937_64 random(23);
+  const std::size_t count = model.file->Regions().size();
+  int refined = 0, coarsened = 0;
+  for (int trial = 0; trial < 24; ++trial)
+  {
+    std::vector<uint8_t> resident(count);
+    const double fraction = trial % 3 == 0 ? 1.0 : 0.6;
+    for (std::size_t r = 0; r < count; ++r)
+      resident[r] = model.file->Regions()[r].level == 0 || std::uniform_real_distribution<double>(0, 1)(random) < fraction;
+    const auto isResident = [&](std::size_t r) { return resident[r] != 0; };
+    const double angle = trial * 0.9;
+    const Vec eye{ model.centre[0] + 1.3 * model.radius * std::cos(angle),
+      model.centre[1] + 1.3 * model.radius * std::sin(angle), model.centre[2] + model.radius * 0.4 };
+    ViewParameters view = Perspective(eye, model.centre, { 0, 0, 1 }, 40, 1e-3 * model.radius, 10 * model.radius, 1);
+    view.pixelsPerUnit = 1000;
+    view.tolerancePixels = std::pow(2.0, trial % 8);
+    const auto selection = model.selector->Select(view, isResident);
+    const double below = selection.refineBelowPixels, at = selection.coarsenAtPixels;
+    CHECK(below <= view.tolerancePixels && view.tolerancePixels < at);
+    const auto cutAt = [&](double tolerance) {
+      ViewParameters other = view;
+      other.tolerancePixels = tolerance;
+      return DrawnSet(model.selector->Select(other, isResident));
+    };
+    const std::vector<std::size_t> cut = DrawnSet(selection);
+    if (below > 0)
+    {
+      CHECK(cutAt(below) == cut);
+      CHECK(cutAt(below * (1 - 1e-9)) != cut);
+      ++refined;
+    }
+    if (std::isfinite(at))
+    {
+      CHECK(cutAt(std::nextafter(at, 0.0)) == cut);
+      CHECK(cutAt(at) != cut);
+      ++coarsened;
+    }
+  }
+  std::printf("  tolerance interval: %d views could refine, %d could coarsen\n", refined, coarsened);
+  CHECK(refined >= 6 && coarsened >= 6);
+}
+
 void TestFrustum(const Model& model)
 {
   const Vec above{ model.centre[0], model.centre[1], model.high[2] + model.radius };
@@ -1251,6 +1297,64 @@ void TestFrameRateController()
   const double coarse = loading.Tolerance();
   loading.Update(0.01, true);
   CHECK(loading.Tolerance() < coarse);
+
+  // Steps act on the cut. A view whose diamonds' projected errors are 1, 2, 4, ... 4096 px,
+  // each split adding as many triangles as all coarser ones: only the tolerance's power of
+  // two matters. A frame costs 40 ms plus 1 ms per 4,000 triangles.
+  const auto triangles = [](double pixels) {
+    double count = 1000;
+    for (double error = 4096; error >= 1; error /= 2)
+      count += error > pixels ? count : 0;
+    return std::min(count, 1e9);
+  };
+  const auto range = [](double pixels) {
+    CutRange same;
+    same.refineBelow = 0;
+    same.coarsenAt = std::numeric_limits<double>::infinity();
+    for (double error = 4096; error >= 1; error /= 2)
+    {
+      if (error > pixels)
+        same.coarsenAt = std::min(same.coarsenAt, error);
+      else
+        same.refineBelow = std::max(same.refineBelow, error);
+    }
+    return same;
+  };
+  const auto seconds = [&](double pixels) { return 0.04 + triangles(pixels) / 4e6; };
+  // Far too coarse: from the maximum, a fast frame's step lands below the finest diamond
+  // drawn whole, so the cut changes at once (without the range, 0.8 a step: 20 frames).
+  FrameRateController steps;
+  steps.SetTargetFramesPerSecond(10);
+  steps.Reset(FrameRateController::MaximumPixels);
+  steps.Update(seconds(steps.Tolerance()), true, range(steps.Tolerance()));
+  std::printf("  controller, cut range: one fast frame from %.0f px to %.0f px\n", FrameRateController::MaximumPixels,
+    steps.Tolerance());
+  CHECK(steps.Tolerance() < 4096 && triangles(steps.Tolerance()) > triangles(FrameRateController::MaximumPixels));
+  // Too fine: a slow frame's step passes the nearest split diamond, so it merges.
+  steps.Reset(1.5);
+  const double slow = 0.5;
+  const double before = triangles(steps.Tolerance());
+  steps.Update(slow, true, range(steps.Tolerance()));
+  CHECK(steps.Tolerance() >= 2 && triangles(steps.Tolerance()) < before);
+  // Over frames: settles inside the band from either end within 20 frames, and stays.
+  for (double start : { 0.5, FrameRateController::MaximumPixels })
+  {
+    steps.Reset(start);
+    double slowest = 0, fastest = 1;
+    for (int f = 0; f < 100; ++f)
+    {
+      const double s = seconds(steps.Tolerance());
+      if (f >= 20)
+      {
+        slowest = std::max(slowest, s);
+        fastest = std::min(fastest, s);
+      }
+      steps.Update(s, true, range(steps.Tolerance()));
+    }
+    std::printf("  controller, cut range from %.1f px: frames %.3f-%.3f s after 20\n", start, fastest, slowest);
+    CHECK(slowest <= FrameRateController::HighFraction * 0.1);
+    CHECK(fastest >= 0.5 * FrameRateController::LowFraction * 0.1);
+  }
 }
 } // namespace
 
@@ -1328,6 +1432,11 @@ int main(int argc, char** argv)
       [&] {
         for (const auto& m : models)
           TestConformity(*m);
+      } },
+    { "ToleranceInterval",
+      [&] {
+        for (const auto& m : models)
+          TestToleranceInterval(*m);
       } },
     { "Frustum",
       [&] {
