@@ -44,6 +44,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <string>
 #include <thread>
 #include <unordered_set>
 #include <vector>
@@ -367,6 +368,8 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   vtkScalarsToColors* ColorTable = nullptr;
   double ColorRange[2] = { 0, 1 };
   vtkOpenGLRenderWindow* Window = nullptr;
+  /// Fragment shader sources by variant (FragmentVariant's switches as bits).
+  std::map<int, std::string> FragmentSources;
   unsigned int TimerQuery = 0;
   bool TimerPending = false;
   double GpuMs = 0;
@@ -562,6 +565,20 @@ constexpr double CoarseSidePixels = 2.0;
 std::size_t MainMemoryShare(int budgetMB)
 {
   return (std::size_t(budgetMB) << 20) / 2;
+}
+
+/// The fragment shader's source for one painting state (see MultiresolutionSurfaceFS.glsl):
+/// the variant's switches defined after the version line VTK puts in.
+std::string FragmentVariant(int colorMode, bool layerView, bool logScale, bool gridLines, bool specular)
+{
+  const std::string source = MultiresolutionSurfaceFS;
+  const std::string versionLine = "//VTK::System::Dec\n";
+  const std::size_t at = source.find(versionLine);
+  std::string defines = "#define COLOR_MODE " + std::to_string(colorMode) + "\n#define LAYER_VIEW " +
+    std::to_string(layerView ? 1 : 0) + "\n#define LOG_SCALE " + std::to_string(logScale ? 1 : 0) +
+    "\n#define GRID_LINES " + std::to_string(gridLines ? 1 : 0) + "\n#define SPECULAR " +
+    std::to_string(specular ? 1 : 0) + "\n";
+  return at == std::string::npos ? source : source.substr(0, at + versionLine.size()) + defines + source.substr(at + versionLine.size());
 }
 
 void UploadInteger3D(vtkTextureObject* texture, vtkOpenGLRenderWindow* window, const std::array<uint32_t, 3>& sides,
@@ -826,8 +843,28 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   releaseEvicted();
 
   vtkOpenGLState* state = window->GetState();
-  vtkShaderProgram* program =
-    window->GetShaderCache()->ReadyShaderProgram(MultiresolutionSurfaceVS, MultiresolutionSurfaceFS, "");
+  // The painting this frame, and the fragment shader compiled for it (a variant a state: see
+  // the shader). The meshes' vertex layouts are bound against the property variant, which
+  // reads both attributes (a variant that does not read the cell coordinate drops it when
+  // linking), at the locations every variant shares; the frame's own variant draws.
+  vtkScalarsToColors* table = this->GetLookupTable();
+  vtkProperty* look = actor->GetProperty();
+  const auto paintingMode = [&](bool hashReady, bool haveProperty) {
+    return this->ColorMode == PropertyColors && (!haveProperty || !hashReady) ? SolidColor : this->ColorMode;
+  };
+  const auto readyProgram = [&](int colorMode) -> vtkShaderProgram* {
+    const bool logScale = colorMode == PropertyColors && table && table->UsingLogScale() != 0;
+    const bool gridLines = this->GridLines && colorMode != CellIdColors;
+    const bool specular = look->GetLighting() && look->GetSpecular() > 0;
+    const int key = colorMode | (layer >= 0 ? 4 : 0) | (logScale ? 8 : 0) | (gridLines ? 16 : 0) | (specular ? 32 : 0);
+    auto found = in.FragmentSources.find(key);
+    if (found == in.FragmentSources.end())
+    {
+      found = in.FragmentSources.emplace(key, FragmentVariant(colorMode, layer >= 0, logScale, gridLines, specular)).first;
+    }
+    return window->GetShaderCache()->ReadyShaderProgram(MultiresolutionSurfaceVS, found->second.c_str(), "");
+  };
+  vtkShaderProgram* program = readyProgram(PropertyColors);
   if (!program)
   {
     if (in.Error.empty())
@@ -1049,11 +1086,6 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     const auto onGpu = [&in](std::size_t region) { return ReadyOnGpu(in.Gpu, region); };
     selection = in.Selector->Select(view, onGpu);
   }
-  const GLuint handle = static_cast<GLuint>(program->GetHandle());
-  const auto uniform3i = [handle](const char* name, int a, int b, int c) {
-    glUniform3i(glGetUniformLocation(handle, name), a, b, c);
-  };
-  vtkScalarsToColors* table = this->GetLookupTable();
   if (property && (table != in.ColorTable || table->GetMTime() != in.ColorTableTime))
   {
     const int size = 1024;
@@ -1084,8 +1116,21 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     in.ColorTableTime = table->GetMTime();
   }
   const bool hashReady = in.HashUploaded || layer >= 0; // a layer's 2D table needs no hash
-  const int colorMode =
-    this->ColorMode == PropertyColors && (!property || !hashReady) ? SolidColor : this->ColorMode;
+  const int colorMode = paintingMode(hashReady, property != nullptr);
+  program = readyProgram(colorMode);
+  if (!program)
+  {
+    if (in.Error.empty())
+    {
+      in.Error = "the multiresolution surface shaders did not compile (see the output window)";
+      vtkErrorMacro(<< in.Error);
+    }
+    return;
+  }
+  const GLuint handle = static_cast<GLuint>(program->GetHandle());
+  const auto uniform3i = [handle](const char* name, int a, int b, int c) {
+    glUniform3i(glGetUniformLocation(handle, name), a, b, c);
+  };
 
   // GPU time of an earlier frame, when the driver has it (never waits).
   if (in.TimerQuery != 0 && in.TimerPending)
@@ -1139,7 +1184,6 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     }
     program->SetUniformMatrix3x3("normalToView", normal);
   }
-  program->SetUniformi("colorMode", colorMode);
   uniform3i("gridDims", int(header.dims[0]), int(header.dims[1]), int(header.dims[2]));
   if (in.HashUploaded)
   {
@@ -1174,14 +1218,11 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
       range[1] = float(std::log10(std::max(in.ColorRange[1], 1e-30)));
     }
     program->SetUniform2f("scalarRange", range);
-    program->SetUniformi("logScale", logScale ? 1 : 0);
     const unsigned char* nan = table->MapValue(std::numeric_limits<double>::quiet_NaN());
     const float nanColor[4] = { nan[0] / 255.f, nan[1] / 255.f, nan[2] / 255.f, nan[3] / 255.f };
     program->SetUniform4f("nanColor", nanColor);
   }
-  vtkProperty* look = actor->GetProperty();
   program->SetUniform3f("solidColor", look->GetDiffuseColor());
-  program->SetUniformi("gridLines", this->GridLines && colorMode != CellIdColors ? 1 : 0);
   program->SetUniformf("gridLineWidth", static_cast<float>(this->GridLineWidth));
   program->SetUniform3f("gridLineColor", this->GridLineColor);
   program->SetUniformf("ambient", static_cast<float>(look->GetAmbient() + (look->GetLighting() ? 0 : 1)));

@@ -6,11 +6,16 @@
 // coordinate crosses an integer, drawn a fixed width in pixels and faded out where cells
 // shrink below a few pixels. In the single-layer view (layer >= 0) the property comes from
 // that layer's 2D table, indexed by (i, j) without the hash.
+//
+// The mapper compiles one variant per painting mode, with these defined (0 or 1):
+// COLOR_MODE (0: solid colour, 1: property, 2: cell id), LAYER_VIEW (one layer drawn),
+// LOG_SCALE, GRID_LINES, SPECULAR. A software rasterizer (llvmpipe) runs both sides of every
+// branch on a uniform, masked; compiled out, the unused paths cost nothing (a tenth of a
+// full-screen frame there), and GPUs keep fewer registers.
 
 in vec3 cellCoord;
 in vec3 viewPosition;
 
-uniform int colorMode;    // 0: solid colour, 1: property, 2: cell id (debug)
 uniform int faceKind;     // 0: top, 1: bottom, 2: side
 uniform ivec3 gridDims;   // nx, ny, nz
 uniform ivec3 tableSides; // m
@@ -22,11 +27,9 @@ uniform int cellTables;          // 0 until the hash and normal tables are loade
 uniform int layer;               // -1: the whole model; else the one layer drawn (0-based)
 uniform sampler2D layerProperty; // nx x ny, R32F: that layer's table
 uniform sampler2D colorMap;      // N x 1, RGBA8
-uniform vec2 scalarRange;        // lookup table range (log10 of it when logScale)
-uniform int logScale;
+uniform vec2 scalarRange;        // lookup table range (log10 of it with LOG_SCALE)
 uniform vec4 nanColor;
 uniform vec3 solidColor;
-uniform int gridLines;
 uniform float gridLineWidth;     // pixels
 uniform vec3 gridLineColor;
 uniform float ambient;
@@ -67,42 +70,51 @@ vec3 DecodeNormal(uint code)
 void main()
 {
   ivec3 cell = clamp(ivec3(floor(cellCoord)), ivec3(0), gridDims - 1);
-  if (layer >= 0 && faceKind == 2)
+#if LAYER_VIEW
+  if (faceKind == 2)
   {
     // A layer's side faces span its interfaces, k to k + 1: seen edge-on they are slivers
     // on screen, where interpolation strays past either interface. Their cell is in the
     // layer; top and bottom faces keep the k their vertices give.
     cell.z = layer;
   }
-  if (colorMode == 2)
+#endif
+#if COLOR_MODE == 2
   {
     int id = cell.x + gridDims.x * (cell.y + gridDims.y * cell.z) + 1;
     gl_FragData[0] = vec4(float(id & 255), float((id >> 8) & 255), float((id >> 16) & 255), 255.0) / 255.0;
-    return;
   }
-  ivec3 slot = layer < 0 ? HashSlot(cell) : ivec3(0);
+#else
+#if !LAYER_VIEW
+  ivec3 slot = HashSlot(cell);
+#endif
 
   vec3 color = solidColor;
-  if (colorMode == 1)
+#if COLOR_MODE == 1
   {
-    float value = layer < 0 ? texelFetch(propertyTable, slot, 0).r : texelFetch(layerProperty, cell.xy, 0).r;
+#if LAYER_VIEW
+    float value = texelFetch(layerProperty, cell.xy, 0).r;
+#else
+    float value = texelFetch(propertyTable, slot, 0).r;
+#endif
     if (isnan(value))
     {
       color = nanColor.rgb;
     }
     else
     {
+#if LOG_SCALE
+      float v = value > 0.0 ? log(value) / log(10.0) : scalarRange.x;
+#else
       float v = value;
-      if (logScale == 1)
-      {
-        v = value > 0.0 ? log(value) / log(10.0) : scalarRange.x;
-      }
+#endif
       float span = scalarRange.y - scalarRange.x;
       float t = span > 0.0 ? clamp((v - scalarRange.x) / span, 0.0, 1.0) : 0.5;
       int size = textureSize(colorMap, 0).x;
       color = texelFetch(colorMap, ivec2(min(int(t * float(size)), size - 1), 0), 0).rgb;
     }
   }
+#endif
 
   // Normal (view space): the original cell's top or bottom face normal (Sec. 5.3), the
   // facet's own for sides. Lit from the camera (headlight), both sides. A layer's cells are
@@ -110,21 +122,25 @@ void main()
   // only: a layer lights every face by its geometric normal, per pixel.
   vec3 facet = normalize(cross(dFdx(viewPosition), dFdy(viewPosition)));
   vec3 normal = facet;
-  if (faceKind < 2 && layer < 0 && cellTables == 1)
+#if !LAYER_VIEW
+  if (faceKind < 2 && cellTables == 1)
   {
     uvec2 codes = texelFetch(cellNormals, slot, 0).xy;
     normal = normalize(normalToView * DecodeNormal(faceKind == 0 ? codes.x : codes.y));
   }
+#endif
   if (dot(normal, facet) < 0.0 && faceKind == 2)
   {
     normal = -normal;
   }
   vec3 toEye = normalize(-viewPosition);
   float lambert = abs(dot(normal, toEye));
-  float highlight = pow(lambert, specularPower);
-  color = color * (ambient + diffuse * lambert) + vec3(specular * highlight);
+  color = color * (ambient + diffuse * lambert);
+#if SPECULAR
+  color += vec3(specular * pow(lambert, specularPower));
+#endif
 
-  if (gridLines == 1)
+#if GRID_LINES
   {
     // Distance to the nearest integer of each coordinate, in pixels; the constant axis sits
     // half a cell from any integer with a zero derivative, so it never makes a line.
@@ -136,5 +152,7 @@ void main()
     float strength = max(line.x, max(line.y, line.z));
     color = mix(color, gridLineColor, strength);
   }
+#endif
   gl_FragData[0] = vec4(color, 1.0);
+#endif
 }

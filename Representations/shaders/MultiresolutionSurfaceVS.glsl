@@ -1,9 +1,12 @@
 //VTK::System::Dec
+#extension GL_ARB_explicit_attrib_location : require
 // Multiresolution surface, vertex stage (paper Sec. 5): positions relative to the model
 // origin, and the cell coordinate (topological coordinate half a cell inside the face).
+// The attributes' locations are fixed: every fragment shader variant links with this stage,
+// and the meshes' vertex layouts, bound once, serve them all.
 
-in vec3 vertexPosition;
-in vec3 cellCoordinate;
+layout(location = 0) in vec3 vertexPosition;
+layout(location = 1) in vec3 cellCoordinate;
 
 uniform mat4 modelToClip;
 uniform mat4 modelToView;
