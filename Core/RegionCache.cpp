@@ -435,7 +435,15 @@ RegionCache::RegionCache(std::shared_ptr<const MultiresolutionFile> file, std::s
       this->Pinned.push_back(this->KeyOf(r, this->CurrentLayer));
     }
   }
-  this->Loader = std::thread([this] { this->Run(); });
+  this->Loader = std::thread([this] { this->Run(false); });
+#ifdef __linux__
+  {
+    std::lock_guard<std::mutex> lock(this->Lock);
+    this->HaveLoaderClock = pthread_getcpuclockid(this->Loader.native_handle(), &this->LoaderClock) == 0;
+    this->WindowStart = std::chrono::steady_clock::now();
+  }
+#endif
+  this->Standby = std::thread([this] { this->Run(true); });
 }
 
 RegionCache::~RegionCache()
@@ -445,8 +453,10 @@ RegionCache::~RegionCache()
     this->Stopping = true;
   }
   this->Wake.notify_all();
+  this->StandbyWake.notify_all();
   this->Idle.notify_all();
   this->Loader.join();
+  this->Standby.join();
 }
 
 bool RegionCache::SetLayer(int32_t layer)
@@ -476,6 +486,7 @@ bool RegionCache::SetLayer(int32_t layer)
     ++this->Changes; // what Get returns has changed
   }
   this->Wake.notify_all();
+  this->StandbyWake.notify_all();
   return true;
 }
 
@@ -554,8 +565,10 @@ void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vec
       }
     }
     this->WantedBlocked = this->PredictedBlocked = false;
+    this->RescueIfStarvedLocked();
   }
   this->Wake.notify_all();
+  this->StandbyWake.notify_all();
 }
 
 void RegionCache::RequestProperty(const std::string& name, int32_t step, int32_t layer)
@@ -569,6 +582,7 @@ void RegionCache::RequestProperty(const std::string& name, int32_t step, int32_t
       this->CurrentProperty->step == step && this->CurrentProperty->layer == layer);
   }
   this->Wake.notify_all();
+  this->StandbyWake.notify_all();
 }
 
 std::shared_ptr<const PropertyTableData> RegionCache::Property() const
@@ -608,13 +622,31 @@ bool RegionCache::PendingLocked() const
 bool RegionCache::Pending() const
 {
   std::lock_guard<std::mutex> lock(this->Lock);
+  this->RescueIfStarvedLocked();
   return this->PendingLocked();
 }
 
 bool RegionCache::WaitIdle(std::chrono::milliseconds timeout) const
 {
   std::unique_lock<std::mutex> lock(this->Lock);
-  return this->Idle.wait_for(lock, timeout, [this] { return !this->PendingLocked(); });
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (this->PendingLocked())
+  {
+    this->RescueIfStarvedLocked();
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= deadline)
+    {
+      return false;
+    }
+    this->Idle.wait_for(lock, std::min<std::chrono::steady_clock::duration>(deadline - now, std::chrono::milliseconds(100)));
+  }
+  return true;
+}
+
+uint64_t RegionCache::StandbyRescues() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->Rescues;
 }
 
 void RegionCache::SetBudget(std::size_t bytes)
@@ -634,6 +666,7 @@ void RegionCache::SetBudget(std::size_t bytes)
     this->WantedBlocked = this->PredictedBlocked = false;
   }
   this->Wake.notify_all();
+  this->StandbyWake.notify_all();
   this->Idle.notify_all();
 }
 
@@ -717,7 +750,7 @@ int64_t RegionCache::NextRegionLocked()
   };
   for (Key key : this->Pinned)
   {
-    if (missing(key))
+    if (missing(key) && !this->Loading.count(key))
     {
       return static_cast<int64_t>(key);
     }
@@ -731,9 +764,9 @@ int64_t RegionCache::NextRegionLocked()
     }
     for (Key key : wanted ? this->Wanted : this->Predicted)
     {
-      if (!missing(key))
+      if (!missing(key) || this->Loading.count(key))
       {
-        continue;
+        continue; // loaded, or being read by the other loader
       }
       // An entry refused earlier for the budget is not decoded again while it cannot fit.
       const std::size_t known = this->Entries[key].bytes;
@@ -798,162 +831,239 @@ void RegionCache::InsertLocked(Key key, std::shared_ptr<const RegionDrawBuffers>
   ++this->Changes;
 }
 
-void RegionCache::Run()
+void RegionCache::Run(bool standby)
 {
 #ifdef __linux__
-  // Below the render thread: decompression must not take the cores a frame (or a software
-  // rasterizer's threads) needs; it uses what the frames leave. At nice 10 it still took a
-  // whole core in frames of a 2-core machine (the scheduler counts a core running it as busy,
-  // so a waking rasterizer thread queued behind a frame's other work); a SCHED_IDLE core
-  // counts as idle, and the waking thread takes it at once.
-  sched_param none{};
-  if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &none) != 0)
+  if (!standby)
   {
+    // Below the render thread: decompression must not take the cores a frame (or a software
+    // rasterizer's threads) needs; it uses what the frames leave. At nice 10 it still took a
+    // whole core in frames of a 2-core machine (the scheduler counts a core running it as
+    // busy, so a waking rasterizer thread queued behind a frame's other work); a SCHED_IDLE
+    // core counts as idle, and the waking thread takes it at once.
+    sched_param none{};
+    if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &none) != 0)
+    {
+      setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+    }
+  }
+  else
+  {
+    // The standby only loads while the idle loader is starved (see RescueIfStarvedLocked): an
+    // ordinary thread, below the render thread. (An unprivileged thread cannot leave
+    // SCHED_IDLE, so the idle loader cannot be raised instead.)
     setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
   }
-  pthread_setname_np(pthread_self(), "resmr-loader"); // so profilers and the view bench can tell it apart
+  // So profilers and the view bench can tell them apart.
+  pthread_setname_np(pthread_self(), standby ? "resmr-standby" : "resmr-loader");
 #endif
-  int handedness = 1;
-  std::string failure;
-  try
-  {
-    handedness = TopologyHandedness(*this->File);
-  }
-  catch (const std::exception& error)
-  {
-    failure = error.what();
-  }
   std::unique_lock<std::mutex> lock(this->Lock);
-  this->Handedness = handedness;
-  if (!failure.empty())
-  {
-    this->Error = failure;
-  }
   while (!this->Stopping)
   {
-    // The roots first (the first image), then the model's tables and the property (colour),
-    // then the regions the view wants.
-    const auto rootMissing = [&]() {
-      for (Key key : this->Pinned)
-      {
-        const auto found = this->Entries.find(key);
-        if (found == this->Entries.end() || (!found->second.buffers && !found->second.failed))
-        {
-          return true;
-        }
-      }
-      return false;
-    };
-    if (!this->TablesTried && !rootMissing())
+    if (standby && !this->Rescuing)
     {
-      lock.unlock();
-      std::shared_ptr<ModelTables> tables = std::make_shared<ModelTables>();
-      std::string error;
-      try
+      this->StandbyWake.wait(lock);
+      continue;
+    }
+    if (!this->LoadNextLocked(lock))
+    {
+      this->Rescuing = this->Rescuing && this->PendingLocked();
+      this->Idle.notify_all();
+      (standby ? this->StandbyWake : this->Wake).wait(lock);
+    }
+  }
+}
+
+void RegionCache::RescueIfStarvedLocked() const
+{
+#ifdef __linux__
+  // Starved: work waited through a whole window while the idle loader ran for under a tenth
+  // of it (the machine's other processes keep every core busy). A long read that runs does
+  // not count, so the standby does not take a core from the frames for it.
+  constexpr auto window = std::chrono::milliseconds(300);
+  const auto now = std::chrono::steady_clock::now();
+  timespec cpu{};
+  if (!this->HaveLoaderClock || clock_gettime(this->LoaderClock, &cpu) != 0)
+  {
+    return;
+  }
+  const double cpuSeconds = cpu.tv_sec + 1e-9 * cpu.tv_nsec;
+  if (this->Rescuing || !this->PendingLocked())
+  {
+    this->WindowStart = now;
+    this->WindowCpuSeconds = cpuSeconds;
+    return;
+  }
+  const double elapsed = std::chrono::duration<double>(now - this->WindowStart).count();
+  if (now - this->WindowStart < window)
+  {
+    return;
+  }
+  if (cpuSeconds - this->WindowCpuSeconds < 0.1 * elapsed)
+  {
+    this->Rescuing = true;
+    ++this->Rescues;
+    this->StandbyWake.notify_all();
+  }
+  this->WindowStart = now;
+  this->WindowCpuSeconds = cpuSeconds;
+#endif
+}
+
+bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock)
+{
+  const auto finished = [&]() { this->Idle.notify_all(); };
+  if (!this->HandednessKnown)
+  {
+    // Both loaders may compute it at once: it is the same either way.
+    lock.unlock();
+    int handedness = 1;
+    std::string failure;
+    try
+    {
+      handedness = TopologyHandedness(*this->File);
+    }
+    catch (const std::exception& error)
+    {
+      failure = error.what();
+    }
+    lock.lock();
+    this->Handedness = handedness;
+    this->HandednessKnown = true;
+    if (!failure.empty())
+    {
+      this->Error = failure;
+    }
+    finished();
+    return true;
+  }
+  // The roots first (the first image), then the model's tables and the property (colour),
+  // then the regions the view wants.
+  const auto rootMissing = [&]() {
+    for (Key key : this->Pinned)
+    {
+      const auto found = this->Entries.find(key);
+      if (found == this->Entries.end() || (!found->second.buffers && !found->second.failed))
       {
-        tables->hash = this->File->ReadHash();
-        tables->normals = this->File->ReadModelArray(ModelChunk::CellNormals);
+        return true;
       }
-      catch (const std::exception& e)
+    }
+    return false;
+  };
+  if (!this->TablesTried && !this->TablesLoading && !rootMissing())
+  {
+    this->TablesLoading = true;
+    lock.unlock();
+    std::shared_ptr<ModelTables> tables = std::make_shared<ModelTables>();
+    std::string error;
+    try
+    {
+      tables->hash = this->File->ReadHash();
+      tables->normals = this->File->ReadModelArray(ModelChunk::CellNormals);
+    }
+    catch (const std::exception& e)
+    {
+      tables.reset();
+      error = e.what();
+    }
+    lock.lock();
+    this->TablesLoading = false;
+    this->TablesTried = true;
+    this->LoadedTables = tables;
+    if (!error.empty())
+    {
+      this->Error = error;
+    }
+    finished();
+    return true;
+  }
+  if (this->PropertyWanted && this->TablesTried && !this->PropertyLoading)
+  {
+    const std::string name = this->PropertyName;
+    const int32_t step = this->PropertyStep;
+    const int32_t layer = this->PropertyLayer;
+    this->PropertyLoading = true;
+    lock.unlock();
+    std::shared_ptr<PropertyTableData> table;
+    std::string error;
+    try
+    {
+      const int index = this->Properties ? this->Properties->Find(name, step) : -1;
+      if (index < 0)
       {
-        tables.reset();
-        error = e.what();
+        error = (this->Properties ? this->Properties->Path() : std::string("no property file")) + ": property " +
+          name + " step " + std::to_string(step) + " not found";
       }
-      lock.lock();
-      this->TablesTried = true;
-      this->LoadedTables = tables;
+      else
+      {
+        table = std::make_shared<PropertyTableData>();
+        table->name = name;
+        table->step = step;
+        table->layer = layer;
+        table->values = layer < 0 ? this->Properties->ReadPacked(static_cast<std::size_t>(index))
+                                  : this->Properties->ReadLayer(static_cast<std::size_t>(index), layer);
+      }
+    }
+    catch (const std::exception& e)
+    {
+      table.reset();
+      error = "property " + name + " step " + std::to_string(step) +
+        (layer >= 0 ? " layer " + std::to_string(layer + 1) : std::string()) + ": " + e.what();
+    }
+    lock.lock();
+    this->PropertyLoading = false;
+    if (name == this->PropertyName && step == this->PropertyStep && layer == this->PropertyLayer)
+    {
+      this->PropertyWanted = false;
+      this->CurrentProperty = table; // null when the table could not be read
       if (!error.empty())
       {
         this->Error = error;
       }
-      this->Idle.notify_all();
-      continue;
     }
-    const bool propertyNow = this->PropertyWanted && this->TablesTried;
-    const int64_t next = propertyNow ? -1 : this->NextRegionLocked();
-    if (propertyNow)
-    {
-      const std::string name = this->PropertyName;
-      const int32_t step = this->PropertyStep;
-      const int32_t layer = this->PropertyLayer;
-      lock.unlock();
-      std::shared_ptr<PropertyTableData> table;
-      std::string error;
-      try
-      {
-        const int index = this->Properties ? this->Properties->Find(name, step) : -1;
-        if (index < 0)
-        {
-          error = (this->Properties ? this->Properties->Path() : std::string("no property file")) + ": property " +
-            name + " step " + std::to_string(step) + " not found";
-        }
-        else
-        {
-          table = std::make_shared<PropertyTableData>();
-          table->name = name;
-          table->step = step;
-          table->layer = layer;
-          table->values = layer < 0 ? this->Properties->ReadPacked(static_cast<std::size_t>(index))
-                                    : this->Properties->ReadLayer(static_cast<std::size_t>(index), layer);
-        }
-      }
-      catch (const std::exception& e)
-      {
-        table.reset();
-        error = "property " + name + " step " + std::to_string(step) +
-          (layer >= 0 ? " layer " + std::to_string(layer + 1) : std::string()) + ": " + e.what();
-      }
-      lock.lock();
-      if (name == this->PropertyName && step == this->PropertyStep && layer == this->PropertyLayer)
-      {
-        this->PropertyWanted = false;
-        this->CurrentProperty = table; // null when the table could not be read
-        if (!error.empty())
-        {
-          this->Error = error;
-        }
-      }
-      this->Idle.notify_all();
-      continue;
-    }
-    if (next < 0)
-    {
-      this->Idle.notify_all();
-      this->Wake.wait(lock);
-      continue;
-    }
-    const Key key = static_cast<Key>(next);
-    const std::size_t region = this->RegionOf(key);
-    const int32_t layer = this->LayerOf(key);
-    lock.unlock();
-    std::shared_ptr<RegionDrawBuffers> buffers;
-    std::string error;
-    try
-    {
-      // ReadRegion, not ReadRegionSurfaces: the buffers need the positions.
-      buffers = std::make_shared<RegionDrawBuffers>(
-        LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin, handedness, layer));
-    }
-    catch (const std::exception& e)
-    {
-      error = e.what();
-    }
-    lock.lock();
-    if (this->Stopping)
-    {
-      break;
-    }
-    if (!error.empty())
-    {
-      this->Entries[key].failed = true;
-      this->Error = error;
-    }
-    else
-    {
-      this->InsertLocked(key, std::move(buffers));
-    }
-    this->Idle.notify_all();
+    finished();
+    return true;
   }
+  const int64_t next = this->NextRegionLocked();
+  if (next < 0)
+  {
+    return false;
+  }
+  const Key key = static_cast<Key>(next);
+  const std::size_t region = this->RegionOf(key);
+  const int32_t layer = this->LayerOf(key);
+  const int handedness = this->Handedness;
+  this->Loading.insert(key);
+  lock.unlock();
+  std::shared_ptr<RegionDrawBuffers> buffers;
+  std::string error;
+  try
+  {
+    // ReadRegion, not ReadRegionSurfaces: the buffers need the positions.
+    buffers = std::make_shared<RegionDrawBuffers>(
+      LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin, handedness, layer));
+  }
+  catch (const std::exception& e)
+  {
+    error = e.what();
+  }
+  lock.lock();
+  this->Loading.erase(key);
+  if (this->Stopping)
+  {
+    return true;
+  }
+  if (!error.empty())
+  {
+    this->Entries[key].failed = true;
+    this->Error = error;
+  }
+  else
+  {
+    this->InsertLocked(key, std::move(buffers));
+  }
+  finished();
+  return true;
 }
 
 } // namespace resmr

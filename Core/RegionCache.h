@@ -31,6 +31,11 @@
 //   positions).
 // - Property tables (Sec. 5.4: one value a hash slot) load on the same thread; the previous
 //   table stays current until the new one is ready.
+// - Loading runs on a thread below the render thread (SCHED_IDLE on Linux: it takes only
+//   cores the frames leave idle). When the machine's other work keeps every core busy, that
+//   thread gets almost nothing; then (work waiting 300 ms, under a tenth of it used, checked
+//   by Request, Pending and WaitIdle) a standby thread at nice 10 loads until nothing is
+//   pending: detail still arrives, a share slower.
 // - Errors reading the file (damaged chunk) are kept, not thrown on the render thread:
 //   LastError() names the file and the region; the region is never resident.
 #pragma once
@@ -43,6 +48,7 @@
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <ctime>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -190,6 +196,8 @@ public:
   /// Bumped whenever a region becomes resident or is evicted (mirrors drop what changed).
   uint64_t Generation() const;
   std::string LastError() const;
+  /// How often the standby loader took over from the idle one (see the contract).
+  uint64_t StandbyRescues() const;
 
 private:
   /// Entries are keyed by (region, layer): region * (nk + 1) + layer + 1.
@@ -200,7 +208,15 @@ private:
   }
   std::size_t RegionOf(Key key) const { return static_cast<std::size_t>(key / this->LayerSlots); }
   int32_t LayerOf(Key key) const { return static_cast<int32_t>(key % this->LayerSlots) - 1; }
-  void Run();
+  /// A loader's loop: the idle loader (SCHED_IDLE on Linux) or the standby, which loads only
+  /// while the idle one is starved.
+  void Run(bool standby);
+  /// Loads the next item (the topology's handedness, the tables, the property, a region),
+  /// the lock released while reading; false when there is nothing this loader can load.
+  bool LoadNextLocked(std::unique_lock<std::mutex>& lock);
+  /// Sets the standby loading when work has waited a while and the idle loader got almost no
+  /// CPU meanwhile. Lock held.
+  void RescueIfStarvedLocked() const;
   /// The next entry to load (roots, then wanted, then predicted), or -1; may mark loading
   /// blocked when an entry whose size is known cannot fit. Lock held.
   int64_t NextRegionLocked();
@@ -222,8 +238,17 @@ private:
   std::vector<std::size_t> Roots;
   std::vector<uint8_t> IsRoot; ///< per region
   mutable std::mutex Lock;
-  mutable std::condition_variable Wake, Idle;
-  std::thread Loader;
+  mutable std::condition_variable Wake, Idle, StandbyWake;
+  std::thread Loader, Standby;
+  std::unordered_set<Key> Loading; ///< being read by a loader
+  bool HandednessKnown = false, TablesLoading = false, PropertyLoading = false;
+  // Starvation of the idle loader (see RescueIfStarvedLocked).
+  mutable bool Rescuing = false;
+  mutable uint64_t Rescues = 0;
+  mutable std::chrono::steady_clock::time_point WindowStart;
+  mutable double WindowCpuSeconds = 0;
+  bool HaveLoaderClock = false;
+  clockid_t LoaderClock{};
   bool Stopping = false;
   std::size_t BudgetBytes = 0;
   std::size_t Bytes = 0;

@@ -160,7 +160,7 @@ def thread_cpu_ms():
         except (OSError, ValueError, IndexError):
             continue
         role = ("render" if tid == main else "rasterizer" if name.startswith("llvmpipe") else
-                "loader" if name == "resmr-loader" else "other")
+                "loader" if name in ("resmr-loader", "resmr-standby") else "other")
         totals[role] += ns / 1e6
     return totals
 

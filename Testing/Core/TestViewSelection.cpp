@@ -18,6 +18,8 @@
 #include "ViewSelection.h"
 
 #include <algorithm>
+#include <atomic>
+#include <thread>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -896,6 +898,33 @@ void TestCache(const std::string& path)
     CHECK(cache.LastError().empty());
     std::printf("  cache: %zu leaves (%zu bytes) + %zu roots (%zu bytes) loaded in %.3f s\n", leaves.size(), leafBytes,
       roots.size(), rootBytes, seconds);
+  }
+  {
+    // Every core kept busy by ordinary threads: the idle loader gets almost nothing, and the
+    // standby loads in its place (Linux, where the loader runs SCHED_IDLE).
+    std::atomic<bool> spin{ true };
+    std::vector<std::thread> spinners;
+    for (unsigned c = 0; c < std::max(2u, std::thread::hardware_concurrency()); ++c)
+      spinners.emplace_back([&spin] {
+        volatile uint64_t n = 0;
+        while (spin.load(std::memory_order_relaxed))
+          n = n + 1;
+      });
+    const auto start = steady_clock::now();
+    RegionCache cache(file, nullptr, SIZE_MAX);
+    CHECK(cache.WaitIdle(seconds(30)));
+    cache.Request(leaves);
+    const bool loaded = cache.WaitIdle(seconds(30));
+    const double took = duration<double>(steady_clock::now() - start).count();
+    spin = false;
+    for (auto& t : spinners)
+      t.join();
+    CHECK(loaded && cache.ResidentCount() == roots.size() + leaves.size() && cache.LastError().empty());
+    std::printf("  cache with every core busy: all loaded in %.2f s, standby rescues %llu\n", took,
+      static_cast<unsigned long long>(cache.StandbyRescues()));
+#ifdef __linux__
+    CHECK(cache.StandbyRescues() > 0);
+#endif
   }
   {
     // A budget for the roots and the first n leaves: loading stops at leaf n.
