@@ -867,6 +867,8 @@ void RegionCache::Run(bool standby)
     }
     if (!this->LoadNextLocked(lock))
     {
+      // Either loader may see the end of the work (the other's last read in flight ends
+      // it when nothing else is left).
       this->Rescuing = this->Rescuing && this->PendingLocked();
       this->Idle.notify_all();
       (standby ? this->StandbyWake : this->Wake).wait(lock);
@@ -888,6 +890,10 @@ void RegionCache::RescueIfStarvedLocked() const
     return;
   }
   const double cpuSeconds = cpu.tv_sec + 1e-9 * cpu.tv_nsec;
+  if (!this->PendingLocked())
+  {
+    this->Rescuing = false; // the work is done: the next wait is the idle loader's again
+  }
   if (this->Rescuing || !this->PendingLocked())
   {
     this->WindowStart = now;
