@@ -45,7 +45,8 @@ parser.add_argument("--child-out", help=argparse.SUPPRESS)
 parser.add_argument("--report-only", action="store_true",
                     help="rewrite OUT.md and OUT.png from OUT.json (an earlier run) and stop")
 args = parser.parse_args()
-simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
+if not args.report_only:
+    simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
 os.makedirs(args.scratch, exist_ok=True)
 
 REAL = {
@@ -272,8 +273,12 @@ def write_report(results):
 
 
 if args.report_only:
-    with open(args.out + ".json") as saved:
-        write_report(json.load(saved))
+    try:
+        with open(args.out + ".json") as saved:
+            recorded = json.load(saved)
+    except (OSError, ValueError) as error:
+        raise SystemExit(f"run_view_bench: --report-only needs the results of a run: {error}")
+    write_report(recorded)
     raise SystemExit
 
 
@@ -418,7 +423,10 @@ def run_child(part, model, entry=None):
                "--resmr", args.resmr, "--scratch", args.scratch, "--data", args.data, "--models", model,
                "--fps", str(args.fps), "--frames", str(args.frames), "--budget", str(args.budget),
                "--stock-max-cells", str(args.stock_max_cells), "--child", part, "--child-out", out]
-    subprocess.run(command + (["--fxaa"] if args.fxaa else []), check=True)
+    done = subprocess.run(command + (["--fxaa"] if args.fxaa else []))
+    if done.returncode != 0:
+        raise SystemExit(f"run_view_bench: measuring {part} on {model} failed (exit {done.returncode}; "
+                         "its output is above); no results written")
     with open(out) as saved:
         return json.load(saved)
 
