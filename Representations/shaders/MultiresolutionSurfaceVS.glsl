@@ -1,5 +1,7 @@
 //VTK::System::Dec
+#if __VERSION__ < 330 && !defined(GL_ES)
 #extension GL_ARB_explicit_attrib_location : require
+#endif
 // Multiresolution surface, vertex stage (paper Sec. 5): positions relative to the model
 // origin, and the cell coordinate (topological coordinate half a cell inside the face).
 // The attributes' locations are fixed: every fragment shader variant links with this stage,
