@@ -24,7 +24,8 @@
 //   every step changes what is drawn. Without it a tolerance raised far above the view's
 //   errors (a slow frame at the roots, or near leaves of a low flight that no tolerance
 //   short of thousands of pixels coarsens) took dozens of frames to mean anything again:
-//   dozens of frames too coarse, or too slow.
+//   dozens of frames too coarse, or too slow. A refining step still lowers the tolerance by
+//   at most MaxRefineStep a frame, since the range is this view's and the next may differ.
 #pragma once
 
 #include <limits>
@@ -49,6 +50,8 @@ public:
   /// The band of frame times, as fractions of the target, the tolerance is held in, and the
   /// time each correction aims at.
   static constexpr double LowFraction = 0.6, HighFraction = 0.85, AimFraction = 0.7;
+  /// The most one frame lowers the tolerance by, as a factor (see CutRange).
+  static constexpr double MaxRefineStep = 0.25;
 
   void SetTargetFramesPerSecond(double fps) { this->TargetSeconds = fps > 0 ? 1.0 / fps : 0.1; }
   double TargetFramesPerSecond() const { return 1.0 / this->TargetSeconds; }

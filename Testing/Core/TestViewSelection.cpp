@@ -1350,15 +1350,22 @@ void TestFrameRateController()
     return same;
   };
   const auto seconds = [&](double pixels) { return 0.04 + triangles(pixels) / 4e6; };
-  // Far too coarse: from the maximum, a fast frame's step lands below the finest diamond
-  // drawn whole, so the cut changes at once (without the range, 0.8 a step: 20 frames).
+  // Far too coarse: from the maximum, fast frames' steps reach below the finest diamond
+  // drawn whole within 3 frames, a quarter at most each (without the range, 0.8 a step: 12).
   FrameRateController steps;
   steps.SetTargetFramesPerSecond(10);
   steps.Reset(FrameRateController::MaximumPixels);
-  steps.Update(seconds(steps.Tolerance()), true, range(steps.Tolerance()));
-  std::printf("  controller, cut range: one fast frame from %.0f px to %.0f px\n", FrameRateController::MaximumPixels,
-    steps.Tolerance());
-  CHECK(steps.Tolerance() < 4096 && triangles(steps.Tolerance()) > triangles(FrameRateController::MaximumPixels));
+  int fastFrames = 0;
+  while (triangles(steps.Tolerance()) == triangles(FrameRateController::MaximumPixels) && fastFrames < 50)
+  {
+    const double before = steps.Tolerance();
+    steps.Update(seconds(steps.Tolerance()), true, range(steps.Tolerance()));
+    CHECK(steps.Tolerance() >= FrameRateController::MaxRefineStep * before);
+    ++fastFrames;
+  }
+  std::printf("  controller, cut range: %d fast frames from %.0f px to %.0f px\n", fastFrames,
+    FrameRateController::MaximumPixels, steps.Tolerance());
+  CHECK(fastFrames <= 3);
   // Too fine: a slow frame's step passes the nearest split diamond, so it merges.
   steps.Reset(1.5);
   const double slow = 0.5;
