@@ -638,9 +638,16 @@ bool RegionCache::WaitIdle(std::chrono::milliseconds timeout) const
     {
       return false;
     }
-    this->Idle.wait_for(lock, std::min<std::chrono::steady_clock::duration>(deadline - now, std::chrono::milliseconds(100)));
+    const std::chrono::steady_clock::duration slice = this->StarvationWindow / 2;
+    this->Idle.wait_for(lock, std::min<std::chrono::steady_clock::duration>(deadline - now, slice));
   }
   return true;
+}
+
+void RegionCache::SetStarvationWindow(std::chrono::milliseconds window)
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  this->StarvationWindow = std::max(window, std::chrono::milliseconds(1));
 }
 
 uint64_t RegionCache::StandbyRescues() const
@@ -882,7 +889,7 @@ void RegionCache::RescueIfStarvedLocked() const
   // Starved: work waited through a whole window while the idle loader ran for under a tenth
   // of it (the machine's other processes keep every core busy). A long read that runs does
   // not count, so the standby does not take a core from the frames for it.
-  constexpr auto window = std::chrono::milliseconds(300);
+  const auto window = this->StarvationWindow;
   const auto now = std::chrono::steady_clock::now();
   timespec cpu{};
   if (!this->HaveLoaderClock || clock_gettime(this->LoaderClock, &cpu) != 0)

@@ -198,6 +198,9 @@ public:
   std::string LastError() const;
   /// How often the standby loader took over from the idle one (see the contract).
   uint64_t StandbyRescues() const;
+  /// How long work waits, the idle loader almost without CPU, before the standby takes over
+  /// (300 ms by default).
+  void SetStarvationWindow(std::chrono::milliseconds window);
 
 private:
   /// Entries are keyed by (region, layer): region * (nk + 1) + layer + 1.
@@ -247,6 +250,7 @@ private:
   mutable uint64_t Rescues = 0;
   mutable std::chrono::steady_clock::time_point WindowStart;
   mutable double WindowCpuSeconds = 0;
+  std::chrono::milliseconds StarvationWindow{ 300 };
   bool HaveLoaderClock = false;
   clockid_t LoaderClock{};
   bool Stopping = false;

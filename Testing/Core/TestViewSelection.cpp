@@ -912,6 +912,9 @@ void TestCache(const std::string& path)
       });
     const auto start = steady_clock::now();
     RegionCache cache(file, nullptr, SIZE_MAX);
+    // A short window: this model's leaves take the loader a few ms of CPU, which a starved
+    // SCHED_IDLE thread may still get within 300 ms.
+    cache.SetStarvationWindow(std::chrono::milliseconds(10));
     CHECK(cache.WaitIdle(seconds(30)));
     cache.Request(leaves);
     const bool loaded = cache.WaitIdle(seconds(30));
