@@ -862,16 +862,18 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     {
       found = in.FragmentSources.emplace(key, FragmentVariant(colorMode, layer >= 0, logScale, gridLines, specular)).first;
     }
-    return window->GetShaderCache()->ReadyShaderProgram(MultiresolutionSurfaceVS, found->second.c_str(), "");
-  };
-  vtkShaderProgram* program = readyProgram(PropertyColors);
-  if (!program)
-  {
-    if (in.Error.empty())
+    vtkShaderProgram* ready =
+      window->GetShaderCache()->ReadyShaderProgram(MultiresolutionSurfaceVS, found->second.c_str(), "");
+    if (!ready && in.Error.empty())
     {
       in.Error = "the multiresolution surface shaders did not compile (see the output window)";
       vtkErrorMacro(<< in.Error);
     }
+    return ready;
+  };
+  vtkShaderProgram* program = readyProgram(PropertyColors);
+  if (!program)
+  {
     return;
   }
   // Uploads, a bounded amount a frame while interacting (the roots and still renders whatever
@@ -1120,11 +1122,6 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   program = readyProgram(colorMode);
   if (!program)
   {
-    if (in.Error.empty())
-    {
-      in.Error = "the multiresolution surface shaders did not compile (see the output window)";
-      vtkErrorMacro(<< in.Error);
-    }
     return;
   }
   const GLuint handle = static_cast<GLuint>(program->GetHandle());
