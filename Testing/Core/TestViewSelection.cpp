@@ -1354,7 +1354,7 @@ void TestFrameRateController()
   };
   const auto seconds = [&](double pixels) { return 0.04 + triangles(pixels) / 4e6; };
   // Far too coarse: from the maximum, fast frames' steps reach below the finest diamond
-  // drawn whole within 3 frames, a quarter at most each (without the range, 0.8 a step: 12).
+  // drawn whole within 3 frames, a quarter at most each (without the range, 0.8 a step: 13).
   FrameRateController steps;
   steps.SetTargetFramesPerSecond(10);
   steps.Reset(FrameRateController::MaximumPixels);
