@@ -597,16 +597,19 @@ std::shared_ptr<const ModelTables> RegionCache::Tables() const
   return this->LoadedTables;
 }
 
+bool RegionCache::MissingLocked(Key key) const
+{
+  const auto found = this->Entries.find(key);
+  return found == this->Entries.end() || (!found->second.buffers && !found->second.failed);
+}
+
 bool RegionCache::PendingLocked() const
 {
   if (this->PropertyWanted || !this->TablesTried)
   {
     return true;
   }
-  const auto missing = [&](Key key) {
-    const auto found = this->Entries.find(key);
-    return found == this->Entries.end() || (!found->second.buffers && !found->second.failed);
-  };
+  const auto missing = [&](Key key) { return this->MissingLocked(key); };
   if (std::any_of(this->Pinned.begin(), this->Pinned.end(), missing))
   {
     return true;
@@ -751,10 +754,7 @@ void RegionCache::EvictLocked(Key key)
 
 int64_t RegionCache::NextRegionLocked()
 {
-  const auto missing = [&](Key key) {
-    const auto found = this->Entries.find(key);
-    return found == this->Entries.end() || (!found->second.buffers && !found->second.failed);
-  };
+  const auto missing = [&](Key key) { return this->MissingLocked(key); };
   for (Key key : this->Pinned)
   {
     if (missing(key) && !this->Loading.count(key))
@@ -952,18 +952,9 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock)
   }
   // The roots first (the first image), then the model's tables and the property (colour),
   // then the regions the view wants.
-  const auto rootMissing = [&]() {
-    for (Key key : this->Pinned)
-    {
-      const auto found = this->Entries.find(key);
-      if (found == this->Entries.end() || (!found->second.buffers && !found->second.failed))
-      {
-        return true;
-      }
-    }
-    return false;
-  };
-  if (!this->TablesTried && !this->TablesLoading && !rootMissing())
+  const bool rootMissing =
+    std::any_of(this->Pinned.begin(), this->Pinned.end(), [&](Key key) { return this->MissingLocked(key); });
+  if (!this->TablesTried && !this->TablesLoading && !rootMissing)
   {
     this->TablesLoading = true;
     lock.unlock();

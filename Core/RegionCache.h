@@ -29,8 +29,8 @@
 //   next Request or SetBudget.
 // - Buffers are made from MultiresolutionFile::ReadRegion (ReadRegionSurfaces drops the
 //   positions).
-// - Property tables (Sec. 5.4: one value a hash slot) load on the same thread; the previous
-//   table stays current until the new one is ready.
+// - Property tables (Sec. 5.4: one value a hash slot) load the same way, off the render
+//   thread; the previous table stays current until the new one is ready.
 // - Loading runs on a thread below the render thread (SCHED_IDLE on Linux: it takes only
 //   cores the frames leave idle). When the machine's other work keeps every core busy, that
 //   thread gets almost nothing; then (work waiting 300 ms, under a tenth of it used, checked
@@ -224,6 +224,8 @@ private:
   /// blocked when an entry whose size is known cannot fit. Lock held.
   int64_t NextRegionLocked();
   bool PendingLocked() const;
+  /// Neither loaded nor failed (it may be being read). Lock held.
+  bool MissingLocked(Key key) const;
   /// The current layer's roots are pinned. Lock held.
   bool IsPinnedLocked(Key key) const;
   /// Resident entries that may be evicted to load `key`, least recently requested first.
