@@ -4,11 +4,13 @@
 #include "MemoryBudget.h"
 
 #include "EclipseKeywordFile.h"
+#include "GrdeclEdits.h"
 #include "GrdeclError.h"
 #include "GrdeclTokenizer.h"
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -125,7 +127,16 @@ bool IsKnownCellArray(const std::string& name)
     "PVTNUM", "IMBNUM", "ROCKNUM", "MULTNUM", "FLUXNUM", "OPERNUM", "ENDNUM", "MISCNUM",
     "SWATINIT", "SWL", "SWCR", "SWU", "SGL", "SGCR", "SGU", "SOWCR", "SOGCR", "KRW", "KRO", "KRG",
     "PCW", "PCG", "PRESSURE", "SWAT", "SGAS", "SOIL", "RS", "RV", "FACIES", "THCONR", "DEPTH",
-    "TRANX", "TRANY", "TRANZ", "MINPV", "PORE", "DIFFMX", "DIFFMY", "DIFFMZ" };
+    "TRANX", "TRANY", "TRANZ", "PORE", "DIFFMX", "DIFFMY", "DIFFMZ" };
+  return names.count(name) > 0;
+}
+
+/// Keywords whose records edit cell arrays (see ReadArrayOperations).
+bool IsEditKeyword(const std::string& name)
+{
+  static const std::unordered_set<std::string> names = { "EQUALS", "MULTIPLY", "ADD", "COPY",
+    "MINVALUE", "MAXVALUE", "COPYBOX", "OPERATE", "OPERATER", "EQUALREG", "MULTIREG", "ADDREG",
+    "COPYREG" };
   return names.count(name) > 0;
 }
 
@@ -134,9 +145,9 @@ bool IsActedOnKeyword(const std::string& name)
 {
   static const std::unordered_set<std::string> names = { "SPECGRID", "DIMENS", "COORD", "ZCORN",
     "DXV", "DYV", "DZV", "MAPAXES", "MAPUNITS", "GRIDUNIT", "GDORIENT", "COORDSYS", "INCLUDE",
-    "IMPORT", "FAULTS", "EQUALS", "MULTIPLY", "ADD", "COPY", "BOX", "ENDBOX", "RUNSPEC", "GRID",
-    "EDIT", "PROPS", "REGIONS", "SOLUTION", "SUMMARY", "SCHEDULE", "END" };
-  return names.count(name) > 0 || IsKnownCellArray(name);
+    "IMPORT", "FAULTS", "BOX", "ENDBOX", "RUNSPEC", "GRID", "EDIT", "PROPS", "REGIONS",
+    "SOLUTION", "SUMMARY", "SCHEDULE", "END" };
+  return names.count(name) > 0 || IsEditKeyword(name) || IsKnownCellArray(name);
 }
 
 struct Box
@@ -317,7 +328,8 @@ private:
   {
     if (this->Deck.dims[0] == 0)
     {
-      this->FailHere(keyword, "appears before SPECGRID or DIMENS gave the grid dimensions");
+      this->FailHere(keyword, "appears before SPECGRID or DIMENS gave the grid dimensions" +
+          this->MissingIncludeNote());
     }
     return this->Deck.CellCount();
   }
@@ -332,9 +344,13 @@ private:
   std::vector<std::string> ReadRecord(const std::string& keyword, bool* sawSlash = nullptr)
   {
     std::vector<std::string> items;
-    for (;;)
+    for (bool first = true;; first = false)
     {
       const Token& token = this->Tokens->Next();
+      if (first)
+      {
+        this->LastRecordLine = token.line;
+      }
       if (token.kind == TokenKind::Slash)
       {
         if (sawSlash)
@@ -512,9 +528,13 @@ private:
     return *slot;
   }
 
-  /// Spooling: true if the array was given (kept or dropped).
+  /// True if the array was given (spooling: kept or dropped).
   bool Defined(const std::string& name)
   {
+    if (!this->Spooling())
+    {
+      return this->Deck.FindArray(name) != nullptr;
+    }
     return this->Spooled(name) ? this->SpoolSlot(name) != nullptr : this->DroppedArrays.count(name) > 0;
   }
 
@@ -637,6 +657,19 @@ private:
     {
       // TOPS may give the top layer only; accept both forms.
       this->ReadTops();
+      return;
+    }
+    if (!wholeGrid && !IsViewerArray(keyword) && !this->Defined(keyword))
+    {
+      // Part of an array the viewer does not build (MULTZ or TRANX in a BOX ...): checked,
+      // not kept, since the cells outside the box would have no value.
+      if (!this->ReadNumbers(keyword, expected, lenient, true, [](int64_t, double) {}))
+      {
+        this->SkipRestOfKeyword();
+        return;
+      }
+      this->RecordLine = this->CurrentLine;
+      this->WarnSkippedEdit(keyword, keyword);
       return;
     }
     if (this->Spooling() && !this->Spooled(keyword))
@@ -837,7 +870,22 @@ private:
     }
   }
 
-  /// EQUALS, MULTIPLY, ADD, COPY: records operating on arrays within a box.
+  // ---------------------------------------------------------------- array edits
+  /// One record of an edit keyword, read and checked before it touches any array.
+  struct ArrayEdit
+  {
+    std::string target;        ///< array written
+    std::string source;        ///< array read (COPY, COPYBOX, OPERATE ...), or ""
+    bool readsTarget = false;  ///< the target's old values matter (MULTIPLY, ADD ...)
+    Box box;                   ///< cells written
+    Box sourceBox;             ///< cells read, cell for cell (COPYBOX; else `box`)
+    std::string regionArray;   ///< *REG, OPERATER: only cells of this region ...
+    int64_t region = 0;        ///< ... with this number
+    std::function<double(double, double)> apply; ///< (old target, source) -> new target
+  };
+
+  /// EQUALS, MULTIPLY, ADD, COPY, MINVALUE, MAXVALUE, COPYBOX, OPERATE and the region forms
+  /// EQUALREG, MULTIREG, ADDREG, COPYREG, OPERATER: records ended by an empty one.
   void ReadArrayOperations(const std::string& keyword)
   {
     Box lastBox = this->CurrentBox ? *this->CurrentBox : this->WholeGrid();
@@ -848,109 +896,375 @@ private:
       {
         return;
       }
-      if (items.size() < 2)
+      this->RecordLine = this->LastRecordLine;
+      ArrayEdit edit = this->ReadEditRecord(keyword, items, lastBox);
+      if (this->CanApply(keyword, edit))
       {
-        this->FailHere(keyword, "record needs an array name and a value");
+        this->ApplyEdit(keyword, edit);
       }
-      const std::string target = Upper(items[0]);
-      const Box box = this->RecordBox(items, 2, lastBox, keyword);
-      lastBox = box;
-      if (keyword == "COPY" && this->Spooling())
+    }
+  }
+
+  double EditValue(const std::vector<std::string>& items, std::size_t index,
+    const std::string& keyword, const std::string& target)
+  {
+    const double value = this->RecordNumber(items, index, keyword, "value for " + target);
+    if (!std::isfinite(value))
+    {
+      this->FailHere(keyword, "value for " + target + " is not finite");
+    }
+    return value;
+  }
+
+  /// The record's arrays, cells and operation; `lastBox` is the box a record without one
+  /// uses (the previous record's, as ECLIPSE does).
+  ArrayEdit ReadEditRecord(
+    const std::string& keyword, const std::vector<std::string>& items, Box& lastBox)
+  {
+    const std::size_t needed = keyword == "COPYBOX" ? 13 : keyword == "OPERATE" ? 9
+      : keyword == "OPERATER"                           ? 4
+      : keyword.size() > 3 && keyword.compare(keyword.size() - 3, 3, "REG") == 0 ? 3
+                                                        : 2;
+    if (items.size() < needed || items[0].empty())
+    {
+      this->FailHere(keyword, "record needs at least " + std::to_string(needed) +
+          " items (array name, values ...), got " + std::to_string(items.size()));
+    }
+    ArrayEdit edit;
+    edit.target = Upper(items[0]);
+    if (keyword == "OPERATE" || keyword == "OPERATER")
+    {
+      return this->ReadOperateRecord(keyword, items, edit);
+    }
+    if (keyword == "EQUALREG" || keyword == "MULTIREG" || keyword == "ADDREG" ||
+      keyword == "COPYREG")
+    {
+      edit.box = this->WholeGrid();
+      edit.sourceBox = edit.box;
+      edit.region = this->RecordInteger(items, 2, keyword, "region number", 0, true);
+      edit.regionArray = this->RegionArrayFor(keyword, items, 3, "M");
+      if (keyword == "COPYREG")
       {
-        const std::string destination = Upper(items[1]);
-        if (!this->Defined(target))
-        {
-          this->FailHere(keyword, "source array " + target + " has not been defined");
-        }
-        if (!this->Spooled(destination))
-        {
-          this->DroppedArrays.insert(destination);
-          continue;
-        }
-        if (!this->Spooled(target))
-        {
-          this->FailHere(keyword, "cannot copy " + target + " into " + destination +
-              ": when the grid is read with bounded memory (resmr build) property arrays are "
-              "not kept; give " + destination + " its values directly (or with EQUALS)");
-        }
-        SpoolFile& in = *this->SpoolSlot(target);
-        SpoolFile& out = this->SpoolFor(destination);
-        std::vector<double> row;
-        this->ForEachRow(box, [&](int64_t first, int64_t count) {
-          row.resize(static_cast<std::size_t>(count));
-          in.Read(first, row.data(), count);
-          out.Write(first, row.data(), count);
-        });
-        continue;
+        edit.source = edit.target;
+        edit.target = Upper(items[1]);
+        edit.apply = [](double, double x) { return x; };
+        return edit;
       }
-      if (keyword == "COPY")
+      const double value = this->EditValue(items, 1, keyword, edit.target);
+      edit.readsTarget = keyword != "EQUALREG";
+      edit.apply = keyword == "EQUALREG" ? std::function<double(double, double)>([value](double, double) { return value; })
+        : keyword == "MULTIREG"          ? std::function<double(double, double)>([value](double r, double) { return r * value; })
+                                         : std::function<double(double, double)>([value](double r, double) { return r + value; });
+      return edit;
+    }
+    if (keyword == "COPYBOX")
+    {
+      edit.source = edit.target;
+      edit.sourceBox = this->RecordBox(items, 1, this->WholeGrid(), keyword);
+      edit.box = this->RecordBox(items, 7, this->WholeGrid(), keyword);
+      for (int axis = 0; axis < 3; ++axis)
       {
-        const std::string destination = Upper(items[1]);
-        const CellArray* source = this->Deck.FindArray(target);
-        if (!source)
+        const auto& s = edit.sourceBox.range;
+        const auto& d = edit.box.range;
+        if (s[2 * axis + 1] - s[2 * axis] != d[2 * axis + 1] - d[2 * axis])
         {
-          this->FailHere(keyword, "source array " + target + " has not been defined");
+          this->FailHere(keyword, "the boxes copied from and to differ in size along " +
+              std::string(1, "IJK"[axis]));
         }
-        const std::size_t sourceIndex = static_cast<std::size_t>(source - this->Deck.arrays.data());
-        CellArray& out = this->ArrayFor(destination);
-        const CellArray& in = this->Deck.arrays[sourceIndex];
-        this->ForEachCell(box, [&](int64_t cell) { out.values[cell] = in.values[cell]; });
-        continue;
       }
-      const double value = this->RecordNumber(items, 1, keyword, "value for " + target);
-      if (!std::isfinite(value))
+      edit.apply = [](double, double x) { return x; };
+      return edit;
+    }
+    edit.box = this->RecordBox(items, 2, lastBox, keyword);
+    edit.sourceBox = edit.box;
+    lastBox = edit.box;
+    if (keyword == "COPY")
+    {
+      edit.source = edit.target;
+      edit.target = Upper(items[1]);
+      edit.apply = [](double, double x) { return x; };
+      return edit;
+    }
+    const double value = this->EditValue(items, 1, keyword, edit.target);
+    edit.readsTarget = keyword != "EQUALS";
+    if (keyword == "EQUALS")
+      edit.apply = [value](double, double) { return value; };
+    else if (keyword == "MULTIPLY")
+      edit.apply = [value](double r, double) { return r * value; };
+    else if (keyword == "ADD")
+      edit.apply = [value](double r, double) { return r + value; };
+    else if (keyword == "MINVALUE")
+      edit.apply = [value](double r, double) { return std::isnan(r) ? r : std::max(r, value); };
+    else
+      edit.apply = [value](double r, double) { return std::isnan(r) ? r : std::min(r, value); };
+    return edit;
+  }
+
+  /// OPERATE: target, box, operation, source, alpha, beta. OPERATER: target, region number,
+  /// operation, source, alpha, beta, region array (OPERNUM if not given).
+  ArrayEdit ReadOperateRecord(
+    const std::string& keyword, const std::vector<std::string>& items, ArrayEdit& edit)
+  {
+    std::size_t next = 1;
+    if (keyword == "OPERATE")
+    {
+      edit.box = this->RecordBox(items, 1, this->CurrentBox ? *this->CurrentBox : this->WholeGrid(), keyword);
+      next = 7;
+    }
+    else
+    {
+      edit.box = this->WholeGrid();
+      edit.region = this->RecordInteger(items, 1, keyword, "region number", 0, true);
+      next = 2;
+    }
+    edit.sourceBox = edit.box;
+    const std::string operation = next < items.size() ? Upper(items[next]) : std::string();
+    edit.source = next + 1 < items.size() ? Upper(items[next + 1]) : std::string();
+    if (edit.source.empty())
+    {
+      this->FailHere(keyword, "record for " + edit.target + " names no source array");
+    }
+    const double alpha = next + 2 < items.size() && !items[next + 2].empty()
+      ? this->EditValue(items, next + 2, keyword, edit.target) : 0.0;
+    const double beta = next + 3 < items.size() && !items[next + 3].empty()
+      ? this->EditValue(items, next + 3, keyword, edit.target) : 0.0;
+    edit.apply = ArrayOperation(operation, alpha, beta);
+    if (!edit.apply)
+    {
+      this->FailHere(keyword, "unknown operation '" + operation + "' for " + edit.target +
+          " (MULTA, POLY, SLOG, LOG10, LOGE, INV, MULTX, ADDX, COPY, MAXLIM, MINLIM, MULTP, "
+          "ABS, MULTIPLY)");
+    }
+    edit.readsTarget = OperationReadsTarget(operation);
+    if (keyword == "OPERATER")
+    {
+      edit.regionArray = this->RegionArrayFor(keyword, items, 6, "OPERNUM");
+    }
+    return edit;
+  }
+
+  std::string RegionArrayFor(const std::string& keyword, const std::vector<std::string>& items,
+    std::size_t index, const std::string& fallback)
+  {
+    const std::string given = index < items.size() && !items[index].empty() ? Upper(items[index]) : fallback;
+    const std::string name = RegionArrayName(given);
+    if (name.empty())
+    {
+      this->FailHere(keyword, "region array '" + given + "' is not M, F, O or a *NUM array");
+    }
+    return name;
+  }
+
+  /// Whether the edit can be applied: skipped with a warning when it touches only arrays the
+  /// viewer does not build; an error when it needs a viewer array that is missing.
+  bool CanApply(const std::string& keyword, const ArrayEdit& edit)
+  {
+    const bool viewerEdit = IsViewerArray(edit.target) ||
+      (!edit.source.empty() && IsViewerArray(edit.source) && this->Defined(edit.source));
+    if (!edit.source.empty() && !this->Defined(edit.source))
+    {
+      if (IsViewerArray(edit.source) || IsViewerArray(edit.target))
       {
-        this->FailHere(keyword, "value for " + target + " is not finite");
+        this->FailHere(keyword, "source array " + edit.source + " has not been defined" +
+            this->MissingIncludeNote());
       }
-      if (this->Spooling())
+      this->WarnSkippedEdit(keyword, edit.source);
+      return false;
+    }
+    if (this->Defined(edit.target))
+    {
+      return true;
+    }
+    if (edit.readsTarget && IsViewerArray(edit.target))
+    {
+      this->FailHere(keyword, "array " + edit.target + " has not been defined" +
+          this->MissingIncludeNote());
+    }
+    if (edit.readsTarget || !viewerEdit || !IsViewerArray(edit.target))
+    {
+      this->WarnSkippedEdit(keyword, edit.target);
+      return false;
+    }
+    return true;
+  }
+
+  /// One warning per keyword, array and place.
+  void WarnSkippedEdit(const std::string& keyword, const std::string& array)
+  {
+    const std::string kind = SimulatorArrayKind(array);
+    const std::string why = kind.empty()
+      ? "is not defined by this deck and is not an array the viewer knows"
+      : "is a " + kind + ", which the viewer does not build";
+    this->Warn(keyword, "array " + array + " " + why + "; edit skipped");
+  }
+
+  void Warn(const std::string& keyword, const std::string& what)
+  {
+    const std::string message = GrdeclError::Format(this->CurrentFile, this->RecordLine, keyword, what);
+    if (this->WarningsGiven.insert(message).second)
+    {
+      this->Deck.warnings.push_back(message);
+    }
+  }
+
+  /// A cell array's values a row of cells at a time, whether held in the deck or spooled.
+  struct ArrayRows
+  {
+    CellArray* held = nullptr;
+    SpoolFile* spooled = nullptr;
+    void Read(int64_t first, int64_t count, double* out) const
+    {
+      if (this->held)
       {
-        if (keyword == "EQUALS" && !this->Spooled(target))
-        {
-          this->DroppedArrays.insert(target);
-          continue;
-        }
-        if (keyword != "EQUALS" && !this->Defined(target))
-        {
-          this->FailHere(keyword, "array " + target + " has not been defined");
-        }
-        if (this->Spooled(target))
-        {
-          SpoolFile& file = this->SpoolFor(target);
-          if (keyword == "EQUALS")
-          {
-            this->EditSpool(file, box, [&](double& v) { v = value; });
-          }
-          else if (keyword == "MULTIPLY")
-          {
-            this->EditSpool(file, box, [&](double& v) { v *= value; });
-          }
-          else
-          {
-            this->EditSpool(file, box, [&](double& v) { v += value; });
-          }
-        }
-        continue;
-      }
-      if (keyword == "EQUALS")
-      {
-        CellArray& array = this->ArrayFor(target);
-        this->ForEachCell(box, [&](int64_t cell) { array.values[cell] = value; });
-        continue;
-      }
-      CellArray* array = this->Deck.FindArray(target);
-      if (!array)
-      {
-        this->FailHere(keyword, "array " + target + " has not been defined");
-      }
-      if (keyword == "MULTIPLY")
-      {
-        this->ForEachCell(box, [&](int64_t cell) { array->values[cell] *= value; });
+        std::copy_n(this->held->values.data() + first, count, out);
       }
       else
       {
-        this->ForEachCell(box, [&](int64_t cell) { array->values[cell] += value; });
+        this->spooled->Read(first, out, count);
       }
     }
+    void Write(int64_t first, int64_t count, const double* in) const
+    {
+      if (this->held)
+      {
+        std::copy_n(in, count, this->held->values.data() + first);
+      }
+      else
+      {
+        this->spooled->Write(first, in, count);
+      }
+    }
+  };
+
+  /// Applies a checked edit, row by row in the box (backwards when a COPYBOX within one array
+  /// would otherwise read rows it has already written).
+  void ApplyEdit(const std::string& keyword, const ArrayEdit& edit)
+  {
+    ArrayRows out, in, regions;
+    if (this->Spooling())
+    {
+      if (!this->Spooled(edit.target))
+      {
+        this->DroppedArrays.insert(edit.target); // a property: checked, not kept
+        return;
+      }
+      if (!edit.source.empty() && !this->Spooled(edit.source))
+      {
+        this->FailHere(keyword, "cannot set " + edit.target + " from " + edit.source +
+            ": when the grid is read with bounded memory (resmr build) property arrays are not "
+            "kept; give " + edit.target + " its values directly (or with EQUALS)");
+      }
+      if (!edit.regionArray.empty() && this->Defined(edit.regionArray))
+      {
+        this->FailHere(keyword, "cannot edit " + edit.target + " by region " +
+            edit.regionArray + ": when the grid is read with bounded memory (resmr build) " +
+            "region arrays are not kept");
+      }
+      out.spooled = &this->SpoolFor(edit.target);
+      in.spooled = edit.source.empty() ? nullptr : this->SpoolSlot(edit.source).get();
+    }
+    else
+    {
+      out.held = &this->ArrayFor(edit.target); // first: it may move the other arrays
+      in.held = edit.source.empty() ? nullptr : this->Deck.FindArray(edit.source);
+      regions.held = edit.regionArray.empty() ? nullptr : this->Deck.FindArray(edit.regionArray);
+    }
+    const bool hasSource = in.held || in.spooled;
+    const bool hasRegions = regions.held != nullptr;
+    const auto& s = edit.sourceBox.range;
+    const auto& d = edit.box.range;
+    const bool backwards = edit.source == edit.target &&
+      std::make_pair(d[4], d[2]) > std::make_pair(s[4], s[2]);
+    const int64_t rows = (d[5] - d[4] + 1) * (d[3] - d[2] + 1);
+    const int64_t count = d[1] - d[0] + 1;
+    std::vector<double> target(count), source(count), region(count);
+    for (int64_t r = 0; r < rows; ++r)
+    {
+      const int64_t row = backwards ? rows - 1 - r : r;
+      const int64_t dj = row % (d[3] - d[2] + 1), dk = row / (d[3] - d[2] + 1);
+      const int64_t to = this->CellIndex(d[0], d[2] + dj, d[4] + dk);
+      const int64_t from = this->CellIndex(s[0], s[2] + dj, s[4] + dk);
+      out.Read(to, count, target.data());
+      if (hasSource)
+      {
+        in.Read(from, count, source.data());
+      }
+      if (hasRegions)
+      {
+        regions.Read(to, count, region.data());
+      }
+      for (int64_t e = 0; e < count; ++e)
+      {
+        // A region array the deck does not give is 1 in every cell, as for ECLIPSE.
+        if (!edit.regionArray.empty() && (hasRegions ? region[e] : 1.0) != double(edit.region))
+        {
+          continue;
+        }
+        const double value = edit.apply(target[e], hasSource ? source[e] : 0.0);
+        target[e] = std::isfinite(value) ? value : std::numeric_limits<double>::quiet_NaN();
+      }
+      out.Write(to, count, target.data());
+    }
+  }
+
+  int64_t CellIndex(int64_t i, int64_t j, int64_t k) const
+  {
+    return (k * this->Deck.dims[1] + j) * this->Deck.dims[0] + i;
+  }
+
+  // ---------------------------------------------------------------- skipped keywords
+  /// Reads a keyword the viewer has no use for to its end (see SkippedKeyword), with one
+  /// warning naming it.
+  void SkipUnusedKeyword(const std::string& keyword, SkippedShape shape, const std::string& why)
+  {
+    if (shape == SkippedShape::OneRecord)
+    {
+      this->ReadRecord(keyword);
+      this->RecordLine = this->CurrentLine;
+      this->Warn(keyword, why + " are not shown by the viewer; skipped");
+      return;
+    }
+    if (shape == SkippedShape::Records)
+    {
+      while (!this->ReadRecord(keyword).empty())
+      {
+      }
+      this->RecordLine = this->CurrentLine;
+      this->Warn(keyword, why + " are not shown by the viewer; skipped");
+      return;
+    }
+    const std::vector<std::string> items = this->ReadRecord(keyword);
+    const std::string name = items.empty() || items[0].empty() ? "(unnamed)" : "'" + items[0] + "'";
+    for (;;)
+    {
+      const Token& token = this->Tokens->Next();
+      if (token.kind == TokenKind::End)
+      {
+        this->FailHere(keyword, "local grid " + name + " has no ENDFIN");
+      }
+      if (token.kind == TokenKind::Word && token.atLineStart && Upper(token.text) == "ENDFIN")
+      {
+        break;
+      }
+    }
+    this->RecordLine = this->CurrentLine;
+    this->Warn(keyword, why + " " + name + " (" + keyword + " ... ENDFIN) is not shown; the "
+        "viewer shows the global grid");
+  }
+
+  /// For errors caused by something a missing INCLUDE would have given.
+  std::string MissingIncludeNote() const
+  {
+    if (this->MissingIncludes.empty())
+    {
+      return "";
+    }
+    std::string note = " (";
+    for (std::size_t i = 0; i < this->MissingIncludes.size(); ++i)
+    {
+      note += (i ? ", " : "") + this->MissingIncludes[i];
+    }
+    return note + (this->MissingIncludes.size() == 1 ? " was" : " were") + " not found)";
   }
 
   void ReadInclude(const std::string& keyword, int depth)
@@ -1000,6 +1314,8 @@ private:
     }
     this->Deck.warnings.push_back(
       GrdeclError::Format(this->CurrentFile, this->CurrentLine, keyword, message + "; skipped"));
+    this->MissingIncludes.push_back(keyword + " of '" + name + "' at " + this->CurrentFile + ":" +
+      std::to_string(this->CurrentLine));
   }
 
   void ParseTextFile(const std::string& path, int depth)
@@ -1039,6 +1355,7 @@ private:
   void HandleKeyword(const std::string& keyword, int depth)
   {
     GrdeclTokenizer& tokens = *this->Tokens;
+    std::string why;
     if (this->CurrentSection == Section::Summary)
     {
       static const std::unordered_set<std::string> leaving = { "SCHEDULE", "END", "RUNSPEC",
@@ -1118,8 +1435,7 @@ private:
     {
       this->ReadFaults();
     }
-    else if (keyword == "EQUALS" || keyword == "MULTIPLY" || keyword == "ADD" ||
-      keyword == "COPY")
+    else if (IsEditKeyword(keyword))
     {
       this->CellCount(keyword);
       this->ReadArrayOperations(keyword);
@@ -1179,6 +1495,10 @@ private:
     else if (this->CurrentSection == Section::Schedule)
     {
       this->SkipRestOfKeyword();
+    }
+    else if (this->InPropertySection() && SkippedKeyword(keyword, why) != SkippedShape::None)
+    {
+      this->SkipUnusedKeyword(keyword, SkippedKeyword(keyword, why), why);
     }
     else if (IsKnownCellArray(keyword) && this->InPropertySection())
     {
@@ -1357,13 +1677,25 @@ private:
     const std::string& file = deck.files.front();
     if (deck.dims[0] == 0)
     {
-      throw GrdeclError(file, 0, "SPECGRID", "no SPECGRID or DIMENS: grid dimensions unknown");
+      throw GrdeclError(file, 0, "SPECGRID",
+        "no SPECGRID or DIMENS: grid dimensions unknown" + this->MissingIncludeNote());
     }
     const bool hasZcorn = this->Spooling() ? this->Spool->zcorn != nullptr : !deck.zcorn.empty();
     if (deck.coord.empty() == hasZcorn)
     {
       throw GrdeclError(file, 0, deck.coord.empty() ? "COORD" : "ZCORN",
-        std::string("missing; corner-point grids need both COORD and ZCORN"));
+        "missing; corner-point grids need both COORD and ZCORN" + this->MissingIncludeNote());
+    }
+    const auto given = [&](const std::string& name, const std::vector<double>& vector) {
+      return !vector.empty() || this->Defined(name);
+    };
+    const bool cartesian = given("DX", deck.dxv) && given("DY", deck.dyv) &&
+      given("DZ", deck.dzv) && given("TOPS", {});
+    if (!hasZcorn && !cartesian && !this->MissingIncludes.empty())
+    {
+      throw GrdeclError(file, 0, "COORD",
+        "no grid geometry: need COORD and ZCORN, or DX/DXV, DY/DYV, DZ/DZV and TOPS" +
+          this->MissingIncludeNote());
     }
     if (this->Spooling() && this->Spool->actnum)
     {
@@ -1419,6 +1751,10 @@ private:
   GrdeclGridSpool* Spool = nullptr; ///< bounded-memory mode when set
   std::string SpoolFolder;
   std::unordered_set<std::string> DroppedArrays; ///< bounded-memory mode: given, not kept
+  int64_t LastRecordLine = 0; ///< line of the first token of the last record read
+  int64_t RecordLine = 0;     ///< line a warning names
+  std::unordered_set<std::string> WarningsGiven;
+  std::vector<std::string> MissingIncludes; ///< "'name' (file:line)" of each INCLUDE not found
 };
 } // namespace
 

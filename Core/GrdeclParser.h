@@ -3,9 +3,15 @@
 // Contract:
 // - Streams every file; holds only the arrays it returns, never the text.
 // - Follows INCLUDE (nested, quoted or bare, relative to the including file or the deck),
-//   IMPORT (binary GRDECL), BOX/ENDBOX, EQUALS, MULTIPLY, ADD, COPY and FAULTS.
+//   IMPORT (binary GRDECL), BOX/ENDBOX, FAULTS and the array edits EQUALS, MULTIPLY, ADD,
+//   COPY, MINVALUE, MAXVALUE, COPYBOX, OPERATE, OPERATER, EQUALREG, MULTIREG, ADDREG, COPYREG.
 // - Skips RUNSPEC/SUMMARY/SCHEDULE content and unknown keywords without choking; any
-//   numeric keyword with one value per cell (or per BOX cell) becomes a cell array.
+//   numeric keyword with one value per cell becomes a cell array (a viewer array, see
+//   GrdeclEdits.h, also when given for a BOX only).
+// - What the viewer does not build is skipped with a warning (GrdeclDeck::warnings) naming
+//   the file, line, keyword and array: edits of simulator and unknown arrays, flow-only
+//   keywords (MULTFLT, NNC, AQUNUM, PINCH, ...), local grids (CARFIN ... ENDFIN), a missing
+//   INCLUDE. An error then caused by a missing INCLUDE names it.
 // - Validates dimensions before allocating and every array's value count.
 // - On bad input throws GrdeclError naming the file, the line and the keyword; a deck
 //   object is only returned complete.
@@ -28,7 +34,7 @@ struct GrdeclParseOptions
   /// Stop at the first SCHEDULE keyword (grid and properties are all defined before it).
   bool stopAtSchedule = true;
   /// Warn (GrdeclDeck::warnings) instead of failing when an INCLUDE file is missing.
-  bool skipMissingIncludes = false;
+  bool skipMissingIncludes = true;
 };
 
 /// Parses an ASCII deck (.grdecl, .DATA, .inc ...) or a binary GRDECL (.bgrdecl), chosen by

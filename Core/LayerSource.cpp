@@ -314,6 +314,8 @@ public:
     return true;
   }
 
+  std::vector<std::string> Warnings() const override { return this->Deck.warnings; }
+
 private:
   /// A cell size as BuildCartesian takes it: the vector form (DXV ...) if given, else the
   /// cell's value (`layerValues` holds layer k of the array when given, else read here).

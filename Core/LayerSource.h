@@ -36,6 +36,9 @@ public:
   virtual std::string Name() const = 0;
   /// The input's MAPAXES, MAPUNITS and GRIDUNIT (none for generated models).
   virtual MapPlacement Placement() const { return {}; }
+  /// What the input left out (deck edits the viewer does not build, missing INCLUDEs ...),
+  /// one message a line naming the file and place.
+  virtual std::vector<std::string> Warnings() const { return {}; }
 };
 
 /// Layers generated on the fly (SyntheticReservoir), never all in memory.

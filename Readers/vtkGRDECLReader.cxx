@@ -173,6 +173,7 @@ bool vtkGRDECLReader::ParseIfNeeded()
   internal.Deck = resmr::GrdeclDeck();
   internal.ParsedFile.clear();
   internal.FailedFile.clear();
+  this->Warnings.clear();
   const auto fail = [&](const std::string& message) {
     internal.Deck = resmr::GrdeclDeck();
     internal.Geometry.reset();
@@ -200,6 +201,11 @@ bool vtkGRDECLReader::ParseIfNeeded()
   }
   internal.ParsedFile = this->FileName;
   internal.ParsedModificationTime = modified;
+  for (const std::string& warning : internal.Deck.warnings)
+  {
+    this->Warnings += warning + "\n";
+    vtkWarningMacro(<< warning);
+  }
   for (const resmr::CellArray& array : internal.Deck.arrays)
   {
     if (!resmr::IsGeometryArrayName(array.name) && !this->CellArraySelection->ArrayExists(array.name.c_str()))

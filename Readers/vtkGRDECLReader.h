@@ -89,6 +89,10 @@ public:
   /// The message of the last error, empty after a successful read.
   const char* GetLastError() { return this->LastError.c_str(); }
 
+  /// What the deck left out (edits of arrays the viewer does not build, flow-only keywords,
+  /// local grids, missing INCLUDE files), one per line naming the file, line and keyword.
+  const char* GetWarnings() { return this->Warnings.c_str(); }
+
   /// Returns 1 if the file looks like a deck this reader can open.
   static int CanReadFile(const char* fileName);
 
@@ -113,6 +117,7 @@ private:
   bool ApplyMapAxes = true;
   bool LeftHanded = false;
   std::string LastError;
+  std::string Warnings;
   vtkNew<vtkDataArraySelection> CellArraySelection;
   vtkNew<vtkDataArraySelection> FaultSelection;
 

@@ -137,6 +137,10 @@ int BuildCommand(int argc, char** argv)
     }
     // A deck's grid is spooled to the scratch folder: memory stays O(one layer) for any input.
     auto source = resmr::OpenLayerSource(input, resmr::ScratchFolder(output, options));
+    for (const std::string& warning : source->Warnings())
+    {
+      std::fprintf(stderr, "resmr: warning: %s\n", warning.c_str());
+    }
     const auto start = std::chrono::steady_clock::now();
     const bool terminal = isatty(2);
     double lastShown = -1;
