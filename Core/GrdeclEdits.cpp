@@ -148,12 +148,12 @@ SkippedShape SkippedKeyword(const std::string& keyword, std::string& why)
     { "THPRES", { SkippedShape::Records, "threshold pressures between regions" } },
     { "AMALGAM", { SkippedShape::Records, "amalgamated local grids" } },
     { "MINPV", { SkippedShape::OneRecord,
-                 "a minimum pore volume under which the simulator makes cells inactive "
-                 "(the viewer shows the cells ACTNUM makes active)" } },
+                 "the minimum pore volume under which the simulator makes cells inactive "
+                 "(it shows the cells ACTNUM makes active)" } },
     { "MINPORV", { SkippedShape::OneRecord,
-                   "a minimum pore volume under which the simulator makes cells inactive "
-                   "(the viewer shows the cells ACTNUM makes active)" } },
-    { "MINPVFIL", { SkippedShape::OneRecord, "a minimum pore volume for filling pinch-outs" } },
+                   "the minimum pore volume under which the simulator makes cells inactive "
+                   "(it shows the cells ACTNUM makes active)" } },
+    { "MINPVFIL", { SkippedShape::OneRecord, "the minimum pore volume for filling pinch-outs" } },
     { "PINCH", { SkippedShape::OneRecord,
                  "connections the simulator makes across pinched-out layers" } },
     { "CARFIN", { SkippedShape::LocalGrid, "a local grid refinement" } },

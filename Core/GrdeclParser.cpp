@@ -1221,7 +1221,7 @@ private:
     {
       this->ReadRecord(keyword);
       this->RecordLine = this->CurrentLine;
-      this->Warn(keyword, why + " are not shown by the viewer; skipped");
+      this->Warn(keyword, "skipped: the viewer does not use " + why);
       return;
     }
     if (shape == SkippedShape::Records)
@@ -1230,7 +1230,7 @@ private:
       {
       }
       this->RecordLine = this->CurrentLine;
-      this->Warn(keyword, why + " are not shown by the viewer; skipped");
+      this->Warn(keyword, "skipped: the viewer does not use " + why);
       return;
     }
     const std::vector<std::string> items = this->ReadRecord(keyword);

@@ -101,8 +101,10 @@ int Info(const char* path, bool skipMissingIncludes)
   {
     return GridInfo(path);
   }
+  // A missing INCLUDE is a warning either way (an error only when the grid then lacks what it
+  // needs); the option stays accepted for older scripts.
+  (void)skipMissingIncludes;
   resmr::GrdeclParseOptions options;
-  options.skipMissingIncludes = skipMissingIncludes;
   resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(path, options);
   for (const std::string& warning : deck.warnings)
   {

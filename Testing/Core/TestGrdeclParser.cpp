@@ -6,6 +6,7 @@
 #include "GrdeclParser.h"
 #include "GrdeclTokenizer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -359,7 +360,7 @@ void TestBadInput()
     { "mapaxes.grdecl", "MAPAXES", "coincide with the origin" });
   ExpectError("noint.grdecl", "SPECGRID\n 2.5 1 1 1 F /\n", { "noint.grdecl:1", "must be an integer" });
   ExpectError("include.DATA", "INCLUDE\n 'does_not_exist.inc' /\n",
-    { "include.DATA:1", "INCLUDE", "does_not_exist.inc", "not found" });
+    { "include.DATA", "no SPECGRID", "INCLUDE of 'does_not_exist.inc' at", "include.DATA:1 was not found" });
   Write("self.inc", "INCLUDE\n 'self.inc' /\n");
   ExpectError("cycle.DATA", "INCLUDE\n 'self.inc' /\n", { "self.inc:1", "INCLUDE", "nested deeper" });
   ExpectError("before.grdecl", "PORO\n 1 2 /\n", { "before.grdecl:1", "PORO", "before SPECGRID" });
@@ -375,12 +376,288 @@ void TestBadInput()
     { "binary_garbage.grdecl:4", "ZCORN", "expected a number" });
   ExpectError("long_token.grdecl", "SPECGRID\n" + std::string(3 << 20, 'A') + "\n",
     { "long_token.grdecl", "longer than 1 MiB" });
-  // Missing INCLUDE tolerated on request, with a warning naming it.
+  // A missing INCLUDE is tolerated with a warning naming it; refused on request.
+  resmr::GrdeclParseOptions strict;
+  strict.skipMissingIncludes = false;
+  ExpectError("strict.DATA", std::string(TwoCells) + "INCLUDE\n 'gone.inc' /\n",
+    { "strict.DATA:13", "INCLUDE", "gone.inc", "not found" }, strict);
   resmr::GrdeclParseOptions lenient;
-  lenient.skipMissingIncludes = true;
   resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(
     Write("lenient.DATA", std::string(TwoCells) + "INCLUDE\n 'gone.inc' /\n"), lenient);
   CHECK(deck.warnings.size() == 1 && deck.warnings[0].find("gone.inc") != std::string::npos);
+}
+
+/// Counts the warnings holding every fragment.
+int WarningsWith(const resmr::GrdeclDeck& deck, const std::vector<std::string>& fragments)
+{
+  int count = 0;
+  for (const std::string& warning : deck.warnings)
+  {
+    bool all = true;
+    for (const std::string& fragment : fragments)
+    {
+      all = all && warning.find(fragment) != std::string::npos;
+    }
+    count += all;
+  }
+  return count;
+}
+
+/// A 3 x 2 x 2 Cartesian deck with every edit keyword and every keyword the viewer skips.
+const char* EditedDeck = R"(RUNSPEC
+DIMENS
+ 3 2 2 /
+GRID
+DX
+ 12*10 /
+DY
+ 12*10 /
+DZ
+ 12*1 /
+TOPS
+ 6*1000 /
+PORO
+ 0.1 0.2 0.3 0.4 0.5 0.6  6*0.9 /
+PERMX
+ 1 2 3 4 5 6 7 8 9 10 11 12 /
+COPYBOX
+PORO 1 3 1 2 1 1  1 3 1 2 2 2 /
+/
+MINVALUE
+ PERMX 3 /
+/
+MAXVALUE
+ PERMX 10 /
+/
+OPERATE
+ PERMY 1* 1* 1* 1* 1* 1* MULTA PERMX 2 1 /
+ PERMZ 1 3 1 2 1 1 MULTX PERMX 0.5 /
+ PERMY 1 1 1 1 1 1 POLY PERMX 1 2 /
+ NTG 4* 2 2 INV PERMX /
+/
+EQUALS
+ MULTNUM 1 /
+ MULTNUM 2 1 1 1 2 1 2 /
+ MULTX 0.5 1 1 1 1 1 1 /
+ FOOBAR 7 /
+/
+MULTIPLY
+ TRANX 0.5 /
+/
+BOX
+ 1 2 1 1 1 1 /
+MULTZ
+ 2*0.1 /
+ENDBOX
+MULTFLT
+ 'F1' 0.1 /
+/
+MULTREGT
+ 1 2 0.5 XYZ 'ALL' M /
+/
+NNC
+ 1 1 1 3 2 2 0.5 /
+/
+MINPV
+ 1e-3 /
+PINCH
+ 0.001 GAP 1* TOPBOT TOP /
+CARFIN
+ 'LGR1' 1 1 1 1 1 1 2 2 2 /
+PORO
+ 8*0.7 /
+EQUALS
+ 'PERMX' 99 /
+/
+ENDFIN
+AQUNUM
+ 1 3 2 2 1e6 1e3 0.3 100 2000 200 1 1 /
+/
+AQUCON
+ 1 1 1 1 1 1 1 'I-' /
+/
+EDIT
+MULTIPLY
+ TRANY 0.5 1 1 1 1 1 1 /
+/
+EQUALS
+ PORV 1000 1 1 1 1 1 1 /
+/
+ADD
+ DEPTH 1 /
+/
+MULTREGP
+ 1 0.5 M /
+/
+EDITNNC
+ 1 1 1 2 1 1 0.5 /
+/
+PROPS
+EQUALS
+ SWL 0.1 /
+/
+OPERATER
+ SWL 2 MULTX SWL 3 1* M /
+/
+REGIONS
+EQUALS
+ SATNUM 1 /
+ OPERNUM 1 /
+/
+EQUALREG
+ SATNUM 5 2 M /
+/
+MULTIREG
+ SATNUM 3 1 /
+/
+ADDREG
+ SATNUM 10 2 M /
+/
+COPYREG
+ SATNUM FIPNUM 1 M /
+/
+EQUALREG
+ PVTNUM 4 1 /
+/
+SOLUTION
+THPRES
+ 1 2 1* /
+/
+MULTIPLY
+ MULTPV 2 /
+/
+)";
+
+
+/// 1-based line of the last line of the first occurrence of `text` in `deck`, as a string.
+std::string LineOf(const char* deck, const char* text)
+{
+  const std::string all(deck);
+  const std::size_t at = all.find(text);
+  CHECK(at != std::string::npos);
+  const std::string upTo = all.substr(0, at + std::strlen(text));
+  const std::size_t lastChar = upTo.find_last_not_of('\n');
+  return std::to_string(1 + std::count(upTo.begin(), upTo.begin() + lastChar, '\n'));
+}
+
+void TestDeckEditsAndSkips()
+{
+  const std::string path = Write("edited.DATA", EditedDeck);
+  const resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(path);
+  const auto values = [&](const char* name) {
+    const resmr::CellArray* array = deck.FindArray(name);
+    CHECK(array != nullptr);
+    return array ? array->values : std::vector<double>(12, -1.0);
+  };
+  // COPYBOX: layer 1 of PORO copied onto layer 2; the CARFIN block's PORO is not read.
+  const std::vector<double> poro = values("PORO");
+  for (int c = 0; c < 6; ++c)
+  {
+    CHECK(poro[c] == poro[c + 6] && std::fabs(poro[c] - 0.1 * (c + 1)) < 1e-12);
+  }
+  // MINVALUE 3, MAXVALUE 10; the CARFIN block's EQUALS PERMX 99 is not applied.
+  const std::vector<double> permx = values("PERMX");
+  const double clamped[12] = { 3, 3, 3, 4, 5, 6, 7, 8, 9, 10, 10, 10 };
+  for (int c = 0; c < 12; ++c)
+  {
+    CHECK(permx[c] == clamped[c]);
+  }
+  // OPERATE: MULTA over the grid, POLY on cell 1 (adds 1 x PERMX^2), MULTX in layer 1, INV in
+  // layer 2 (cells outside the box have no value).
+  const std::vector<double> permy = values("PERMY"), permz = values("PERMZ"), ntg = values("NTG");
+  CHECK(permy[0] == 2 * 3 + 1 + 3 * 3);
+  for (int c = 1; c < 12; ++c)
+  {
+    CHECK(permy[c] == 2 * clamped[c] + 1);
+  }
+  for (int c = 0; c < 12; ++c)
+  {
+    CHECK(c < 6 ? permz[c] == 0.5 * clamped[c] : std::isnan(permz[c]));
+    CHECK(c >= 6 ? std::fabs(ntg[c] - 1.0 / clamped[c]) < 1e-15 : std::isnan(ntg[c]));
+  }
+  // Regions: MULTNUM 2 in column I = 1, 1 elsewhere. SATNUM: 1, then 5 in region 2, then x3
+  // in region 1, then +10 in region 2; FIPNUM copied from SATNUM in region 1 only; PVTNUM 4
+  // in region 1 only. OPERATER: SWL x3 in MULTNUM region 2.
+  const std::vector<double> satnum = values("SATNUM"), fipnum = values("FIPNUM");
+  const std::vector<double> pvtnum = values("PVTNUM"), swl = values("SWL");
+  for (int c = 0; c < 12; ++c)
+  {
+    const bool region2 = c % 3 == 0;
+    CHECK(satnum[c] == (region2 ? 15 : 3));
+    CHECK(region2 ? std::isnan(fipnum[c]) : fipnum[c] == 3);
+    CHECK(region2 ? std::isnan(pvtnum[c]) : pvtnum[c] == 4);
+    CHECK(std::fabs(swl[c] - (region2 ? 0.3 : 0.1)) < 1e-15);
+  }
+  // Nothing the viewer does not build became an array.
+  for (const char* name : { "MULTX", "MULTZ", "TRANX", "TRANY", "PORV", "DEPTH", "FOOBAR",
+         "MULTPV" })
+  {
+    CHECK(deck.FindArray(name) == nullptr);
+  }
+  // One warning each, naming the file, the line, the keyword and the array.
+  const std::string file = path + ":";
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTX 0.5") + ":", "keyword EQUALS", "MULTX", "flow multiplier" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, " FOOBAR 7") + ":", "keyword EQUALS", "FOOBAR", "not an array the viewer knows" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTIPLY\n TRANX") + ":", "keyword MULTIPLY", "TRANX", "transmissibility" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTZ\n") + ":", "keyword MULTZ", "MULTZ" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTFLT") + ":", "keyword MULTFLT" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTREGT") + ":", "keyword MULTREGT" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "NNC\n") + ":", "keyword NNC" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MINPV") + ":", "keyword MINPV", "inactive" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "PINCH") + ":", "keyword PINCH" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "CARFIN") + ":", "keyword CARFIN", "'LGR1'", "global grid" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "AQUNUM") + ":", "keyword AQUNUM" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "AQUCON") + ":", "keyword AQUCON" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTIPLY\n TRANY") + ":", "keyword MULTIPLY", "TRANY" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "EQUALS\n PORV") + ":", "keyword EQUALS", "PORV", "pore volume" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "ADD\n DEPTH") + ":", "keyword ADD", "DEPTH", "depth" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTREGP") + ":", "keyword MULTREGP" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "EDITNNC") + ":", "keyword EDITNNC" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "THPRES") + ":", "keyword THPRES" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTIPLY\n MULTPV") + ":", "keyword MULTIPLY", "MULTPV" }) == 1);
+  CHECK(deck.warnings.size() == 19);
+  for (const std::string& warning : deck.warnings)
+  {
+    std::printf("  warning: %s\n", warning.c_str());
+  }
+
+  // The bounded-memory parse (resmr build) gives the same warnings.
+  const std::string spoolFolder = Directory + "/spool";
+  std::system(("mkdir -p '" + spoolFolder + "'").c_str());
+  resmr::GrdeclGridSpool spool;
+  const resmr::GrdeclDeck streamed = resmr::ParseGrdeclGrid(path, spoolFolder, spool);
+  CHECK(streamed.warnings == deck.warnings);
+
+  // Edits the viewer cannot honour on arrays it needs stay errors naming file, line, keyword.
+  const std::string twoCells(TwoCells);
+  ExpectError("copy_tran.grdecl", twoCells + "COPY\n TRANX PORO /\n/\n",
+    { "copy_tran.grdecl:13", "keyword COPY", "source array TRANX has not been defined" });
+  ExpectError("operate.grdecl", twoCells + "PORO\n 2*0.1 /\nOPERATE\n PORO 4* 1 1 SQRT PORO /\n/\n",
+    { "operate.grdecl:15", "keyword OPERATE", "unknown operation 'SQRT'" });
+  ExpectError("operate_poly.grdecl", twoCells + "PORO\n 2*0.1 /\nOPERATE\n NTG 4* 1 1 POLY PORO 1 1 /\n/\n",
+    { "operate_poly.grdecl:15", "keyword OPERATE", "array NTG has not been defined" });
+  ExpectError("minvalue.grdecl", twoCells + "MINVALUE\n PORO 0.1 /\n/\n",
+    { "minvalue.grdecl:13", "keyword MINVALUE", "array PORO has not been defined" });
+  ExpectError("copybox.grdecl", twoCells + "PORO\n 2*0.1 /\nCOPYBOX\n PORO 1 1 1 1 1 1 1 2 1 1 1 1 /\n/\n",
+    { "copybox.grdecl:15", "keyword COPYBOX", "differ in size along I" });
+  ExpectError("carfin.grdecl", twoCells + "CARFIN\n 'L1' 1 1 1 1 1 1 2 2 2 /\nPORO\n 8*0.1 /\n",
+    { "carfin.grdecl:13", "keyword CARFIN", "'L1' has no ENDFIN" });
+  ExpectError("region.grdecl", twoCells + "EQUALREG\n PORO 0.1 1 Q /\n/\n",
+    { "region.grdecl:13", "keyword EQUALREG", "region array 'Q'" });
+
+  // A missing INCLUDE is a warning; when it held what the grid needs, the error names it.
+  Write("grid_only.inc", twoCells);
+  const resmr::GrdeclDeck missingSolution = Parse("missing_solution.DATA",
+    "GRID\nINCLUDE\n 'grid_only.inc' /\nSOLUTION\nINCLUDE\n 'not_shipped.inc' /\n");
+  CHECK(WarningsWith(missingSolution, { "missing_solution.DATA:5", "INCLUDE", "not_shipped.inc", "not found" }) == 1);
+  CHECK(missingSolution.CellCount() == 2);
+  ExpectError("missing_grid.DATA", "GRID\nINCLUDE\n 'gone_grid.inc' /\nPORO\n 2*0.1 /\n",
+    { "missing_grid.DATA:4", "PORO", "before SPECGRID", "INCLUDE of 'gone_grid.inc' at",
+      "missing_grid.DATA:2 was not found" });
+  ExpectError("missing_zcorn.DATA", "SPECGRID\n 2 1 1 1 F /\nINCLUDE\n 'gone_zcorn.inc' /\n",
+    { "missing_zcorn.DATA", "no grid geometry", "INCLUDE of 'gone_zcorn.inc'" });
+  ExpectError("missing_poro.DATA", twoCells + "INCLUDE\n 'gone_poro.inc' /\nMULTIPLY\n PORO 2 /\n/\n",
+    { "missing_poro.DATA:15", "keyword MULTIPLY", "PORO has not been defined", "gone_poro.inc" });
 }
 } // namespace
 
@@ -397,7 +674,7 @@ int main()
     { "tokenizer", TestTokenizer }, { "corner-point deck", TestCornerPointDeck },
     { "faulted sharing", TestFaultedSharing }, { "cartesian and edits", TestCartesianAndEdits },
     { "includes and mapaxes", TestIncludesAndMapAxes }, { "binary grdecl", TestBinaryGrdecl },
-    { "bad input", TestBadInput } };
+    { "bad input", TestBadInput }, { "deck edits and skipped keywords", TestDeckEditsAndSkips } };
   const bool passed = resmr_testing::RunNamedTests(tests);
   std::system(("rm -rf '" + Directory + "'").c_str());
   return passed ? 0 : 1;

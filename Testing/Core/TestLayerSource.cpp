@@ -290,6 +290,53 @@ PERMX
 )");
   CHECK(CompareWithInMemory(edited));
 
+  // ACTNUM edited by COPYBOX, MINVALUE, MAXVALUE, OPERATE and EQUALREG (no MULTNUM: region 1
+  // everywhere), among keywords the viewer skips and a local grid whose arrays are not read.
+  const std::string more = Directory + "/MORE_EDITS.grdecl";
+  WriteAll(more, std::string(CornerPointGrid) + R"(ACTNUM
+ 1 0 1 1 1 1 0 1 1 1 1 1 /
+COPYBOX
+ ACTNUM 1 3 1 2 1 1  1 3 1 2 2 2 /
+/
+MAXVALUE
+ ACTNUM 1 /
+/
+MINVALUE
+ ACTNUM 0 /
+/
+OPERATE
+ ACTNUM 3 3 2 2 2 2 MULTX ACTNUM 0 /
+/
+EQUALREG
+ ACTNUM 1 1 M 3 3 1 1 1 1 /
+/
+MULTFLT
+ 'F1' 0.5 /
+/
+CARFIN
+ 'L1' 1 1 1 1 1 1 2 2 2 /
+ACTNUM
+ 8*0 /
+ENDFIN
+EQUALS
+ TRANX 0 /
+/
+)");
+  CHECK(CompareWithInMemory(more));
+  {
+    // EQUALREG leaves every cell active here (region 1 is the whole grid); the source of the
+    // stream saw the deck's warnings.
+    auto source = resmr::OpenLayerSource(more, SpoolDirectory);
+    const std::vector<std::string> warnings = source->Warnings();
+    CHECK(warnings.size() == 3);
+  }
+  // By region when MULTNUM is given: resmr build does not keep region arrays, so refused.
+  const std::string byRegion = Directory + "/BY_REGION.grdecl";
+  WriteAll(byRegion, std::string(CornerPointGrid) + "MULTNUM\n 12*1 /\nEQUALREG\n ACTNUM 0 1 M /\n/\n");
+  resmr_testing::ExpectError<resmr::GrdeclError>("EQUALREG on ACTNUM",
+    [&] { resmr::OpenLayerSource(byRegion, SpoolDirectory); },
+    { byRegion + ":", "keyword EQUALREG", "ACTNUM", "region" });
+
   // A Cartesian deck: DX/DY/DZ/TOPS, TOPS for the top layer only, a DZ edit in a box.
   const std::string cartesian = Directory + "/CARTESIAN.DATA";
   WriteAll(cartesian, R"(RUNSPEC
