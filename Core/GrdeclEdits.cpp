@@ -140,7 +140,9 @@ SkippedShape SkippedKeyword(const std::string& keyword, std::string& why)
     { "EDITNNC", { SkippedShape::Records, "non-neighbour connection multipliers" } },
     { "EDITNNCR", { SkippedShape::Records, "non-neighbour connection transmissibilities" } },
     { "NNC", { SkippedShape::Records, "non-neighbour connections" } },
-    { "AQUNUM", { SkippedShape::Records, "numerical aquifer cells" } },
+    { "AQUNUM", { SkippedShape::Records,
+                  "numerical aquifers (the simulator gives their cells the aquifer's porosity "
+                  "and permeability; the viewer shows the grid's)" } },
     { "AQUCON", { SkippedShape::Records, "aquifer connections" } },
     { "AQUCT", { SkippedShape::Records, "Carter-Tracy aquifers" } },
     { "AQUFETP", { SkippedShape::Records, "Fetkovich aquifers" } },

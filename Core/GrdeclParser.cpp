@@ -112,6 +112,18 @@ bool LooksLikeKeyword(std::string_view word)
   return true;
 }
 
+bool IsRegionArrayName(const std::string& name)
+{
+  return name.size() > 3 && name.compare(name.size() - 3, 3, "NUM") == 0;
+}
+
+/// The value of a cell the deck gives no value: region numbers and ACTNUM are 1 there, as
+/// for ECLIPSE and OPM; any other array has none (NaN).
+double NotGiven(const std::string& name)
+{
+  return IsRegionArrayName(name) ? 1.0 : std::numeric_limits<double>::quiet_NaN();
+}
+
 bool IsIntegerArrayName(const std::string& name)
 {
   return name == "ACTNUM" || name == "FACIES" || (name.size() > 3 && name.compare(name.size() - 3, 3, "NUM") == 0);
@@ -460,7 +472,7 @@ private:
     CellArray array;
     array.name = name;
     array.isInteger = IsIntegerArrayName(name);
-    array.values.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
+    array.values.assign(static_cast<std::size_t>(n), NotGiven(name));
     this->Deck.arrays.push_back(std::move(array));
     return this->Deck.arrays.back();
   }
@@ -523,7 +535,7 @@ private:
     {
       const int64_t n = this->CellCount(name);
       slot.reset(new SpoolFile(this->SpoolFolder, name));
-      slot->Fill(0, n, std::numeric_limits<double>::quiet_NaN());
+      slot->Fill(0, n, NotGiven(name));
     }
     return *slot;
   }
@@ -1061,7 +1073,7 @@ private:
   {
     const bool viewerEdit = IsViewerArray(edit.target) ||
       (!edit.source.empty() && IsViewerArray(edit.source) && this->Defined(edit.source));
-    if (!edit.source.empty() && !this->Defined(edit.source))
+    if (!edit.source.empty() && !this->Defined(edit.source) && !IsRegionArrayName(edit.source))
     {
       if (IsViewerArray(edit.source) || IsViewerArray(edit.target))
       {
@@ -1071,9 +1083,9 @@ private:
       this->WarnSkippedEdit(keyword, edit.source);
       return false;
     }
-    if (this->Defined(edit.target))
+    if (this->Defined(edit.target) || IsRegionArrayName(edit.target))
     {
-      return true;
+      return true; // region numbers not given are 1
     }
     if (edit.readsTarget && IsViewerArray(edit.target))
     {
@@ -1161,11 +1173,15 @@ private:
             "region arrays are not kept");
       }
       out.spooled = &this->SpoolFor(edit.target);
-      in.spooled = edit.source.empty() ? nullptr : this->SpoolSlot(edit.source).get();
+      in.spooled = edit.source.empty() ? nullptr : &this->SpoolFor(edit.source);
     }
     else
     {
-      out.held = &this->ArrayFor(edit.target); // first: it may move the other arrays
+      if (!edit.source.empty())
+      {
+        this->ArrayFor(edit.source); // a region array not given yet: 1 in every cell
+      }
+      out.held = &this->ArrayFor(edit.target); // before taking pointers: it may move arrays
       in.held = edit.source.empty() ? nullptr : this->Deck.FindArray(edit.source);
       regions.held = edit.regionArray.empty() ? nullptr : this->Deck.FindArray(edit.regionArray);
     }

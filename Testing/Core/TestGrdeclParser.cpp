@@ -575,7 +575,7 @@ void TestDeckEditsAndSkips()
     CHECK(c < 6 ? permz[c] == 0.5 * clamped[c] : std::isnan(permz[c]));
     CHECK(c >= 6 ? std::fabs(ntg[c] - 1.0 / clamped[c]) < 1e-15 : std::isnan(ntg[c]));
   }
-  // Regions: MULTNUM 2 in column I = 1, 1 elsewhere. SATNUM: 1, then 5 in region 2, then x3
+  // Regions (1 where not given): MULTNUM 2 in column I = 1. SATNUM: 1, then 5 in region 2, then x3
   // in region 1, then +10 in region 2; FIPNUM copied from SATNUM in region 1 only; PVTNUM 4
   // in region 1 only. OPERATER: SWL x3 in MULTNUM region 2.
   const std::vector<double> satnum = values("SATNUM"), fipnum = values("FIPNUM");
@@ -584,8 +584,8 @@ void TestDeckEditsAndSkips()
   {
     const bool region2 = c % 3 == 0;
     CHECK(satnum[c] == (region2 ? 15 : 3));
-    CHECK(region2 ? std::isnan(fipnum[c]) : fipnum[c] == 3);
-    CHECK(region2 ? std::isnan(pvtnum[c]) : pvtnum[c] == 4);
+    CHECK(fipnum[c] == (region2 ? 1 : 3)); // region arrays not given are 1
+    CHECK(pvtnum[c] == (region2 ? 1 : 4));
     CHECK(std::fabs(swl[c] - (region2 ? 0.3 : 0.1)) < 1e-15);
   }
   // Nothing the viewer does not build became an array.

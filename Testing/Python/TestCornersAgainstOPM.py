@@ -9,67 +9,15 @@ import os
 import tempfile
 
 import numpy as np
-from opm.io.ecl import EclOutput, EGrid
 from opm.io.ecl_state import EclipseState
-from opm.io.parser import Parser
 
 import resmr_testing as rt
+from opm_testing import corner_error, opm_corners, opm_deck, our_corners
 
 args = rt.arguments()
 rt.load_plugin(args.plugin)
 DATA = args.data
 work = tempfile.mkdtemp(prefix="resmr-opm-", dir=args.temp)
-
-# ECLIPSE corner (di + 2 dj + 4 dk) of each VTK hexahedron point.
-ECLIPSE_CORNER_OF_VTK_POINT = np.array([0, 1, 3, 2, 4, 5, 7, 6])
-
-
-def opm_deck(path, extra_keywords=()):
-    parser = Parser()
-    for keyword in extra_keywords:
-        parser.add_keyword(keyword)
-    return parser.parse(path)
-
-
-def opm_corners(deck, dims, name):
-    nx, ny, nz = dims
-    header = np.zeros(100, np.int32)
-    header[0] = 1
-    header[1:4] = dims
-    egrid_path = os.path.join(work, name + ".EGRID")
-    out = EclOutput(egrid_path)
-    out.write("FILEHEAD", np.zeros(100, np.int32))
-    out.write("GRIDHEAD", header)
-    out.write("COORD", np.asarray(deck["COORD"].get_raw_array(), np.float32))
-    out.write("ZCORN", np.asarray(deck["ZCORN"].get_raw_array(), np.float32))
-    out.write("ACTNUM", np.ones(nx * ny * nz, np.int32))
-    out.write("ENDGRID", np.zeros(0, np.int32))
-    del out
-    grid = EGrid(egrid_path)
-    corners = np.zeros((nx * ny * nz, 8, 3))
-    for k in range(nz):
-        for j in range(ny):
-            for i in range(nx):
-                x, y, z = grid.xyz_from_ijk(i, j, k)
-                corners[(k * ny + j) * nx + i] = np.column_stack([x, y, z])
-    return corners
-
-
-def our_corners(grid, dims):
-    """Our corners as (cells, 8, 3) in ECLIPSE cell and corner order, depth positive."""
-    nx, ny, nz = dims
-    points, hexahedra = rt.points_and_cells(grid)
-    i = rt.cell_array(grid, "I") - 1
-    j = rt.cell_array(grid, "J") - 1
-    k = rt.cell_array(grid, "K") - 1
-    mirrored = nz > 1 and k[0] == nz - 1
-    corner_of_point = ECLIPSE_CORNER_OF_VTK_POINT ^ (4 if mirrored else 0)
-    eclipse_cell = (k * ny + j) * nx + i
-    corners = np.zeros((nx * ny * nz, 8, 3))
-    corners[eclipse_cell[:, None], corner_of_point[None, :]] = points[hexahedra]
-    corners[..., 2] *= -1.0  # back to depth
-    return corners, mirrored
-
 
 HEXAHEDRON_FACES = np.array([[0, 4, 7, 3], [1, 2, 6, 5], [0, 1, 5, 4], [3, 7, 6, 2],
                              [0, 3, 2, 1], [4, 5, 6, 7]])
@@ -103,12 +51,10 @@ def check_volumes_positive(grid, name):
 def compare_corners(name, path, opm_path, dims, extra_keywords=(), properties=()):
     reader, grid = rt.read_grid(path, ApplyMapAxes=0)
     deck = opm_deck(opm_path, extra_keywords)
-    reference = opm_corners(deck, dims, name)
+    reference = opm_corners(deck, dims, name, work)
     ours, mirrored = our_corners(grid, dims)
-    scale = np.abs(reference).max(axis=(0, 1))
     # OPM's corners come from float32 COORD/ZCORN: allow a few float32 ulps of the extent.
-    tolerance = 4 * np.finfo(np.float32).eps * scale
-    error = np.abs(ours - reference).max(axis=(0, 1))
+    error, tolerance = corner_error(ours, reference)
     print(f"{name}: max corner difference x {error[0]:.3g} y {error[1]:.3g} z {error[2]:.3g}"
           f" (tolerance {tolerance.round(6)}), stored k-mirrored: {mirrored}")
     if np.any(error > tolerance):
