@@ -152,6 +152,23 @@ bool IsEditKeyword(const std::string& name)
   return names.count(name) > 0;
 }
 
+bool IsRegionEdit(const std::string& name)
+{
+  return name == "EQUALREG" || name == "MULTIREG" || name == "ADDREG" || name == "COPYREG";
+}
+
+/// Items an edit record must have: array name(s), box or region, value or operation.
+std::size_t MinimumEditItems(const std::string& keyword)
+{
+  if (keyword == "COPYBOX")
+    return 13; // array, the box read, the box written
+  if (keyword == "OPERATE")
+    return 9; // target, box, operation, source
+  if (keyword == "OPERATER")
+    return 4; // target, region, operation, source
+  return IsRegionEdit(keyword) ? 3 : 2;
+}
+
 /// Keywords that change the deck when read (geometry, arrays, edits, sections, INCLUDE).
 bool IsActedOnKeyword(const std::string& name)
 {
@@ -933,10 +950,7 @@ private:
   ArrayEdit ReadEditRecord(
     const std::string& keyword, const std::vector<std::string>& items, Box& lastBox)
   {
-    const std::size_t needed = keyword == "COPYBOX" ? 13 : keyword == "OPERATE" ? 9
-      : keyword == "OPERATER"                           ? 4
-      : keyword.size() > 3 && keyword.compare(keyword.size() - 3, 3, "REG") == 0 ? 3
-                                                        : 2;
+    const std::size_t needed = MinimumEditItems(keyword);
     if (items.size() < needed || items[0].empty())
     {
       this->FailHere(keyword, "record needs at least " + std::to_string(needed) +
@@ -948,8 +962,7 @@ private:
     {
       return this->ReadOperateRecord(keyword, items, edit);
     }
-    if (keyword == "EQUALREG" || keyword == "MULTIREG" || keyword == "ADDREG" ||
-      keyword == "COPYREG")
+    if (IsRegionEdit(keyword))
     {
       edit.box = this->WholeGrid();
       edit.sourceBox = edit.box;
@@ -964,9 +977,12 @@ private:
       }
       const double value = this->EditValue(items, 1, keyword, edit.target);
       edit.readsTarget = keyword != "EQUALREG";
-      edit.apply = keyword == "EQUALREG" ? std::function<double(double, double)>([value](double, double) { return value; })
-        : keyword == "MULTIREG"          ? std::function<double(double, double)>([value](double r, double) { return r * value; })
-                                         : std::function<double(double, double)>([value](double r, double) { return r + value; });
+      if (keyword == "EQUALREG")
+        edit.apply = [value](double, double) { return value; };
+      else if (keyword == "MULTIREG")
+        edit.apply = [value](double r, double) { return r * value; };
+      else
+        edit.apply = [value](double r, double) { return r + value; };
       return edit;
     }
     if (keyword == "COPYBOX")
