@@ -5,6 +5,7 @@
 
 #include "EclipseGrid.h"
 #include "EclipseResults.h"
+#include "GrdeclError.h"
 #include "GrdeclParser.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
@@ -33,8 +34,13 @@ const char* AddPropertiesUsage =
   "           resmr synth NI NJ NK --seed SEED --steps STEPS would write, streamed from the\n"
   "           generator layer by layer (no file; any size, beyond an EGRID's 268M cells)\n"
   "  -o FILE  property file (default: FILE.resmrp beside FILE.resmr); tables it already\n"
-  "           holds are kept unless replaced (same name and step). The .resmr file is only\n"
-  "           read, never written.\n";
+  "           holds are kept unless replaced (same name and step). Report steps it holds\n"
+  "           already (same array, step, report number and time) are kept and not read\n"
+  "           again: run again on a run still being written, it adds the new steps. The\n"
+  "           .resmr file is only read, never written.\n"
+  "  A restart cut short or damaged gives its complete steps; the incomplete ones are\n"
+  "  reported (file, step, byte offset) and left out, and the exit status is 0 unless\n"
+  "  nothing could be read.\n";
 
 bool Exists(const std::string& path)
 {
@@ -185,6 +191,18 @@ int AddSyntheticProperties(const std::string& spec, const resmr::Multiresolution
   return passes;
 }
 
+/// True if `older` holds this report step's table already, for the same step of the run.
+bool HoldsStep(const resmr::PropertyFile& older, const resmr::PropertyTable& table)
+{
+  const int index = older.Find(table.name, table.step);
+  if (index < 0)
+  {
+    return false;
+  }
+  const resmr::PropertyTable& held = older.Tables()[static_cast<std::size_t>(index)];
+  return held.reportNumber == table.reportNumber && held.days == table.days;
+}
+
 /// The geometry's active cells per layer, to check that results belong to this grid.
 int64_t ActiveCount(const resmr::MultiresolutionFile& geometry)
 {
@@ -253,7 +271,7 @@ int AddPropertiesCommand(int argc, char** argv)
     resmr::PropertyFileWriter writer(output, geometry);
     std::vector<float> values; // one whole array, for file inputs only
     const float none = std::numeric_limits<float>::quiet_NaN();
-    int64_t added = 0;
+    int64_t added = 0, kept = 0, leftOut = 0;
     int generatorPasses = 0;
     const auto report = [&](const resmr::PropertyTable& table) {
       ++added;
@@ -295,11 +313,25 @@ int AddPropertiesCommand(int argc, char** argv)
         {
           std::fprintf(stderr, "resmr add-properties: warning: %s\n", warning.c_str());
         }
+        leftOut += static_cast<int64_t>(results.SkippedSteps().size());
+        // A record whose blocks turn out damaged costs that table only.
+        const auto readable = [&](const std::function<bool()>& read) {
+          try
+          {
+            return read();
+          }
+          catch (const resmr::GrdeclError& error)
+          {
+            std::fprintf(stderr, "resmr add-properties: warning: %s; left out\n", error.what());
+            ++leftOut;
+            return false;
+          }
+        };
         if (!isRestart)
         {
           for (const auto& array : results.StaticArrays())
           {
-            if (results.ReadStatic<float>(array.name, values.data(), none))
+            if (readable([&] { return results.ReadStatic<float>(array.name, values.data(), none); }))
             {
               resmr::PropertyTable table;
               table.name = array.name;
@@ -314,13 +346,18 @@ int AddPropertiesCommand(int argc, char** argv)
           {
             for (const std::string& name : steps[s].names)
             {
-              if (results.ReadDynamic<float>(s, name, values.data(), none))
+              resmr::PropertyTable table;
+              table.name = name;
+              table.step = static_cast<int32_t>(s);
+              table.reportNumber = steps[s].reportNumber;
+              table.days = steps[s].days;
+              if (older && HoldsStep(*older, table))
               {
-                resmr::PropertyTable table;
-                table.name = name;
-                table.step = static_cast<int32_t>(s);
-                table.reportNumber = steps[s].reportNumber;
-                table.days = steps[s].days;
+                ++kept; // copied from the older file below
+                continue;
+              }
+              if (readable([&] { return results.ReadDynamic<float>(s, name, values.data(), none); }))
+              {
                 add(table);
               }
             }
@@ -352,18 +389,33 @@ int AddPropertiesCommand(int argc, char** argv)
         }
       }
     }
-    if (added == 0)
+    if (added == 0 && kept == 0)
     {
       throw std::invalid_argument("no property found in the inputs; " + output + " not written");
     }
-    if (older)
+    std::size_t tables = older ? older->Tables().size() : 0;
+    if (added > 0)
     {
-      writer.CopyFrom(*older);
+      if (older)
+      {
+        writer.CopyFrom(*older);
+      }
+      writer.Commit();
+      tables = writer.TableCount();
     }
-    writer.Commit();
-    std::printf("{\"geometry\": \"%s\", \"properties\": \"%s\", \"tables_added\": %lld, \"tables\": %zu, "
-                "\"generator_passes\": %d}\n",
-      geometryPath.c_str(), output.c_str(), static_cast<long long>(added), writer.TableCount(), generatorPasses);
+    else
+    {
+      std::fprintf(stderr, "resmr add-properties: %s already holds every step found; not rewritten\n", output.c_str());
+    }
+    if (leftOut > 0)
+    {
+      std::fprintf(stderr, "resmr add-properties: warning: %lld report steps or tables left out (see above)\n",
+        static_cast<long long>(leftOut));
+    }
+    std::printf("{\"geometry\": \"%s\", \"properties\": \"%s\", \"tables_added\": %lld, \"tables_kept\": %lld, "
+                "\"tables\": %zu, \"left_out\": %lld, \"generator_passes\": %d}\n",
+      geometryPath.c_str(), output.c_str(), static_cast<long long>(added), static_cast<long long>(kept), tables,
+      static_cast<long long>(leftOut), generatorPasses);
     return 0;
   }
   catch (const std::exception& error)
