@@ -386,7 +386,15 @@ void EclipseResults::IndexRestart(
   }
   const bool started = this->ReportSteps.size() > firstStep;
   const bool damaged = scan.damagedAt >= 0;
-  const bool unclosed = scan.closesSolutions && !scan.lastClosed;
+  // Files with STARTSOL close each solution with ENDSOL. Without them a step's end is not
+  // written: one holding no array yet, or fewer than the step before it, is still being
+  // written.
+  const std::size_t count = this->ReportSteps.size();
+  const bool unclosed = scan.closesSolutions
+    ? !scan.lastClosed
+    : started &&
+      (this->ReportSteps.back().names.empty() ||
+        (count > firstStep + 1 && this->ReportSteps.back().names.size() < this->ReportSteps[count - 2].names.size()));
   // In a unified restart, damage after the last step's ENDSOL belongs to the step after it;
   // a per-step file is one step, left out for any damage.
   const bool lastWhole = !unclosed && (!damaged || (this->Unified && scan.closesSolutions));

@@ -53,7 +53,7 @@ echo "== building ${fuzzer}"
 # -fno-sanitize-recover: a UBSan report is a crash with an artifact, not a line in the log.
 "${cxx}" -std=c++17 -g -O1 -fno-omit-frame-pointer \
   -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-  -I "${repo}/Core" "${repo}"/Core/*.cpp "${here}/${target}.cpp" -o "${fuzzer}"
+  -I "${repo}/Core" "${repo}"/Core/*.cpp "${here}/${target}.cpp" -o "${fuzzer}" -llzo2
 
 # ---------------------------------------------------------------- corpus
 find "${seeds}" -maxdepth 1 -type f -exec cp -n {} "${work}/corpus/" \;
