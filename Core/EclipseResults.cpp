@@ -292,7 +292,7 @@ void EclipseResults::LeaveOut(const std::string& path, int reportNumber, int64_t
     ? "the report step after report " + std::to_string(this->ReportSteps.back().reportNumber)
     : std::string("its report steps");
   this->Notes.push_back(path + ": " + step + " left out: incomplete at byte " + std::to_string(offset) + " (" +
-    reason + "); the other steps are shown");
+    reason + "); the other steps are kept");
 }
 
 void EclipseResults::ListDynamicArrays()
