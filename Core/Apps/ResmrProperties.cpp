@@ -13,6 +13,7 @@
 #include "SyntheticReservoirWriter.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -203,6 +204,83 @@ bool HoldsStep(const resmr::PropertyFile& older, const resmr::PropertyTable& tab
   return held.reportNumber == table.reportNumber && held.days == table.days;
 }
 
+/// The tables of an EGRID's INIT and restarts (or of an INIT or restart beside its EGRID), by
+/// `add`: steps `older` holds already are counted in `kept`, not read again; steps and arrays
+/// of files cut short or damaged are counted in `leftOut`, with a warning.
+void AddEclipseResults(const std::string& input, bool isInit, bool isRestart, const std::string& geometryPath,
+  const std::array<int64_t, 3>& dims, int64_t active, const resmr::PropertyFile* older, std::vector<float>& values,
+  const std::function<void(resmr::PropertyTable)>& add, int64_t& kept, int64_t& leftOut)
+{
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  const std::string gridPath = (isInit || isRestart) ? GridBeside(input) : input;
+  const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath, 0, resmr::EclipseGridParts::ActiveCellsOnly);
+  if (grid.deck.dims != dims)
+  {
+    throw std::invalid_argument(gridPath + ": grid " + std::to_string(grid.deck.dims[0]) + "x" +
+      std::to_string(grid.deck.dims[1]) + "x" + std::to_string(grid.deck.dims[2]) + " is not the grid of " + geometryPath);
+  }
+  if (grid.activeCells != active)
+  {
+    throw std::invalid_argument(gridPath + ": " + std::to_string(grid.activeCells) + " active cells, " + geometryPath +
+      " has " + std::to_string(active) + ": results of another grid");
+  }
+  const resmr::EclipseResults results(gridPath, grid);
+  for (const std::string& warning : results.Warnings())
+  {
+    std::fprintf(stderr, "resmr add-properties: warning: %s\n", warning.c_str());
+  }
+  leftOut += static_cast<int64_t>(results.SkippedSteps().size());
+  // A record whose blocks turn out damaged costs that table only.
+  const auto readable = [&](const std::function<bool()>& read) {
+    try
+    {
+      return read();
+    }
+    catch (const resmr::GrdeclError& error)
+    {
+      std::fprintf(stderr, "resmr add-properties: warning: %s; left out\n", error.what());
+      ++leftOut;
+      return false;
+    }
+  };
+  if (!isRestart)
+  {
+    for (const auto& array : results.StaticArrays())
+    {
+      if (readable([&] { return results.ReadStatic<float>(array.name, values.data(), none); }))
+      {
+        resmr::PropertyTable table;
+        table.name = array.name;
+        add(table);
+      }
+    }
+  }
+  if (!isInit)
+  {
+    const auto& steps = results.Steps();
+    for (std::size_t s = 0; s < steps.size(); ++s)
+    {
+      for (const std::string& name : steps[s].names)
+      {
+        resmr::PropertyTable table;
+        table.name = name;
+        table.step = static_cast<int32_t>(s);
+        table.reportNumber = steps[s].reportNumber;
+        table.days = steps[s].days;
+        if (older && HoldsStep(*older, table))
+        {
+          ++kept; // copied from the older file below
+          continue;
+        }
+        if (readable([&] { return results.ReadDynamic<float>(s, name, values.data(), none); }))
+        {
+          add(table);
+        }
+      }
+    }
+  }
+}
+
 /// The geometry's active cells per layer, to check that results belong to this grid.
 int64_t ActiveCount(const resmr::MultiresolutionFile& geometry)
 {
@@ -270,7 +348,6 @@ int AddPropertiesCommand(int argc, char** argv)
     }
     resmr::PropertyFileWriter writer(output, geometry);
     std::vector<float> values; // one whole array, for file inputs only
-    const float none = std::numeric_limits<float>::quiet_NaN();
     int64_t added = 0, kept = 0, leftOut = 0;
     int generatorPasses = 0;
     const auto report = [&](const resmr::PropertyTable& table) {
@@ -296,73 +373,7 @@ int AddPropertiesCommand(int argc, char** argv)
                                                                     std::isdigit(static_cast<unsigned char>(ext[1])));
       if (ext == "EGRID" || ext == "FEGRID" || isInit || isRestart)
       {
-        const std::string gridPath = (isInit || isRestart) ? GridBeside(input) : input;
-        const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath, 0, resmr::EclipseGridParts::ActiveCellsOnly);
-        if (grid.deck.dims != dims)
-        {
-          throw std::invalid_argument(gridPath + ": grid " + std::to_string(grid.deck.dims[0]) + "x" +
-            std::to_string(grid.deck.dims[1]) + "x" + std::to_string(grid.deck.dims[2]) + " is not the grid of " + geometryPath);
-        }
-        if (grid.activeCells != active)
-        {
-          throw std::invalid_argument(gridPath + ": " + std::to_string(grid.activeCells) + " active cells, " + geometryPath +
-            " has " + std::to_string(active) + ": results of another grid");
-        }
-        const resmr::EclipseResults results(gridPath, grid);
-        for (const std::string& warning : results.Warnings())
-        {
-          std::fprintf(stderr, "resmr add-properties: warning: %s\n", warning.c_str());
-        }
-        leftOut += static_cast<int64_t>(results.SkippedSteps().size());
-        // A record whose blocks turn out damaged costs that table only.
-        const auto readable = [&](const std::function<bool()>& read) {
-          try
-          {
-            return read();
-          }
-          catch (const resmr::GrdeclError& error)
-          {
-            std::fprintf(stderr, "resmr add-properties: warning: %s; left out\n", error.what());
-            ++leftOut;
-            return false;
-          }
-        };
-        if (!isRestart)
-        {
-          for (const auto& array : results.StaticArrays())
-          {
-            if (readable([&] { return results.ReadStatic<float>(array.name, values.data(), none); }))
-            {
-              resmr::PropertyTable table;
-              table.name = array.name;
-              add(table);
-            }
-          }
-        }
-        if (!isInit)
-        {
-          const auto& steps = results.Steps();
-          for (std::size_t s = 0; s < steps.size(); ++s)
-          {
-            for (const std::string& name : steps[s].names)
-            {
-              resmr::PropertyTable table;
-              table.name = name;
-              table.step = static_cast<int32_t>(s);
-              table.reportNumber = steps[s].reportNumber;
-              table.days = steps[s].days;
-              if (older && HoldsStep(*older, table))
-              {
-                ++kept; // copied from the older file below
-                continue;
-              }
-              if (readable([&] { return results.ReadDynamic<float>(s, name, values.data(), none); }))
-              {
-                add(table);
-              }
-            }
-          }
-        }
+        AddEclipseResults(input, isInit, isRestart, geometryPath, dims, active, older.get(), values, add, kept, leftOut);
       }
       else
       {
