@@ -207,6 +207,21 @@ void GrowingRun(const std::string& resmrTool, const std::string& egrid, const st
     const bool cut = stage.size != file.Size();
     CHECK((warnings.find("left out: incomplete at byte") != std::string::npos) == cut);
     CHECK(JsonNumber(json, "left_out") == (cut ? 1 : 0));
+    // resmr info lists the same steps, and the one left out with its file and offset.
+    CHECK(Run(resmrTool + " info '" + run + "' > '" + output + "' 2> '" + errors + "'") == 0);
+    const std::string info = Slurp(output);
+    std::size_t offered = 0;
+    for (std::size_t at = info.find("\"days\": "); at != std::string::npos; at = info.find("\"days\": ", at + 1))
+    {
+      ++offered;
+    }
+    CHECK(offered == stage.complete);
+    const std::string leftOut = cut ? "\"steps_left_out\": [{\"file\": \"" + folder + stem + ".UNRST\", \"report\": " +
+        // (-1 while the cut step's SEQNUM record is not whole)
+        std::to_string(stage.size >= starts[stage.complete] + 36 ? whole.Steps()[stage.complete].reportNumber : -1) +
+        ", \"offset\": "
+                                    : std::string("\"steps_left_out\": []");
+    CHECK(info.find(leftOut) != std::string::npos);
     // The INIT's arrays are read again each time; only the new steps' arrays are added.
     CHECK(JsonNumber(json, "tables_added") == static_cast<long long>(statics + (stage.complete - before) * names));
     CHECK(JsonNumber(json, "tables_kept") == static_cast<long long>(before * names));
