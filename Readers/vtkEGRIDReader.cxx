@@ -82,6 +82,7 @@ struct vtkEGRIDReader::Internals
     this->Arrays.clear();
     this->Times.clear();
     this->OpenedFile.clear();
+    this->RescanCompanions = false; // a full open indexes them anyway
   }
 };
 
