@@ -233,6 +233,41 @@ void PerStepRestartCut()
   }
 }
 
+/// A formatted unified restart (SPE1's FUNRST beside its grid) cut at random offsets,
+/// inside tokens and between them: the steps whose ENDSOL is whole are offered.
+void FormattedRestartCut()
+{
+  const std::string from = DataDir + "/spe1/opm-common";
+  const std::string folder = TempDir + "/spe1-funrst";
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  fs::create_symlink(from + "/SPE1CASE1.EGRID", folder + "/SPE1_TESTCASE.EGRID");
+  const EclipseGrid grid = ReadEclipseGrid(folder + "/SPE1_TESTCASE.EGRID");
+  const std::string bytes = Slurp(from + "/SPE1_TESTCASE.FUNRST");
+  // Each step ends with its ENDSOL record: the closing quote of its 'MESS' type.
+  std::vector<int64_t> ends;
+  for (std::size_t at = bytes.find("'ENDSOL  '"); at != std::string::npos; at = bytes.find("'ENDSOL  '", at + 1))
+  {
+    ends.push_back(static_cast<int64_t>(bytes.find("'MESS'", at) + 6));
+  }
+  CHECK(ends.size() == 9);
+  std::mt19937_64 random(11);
+  std::vector<int64_t> cuts = CutOffsets(random, static_cast<int64_t>(bytes.size()));
+  cuts.push_back(ends[3]);
+  cuts.push_back(ends[3] - 1);
+  const std::string path = folder + "/SPE1_TESTCASE.FUNRST";
+  for (const int64_t cut : cuts)
+  {
+    Spit(path, bytes.substr(0, static_cast<std::size_t>(cut)));
+    const EclipseResults results(folder + "/SPE1_TESTCASE.EGRID", grid);
+    const auto complete = static_cast<std::size_t>(std::count_if(ends.begin(), ends.end(), [&](int64_t end) { return end <= cut; }));
+    std::printf("FUNRST cut at byte %lld: %zu steps offered (expected %zu), %zu left out\n", static_cast<long long>(cut),
+      results.Steps().size(), complete, results.SkippedSteps().size());
+    CHECK(results.Steps().size() == complete);
+    CHECK(results.SkippedSteps().size() == (cut == ends[3] ? 0u : 1u));
+  }
+}
+
 /// An empty, a damaged and a foreign INIT: a warning, no static arrays, the steps intact.
 void BadInit()
 {
@@ -328,6 +363,7 @@ int main(int argc, char** argv)
   const bool passed = resmr_testing::RunNamedTests({
     { "unified restart cut at random offsets", UnifiedRestartCut },
     { "per-step restarts cut at random offsets", PerStepRestartCut },
+    { "formatted restart cut at random offsets", FormattedRestartCut },
     { "empty, damaged and foreign INIT", BadInit },
     { "run appended record by record", AppendedRun },
   });
