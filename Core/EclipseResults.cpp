@@ -67,6 +67,7 @@ std::string FirstExisting(const fs::path& directory, const std::string& stem,
   }
   return {};
 }
+
 /// An error message without the file name it starts with (the caller names the file).
 std::string WithoutPath(const std::string& message, const std::string& path)
 {
