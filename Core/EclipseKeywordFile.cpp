@@ -334,8 +334,9 @@ bool ParseReal(std::string token, double& value)
 }
 } // namespace
 
-EclipseKeywordFile::EclipseKeywordFile(const std::string& path)
+EclipseKeywordFile::EclipseKeywordFile(const std::string& path, KeywordFileIndexing indexing)
   : FilePath(path)
+  , Indexing(indexing)
 {
   this->Descriptor = open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (this->Descriptor < 0)
@@ -353,12 +354,12 @@ EclipseKeywordFile::EclipseKeywordFile(const std::string& path)
   {
     if (LooksLikeUnformatted(path))
     {
-      this->IndexUnformatted();
+      this->IndexLeniently(&EclipseKeywordFile::IndexUnformatted);
     }
     else if (LooksLikeFormatted(path))
     {
       this->Formatted = true;
-      this->IndexFormatted();
+      this->IndexLeniently(&EclipseKeywordFile::IndexFormatted);
     }
     else
     {
@@ -463,6 +464,24 @@ void EclipseKeywordFile::ReadRaw(int64_t offset, void* data, int64_t size, const
   }
 }
 
+void EclipseKeywordFile::IndexLeniently(void (EclipseKeywordFile::*pass)())
+{
+  try
+  {
+    (this->*pass)();
+  }
+  catch (const GrdeclError& error)
+  {
+    if (this->Indexing == KeywordFileIndexing::WholeFile)
+    {
+      throw;
+    }
+    // The records before the failing one are whole and checked; they are kept.
+    this->Stopped = this->IndexPosition;
+    this->StoppedBecause = error.what();
+  }
+}
+
 void EclipseKeywordFile::IndexUnformatted()
 {
   // Headers and markers are read through a small window: files of many small records
@@ -486,6 +505,7 @@ void EclipseKeywordFile::IndexUnformatted()
   int64_t position = 0;
   while (position < this->FileSize)
   {
+    this->IndexPosition = position;
     EclipseRecord record;
     record.headerOffset = position;
     if (this->FileSize - position < HeaderBytes)
@@ -823,7 +843,7 @@ void EclipseKeywordFile::IndexFormatted()
   std::string token;
   bool quoted = false;
   int64_t start = 0;
-  while (cursor.Next(token, quoted, start))
+  while ((this->IndexPosition = cursor.Offset, cursor.Next(token, quoted, start)))
   {
     EclipseRecord record;
     record.headerOffset = start;
@@ -867,6 +887,12 @@ void EclipseKeywordFile::IndexFormatted()
       }
     }
     record.endOffset = cursor.Offset;
+    if (this->Indexing == KeywordFileIndexing::UpToLastWholeRecord && tokens > 0 &&
+      record.endOffset == this->FileSize)
+    {
+      // Writers end every line; a last value touching the end may have been cut inside.
+      this->Fail(&record, start, "the last value ends the file without a line end (cut inside it?)");
+    }
     this->Index.push_back(std::move(record));
   }
   if (cursor.Offset < this->FileSize)

@@ -12,6 +12,11 @@
 // - Every marker, length, count and type is checked. Corrupt or truncated files throw
 //   GrdeclError naming the file, the keyword and the byte offset. Never reads past the end of
 //   the file, never allocates more than the file can hold.
+// - Opened with KeywordFileIndexing::UpToLastWholeRecord (results files: INIT, restarts,
+//   which a simulator may still be appending to or may have cut short), indexing stops at
+//   the first record that is cut or damaged instead of throwing: Records() holds every whole
+//   record before it, and StoppedAt()/StopReason() say where and why. The size is taken once,
+//   at open, so a file still being written is never read past that point.
 // - Reads are positional (pread), so one open file may be read from several threads.
 #pragma once
 
@@ -55,11 +60,19 @@ struct EclipseRecord
   }
 };
 
+enum class KeywordFileIndexing
+{
+  WholeFile,            ///< any damage throws (grids)
+  UpToLastWholeRecord   ///< stop before the first cut or damaged record (results)
+};
+
 class EclipseKeywordFile
 {
 public:
-  /// Opens and indexes the file; throws GrdeclError if it is not a valid keyword file.
-  explicit EclipseKeywordFile(const std::string& path);
+  /// Opens and indexes the file; throws GrdeclError if it is not a valid keyword file (with
+  /// UpToLastWholeRecord: only if it does not start like one).
+  explicit EclipseKeywordFile(
+    const std::string& path, KeywordFileIndexing indexing = KeywordFileIndexing::WholeFile);
   ~EclipseKeywordFile();
   EclipseKeywordFile(const EclipseKeywordFile&) = delete;
   EclipseKeywordFile& operator=(const EclipseKeywordFile&) = delete;
@@ -75,6 +88,11 @@ public:
   int64_t Size() const { return this->FileSize; }
   bool IsFormatted() const { return this->Formatted; }
   const std::vector<EclipseRecord>& Records() const { return this->Index; }
+  /// UpToLastWholeRecord: the byte offset where indexing stopped before the end of the file
+  /// (the first cut or damaged record), or -1 if every byte was indexed.
+  int64_t StoppedAt() const { return this->Stopped; }
+  /// Why indexing stopped there (the error a whole-file index would have thrown).
+  const std::string& StopReason() const { return this->StoppedBecause; }
 
   /// First record named `name` at or after index `from`, or nullptr.
   const EclipseRecord* Find(const std::string& name, std::size_t from = 0) const;
@@ -112,6 +130,9 @@ private:
   friend class EclipseRecordCursor;
   void IndexUnformatted();
   void IndexFormatted();
+  /// Runs an indexing pass; with UpToLastWholeRecord, a failure at `position` ends the index
+  /// there instead of propagating.
+  void IndexLeniently(void (EclipseKeywordFile::*pass)());
   int64_t WalkBlocks(const EclipseRecord& record) const;
   void ReadRaw(int64_t offset, void* data, int64_t size, const EclipseRecord* record) const;
   template <typename T>
@@ -127,6 +148,10 @@ private:
   int Descriptor = -1;
   int64_t FileSize = 0;
   bool Formatted = false;
+  KeywordFileIndexing Indexing = KeywordFileIndexing::WholeFile;
+  int64_t Stopped = -1;
+  std::string StoppedBecause;
+  int64_t IndexPosition = 0; ///< start of the record being indexed (where a lenient index stops)
   std::vector<EclipseRecord> Index;
 };
 

@@ -67,6 +67,31 @@ std::string FirstExisting(const fs::path& directory, const std::string& stem,
   }
   return {};
 }
+
+/// An error message without the file name it starts with (the caller names the file).
+std::string WithoutPath(const std::string& message, const std::string& path)
+{
+  return message.compare(0, path.size() + 2, path + ": ") == 0 ? message.substr(path.size() + 2) : message;
+}
+
+/// Why a results file cannot be used at all, or empty if it opened: `file` is then set.
+std::string OpenResultsFile(const std::string& path, std::unique_ptr<EclipseKeywordFile>& file)
+{
+  std::error_code error;
+  if (fs::file_size(path, error) == 0 && !error)
+  {
+    return "the file is empty";
+  }
+  try
+  {
+    file = std::make_unique<EclipseKeywordFile>(path, KeywordFileIndexing::UpToLastWholeRecord);
+  }
+  catch (const std::exception& failure)
+  {
+    return WithoutPath(failure.what(), path);
+  }
+  return {};
+}
 } // namespace
 
 std::string EclipseResults::FindInit(const std::string& gridPath)
@@ -167,30 +192,10 @@ EclipseResults::EclipseResults(const std::string& gridPath, const EclipseGrid& g
   }
   else
   {
-    this->InitFile = std::make_unique<EclipseKeywordFile>(this->Init);
-    this->IndexInit();
+    this->OpenInit();
   }
-
-  this->Restarts = FindRestarts(gridPath, this->Unified);
-  if (this->Restarts.empty())
-  {
-    this->Notes.push_back(gridPath + ": no restart files beside it (" + StemOf(gridPath) +
-      ".UNRST or .Xnnnn): no time steps");
-  }
-  else if (this->Unified)
-  {
-    this->UnifiedFile = std::make_unique<EclipseKeywordFile>(this->Restarts.front());
-    this->IndexRestart(0, *this->UnifiedFile, -1);
-  }
-  else
-  {
-    for (std::size_t f = 0; f < this->Restarts.size(); ++f)
-    {
-      const std::string& path = this->Restarts[f];
-      const EclipseKeywordFile file(path);
-      this->IndexRestart(f, file, std::stoi(path.substr(path.size() - 4)));
-    }
-  }
+  this->OpenRestarts(gridPath);
+  this->ListDynamicArrays();
 
   // Times: DOUBHEAD's day count when written, else dates counted from the start date.
   for (EclipseReportStep& step : this->ReportSteps)
@@ -216,7 +221,98 @@ bool EclipseResults::FitsGrid(int64_t count) const
       (this->DualPorosity && count == 2 * this->CellCount));
 }
 
-void EclipseResults::IndexInit()
+void EclipseResults::OpenInit()
+{
+  std::string problem = OpenResultsFile(this->Init, this->InitFile);
+  if (problem.empty() && this->InitFile->StoppedAt() >= 0)
+  {
+    problem = "damaged or cut short at byte " + std::to_string(this->InitFile->StoppedAt()) + " (" +
+      WithoutPath(this->InitFile->StopReason(), this->Init) + ")";
+  }
+  else if (problem.empty() && this->InitFile->Records().empty())
+  {
+    problem = "holds no records";
+  }
+  if (problem.empty())
+  {
+    try
+    {
+      if (this->IndexInit())
+      {
+        return;
+      }
+      problem.clear(); // a foreign INIT: IndexInit said why
+    }
+    catch (const std::exception& failure)
+    {
+      problem = WithoutPath(failure.what(), this->Init);
+    }
+  }
+  this->InitFile.reset();
+  this->Static.clear();
+  this->StaticRecords.clear();
+  if (!problem.empty())
+  {
+    this->Notes.push_back(this->Init + ": " + problem + ": the INIT file is not used (no static properties)");
+  }
+}
+
+void EclipseResults::OpenRestarts(const std::string& gridPath)
+{
+  this->Restarts = FindRestarts(gridPath, this->Unified);
+  if (this->Restarts.empty())
+  {
+    this->Notes.push_back(gridPath + ": no restart files beside it (" + StemOf(gridPath) +
+      ".UNRST or .Xnnnn): no time steps");
+    return;
+  }
+  for (std::size_t f = 0; f < this->Restarts.size(); ++f)
+  {
+    const std::string& path = this->Restarts[f];
+    const int number = this->Unified ? -1 : std::stoi(path.substr(path.size() - 4));
+    std::unique_ptr<EclipseKeywordFile> file;
+    const std::string problem = OpenResultsFile(path, file);
+    if (!problem.empty())
+    {
+      this->LeaveOut(path, number, 0, problem);
+      continue;
+    }
+    this->IndexRestart(f, *file, number);
+    if (this->Unified)
+    {
+      this->UnifiedFile = std::move(file);
+    }
+  }
+}
+
+void EclipseResults::LeaveOut(const std::string& path, int reportNumber, int64_t offset, const std::string& reason)
+{
+  this->Skipped.push_back({ path, reportNumber, offset, reason });
+  const std::string step = reportNumber >= 0 ? "report step " + std::to_string(reportNumber)
+    : this->Unified && !this->ReportSteps.empty()
+    ? "the report step after report " + std::to_string(this->ReportSteps.back().reportNumber)
+    : std::string("its report steps");
+  this->Notes.push_back(path + ": " + step + " left out: incomplete at byte " + std::to_string(offset) + " (" +
+    reason + "); the other steps are kept");
+}
+
+void EclipseResults::ListDynamicArrays()
+{
+  // Arrays of the steps kept only, in the order they were first met.
+  this->Dynamic.clear();
+  for (const EclipseResultArray& array : this->SeenDynamic)
+  {
+    const bool used = std::any_of(this->ReportSteps.begin(), this->ReportSteps.end(), [&](const EclipseReportStep& step) {
+      return std::find(step.names.begin(), step.names.end(), array.name) != step.names.end();
+    });
+    if (used)
+    {
+      this->Dynamic.push_back(array);
+    }
+  }
+}
+
+bool EclipseResults::IndexInit()
 {
   const EclipseKeywordFile& file = *this->InitFile;
   const auto& records = file.Records();
@@ -251,7 +347,7 @@ void EclipseResults::IndexInit()
           ": the INIT file does not belong to this grid; its arrays are not shown");
         this->Static.clear();
         this->StaticRecords.clear();
-        return;
+        return false;
       }
       continue;
     }
@@ -267,10 +363,59 @@ void EclipseResults::IndexInit()
       this->StaticRecords.push_back(r);
     }
   }
+  return true;
 }
+
+struct EclipseResults::RestartScan
+{
+  int64_t damagedAt = -1; ///< the record where reading the index failed, or -1
+  std::string damage;
+  bool closesSolutions = false; ///< STARTSOL met: a step is whole only with its ENDSOL
+  bool lastClosed = false;      ///< the last step's ENDSOL met
+};
 
 void EclipseResults::IndexRestart(
   std::size_t fileIndex, const EclipseKeywordFile& file, int fileReportNumber)
+{
+  const std::size_t firstStep = this->ReportSteps.size();
+  RestartScan scan;
+  this->ScanRestart(fileIndex, file, fileReportNumber, scan);
+  if (scan.damagedAt < 0 && file.StoppedAt() >= 0)
+  {
+    scan.damagedAt = file.StoppedAt();
+    scan.damage = WithoutPath(file.StopReason(), file.Path());
+  }
+  const bool started = this->ReportSteps.size() > firstStep;
+  const bool damaged = scan.damagedAt >= 0;
+  // Files with STARTSOL close each solution with ENDSOL. Without them a step's end is not
+  // written: one holding no array yet, or fewer than the step before it, is still being
+  // written.
+  const std::size_t count = this->ReportSteps.size();
+  const bool unclosed = scan.closesSolutions
+    ? !scan.lastClosed
+    : started &&
+      (this->ReportSteps.back().names.empty() ||
+        (count > firstStep + 1 && this->ReportSteps.back().names.size() < this->ReportSteps[count - 2].names.size()));
+  // In a unified restart, damage after the last step's ENDSOL belongs to the step after it;
+  // a per-step file is one step, left out for any damage.
+  const bool lastWhole = !unclosed && (!damaged || (this->Unified && scan.closesSolutions));
+  const std::string rest = damaged ? scan.damage + "; nothing after it is read" : std::string();
+  if (started && !lastWhole)
+  {
+    // A writer still appending, or a cut.
+    const int number = this->ReportSteps.back().reportNumber;
+    this->ReportSteps.pop_back();
+    this->LeaveOut(file.Path(), number, damaged ? scan.damagedAt : file.Size(),
+      damaged ? rest : "its solution has no ENDSOL: the file ends there (still being written, or cut)");
+  }
+  else if (damaged)
+  {
+    this->LeaveOut(file.Path(), fileReportNumber, scan.damagedAt, rest);
+  }
+}
+
+void EclipseResults::ScanRestart(
+  std::size_t fileIndex, const EclipseKeywordFile& file, int fileReportNumber, RestartScan& scan)
 {
   const auto& records = file.Records();
   const std::string& path = file.Path();
@@ -286,105 +431,117 @@ void EclipseResults::IndexRestart(
     step->file = fileIndex;
     step->days = std::nan("");
     inLocalGrid = inSolution = sawSolution = headerRead = timeRead = mismatch = false;
+    scan.lastClosed = false;
   };
-  for (std::size_t r = 0; r < records.size(); ++r)
+  std::size_t r = 0;
+  try
   {
-    const EclipseRecord& record = records[r];
-    const std::string& name = record.name;
-    if (name == "SEQNUM")
+    for (; r < records.size(); ++r)
     {
-      int32_t number = static_cast<int32_t>(this->ReportSteps.size());
-      if (record.IsNumeric() && record.count >= 1)
+      const EclipseRecord& record = records[r];
+      const std::string& name = record.name;
+      if (name == "SEQNUM")
       {
+        int32_t number = static_cast<int32_t>(this->ReportSteps.size());
+        if (record.IsNumeric() && record.count >= 1)
+        {
+          integers.resize(static_cast<std::size_t>(record.count));
+          file.Read(record, integers.data());
+          number = integers[0];
+        }
+        startStep(fileReportNumber >= 0 ? fileReportNumber : number);
+        continue;
+      }
+      if (!step)
+      {
+        if (name != "INTEHEAD")
+        {
+          continue; // nothing before the first step's header belongs to a step
+        }
+        startStep(fileReportNumber >= 0 ? fileReportNumber : static_cast<int>(this->ReportSteps.size()));
+      }
+      if (name == "LGR")
+      {
+        inLocalGrid = true;
+        continue;
+      }
+      if (name == "ENDLGR")
+      {
+        inLocalGrid = false;
+        continue;
+      }
+      if (inLocalGrid)
+      {
+        continue;
+      }
+      if (name == "INTEHEAD" && !headerRead && record.IsNumeric() && record.count > 66)
+      {
+        headerRead = true;
         integers.resize(static_cast<std::size_t>(record.count));
         file.Read(record, integers.data());
-        number = integers[0];
+        step->date = { integers[66], integers[65], integers[64] };
+        if (integers[11] != this->Expected)
+        {
+          mismatch = true;
+          this->Notes.push_back(path + ": keyword INTEHEAD: report step " +
+            std::to_string(step->reportNumber) + " has " + std::to_string(integers[11]) +
+            " active cells, but the grid has " + std::to_string(this->Expected) +
+            ": this restart does not belong to the grid; its arrays are not shown");
+        }
+        continue;
       }
-      startStep(fileReportNumber >= 0 ? fileReportNumber : number);
-      continue;
-    }
-    if (!step)
-    {
-      if (name != "INTEHEAD")
+      if (name == "DOUBHEAD" && !timeRead && record.IsNumeric() && record.count >= 1)
       {
-        continue; // nothing before the first step's header belongs to a step
+        timeRead = true;
+        file.ReadNumbers(record, numbers);
+        step->days = numbers[0];
+        continue;
       }
-      startStep(fileReportNumber >= 0 ? fileReportNumber : static_cast<int>(this->ReportSteps.size()));
-    }
-    if (name == "LGR")
-    {
-      inLocalGrid = true;
-      continue;
-    }
-    if (name == "ENDLGR")
-    {
-      inLocalGrid = false;
-      continue;
-    }
-    if (inLocalGrid)
-    {
-      continue;
-    }
-    if (name == "INTEHEAD" && !headerRead && record.IsNumeric() && record.count > 66)
-    {
-      headerRead = true;
-      integers.resize(static_cast<std::size_t>(record.count));
-      file.Read(record, integers.data());
-      step->date = { integers[66], integers[65], integers[64] };
-      if (integers[11] != this->Expected)
+      if (name == "STARTSOL")
       {
-        mismatch = true;
-        this->Notes.push_back(path + ": keyword INTEHEAD: report step " +
-          std::to_string(step->reportNumber) + " has " + std::to_string(integers[11]) +
-          " active cells, but the grid has " + std::to_string(this->Expected) +
-          ": this restart does not belong to the grid; its arrays are not shown");
+        inSolution = sawSolution = scan.closesSolutions = true;
+        continue;
       }
-      continue;
-    }
-    if (name == "DOUBHEAD" && !timeRead && record.IsNumeric() && record.count >= 1)
-    {
-      timeRead = true;
-      file.ReadNumbers(record, numbers);
-      step->days = numbers[0];
-      continue;
-    }
-    if (name == "STARTSOL")
-    {
-      inSolution = sawSolution = true;
-      continue;
-    }
-    if (name == "ENDSOL")
-    {
-      inSolution = false;
-      continue;
-    }
-    if (mismatch || !record.IsNumeric() || IsHeaderRecord(name) || (sawSolution && !inSolution))
-    {
-      continue;
-    }
-    if (!this->FitsGrid(record.count))
-    {
-      static const std::set<std::string> perCell = { "PRESSURE", "SWAT", "SGAS", "SOIL", "RS", "RV" };
-      if (perCell.count(name) > 0)
+      if (name == "ENDSOL")
       {
-        this->Notes.push_back(path + ": keyword " + name + ": report step " +
-          std::to_string(step->reportNumber) + " has " + std::to_string(record.count) +
-          " values, the grid has " + std::to_string(this->Expected) + " active cells; not shown");
+        inSolution = false;
+        scan.lastClosed = true;
+        continue;
       }
-      continue;
+      if (mismatch || !record.IsNumeric() || IsHeaderRecord(name) || (sawSolution && !inSolution))
+      {
+        continue;
+      }
+      if (!this->FitsGrid(record.count))
+      {
+        static const std::set<std::string> perCell = { "PRESSURE", "SWAT", "SGAS", "SOIL", "RS", "RV" };
+        if (perCell.count(name) > 0)
+        {
+          this->Notes.push_back(path + ": keyword " + name + ": report step " +
+            std::to_string(step->reportNumber) + " has " + std::to_string(record.count) +
+            " values, the grid has " + std::to_string(this->Expected) + " active cells; not shown");
+        }
+        continue;
+      }
+      if (std::find(step->names.begin(), step->names.end(), name) != step->names.end())
+      {
+        continue;
+      }
+      step->names.push_back(name);
+      step->records.push_back(r);
+      const bool known = std::any_of(this->SeenDynamic.begin(), this->SeenDynamic.end(),
+        [&](const EclipseResultArray& array) { return array.name == name; });
+      if (!known)
+      {
+        this->SeenDynamic.push_back({ name, record.type });
+      }
     }
-    if (std::find(step->names.begin(), step->names.end(), name) != step->names.end())
-    {
-      continue;
-    }
-    step->names.push_back(name);
-    step->records.push_back(r);
-    const bool known = std::any_of(this->Dynamic.begin(), this->Dynamic.end(),
-      [&](const EclipseResultArray& array) { return array.name == name; });
-    if (!known)
-    {
-      this->Dynamic.push_back({ name, record.type });
-    }
+  }
+  catch (const std::exception& failure)
+  {
+    // A header record whose data blocks are damaged: the index ends before it.
+    scan.damagedAt = records[r].headerOffset;
+    scan.damage = WithoutPath(failure.what(), path);
   }
 }
 
@@ -483,7 +640,8 @@ bool EclipseResults::ReadDynamic(std::size_t stepIndex, const std::string& name,
   if (!this->StepFile || this->StepFileIndex != step.file)
   {
     this->StepFile.reset();
-    this->StepFile = std::make_unique<EclipseKeywordFile>(this->Restarts[step.file]);
+    this->StepFile = std::make_unique<EclipseKeywordFile>(
+      this->Restarts[step.file], KeywordFileIndexing::UpToLastWholeRecord);
     this->StepFileIndex = step.file;
   }
   const EclipseKeywordFile& file = *this->StepFile;

@@ -12,7 +12,15 @@
 //   porosity: the matrix values (the first part) are used. LGR sections are skipped.
 // - Not thread-safe: per-step restarts keep the last step's file open between calls.
 // - Arrays or steps that do not fit the grid (another active count) are left out with a
-//   warning naming the file and keyword; corrupt files throw GrdeclError.
+//   warning naming the file and keyword.
+// - Damage costs only the damaged part (a run may be cut short, or still being written):
+//   an empty, damaged or foreign INIT gives a warning and no static arrays; companions are
+//   indexed up to their last whole record, and a report step is offered only when it is
+//   complete: every record whole and, in files that close solutions with ENDSOL, its ENDSOL
+//   written. An incomplete step (the last of a unified restart cut short, a per-step file
+//   cut or damaged) is left out with a warning naming the file, the step and the byte
+//   offset (SkippedSteps()); the other steps stay. Nothing here throws for a damaged
+//   companion; reading a record whose blocks turn out damaged throws GrdeclError.
 #pragma once
 
 #include "EclipseGrid.h"
@@ -48,6 +56,15 @@ struct EclipseReportStep
   std::vector<std::size_t> records; ///< their record index in the file
 };
 
+/// A report step left out because its file is cut short or damaged there.
+struct EclipseSkippedStep
+{
+  std::string file;
+  int reportNumber = -1; ///< -1 if the cut falls before the step's number is known
+  int64_t offset = 0;    ///< byte offset of the first record that is not whole
+  std::string reason;
+};
+
 class EclipseResults
 {
 public:
@@ -60,6 +77,10 @@ public:
   const std::vector<std::string>& RestartPaths() const { return this->Restarts; }
   bool UnifiedRestart() const { return this->Unified; }
   const std::vector<std::string>& Warnings() const { return this->Notes; }
+  /// Report steps left out, in file order.
+  const std::vector<EclipseSkippedStep>& SkippedSteps() const { return this->Skipped; }
+  /// False if an INIT beside the grid could not be used at all (empty, damaged, foreign).
+  bool InitUsable() const { return this->InitFile != nullptr; }
 
   const std::vector<EclipseResultArray>& StaticArrays() const { return this->Static; }
   const std::vector<EclipseResultArray>& DynamicArrays() const { return this->Dynamic; }
@@ -79,8 +100,15 @@ public:
   static std::vector<std::string> FindRestarts(const std::string& gridPath, bool& unified);
 
 private:
-  void IndexInit();
+  void OpenInit();
+  bool IndexInit(); ///< false for an INIT of another grid (a warning says why)
+  void OpenRestarts(const std::string& gridPath);
+  /// Indexes one restart file's steps and leaves out its last one if it is not whole.
   void IndexRestart(std::size_t fileIndex, const EclipseKeywordFile& file, int fileReportNumber);
+  struct RestartScan;
+  void ScanRestart(std::size_t fileIndex, const EclipseKeywordFile& file, int fileReportNumber, RestartScan& scan);
+  void LeaveOut(const std::string& path, int reportNumber, int64_t offset, const std::string& reason);
+  void ListDynamicArrays();
   bool FitsGrid(int64_t count) const;
   template <typename T>
   void Scatter(const EclipseKeywordFile& file, const EclipseRecord& record, T* cellValues, T fill) const;
@@ -97,6 +125,9 @@ private:
   std::vector<std::string> Restarts;
   bool Unified = false;
   std::vector<std::string> Notes;
+  std::vector<EclipseSkippedStep> Skipped;
+  /// Record types of restart arrays as first met, for ListDynamicArrays.
+  std::vector<EclipseResultArray> SeenDynamic;
   std::vector<EclipseResultArray> Static;
   std::vector<std::size_t> StaticRecords;
   std::vector<EclipseResultArray> Dynamic;

@@ -19,6 +19,7 @@
 #include "EclipseGrid.h"
 #include "EclipseKeywordFile.h"
 #include "EclipseResults.h"
+#include "GrdeclError.h"
 #include "ResMRExplicitGrid.h"
 
 #include <algorithm>
@@ -62,6 +63,7 @@ struct vtkEGRIDReader::Internals
   std::unique_ptr<resmr::EclipseResults> Results;
   std::vector<SelectableArray> Arrays;
   std::vector<double> Times; ///< one per report step, strictly increasing
+  bool RescanCompanions = false; ///< Reload(): index INIT and restarts again, keep the grid
 
   /// Geometry, I/J/K/ACTNUM and the selected static arrays, shared by every step's output.
   vtkSmartPointer<vtkExplicitStructuredGrid> Base;
@@ -80,6 +82,7 @@ struct vtkEGRIDReader::Internals
     this->Arrays.clear();
     this->Times.clear();
     this->OpenedFile.clear();
+    this->RescanCompanions = false; // a full open indexes them anyway
   }
 };
 
@@ -178,7 +181,7 @@ bool vtkEGRIDReader::OpenIfNeeded()
   if (internal.Results && internal.OpenedFile == this->FileName &&
     internal.OpenedModificationTime == modified)
   {
-    return true;
+    return !internal.RescanCompanions || this->RescanCompanions();
   }
   if (internal.FailedFile == this->FileName && internal.FailedModificationTime == modified)
   {
@@ -210,7 +213,51 @@ bool vtkEGRIDReader::OpenIfNeeded()
   }
   internal.OpenedFile = this->FileName;
   internal.OpenedModificationTime = modified;
+  this->ListArraysAndTimes();
+  return true;
+}
 
+bool vtkEGRIDReader::RescanCompanions()
+{
+  Internals& internal = *this->Internal;
+  internal.RescanCompanions = false;
+  try
+  {
+    internal.Results = std::make_unique<resmr::EclipseResults>(this->FileName, *internal.Grid);
+  }
+  catch (const std::exception& error)
+  {
+    internal.Reset();
+    this->ReportError(error.what());
+    return false;
+  }
+  // The INIT may have changed too: static arrays are read again when next shown.
+  if (internal.Base)
+  {
+    for (const std::string& name : internal.BaseStaticArrays)
+    {
+      internal.Base->GetCellData()->RemoveArray(name.c_str());
+    }
+  }
+  internal.BaseStaticArrays.clear();
+  internal.Arrays.clear();
+  internal.Times.clear();
+  this->Warnings.clear();
+  this->ListArraysAndTimes();
+  return true;
+}
+
+void vtkEGRIDReader::Reload()
+{
+  // Only the companions: the grid of a run being written does not change.
+  this->Internal->RescanCompanions = true;
+  this->Internal->FailedFile.clear();
+  this->Modified();
+}
+
+void vtkEGRIDReader::ListArraysAndTimes()
+{
+  Internals& internal = *this->Internal;
   std::vector<std::string> warnings = internal.Grid->deck.warnings;
   warnings.insert(warnings.end(), internal.Results->Warnings().begin(), internal.Results->Warnings().end());
 
@@ -267,10 +314,14 @@ bool vtkEGRIDReader::OpenIfNeeded()
   }
   for (const std::string& warning : warnings)
   {
-    this->Warnings += warning + "\n";
-    vtkWarningMacro(<< warning);
+    this->AddWarning(warning);
   }
-  return true;
+}
+
+void vtkEGRIDReader::AddWarning(const std::string& warning)
+{
+  this->Warnings += warning + "\n";
+  vtkWarningMacro(<< warning);
 }
 
 bool vtkEGRIDReader::BuildBaseIfNeeded()
@@ -352,7 +403,30 @@ vtkSmartPointer<vtkDataArray> ReadCellArray(const resmr::EclipseResults& results
   }
   return found ? result : nullptr;
 }
+/// ReadCellArray, with a record whose blocks turn out damaged costing that array only:
+/// nullptr, and `why` says what was left out.
+vtkSmartPointer<vtkDataArray> ReadCellArrayOrExplain(const resmr::EclipseResults& results,
+  const SelectableArray& array, std::size_t step, const resmr_readers::CellOrder& order, std::string& why)
+{
+  try
+  {
+    return ReadCellArray(results, array, step, order);
+  }
+  catch (const resmr::GrdeclError& error)
+  {
+    why = std::string(error.what()) + "; " + array.shownName + " is not shown";
+    return nullptr;
+  }
+}
 } // namespace
+
+void vtkEGRIDReader::WarnOnce(const std::string& warning)
+{
+  if (!warning.empty() && this->Warnings.find(warning) == std::string::npos)
+  {
+    this->AddWarning(warning);
+  }
+}
 
 void vtkEGRIDReader::UpdateStaticArrays()
 {
@@ -368,7 +442,10 @@ void vtkEGRIDReader::UpdateStaticArrays()
     const bool present = internal.BaseStaticArrays.count(array.shownName) > 0;
     if (wanted && !present)
     {
-      if (auto values = ReadCellArray(*internal.Results, array, 0, internal.Order))
+      std::string why;
+      auto values = ReadCellArrayOrExplain(*internal.Results, array, 0, internal.Order, why);
+      this->WarnOnce(why);
+      if (values)
       {
         cellData->AddArray(values);
         internal.BaseStaticArrays.insert(array.shownName);
@@ -459,7 +536,10 @@ int vtkEGRIDReader::RequestData(
       {
         if (array.dynamic && this->CellArraySelection->ArrayIsEnabled(array.shownName.c_str()))
         {
-          if (auto values = ReadCellArray(*internal.Results, array, step, internal.Order))
+          std::string why;
+          auto values = ReadCellArrayOrExplain(*internal.Results, array, step, internal.Order, why);
+          this->WarnOnce(why);
+          if (values)
           {
             cellData->AddArray(values);
           }

@@ -7,7 +7,10 @@
  * z = -depth, corners shared where ECLIPSE connects cells, cell arrays I, J, K (from 1) and
  * ACTNUM, HIDDENCELL for inactive cells. The grid is built by the same code.
  *
- * Companion files are found by the EGRID's basename. Arrays with one value per active cell
+ * Companion files are found by the EGRID's basename. A damaged, empty or foreign INIT, and
+ * report steps whose restart is cut short or damaged (a run still being written), are left
+ * out with a warning (Warnings) naming the file, the step and the byte offset; the grid and
+ * the other steps open. Reload() (File > Reload Files) indexes the companions again. Arrays with one value per active cell
  * are mapped to cells through the EGRID's ACTNUM; inactive cells get NaN (real arrays) or 0.
  * Report steps become time steps in days (TIME_STEPS); only the requested step's selected
  * arrays are read, by seeking to record offsets indexed once when the file is opened. The
@@ -89,9 +92,15 @@ public:
 
   /// The message of the last error, empty after a successful read.
   const char* GetLastError() { return this->LastError.c_str(); }
-  /// Warnings of the last file opened (LGRs, dual porosity, missing companions ...), one
-  /// per line.
+  /// Warnings of the last file opened (LGRs, dual porosity, missing companions, an INIT or
+  /// report steps left out because their file is empty, cut short or damaged, each with the
+  /// file, step and byte offset ...), one per line.
   const char* GetWarnings() { return this->Warnings.c_str(); }
+
+  /// Indexes the INIT and restart files again on the next update (File > Reload Files,
+  /// ReloadFiles() in pvpython): the report steps a simulator has completed since are
+  /// offered. The grid itself is kept.
+  void Reload();
 
   /// Returns 1 if the file is an ECLIPSE keyword file (EGRID; old GRID files are opened only
   /// to be refused with a message).
@@ -109,8 +118,12 @@ private:
   void operator=(const vtkEGRIDReader&) = delete;
 
   bool OpenIfNeeded();
+  bool RescanCompanions();
+  void ListArraysAndTimes();
   bool BuildBaseIfNeeded();
   void UpdateStaticArrays();
+  void AddWarning(const std::string& message);
+  void WarnOnce(const std::string& message); ///< unless Warnings holds it already (or empty)
   void ReportError(const std::string& message);
 
   char* FileName = nullptr;

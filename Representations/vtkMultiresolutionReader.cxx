@@ -30,6 +30,18 @@ bool IsFile(const std::string& path)
   struct stat status;
   return !path.empty() && stat(path.c_str(), &status) == 0 && S_ISREG(status.st_mode);
 }
+
+/// Changes whenever the file is rewritten (a new file renamed into place has a new inode).
+std::string FileStamp(const std::string& path)
+{
+  struct stat status;
+  if (path.empty() || stat(path.c_str(), &status) != 0)
+  {
+    return {};
+  }
+  return std::to_string(status.st_ino) + ":" + std::to_string(status.st_size) + ":" +
+    std::to_string(status.st_mtim.tv_sec) + "." + std::to_string(status.st_mtim.tv_nsec);
+}
 } // namespace
 
 vtkMultiresolutionReader::vtkMultiresolutionReader()
@@ -72,6 +84,7 @@ int vtkMultiresolutionReader::RequestInformation(
   {
     const resmr::MultiresolutionFile geometry(this->FileName); // checks header, index and trailer
     this->ResolvedPropertyFile = this->PropertyPathFor();
+    this->PropertyFileStamp = FileStamp(this->ResolvedPropertyFile);
     if (this->ResolvedPropertyFile.empty())
     {
       return 1;

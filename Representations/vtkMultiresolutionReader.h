@@ -44,6 +44,13 @@ public:
 
   /// The property file actually used after the last update (empty if none).
   const std::string& GetResolvedPropertyFileName() const { return this->ResolvedPropertyFile; }
+  /// Which version of that file it was (inode, size, modification time): the view opens the
+  /// file again when a rewrite (resmr add-properties adding steps) changes it.
+  const std::string& GetPropertyFileStamp() const { return this->PropertyFileStamp; }
+
+  /// Reads the property file again on the next update (File > Reload Files, ReloadFiles() in
+  /// pvpython): steps added since are offered.
+  void Reload() { this->Modified(); }
 
   /// The property file's step shown at `time` (days): the last not after it (0 if none).
   int GetStepNumber(double time) const;
@@ -70,6 +77,7 @@ private:
   std::string PropertyFileName;
   bool ApplyMapAxes = true;
   std::string ResolvedPropertyFile;
+  std::string PropertyFileStamp;
   std::string LastError;
   std::string InformationFailed; ///< why RequestInformation failed (the file did not open)
   std::vector<double> StepDays;     ///< per report step, from the property file

@@ -338,7 +338,7 @@ private:
 struct vtkMultiresolutionSurfaceMapper::Internals
 {
   // Files (reopened when the descriptor names others).
-  std::string FilePath, PropertyPath;
+  std::string FilePath, PropertyPath, PropertyStamp;
   int32_t Step = 0;
   std::shared_ptr<const resmr::MultiresolutionFile> File;
   std::shared_ptr<const resmr::PropertyFile> Properties;
@@ -399,6 +399,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
     this->File.reset();
     this->FilePath.clear();
     this->PropertyPath.clear();
+    this->PropertyStamp.clear();
     this->HashUploaded = false;
     this->UploadedProperty.reset();
     this->CancelUploads();
@@ -525,7 +526,8 @@ void vtkMultiresolutionSurfaceMapper::ReleaseGraphicsResources(vtkWindow* window
 namespace
 {
 /// (.resmr path, .resmrp path, step, map axes) from the descriptor; false if it has none.
-bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties, int32_t& step, bool& mapAxes)
+bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties, int32_t& step, bool& mapAxes,
+  std::string& propertiesStamp)
 {
   vtkFieldData* fields = input ? input->GetFieldData() : nullptr;
   vtkStringArray* source =
@@ -539,6 +541,7 @@ bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties
   properties = source->GetValue(1);
   step = static_cast<int32_t>(std::stol(source->GetValue(2)));
   mapAxes = source->GetNumberOfValues() > 3 && source->GetValue(3) == "1";
+  propertiesStamp = source->GetNumberOfValues() > 4 ? source->GetValue(4) : std::string();
   return true;
 }
 
@@ -618,10 +621,10 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     return; // hardware picking: the descriptor has no cells to name
   }
   vtkDataObject* input = this->GetInputDataObject(0, 0);
-  std::string filePath, propertyPath;
+  std::string filePath, propertyPath, propertyStamp;
   int32_t step = 0;
   bool applyMapAxes = false;
-  if (!ReadSource(input, filePath, propertyPath, step, applyMapAxes))
+  if (!ReadSource(input, filePath, propertyPath, step, applyMapAxes, propertyStamp))
   {
     return; // an empty piece (another rank) or no file yet
   }
@@ -632,6 +635,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     in.Close();
     in.FilePath = filePath;
     in.PropertyPath = propertyPath;
+    in.PropertyStamp = propertyStamp;
     in.Error = message;
     if (message != in.Reported)
     {
@@ -640,8 +644,9 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     }
   };
 
-  // (Re)open the files when the descriptor names others.
-  if (filePath != in.FilePath || propertyPath != in.PropertyPath || !in.Cache)
+  // (Re)open the files when the descriptor names others, or the property file was rewritten
+  // (steps added to a run still being written).
+  if (filePath != in.FilePath || propertyPath != in.PropertyPath || propertyStamp != in.PropertyStamp || !in.Cache)
   {
     in.Close();
     in.ReleaseGpu();
@@ -659,6 +664,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
       in.Cache.reset(new resmr::RegionCache(in.File, in.Properties, MainMemoryShare(this->MemoryBudgetMB)));
       in.FilePath = filePath;
       in.PropertyPath = propertyPath;
+      in.PropertyStamp = propertyStamp;
       in.Reported.clear();
     }
     catch (const std::exception& error)

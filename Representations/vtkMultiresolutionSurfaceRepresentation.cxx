@@ -81,6 +81,7 @@ int vtkMultiresolutionSurfaceRepresentation::RequestData(
       source->InsertNextValue(reader->GetResolvedPropertyFileName());
       source->InsertNextValue(std::to_string(step));
       source->InsertNextValue(reader->GetApplyMapAxes() ? "1" : "0");
+      source->InsertNextValue(reader->GetPropertyFileStamp());
       this->Delivered->GetFieldData()->AddArray(source);
       // The Layer property's range: the header is read once a file (the mapper opens it again
       // where it draws, which may be another process).

@@ -5,6 +5,7 @@
 
 #include "EclipseGrid.h"
 #include "EclipseResults.h"
+#include "GrdeclError.h"
 #include "GrdeclParser.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
@@ -12,6 +13,7 @@
 #include "SyntheticReservoirWriter.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -33,8 +35,13 @@ const char* AddPropertiesUsage =
   "           resmr synth NI NJ NK --seed SEED --steps STEPS would write, streamed from the\n"
   "           generator layer by layer (no file; any size, beyond an EGRID's 268M cells)\n"
   "  -o FILE  property file (default: FILE.resmrp beside FILE.resmr); tables it already\n"
-  "           holds are kept unless replaced (same name and step). The .resmr file is only\n"
-  "           read, never written.\n";
+  "           holds are kept unless replaced (same name and step). Report steps it holds\n"
+  "           already (same array, step, report number and time) are kept and not read\n"
+  "           again: run again on a run still being written, it adds the new steps. The\n"
+  "           .resmr file is only read, never written.\n"
+  "  A restart cut short or damaged gives its complete steps; the incomplete ones are\n"
+  "  reported (file, step, byte offset) and left out, and the exit status is 0 unless\n"
+  "  nothing could be read.\n";
 
 bool Exists(const std::string& path)
 {
@@ -185,6 +192,95 @@ int AddSyntheticProperties(const std::string& spec, const resmr::Multiresolution
   return passes;
 }
 
+/// True if `older` holds this report step's table already, for the same step of the run.
+bool HoldsStep(const resmr::PropertyFile& older, const resmr::PropertyTable& table)
+{
+  const int index = older.Find(table.name, table.step);
+  if (index < 0)
+  {
+    return false;
+  }
+  const resmr::PropertyTable& held = older.Tables()[static_cast<std::size_t>(index)];
+  return held.reportNumber == table.reportNumber && held.days == table.days;
+}
+
+/// The tables of an EGRID's INIT and restarts (or of an INIT or restart beside its EGRID), by
+/// `add`: steps `older` holds already are counted in `kept`, not read again; steps and arrays
+/// of files cut short or damaged are counted in `leftOut`, with a warning.
+void AddEclipseResults(const std::string& input, bool isInit, bool isRestart, const std::string& geometryPath,
+  const std::array<int64_t, 3>& dims, int64_t active, const resmr::PropertyFile* older, std::vector<float>& values,
+  const std::function<void(resmr::PropertyTable)>& add, int64_t& kept, int64_t& leftOut)
+{
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  const std::string gridPath = (isInit || isRestart) ? GridBeside(input) : input;
+  const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath, 0, resmr::EclipseGridParts::ActiveCellsOnly);
+  if (grid.deck.dims != dims)
+  {
+    throw std::invalid_argument(gridPath + ": grid " + std::to_string(grid.deck.dims[0]) + "x" +
+      std::to_string(grid.deck.dims[1]) + "x" + std::to_string(grid.deck.dims[2]) + " is not the grid of " + geometryPath);
+  }
+  if (grid.activeCells != active)
+  {
+    throw std::invalid_argument(gridPath + ": " + std::to_string(grid.activeCells) + " active cells, " + geometryPath +
+      " has " + std::to_string(active) + ": results of another grid");
+  }
+  const resmr::EclipseResults results(gridPath, grid);
+  for (const std::string& warning : results.Warnings())
+  {
+    std::fprintf(stderr, "resmr add-properties: warning: %s\n", warning.c_str());
+  }
+  leftOut += static_cast<int64_t>(results.SkippedSteps().size());
+  // A record whose blocks turn out damaged costs that table only.
+  const auto readable = [&](const std::function<bool()>& read) {
+    try
+    {
+      return read();
+    }
+    catch (const resmr::GrdeclError& error)
+    {
+      std::fprintf(stderr, "resmr add-properties: warning: %s; left out\n", error.what());
+      ++leftOut;
+      return false;
+    }
+  };
+  if (!isRestart)
+  {
+    for (const auto& array : results.StaticArrays())
+    {
+      if (readable([&] { return results.ReadStatic<float>(array.name, values.data(), none); }))
+      {
+        resmr::PropertyTable table;
+        table.name = array.name;
+        add(table);
+      }
+    }
+  }
+  if (!isInit)
+  {
+    const auto& steps = results.Steps();
+    for (std::size_t s = 0; s < steps.size(); ++s)
+    {
+      for (const std::string& name : steps[s].names)
+      {
+        resmr::PropertyTable table;
+        table.name = name;
+        table.step = static_cast<int32_t>(s);
+        table.reportNumber = steps[s].reportNumber;
+        table.days = steps[s].days;
+        if (older && HoldsStep(*older, table))
+        {
+          ++kept; // copied from the older file below
+          continue;
+        }
+        if (readable([&] { return results.ReadDynamic<float>(s, name, values.data(), none); }))
+        {
+          add(table);
+        }
+      }
+    }
+  }
+}
+
 /// The geometry's active cells per layer, to check that results belong to this grid.
 int64_t ActiveCount(const resmr::MultiresolutionFile& geometry)
 {
@@ -252,8 +348,7 @@ int AddPropertiesCommand(int argc, char** argv)
     }
     resmr::PropertyFileWriter writer(output, geometry);
     std::vector<float> values; // one whole array, for file inputs only
-    const float none = std::numeric_limits<float>::quiet_NaN();
-    int64_t added = 0;
+    int64_t added = 0, kept = 0, leftOut = 0;
     int generatorPasses = 0;
     const auto report = [&](const resmr::PropertyTable& table) {
       ++added;
@@ -278,54 +373,7 @@ int AddPropertiesCommand(int argc, char** argv)
                                                                     std::isdigit(static_cast<unsigned char>(ext[1])));
       if (ext == "EGRID" || ext == "FEGRID" || isInit || isRestart)
       {
-        const std::string gridPath = (isInit || isRestart) ? GridBeside(input) : input;
-        const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath, 0, resmr::EclipseGridParts::ActiveCellsOnly);
-        if (grid.deck.dims != dims)
-        {
-          throw std::invalid_argument(gridPath + ": grid " + std::to_string(grid.deck.dims[0]) + "x" +
-            std::to_string(grid.deck.dims[1]) + "x" + std::to_string(grid.deck.dims[2]) + " is not the grid of " + geometryPath);
-        }
-        if (grid.activeCells != active)
-        {
-          throw std::invalid_argument(gridPath + ": " + std::to_string(grid.activeCells) + " active cells, " + geometryPath +
-            " has " + std::to_string(active) + ": results of another grid");
-        }
-        const resmr::EclipseResults results(gridPath, grid);
-        for (const std::string& warning : results.Warnings())
-        {
-          std::fprintf(stderr, "resmr add-properties: warning: %s\n", warning.c_str());
-        }
-        if (!isRestart)
-        {
-          for (const auto& array : results.StaticArrays())
-          {
-            if (results.ReadStatic<float>(array.name, values.data(), none))
-            {
-              resmr::PropertyTable table;
-              table.name = array.name;
-              add(table);
-            }
-          }
-        }
-        if (!isInit)
-        {
-          const auto& steps = results.Steps();
-          for (std::size_t s = 0; s < steps.size(); ++s)
-          {
-            for (const std::string& name : steps[s].names)
-            {
-              if (results.ReadDynamic<float>(s, name, values.data(), none))
-              {
-                resmr::PropertyTable table;
-                table.name = name;
-                table.step = static_cast<int32_t>(s);
-                table.reportNumber = steps[s].reportNumber;
-                table.days = steps[s].days;
-                add(table);
-              }
-            }
-          }
-        }
+        AddEclipseResults(input, isInit, isRestart, geometryPath, dims, active, older.get(), values, add, kept, leftOut);
       }
       else
       {
@@ -352,18 +400,33 @@ int AddPropertiesCommand(int argc, char** argv)
         }
       }
     }
-    if (added == 0)
+    if (added == 0 && kept == 0)
     {
       throw std::invalid_argument("no property found in the inputs; " + output + " not written");
     }
-    if (older)
+    std::size_t tables = older ? older->Tables().size() : 0;
+    if (added > 0)
     {
-      writer.CopyFrom(*older);
+      if (older)
+      {
+        writer.CopyFrom(*older);
+      }
+      writer.Commit();
+      tables = writer.TableCount();
     }
-    writer.Commit();
-    std::printf("{\"geometry\": \"%s\", \"properties\": \"%s\", \"tables_added\": %lld, \"tables\": %zu, "
-                "\"generator_passes\": %d}\n",
-      geometryPath.c_str(), output.c_str(), static_cast<long long>(added), writer.TableCount(), generatorPasses);
+    else
+    {
+      std::fprintf(stderr, "resmr add-properties: %s already holds every step found; not rewritten\n", output.c_str());
+    }
+    if (leftOut > 0)
+    {
+      std::fprintf(stderr, "resmr add-properties: warning: %lld report steps or tables left out (see above)\n",
+        static_cast<long long>(leftOut));
+    }
+    std::printf("{\"geometry\": \"%s\", \"properties\": \"%s\", \"tables_added\": %lld, \"tables_kept\": %lld, "
+                "\"tables\": %zu, \"left_out\": %lld, \"generator_passes\": %d}\n",
+      geometryPath.c_str(), output.c_str(), static_cast<long long>(added), static_cast<long long>(kept), tables,
+      static_cast<long long>(leftOut), generatorPasses);
     return 0;
   }
   catch (const std::exception& error)

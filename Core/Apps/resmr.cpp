@@ -82,6 +82,15 @@ int GridInfo(const char* path)
     }
     std::printf("]}");
   }
+  // Steps of a run cut short (or still being written) that are not offered, and why.
+  std::printf("], \"init_used\": %s, \"steps_left_out\": [", results.InitUsable() ? "true" : "false");
+  for (std::size_t s = 0; s < results.SkippedSteps().size(); ++s)
+  {
+    const resmr::EclipseSkippedStep& skipped = results.SkippedSteps()[s];
+    std::printf("%s{\"file\": %s, \"report\": %d, \"offset\": %lld, \"reason\": %s}", s ? ", " : "",
+      JsonString(skipped.file).c_str(), skipped.reportNumber, static_cast<long long>(skipped.offset),
+      JsonString(skipped.reason).c_str());
+  }
   std::printf("]}\n");
   return 0;
 }

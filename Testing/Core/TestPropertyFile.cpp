@@ -3,10 +3,13 @@
 // INIT array and every array of every report step, then of the GRDECL deck's arrays;
 // the geometry file's bytes never change; every packed value, found through the geometry's
 // perfect hash, and every layer value equal the simulator's; files of another geometry,
-// truncated or corrupt property files are refused with the file named.
+// truncated or corrupt property files are refused with the file named; a run still being
+// written (Reek's UNRST growing, cut inside a step) gets its complete steps, and only the new
+// ones when add-properties runs again.
 #include "CoreTesting.h"
 
 #include "EclipseGrid.h"
+#include "EclipseKeywordFile.h"
 #include "EclipseResults.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
@@ -135,6 +138,121 @@ int CheckTables(const MultiresolutionFile& geometry, const PropertyFile& propert
   std::printf("%lld inactive cells' slots checked against their nearest active cell\n", static_cast<long long>(inactiveSlots));
   return checked;
 }
+/// The number after `"key": ` in a JSON line, or -1.
+long long JsonNumber(const std::string& json, const std::string& key)
+{
+  const std::size_t at = json.find("\"" + key + "\": ");
+  return at == std::string::npos ? -1 : std::atoll(json.c_str() + at + key.size() + 4);
+}
+
+/// A run still being written (Reek's UNRST growing step by step, cut inside a step):
+/// add-properties writes the complete steps and reports the cut one (exit 0); run again, it
+/// adds only the steps completed since and keeps the others; every table equals the whole
+/// run's. Nothing readable at all is an error.
+void GrowingRun(const std::string& resmrTool, const std::string& egrid, const std::string& geometryPath,
+  const std::string& temp, const EclipseGrid& grid, const EclipseResults& whole)
+{
+  const std::string folder = temp + "/reek-run", stem = "/2_R001_REEK-0";
+  const std::string source = egrid.substr(0, egrid.size() - 6);
+  const std::string unrst = Slurp(source + ".UNRST");
+  const std::string run = folder + stem + ".EGRID", properties = folder + "/run.resmrp";
+  mkdir(folder.c_str(), 0755);
+  for (const char* extension : { ".EGRID", ".INIT", ".UNRST" })
+  {
+    std::remove((folder + stem + extension).c_str());
+  }
+  CHECK(symlink(egrid.c_str(), run.c_str()) == 0);
+  std::remove(properties.c_str());
+  const EclipseKeywordFile file(source + ".UNRST");
+  std::vector<int64_t> starts;
+  for (const EclipseRecord& record : file.Records())
+  {
+    if (record.name == "SEQNUM")
+    {
+      starts.push_back(record.headerOffset);
+    }
+  }
+  CHECK(starts.size() == 4 && whole.Steps().size() == 4);
+  if (starts.size() != 4)
+  {
+    return;
+  }
+  const auto writeRestart = [&](int64_t size) {
+    std::ofstream out(folder + stem + ".UNRST", std::ios::binary | std::ios::trunc);
+    out.write(unrst.data(), static_cast<std::streamsize>(size));
+  };
+  const std::string output = folder + "/out.json", errors = folder + "/err.txt";
+  const std::string command = resmrTool + " add-properties '" + geometryPath + "' '" + run + "' -o '" + properties +
+    "' > '" + output + "' 2> '" + errors + "'";
+
+  // No INIT and an empty restart: nothing readable, an error.
+  writeRestart(0);
+  CHECK(Run(command) != 0);
+  CHECK(Slurp(errors).find("no property found") != std::string::npos);
+
+  CHECK(symlink((source + ".INIT").c_str(), (folder + stem + ".INIT").c_str()) == 0);
+  const std::size_t names = whole.Steps()[0].names.size(), statics = whole.StaticArrays().size();
+  const struct
+  {
+    int64_t size;
+    std::size_t complete;
+  } stages[] = { { starts[2] + 1000, 2 }, { starts[3] + 5, 3 }, { file.Size(), 4 } };
+  std::size_t before = 0;
+  for (const auto& stage : stages)
+  {
+    writeRestart(stage.size);
+    CHECK(Run(command) == 0);
+    const std::string json = Slurp(output), warnings = Slurp(errors);
+    std::printf("UNRST of %lld bytes: %s", static_cast<long long>(stage.size), json.c_str());
+    const bool cut = stage.size != file.Size();
+    CHECK((warnings.find("left out: incomplete at byte") != std::string::npos) == cut);
+    CHECK(JsonNumber(json, "left_out") == (cut ? 1 : 0));
+    // resmr info lists the same steps, and the one left out with its file and offset.
+    CHECK(Run(resmrTool + " info '" + run + "' > '" + output + "' 2> '" + errors + "'") == 0);
+    const std::string info = Slurp(output);
+    std::size_t offered = 0;
+    for (std::size_t at = info.find("\"days\": "); at != std::string::npos; at = info.find("\"days\": ", at + 1))
+    {
+      ++offered;
+    }
+    CHECK(offered == stage.complete);
+    const std::string leftOut = cut ? "\"steps_left_out\": [{\"file\": \"" + folder + stem + ".UNRST\", \"report\": " +
+        // (-1 while the cut step's SEQNUM record is not whole)
+        std::to_string(stage.size >= starts[stage.complete] + 36 ? whole.Steps()[stage.complete].reportNumber : -1) +
+        ", \"offset\": "
+                                    : std::string("\"steps_left_out\": []");
+    CHECK(info.find(leftOut) != std::string::npos);
+    // The INIT's arrays are read again each time; only the new steps' arrays are added.
+    CHECK(JsonNumber(json, "tables_added") == static_cast<long long>(statics + (stage.complete - before) * names));
+    CHECK(JsonNumber(json, "tables_kept") == static_cast<long long>(before * names));
+    const MultiresolutionFile geometry(geometryPath);
+    const PropertyFile written(properties);
+    CHECK(written.Tables().size() == statics + stage.complete * names);
+    CHECK(written.Find("PRESSURE", static_cast<int32_t>(stage.complete - 1)) >= 0);
+    CHECK(written.Find("PRESSURE", static_cast<int32_t>(stage.complete)) < 0);
+    CHECK(CheckTables(geometry, written, grid, whole) == static_cast<int>(written.Tables().size()));
+    before = stage.complete;
+  }
+  // Nothing new: every step kept, only the INIT's arrays read again.
+  CHECK(Run(command) == 0);
+  CHECK(JsonNumber(Slurp(output), "tables_kept") == static_cast<long long>(4 * names));
+  CHECK(JsonNumber(Slurp(output), "tables_added") == static_cast<long long>(statics));
+  {
+    const MultiresolutionFile geometry(geometryPath);
+    const PropertyFile written(properties);
+    CHECK(written.Tables().size() == statics + 4 * names);
+    CHECK(CheckTables(geometry, written, grid, whole) == static_cast<int>(written.Tables().size()));
+  }
+  for (const char* extension : { ".EGRID", ".INIT", ".UNRST" })
+  {
+    std::remove((folder + stem + extension).c_str());
+  }
+  for (const std::string& path : { properties, output, errors })
+  {
+    std::remove(path.c_str());
+  }
+  rmdir(folder.c_str());
+}
 } // namespace
 
 int main(int argc, char** argv)
@@ -188,6 +306,8 @@ int main(int argc, char** argv)
     const MultiresolutionFile geometry(reekGeometry);
     const PropertyFile properties(reekProperties);
     CHECK(CheckTables(geometry, properties, reekGrid, reekResults) == static_cast<int>(properties.Tables().size()));
+    std::remove(reekProperties.c_str());
+    GrowingRun(resmrTool, reek, reekGeometry, temp, reekGrid, reekResults);
     std::remove(reekProperties.c_str());
     std::remove(reekGeometry.c_str());
   }

@@ -13,12 +13,15 @@
 //   part 1            input.INIT    (input.FINIT)
 //   part 2, 3 parts   input.UNRST   (input.FUNRST)                     unified restart
 //   part 2.., more    input.X0000, input.X0001, ... (input.Fnnnn)      per-step restarts
-// An empty part writes no file (a missing companion). An input without the marker is a
-// single EGRID (or any keyword file: INIT, UNRST, binary GRDECL), so real files are seeds
-// as they are.
+// An empty part writes no file (a missing companion), except an empty part 0 of an input
+// with more parts: it becomes the fixed grid, a valid small EGRID (the 6x5x3 model of
+// resmr synth 6 5 3, seed 1, generated once per process), so that fuzzed INIT and restart
+// files always meet a sound grid and reach the companion paths (cut and damaged files,
+// incomplete report steps). An input without the marker is a single EGRID (or any keyword
+// file: INIT, UNRST, binary GRDECL), so real files are seeds as they are.
 //
-// Per input: every part is sniffed (LooksLike*), opened as an EclipseKeywordFile and every
-// record read (numeric ones as double, float and int32_t, character ones as strings, MESS
+// Per input: every part is sniffed (LooksLike*), opened as an EclipseKeywordFile (and, for
+// parts 1.., indexed up to the last whole record as results files are) and every record read (numeric ones as double, float and int32_t, character ones as strings, MESS
 // ones must be refused); then ReadEclipseGrid on part 0 (maxCells 1 << 20), grid invariants
 // checked, EclipseResults built and every static array and every dynamic array of every
 // step read (double, float, int32_t); last the corner-point geometry of the grid is built
@@ -33,6 +36,8 @@
 #include "EclipseResults.h"
 #include "FuzzReplay.h"
 #include "GrdeclError.h"
+#include "SyntheticReservoir.h"
+#include "SyntheticReservoirWriter.h"
 
 #include <algorithm>
 #include <cctype>
@@ -117,6 +122,40 @@ std::string LastOutcome; // what the last input did, for the replay log
 #define RESMR_FUZZ_OUTCOME(text) ((void)0)
 #endif
 
+/// The bytes of the fixed grid (see the input layout above).
+const std::string& FixedGrid()
+{
+  static const std::string bytes = [] {
+    const char* tmp = std::getenv("TMPDIR");
+    std::string directory = std::string(tmp && *tmp ? tmp : "/tmp") + "/resmr-fuzz-grid-XXXXXX";
+    if (!mkdtemp(directory.data()))
+    {
+      std::perror("mkdtemp");
+      std::abort();
+    }
+    resmr::SyntheticParameters parameters;
+    parameters.nx = 6;
+    parameters.ny = 5;
+    parameters.nz = 3;
+    const resmr::SyntheticOutput written =
+      resmr::WriteSyntheticEclipse(resmr::SyntheticReservoir(parameters), directory + "/FIXED.EGRID");
+    std::string grid;
+    resmr_fuzz::ReadWholeFile(directory + "/FIXED.EGRID", grid);
+    for (const std::string& path : written.files)
+    {
+      std::remove(path.c_str());
+    }
+    rmdir(directory.c_str());
+    if (grid.empty())
+    {
+      std::fprintf(stderr, "FuzzEclipseOutput: the fixed grid was not written\n");
+      std::abort();
+    }
+    return grid;
+  }();
+  return bytes;
+}
+
 InputFiles& TheInputFiles()
 {
   static InputFiles files; // one per process, reused across iterations
@@ -191,8 +230,8 @@ int64_t CountTokens(std::string_view text, std::size_t& longest)
 }
 
 /// Opens one keyword file (its bytes are `contents`) and reads every record the ways a
-/// caller may.
-std::string ReadEveryRecord(const std::string& path, std::string_view contents)
+/// caller may; a results file (INIT, restart) indexed up to its last whole record.
+std::string ReadEveryRecord(const std::string& path, std::string_view contents, bool results)
 {
   int64_t records = 0, errors = 0;
   std::string other;
@@ -206,7 +245,16 @@ std::string ReadEveryRecord(const std::string& path, std::string_view contents)
   }
   try
   {
-    const resmr::EclipseKeywordFile file(path);
+    const resmr::EclipseKeywordFile file(path,
+      results ? resmr::KeywordFileIndexing::UpToLastWholeRecord : resmr::KeywordFileIndexing::WholeFile);
+    // A lenient index stops exactly where its last whole record ends.
+    const int64_t lastEnd = file.Records().empty() ? 0 : file.Records().back().endOffset;
+    if (file.StoppedAt() >= 0 && (file.StoppedAt() != lastEnd || file.StoppedAt() >= file.Size()))
+    {
+      BrokenInvariant(path + ": index stopped at byte " + std::to_string(file.StoppedAt()) +
+        ", its last whole record ends at " + std::to_string(lastEnd) + ", the file has " +
+        std::to_string(file.Size()) + " bytes");
+    }
     std::vector<double> numbers;
     std::vector<float> floats;
     std::vector<int32_t> integers;
@@ -381,10 +429,23 @@ std::string ReadEveryResult(const resmr::EclipseResults& results, int64_t cells)
       BrokenInvariant("ReadDynamic accepted a step past the end");
     }
   }
+  for (const resmr::EclipseSkippedStep& skipped : results.SkippedSteps())
+  {
+    if (skipped.offset < 0 || skipped.reason.empty())
+    {
+      BrokenInvariant(skipped.file + ": step left out at byte " + std::to_string(skipped.offset) +
+        " with reason '" + skipped.reason + "'");
+    }
+  }
+  if (results.Warnings().size() < results.SkippedSteps().size())
+  {
+    BrokenInvariant("a step was left out without a warning");
+  }
   return std::to_string(results.StaticArrays().size()) + " static, " +
     std::to_string(results.Steps().size()) + " steps, " +
     std::to_string(results.DynamicArrays().size()) + " dynamic names, " + std::to_string(read) +
-    " arrays read, " + std::to_string(results.Warnings().size()) + " warnings";
+    " arrays read, " + std::to_string(results.SkippedSteps().size()) + " steps left out, " +
+    std::to_string(results.Warnings().size()) + " warnings";
 }
 } // namespace
 
@@ -402,13 +463,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
     {
       continue; // a missing companion
     }
-    const std::string& path = files.Write(PartName(p, parts.size(), StartsFormatted(parts[p])), parts[p]);
+    const std::string_view part = p == 0 && parts.size() > 1 && parts[0].empty() ? FixedGrid() : parts[p];
+    const std::string& path = files.Write(PartName(p, parts.size(), StartsFormatted(part)), part);
     if (p == 0)
     {
       gridPath = path;
     }
     outcome += (outcome.empty() ? "" : "; ") + path.substr(path.rfind('/') + 1) + ": " +
-      ReadEveryRecord(path, parts[p]);
+      ReadEveryRecord(path, part, p > 0);
   }
   try
   {

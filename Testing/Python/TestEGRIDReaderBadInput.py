@@ -2,7 +2,10 @@
 record markers that disagree, counts larger than the file, unknown types, old GRID files)
 give one clear error naming the file and keyword and an empty output; restarts of another
 grid and missing companions give warnings naming the file, and the grid is still shown.
-The reader then recovers on a good file."""
+An empty, bit-flipped or foreign INIT gives a warning and no static arrays, the steps stay; a
+restart cut short offers its complete steps and names the one left out (file, step, byte);
+a damaged data block met only when an array is read costs that array, with a warning. The
+reader then recovers on a good file."""
 import os
 import shutil
 import struct
@@ -101,6 +104,66 @@ if grid.GetCellData().GetArray("PRESSURE") is not None:
     rt.fail("restart of another grid: its PRESSURE is shown")
 if grid.GetCellData().GetArray("PORO") is None:
     rt.fail("restart of another grid: the INIT arrays are lost too")
+
+# Damaged INITs: the grid and the restart steps are shown, no static array, a warning.
+with open(EIGHT + ".INIT", "rb") as handle:
+    INIT = handle.read()
+third = header_offset(INIT, "DOUBHEAD")
+BAD_INITS = {
+    "EMPTYINIT": (b"", ["EMPTYINIT.INIT", "the file is empty"]),
+    "FLIPPEDINIT": (with_bytes(INIT, third + 3, bytes([INIT[third + 3] ^ 0x02])),
+                    ["FLIPPEDINIT.INIT", f"damaged or cut short at byte {third}"]),
+    "FOREIGNINIT": (open(os.path.join(args.data, "spe1/resdata_rft/SPE1.INIT"), "rb").read(),
+                    ["FOREIGNINIT.INIT", "does not belong to this grid"]),
+}
+for stem, (content, fragments) in BAD_INITS.items():
+    base = os.path.join(work, stem)
+    shutil.copy(EIGHT + ".EGRID", base + ".EGRID")
+    shutil.copy(EIGHT + ".UNRST", base + ".UNRST")
+    with open(base + ".INIT", "wb") as handle:
+        handle.write(content)
+    reader, grid = open_with_warnings(base + ".EGRID", fragments)
+    if grid.GetCellData().GetArray("PORO") is not None:
+        rt.fail(f"{stem}: static arrays shown from a bad INIT")
+    if len(reader.TimestepValues) != 3 or grid.GetCellData().GetArray("PRESSURE") is None:
+        rt.fail(f"{stem}: the restart steps are lost too")
+    simple.Delete(reader)
+
+# A restart cut inside its third step: two steps, the third named with its byte offset; and
+# a data block marker damaged inside the second step's SWAT: the array is left out with a
+# warning when that step is shown, the rest of the step is.
+with open(EIGHT + ".UNRST", "rb") as handle:
+    UNRST = handle.read()
+seqnums = [i - 4 for i in range(len(UNRST)) if UNRST.startswith(b"SEQNUM  ", i)]
+base = os.path.join(work, "CUTRUN")
+shutil.copy(EIGHT + ".EGRID", base + ".EGRID")
+shutil.copy(EIGHT + ".INIT", base + ".INIT")
+with open(base + ".UNRST", "wb") as handle:
+    handle.write(UNRST[: seqnums[2] + 500])
+reader, grid = open_with_warnings(base + ".EGRID", ["CUTRUN.UNRST", "report step 2 left out: incomplete at byte"])
+if len(reader.TimestepValues) != 2:
+    rt.fail(f"cut restart: {len(reader.TimestepValues)} steps offered, expected 2")
+simple.Delete(reader)
+swat = UNRST.index(b"SWAT    ", seqnums[1]) - 4
+marker = swat + 24
+base = os.path.join(work, "BLOCKRUN")
+shutil.copy(EIGHT + ".EGRID", base + ".EGRID")
+shutil.copy(EIGHT + ".INIT", base + ".INIT")
+with open(base + ".UNRST", "wb") as handle:
+    # The end marker of SWAT's data block: indexing checks only the first marker.
+    handle.write(with_bytes(UNRST, marker + 4 + 32, struct.pack(">i", 33)))
+reader, grid = open_with_warnings(base + ".EGRID", [])
+times = list(reader.TimestepValues)
+reader.UpdatePipeline(times[1])
+grid = servermanager.Fetch(reader, arg1=None, arg2=None, idx=0)
+reader.UpdatePropertyInformation()
+warnings = reader.GetPropertyValue("Warnings")
+if reader.GetPropertyValue("LastError") or grid.GetCellData().GetArray("PRESSURE") is None:
+    rt.fail(f"damaged SWAT block: the step failed: {reader.GetPropertyValue('LastError')}")
+if grid.GetCellData().GetArray("SWAT") is not None or "SWAT is not shown" not in warnings:
+    rt.fail(f"damaged SWAT block: SWAT shown or not warned: {warnings!r}")
+print(f"BLOCKRUN: step 2 shown without SWAT, warned: {warnings.strip().splitlines()[-1]}")
+simple.Delete(reader)
 
 # The same reader recovers on a good file.
 reader.FileName = EIGHT + ".EGRID"
