@@ -393,11 +393,12 @@ void PutRecord(ByteWriter& out, const RegionRecord& r)
   out.Bytes.resize(start + RecordBytes, 0);
 }
 
-RegionRecord GetRecord(ByteReader& in)
+/// A record as PutRecord wrote it; `reservedZero` tells whether its unused bytes are zero.
+RegionRecord GetRecord(ByteReader& in, bool& reservedZero)
 {
   RegionRecord r;
   r.level = in.Get<int32_t>();
-  in.Get<int32_t>();
+  const int32_t reserved = in.Get<int32_t>();
   r.index = in.Get<int64_t>();
   r.columns = in.Get<int64_t>();
   r.activeCells = in.Get<int64_t>();
@@ -416,6 +417,7 @@ RegionRecord GetRecord(ByteReader& in)
   }
   uint8_t padding[RecordBytes - 4 - 4 - 8 * 4 - 24 - 8 - 32 - 4 * 20];
   in.GetBytes(padding, sizeof(padding));
+  reservedZero = reserved == 0 && std::all_of(padding, padding + sizeof(padding), [](uint8_t b) { return b == 0; });
   return r;
 }
 } // namespace
@@ -1158,9 +1160,14 @@ void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
   this->Records.reserve(this->Head.regionCount);
   for (uint64_t i = 0; i < this->Head.regionCount; ++i)
   {
-    RegionRecord r = GetRecord(index);
+    bool reservedZero = false;
+    RegionRecord r = GetRecord(index, reservedZero);
     const std::string place = path + ": index record " + std::to_string(i) + " (level " + std::to_string(r.level) +
       ", region " + std::to_string(r.index) + ")";
+    if (!reservedZero)
+    {
+      throw MultiresolutionFileError(place + ": reserved bytes are not zero (corrupt)");
+    }
     CheckRecord(r, this->Head, place);
     if (!seen.insert({ r.level, r.index }).second)
     {
