@@ -625,9 +625,10 @@ void CheckRecord(const RegionRecord& r, const MultiresolutionHeader& h, const st
   {
     const auto& c = *cone;
     const bool finite = std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]) && std::isfinite(c[3]);
-    if (!finite || !(c[3] == -2 || (c[3] >= -1 && c[3] <= 1)))
+    const double length = std::sqrt(double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2]);
+    if (!finite || !(c[3] == -2 || (c[3] >= -1 && c[3] <= 1 && std::fabs(length - 1) < 1e-3)))
     {
-      fail("normal cone is not finite or its cosine not in [-1, 1] (nor -2, empty)");
+      fail("normal cone is not finite, its axis not of unit length or its cosine not in [-1, 1] (nor -2, empty)");
     }
   }
 }

@@ -190,6 +190,14 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
   ExpectGeometryRefused("record error", valid, "error -1", SetRecord<float>(2, 64, -1.0f));
   ExpectGeometryRefused("record own error", valid, "own error inf", SetRecord<float>(2, 68, INFINITY));
   ExpectGeometryRefused("record cone", valid, "normal cone", SetRecord<float>(3, 72 + 12, 3.0f));
+  ExpectGeometryRefused("record cone axis", valid, "normal cone", [](Bytes& f) {
+    const std::size_t at = static_cast<std::size_t>(IndexAt(f)) + 3 * 192 + 88; // the bottom cone
+    if (Load<float>(f, at + 12) == -2.0f)
+    {
+      Store<float>(f, at + 12, 0.5f);
+    }
+    Store<float>(f, at + 8, Load<float>(f, at + 8) + 0.5f);
+  });
   ExpectGeometryRefused("record chunk offset", valid, "mesh at byte", SetRecord<uint64_t>(0, 104, 1u << 30));
   ExpectGeometryRefused("record chunk raw", valid, "cannot decompress", SetRecord<uint32_t>(0, 104 + 20 + 12, 1u << 30));
   ExpectGeometryRefused("record duplicate", valid, "a second record", [](Bytes& f) {
