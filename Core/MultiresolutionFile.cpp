@@ -265,6 +265,7 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
   mesh.active.resize(static_cast<std::size_t>(columns) * layers);
   in.GetBytes(mesh.active.data(), mesh.active.size());
   mesh.openSides.resize(mesh.active.size());
+  int64_t activeCells = 0;
   for (std::size_t i = 0; i < mesh.active.size(); ++i)
   {
     if (mesh.active[i] >> 5)
@@ -274,9 +275,23 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
     }
     mesh.openSides[i] = mesh.active[i] >> 1;
     mesh.active[i] &= 1;
+    activeCells += mesh.active[i];
+  }
+  if (activeCells != record.activeCells)
+  {
+    throw MultiresolutionFileError(in.Where() + ": " + std::to_string(activeCells) + " active cells, the index says " +
+      std::to_string(record.activeCells));
   }
   mesh.cutEdges.resize(columns);
   in.GetBytes(mesh.cutEdges.data(), mesh.cutEdges.size());
+  for (std::size_t c = 0; c < mesh.cutEdges.size(); ++c)
+  {
+    if (mesh.cutEdges[c] >> 4)
+    {
+      throw MultiresolutionFileError(in.Where() + ": cut edges " + std::to_string(mesh.cutEdges[c]) + " of column " +
+        std::to_string(c) + " name an edge beyond the column's four");
+    }
+  }
 }
 
 std::vector<uint8_t> EncodeSurface(const RegionSurface& surface)

@@ -217,6 +217,55 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
   ExpectGeometryRefused("model layer size", valid, "active flags part 0: 11 bytes", setModel(0, 20, 11));
 }
 
+/// The geometry file with the change opens, but region `region` is refused when read, naming
+/// the file, the region and `fragment`; every other region still reads.
+void ExpectRegionRefused(const std::string& label, const Bytes& file, std::size_t region, const std::string& fragment)
+{
+  const std::string path = Temp + "/region.resmr";
+  Spill(path, file);
+  const MultiresolutionFile opened(path);
+  const auto& record = opened.Regions()[region];
+  resmr_testing::ExpectError<MultiresolutionFileError>("region " + label, [&] { opened.ReadRegion(region); },
+    { path, "region (level " + std::to_string(record.level) + ", index " + std::to_string(record.index) + ")", fragment });
+  for (std::size_t r = 0; r < opened.Regions().size(); ++r)
+  {
+    if (r != region)
+    {
+      CHECK(opened.ReadRegion(r).ColumnCount() == opened.Regions()[r].columns);
+    }
+  }
+}
+
+/// What the region decoder checks inside a chunk against the index (chunks changed in the
+/// unpacked form, then compressed again with their CRCs).
+void RegionContents(const Bytes& valid)
+{
+  const auto layout = resmr_fuzz::ResmrLayout();
+  ExpectRegionRefused("active cells", Changed(valid, layout, SetRecord<int64_t>(1, 24, 0)), 1,
+    "active cells, the index says 0");
+  Bytes unpacked = resmr_fuzz::UnpackChunks(valid, layout);
+  const std::size_t record = static_cast<std::size_t>(IndexAt(unpacked)) + 2 * 192;
+  const uint64_t mesh = Load<uint64_t>(unpacked, record + 104);
+  const uint32_t meshBytes = Load<uint32_t>(unpacked, record + 104 + 8);
+  // The mesh chunk ends with one byte of cut edges a column (bits 0-3).
+  Bytes cut = unpacked;
+  cut[static_cast<std::size_t>(mesh + meshBytes - 1)] = 0x10;
+  ExpectRegionRefused("cut edges", resmr_fuzz::Repair(cut.data(), cut.size(), layout), 2, "cut edges 16 of column");
+  // Its magic (MESH), then the layer count.
+  Bytes layers = unpacked;
+  Store<uint32_t>(layers, static_cast<std::size_t>(mesh + 4), 3);
+  ExpectRegionRefused("layers", resmr_fuzz::Repair(layers.data(), layers.size(), layout), 2,
+    "3 layers");
+  // Unchanged, the unpacked form packs into a file that reads as the original.
+  const Bytes repacked = resmr_fuzz::Repair(unpacked.data(), unpacked.size(), layout);
+  Spill(Temp + "/repacked.resmr", repacked);
+  const MultiresolutionFile file(Temp + "/repacked.resmr");
+  for (std::size_t r = 0; r < file.Regions().size(); ++r)
+  {
+    CHECK(file.ReadRegion(r).VertexCount() == file.Regions()[r].vertices);
+  }
+}
+
 // .resmrp header fields (PropertyFile.cpp, HeaderOf).
 constexpr std::size_t PVersion = 8, PDims = 20, PSides = 44, PTables = 56;
 
@@ -334,6 +383,7 @@ int main(int argc, char** argv)
   }
   const bool ok = resmr_testing::RunNamedTests({
     { "geometry header and index fields", [&] { GeometryFields(validGeometry, geometry); } },
+    { "region decoder against the index", [&] { RegionContents(validGeometry); } },
     { "property header and index fields", [&] { PropertyFields(validProperties, properties, geometry); } },
     { "resmr info refuses a flat lattice", [&] { ToolRefusesFlatModel(validGeometry); } },
   });

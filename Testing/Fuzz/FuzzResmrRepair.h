@@ -3,9 +3,10 @@
 // the geometry id, header CRC), so that the mutations reach the parsers instead of stopping
 // at the first CRC. Chunks may come unpacked (a reference whose stored and raw sizes agree
 // is taken to point at raw bytes, which are LZO-compressed and appended before the index),
-// so that mutations of a chunk's contents reach the decoders rather than LZO's; other
-// chunks stay as they are, with their CRC recomputed. UnpackChunks() turns a valid file
-// into that form (how the unpacked seeds are made).
+// so that mutations of a chunk's contents reach the decoders rather than LZO's (unless the
+// bytes are an LZO stream of that size); other chunks stay as they are, with their CRC
+// recomputed. UnpackChunks() turns a valid file into that form (how the unpacked seeds are
+// made).
 #pragma once
 
 #include "ByteStream.h"
@@ -81,6 +82,26 @@ inline bool LocateIndex(const std::vector<uint8_t>& file, const FileLayout& layo
   return true;
 }
 
+/// Whether the `stored` bytes at `offset` are an LZO stream of `raw` bytes (a packed chunk
+/// that happens to be as long as its contents, not an unpacked one).
+inline bool Decompresses(const std::vector<uint8_t>& file, uint64_t offset, uint32_t stored, uint32_t raw)
+{
+  resmr::ChunkRef ref;
+  ref.offset = offset;
+  ref.stored = stored;
+  ref.raw = raw;
+  ref.crc = resmr::Crc32(file.data() + offset, stored);
+  try
+  {
+    resmr::DecompressChunk(file.data(), file.size(), ref, "repair");
+    return true;
+  }
+  catch (const resmr::MultiresolutionFileError&)
+  {
+    return false;
+  }
+}
+
 /// The mutated file with every checksum right again (see above). Inputs too short or without
 /// a place for the index get only their header CRC (when they have a header). With `pack`
 /// false, no chunk is taken for unpacked (only CRCs are recomputed).
@@ -102,7 +123,7 @@ inline std::vector<uint8_t> Repair(const uint8_t* data, std::size_t size, const 
         continue; // outside the data part: the reader must say so
       }
       const uint8_t* bytes = file.data() + offset;
-      if (pack && stored == raw && stored > 0)
+      if (pack && stored == raw && stored > 0 && !Decompresses(file, offset, stored, raw))
       {
         const auto compressed = resmr::CompressChunk(std::vector<uint8_t>(bytes, bytes + stored));
         Store<uint64_t>(index, at, indexOffset + packed.size());
