@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <set>
 #include <stdexcept>
 
 namespace resmr
@@ -168,10 +169,11 @@ PropertyFile::PropertyFile(const std::string& path)
     const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
     this->CheckHeader(tables, indexSize);
     ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
+    std::set<std::pair<std::string, int32_t>> seen;
     for (uint32_t t = 0; t < tables; ++t)
     {
       PropertyTable table = this->ReadTable(index, t, indexOffset);
-      if (this->Find(table.name, table.step) >= 0)
+      if (!seen.insert({ table.name, table.step }).second)
       {
         throw MultiresolutionFileError(path + ": index table " + std::to_string(t) + " (" + TableName(table) +
           "): a second table of the same name and step (corrupt)");
@@ -252,9 +254,10 @@ PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t in
   const std::string place = this->FilePath + ": index table " + std::to_string(t) + " (" + TableName(table) + ")";
   const auto fail = [&](const std::string& what) { throw MultiresolutionFileError(place + ": " + what + " (corrupt)"); };
   const bool text = std::all_of(table.name.begin(), table.name.end(), [](char c) { return c >= 0x20 && c <= 0x7e; });
-  if (table.name.empty() || table.name.size() >= NameBytes || !text)
+  const bool padded = std::all_of(name + std::min(table.name.size(), NameBytes), name + NameBytes, [](char c) { return c == 0; });
+  if (table.name.empty() || table.name.size() >= NameBytes || !text || !padded)
   {
-    fail("the name is not 1 to 31 printable characters");
+    fail("the name is not 1 to 31 printable characters, NUL-padded");
   }
   if (table.step < -1 || table.reportNumber < 0 || !std::isfinite(table.days) ||
     (table.step < 0 && (table.reportNumber != 0 || table.days != 0)))

@@ -312,6 +312,7 @@ void PropertyFields(const Bytes& valid, const std::string& validPath, const std:
   ExpectPropertiesRefused("name unterminated", valid, "the name is not", [&](Bytes& f) {
     std::memset(&f[static_cast<std::size_t>(index)], 'A', 32);
   });
+  ExpectPropertiesRefused("name padding", valid, "NUL-padded", setTable(0, 31, uint8_t('x')));
   ExpectPropertiesRefused("step -5", valid, "step -5", setTable(0, 32, int32_t(-5)));
   ExpectPropertiesRefused("report -1", valid, "report -1", setTable(tables - 1, 36, int32_t(-1)));
   ExpectPropertiesRefused("days NaN", valid, "day", setTable(tables - 1, 40, NaN));
