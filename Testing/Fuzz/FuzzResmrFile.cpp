@@ -22,15 +22,18 @@
 #include "MultiresolutionFile.h"
 #include "RegionMesh.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <new>
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 namespace
@@ -152,6 +155,40 @@ void CheckRegion(const resmr::MultiresolutionFile& file, const resmr::RegionReco
   }
 }
 
+/// What an opened file's header promises (the fields a reader draws with).
+void CheckHeader(const resmr::MultiresolutionFile& file)
+{
+  if (!resmr_fuzz::InvariantsChecked())
+  {
+    return;
+  }
+  const auto& h = file.Header();
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!(h.latticeStep[a] > 0) || !std::isfinite(h.latticeStep[a]) || !std::isfinite(h.latticeOrigin[a]) ||
+      h.dims[a] <= 0)
+    {
+      BrokenInvariant("opened with lattice step " + std::to_string(h.latticeStep[a]) + ", origin " +
+        std::to_string(h.latticeOrigin[a]) + " or dimension " + std::to_string(h.dims[a]) + " on axis " +
+        std::to_string(a));
+    }
+  }
+  if (!(h.box[0] < h.box[2]) || !(h.box[1] < h.box[3]) || !std::isfinite(h.box[0] + h.box[1] + h.box[2] + h.box[3]))
+  {
+    BrokenInvariant("opened with an empty or infinite hierarchy box");
+  }
+  int32_t deepest = -1;
+  for (const auto& r : file.Regions())
+  {
+    deepest = std::max(deepest, r.level);
+  }
+  if (deepest != h.leafLevel)
+  {
+    BrokenInvariant("opened with leaf level " + std::to_string(h.leafLevel) + ", deepest region at " +
+      std::to_string(deepest));
+  }
+}
+
 /// Decodes every region and model array; returns the number of parts refused.
 int ReadEverything(const resmr::MultiresolutionFile& file, std::string& firstError)
 {
@@ -217,6 +254,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
   try
   {
     const resmr::MultiresolutionFile file(path);
+    CheckHeader(file);
     std::string firstError;
     const int refused = ReadEverything(file, firstError);
     if (MustBeValid && refused > 0)
@@ -225,6 +263,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
     }
     RESMR_FUZZ_OUTCOME("opened, " + std::to_string(file.Regions().size()) + " regions, " +
       std::to_string(refused) + " parts refused" + (refused ? ", first: " + firstError : std::string()));
+  }
+  catch (const std::bad_alloc&)
+  {
+    // A file of at most a few MiB never needs a GiB: a size taken from the file unchecked.
+    BrokenInvariant("std::bad_alloc: an allocation beyond the file's means");
   }
   catch (const std::exception& error)
   {
@@ -240,8 +283,24 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
 }
 
 #ifdef RESMR_FUZZ_STANDALONE
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer)
+#define RESMR_FUZZ_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define RESMR_FUZZ_SANITIZED 1
+#endif
+
 int main(int argc, char** argv)
 {
+#ifndef RESMR_FUZZ_SANITIZED
+  // What libFuzzer's malloc limit does when fuzzing: an allocation of a size taken from the
+  // file unchecked fails (std::bad_alloc, a finding) instead of filling the machine. Not
+  // under ASan, which reserves terabytes of address space for its shadow memory.
+  const rlimit limit{ rlim_t(2) << 30, rlim_t(2) << 30 };
+  setrlimit(RLIMIT_AS, &limit);
+#endif
   if (argc == 4 && std::string(argv[1]) == "--unpack")
   {
     std::string contents;

@@ -26,9 +26,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <new>
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 namespace
@@ -88,6 +90,36 @@ constexpr bool MustBeValid = false;
   resmr_fuzz::BrokenInvariant("FuzzResmrpFile", what);
 }
 
+/// What an opened file's index promises: as many tables as the header says fill it, each
+/// chunk of the size its values call for.
+void CheckIndex(const resmr::PropertyFile& file, const std::vector<uint8_t>& bytes, uint64_t slots)
+{
+  if (!resmr_fuzz::InvariantsChecked())
+  {
+    return;
+  }
+  const auto& dims = file.Dimensions();
+  const uint64_t indexSize = resmr_fuzz::Load<uint64_t>(bytes, bytes.size() - resmr::IndexTrailerBytes + 8);
+  const uint64_t perTable = 56 + 20 * (static_cast<uint64_t>(dims[2]) + 1);
+  if (indexSize != file.Tables().size() * perTable)
+  {
+    BrokenInvariant("opened with " + std::to_string(file.Tables().size()) + " tables in an index of " +
+      std::to_string(indexSize) + " bytes");
+  }
+  for (const auto& table : file.Tables())
+  {
+    bool sized = table.packed.raw == slots * 4;
+    for (const auto& layer : table.layers)
+    {
+      sized = sized && layer.raw == static_cast<uint64_t>(dims[0] * dims[1]) * 4;
+    }
+    if (!sized)
+    {
+      BrokenInvariant("opened with table " + table.name + " of chunks the wrong size for its values");
+    }
+  }
+}
+
 /// Reads every table, packed and by layers; returns the number of parts refused.
 int ReadEverything(const resmr::PropertyFile& file, const std::array<int64_t, 3>& dims, uint64_t slots,
   std::string& firstError)
@@ -129,20 +161,28 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
 {
   static InputFile input;
   static const resmr_fuzz::FileLayout layout = resmr_fuzz::ResmrpLayout();
-  const std::string& path = input.Write(resmr_fuzz::Repair(data, size, layout));
+  const std::vector<uint8_t> bytes = resmr_fuzz::Repair(data, size, layout);
+  const std::string& path = input.Write(bytes);
   try
   {
     const resmr::PropertyFile file(path);
     const std::array<int64_t, 3> dims = file.Dimensions();
     const auto& sides = file.HashTableSides();
+    const uint64_t slots = uint64_t(sides[0]) * sides[1] * sides[2];
+    CheckIndex(file, bytes, slots);
     std::string firstError;
-    const int refused = ReadEverything(file, dims, uint64_t(sides[0]) * sides[1] * sides[2], firstError);
+    const int refused = ReadEverything(file, dims, slots, firstError);
     if (MustBeValid && refused > 0)
     {
       BrokenInvariant("a valid seed refused: " + firstError);
     }
     RESMR_FUZZ_OUTCOME("opened, " + std::to_string(file.Tables().size()) + " tables, " +
       std::to_string(refused) + " parts refused" + (refused ? ", first: " + firstError : std::string()));
+  }
+  catch (const std::bad_alloc&)
+  {
+    // A file of at most a few MiB never needs a GiB: a size taken from the file unchecked.
+    BrokenInvariant("std::bad_alloc: an allocation beyond the file's means");
   }
   catch (const std::exception& error)
   {
@@ -158,8 +198,24 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
 }
 
 #ifdef RESMR_FUZZ_STANDALONE
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer)
+#define RESMR_FUZZ_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define RESMR_FUZZ_SANITIZED 1
+#endif
+
 int main(int argc, char** argv)
 {
+#ifndef RESMR_FUZZ_SANITIZED
+  // What libFuzzer's malloc limit does when fuzzing: an allocation of a size taken from the
+  // file unchecked fails (std::bad_alloc, a finding) instead of filling the machine. Not
+  // under ASan, which reserves terabytes of address space for its shadow memory.
+  const rlimit limit{ rlim_t(2) << 30, rlim_t(2) << 30 };
+  setrlimit(RLIMIT_AS, &limit);
+#endif
   if (argc == 4 && std::string(argv[1]) == "--unpack")
   {
     std::string contents;
