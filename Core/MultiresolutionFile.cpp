@@ -3,17 +3,20 @@
 
 #include "AtomicOutputFile.h"
 #include "CornerPointGeometry.h"
+#include "DiamondHierarchy.h"
 
 #include <lzo/lzo1x.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fcntl.h>
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -36,6 +39,13 @@ constexpr uint32_t TrianglesMagic = 0x53495254; // "TRIS"
 /// No chunk of a sane file comes near this (a region holds Cmax columns).
 constexpr uint64_t MaxRawChunk = uint64_t(1) << 31;
 constexpr const char* ChunkNames[4] = { "mesh", "top surface", "bottom surface", "side surface" };
+
+/// Most bytes `stored` bytes of LZO1X can decompress to: a match's length grows by 255 a
+/// byte, so no byte stands for more than 255 (a margin for the stream's ends).
+uint64_t MaxExpansion(uint64_t stored)
+{
+  return 256 * stored + 64;
+}
 
 void InitialiseLzo()
 {
@@ -255,6 +265,7 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
   mesh.active.resize(static_cast<std::size_t>(columns) * layers);
   in.GetBytes(mesh.active.data(), mesh.active.size());
   mesh.openSides.resize(mesh.active.size());
+  int64_t activeCells = 0;
   for (std::size_t i = 0; i < mesh.active.size(); ++i)
   {
     if (mesh.active[i] >> 5)
@@ -264,9 +275,23 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
     }
     mesh.openSides[i] = mesh.active[i] >> 1;
     mesh.active[i] &= 1;
+    activeCells += mesh.active[i];
+  }
+  if (activeCells != record.activeCells)
+  {
+    throw MultiresolutionFileError(in.Where() + ": " + std::to_string(activeCells) + " active cells, the index says " +
+      std::to_string(record.activeCells));
   }
   mesh.cutEdges.resize(columns);
   in.GetBytes(mesh.cutEdges.data(), mesh.cutEdges.size());
+  for (std::size_t c = 0; c < mesh.cutEdges.size(); ++c)
+  {
+    if (mesh.cutEdges[c] >> 4)
+    {
+      throw MultiresolutionFileError(in.Where() + ": cut edges " + std::to_string(mesh.cutEdges[c]) + " of column " +
+        std::to_string(c) + " name an edge beyond the column's four");
+    }
+  }
 }
 
 std::vector<uint8_t> EncodeSurface(const RegionSurface& surface)
@@ -383,11 +408,12 @@ void PutRecord(ByteWriter& out, const RegionRecord& r)
   out.Bytes.resize(start + RecordBytes, 0);
 }
 
-RegionRecord GetRecord(ByteReader& in)
+/// A record as PutRecord wrote it; `reservedZero` tells whether its unused bytes are zero.
+RegionRecord GetRecord(ByteReader& in, bool& reservedZero)
 {
   RegionRecord r;
   r.level = in.Get<int32_t>();
-  in.Get<int32_t>();
+  const int32_t reserved = in.Get<int32_t>();
   r.index = in.Get<int64_t>();
   r.columns = in.Get<int64_t>();
   r.activeCells = in.Get<int64_t>();
@@ -406,6 +432,7 @@ RegionRecord GetRecord(ByteReader& in)
   }
   uint8_t padding[RecordBytes - 4 - 4 - 8 * 4 - 24 - 8 - 32 - 4 * 20];
   in.GetBytes(padding, sizeof(padding));
+  reservedZero = reserved == 0 && std::all_of(padding, padding + sizeof(padding), [](uint8_t b) { return b == 0; });
   return r;
 }
 } // namespace
@@ -421,6 +448,11 @@ std::vector<uint8_t> Decompress(const uint8_t* data, uint64_t size, const ChunkR
   if (Crc32(data + ref.offset, ref.stored) != ref.crc)
   {
     throw MultiresolutionFileError(place + ": checksum mismatch (corrupt data)");
+  }
+  if (ref.raw > MaxExpansion(ref.stored))
+  {
+    throw MultiresolutionFileError(place + ": " + std::to_string(ref.stored) + " bytes cannot decompress to " +
+      std::to_string(ref.raw) + " (corrupt)");
   }
   std::vector<uint8_t> raw(ref.raw);
   lzo_uint length = ref.raw;
@@ -458,6 +490,210 @@ RegionMesh DecodeRegion(const uint8_t* data, uint64_t size, const std::string& p
   ByteReader in(raw.data(), raw.size(), region + ChunkNames[RegionRecord::Side]);
   DecodeTriangles(in, mesh.sideTriangles, static_cast<uint64_t>(mesh.VertexCount()));
   return mesh;
+}
+
+/// Model chunks a long array of `bytes` takes (ChunkFile::AddModelArray; one if empty).
+uint64_t ModelPieces(uint64_t bytes)
+{
+  return std::max<uint64_t>(1, (bytes + ModelPieceBytes - 1) / ModelPieceBytes);
+}
+
+/// Throws naming the header field and what it must be.
+[[noreturn]] void BadField(const std::string& path, const std::string& field, const std::string& value, const std::string& must)
+{
+  throw MultiresolutionFileError(path + ": header field '" + field + "' is " + value + ", must be " + must + " (corrupt)");
+}
+
+std::string Number(double value)
+{
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.17g", value);
+  return text;
+}
+
+/// Every header field against what it must be (the map placement is checked as it is read).
+void CheckHeader(const MultiresolutionHeader& h, const std::string& path)
+{
+  const char* const axes[3] = { "x", "y", "depth" };
+  const int64_t maxDim = int64_t(1) << 24;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (h.dims[a] <= 0 || h.dims[a] > maxDim)
+    {
+      BadField(path, std::string("dimensions (n") + "xyz"[a] + ")", std::to_string(h.dims[a]), "1 to " + std::to_string(maxDim));
+    }
+  }
+  if (h.dims[0] * h.dims[1] > (int64_t(1) << 40) / h.dims[2])
+  {
+    BadField(path, "dimensions", std::to_string(h.dims[0]) + " x " + std::to_string(h.dims[1]) + " x " +
+      std::to_string(h.dims[2]), "at most 2^40 cells");
+  }
+  for (int a = 0; a < 2; ++a)
+  {
+    if (!std::isfinite(h.box[a]) || !std::isfinite(h.box[a + 2]) || !(h.box[a] < h.box[a + 2]))
+    {
+      BadField(path, std::string("hierarchy box (") + axes[a] + ")", Number(h.box[a]) + " to " + Number(h.box[a + 2]),
+        "finite with a positive extent");
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!std::isfinite(h.latticeOrigin[a]))
+    {
+      BadField(path, std::string("lattice origin (") + axes[a] + ")", Number(h.latticeOrigin[a]), "finite");
+    }
+    if (!std::isfinite(h.latticeStep[a]) || !(h.latticeStep[a] > 0))
+    {
+      BadField(path, std::string("lattice step (") + axes[a] + ")", Number(h.latticeStep[a]), "positive and finite");
+    }
+  }
+  // The lattice's integers (int32) reach the whole box.
+  for (int a = 0; a < 2; ++a)
+  {
+    const double reach = std::ldexp(h.latticeStep[a], 31);
+    if (std::fabs(h.box[a] - h.latticeOrigin[a]) >= reach || std::fabs(h.box[a + 2] - h.latticeOrigin[a]) >= reach)
+    {
+      BadField(path, std::string("lattice step (") + axes[a] + ")", Number(h.latticeStep[a]),
+        "large enough for the lattice to reach the hierarchy box");
+    }
+  }
+  if (h.leafLevel < 0 || h.leafLevel > DiamondHierarchy::MaxDepth)
+  {
+    BadField(path, "leaf level", std::to_string(h.leafLevel), "0 to " + std::to_string(DiamondHierarchy::MaxDepth));
+  }
+  if (h.cmax < 1)
+  {
+    BadField(path, "Cmax", std::to_string(h.cmax), "at least 1");
+  }
+  // Each level holds at most 2^(level + 1) regions.
+  const uint64_t maxRegions = h.leafLevel >= 38 ? uint64_t(1) << 40 : (uint64_t(4) << h.leafLevel) - 2;
+  if (h.regionCount < static_cast<uint64_t>(h.leafLevel) + 1 || h.regionCount > maxRegions)
+  {
+    BadField(path, "region count", std::to_string(h.regionCount),
+      std::to_string(h.leafLevel + 1) + " to " + std::to_string(maxRegions) + " for leaf level " + std::to_string(h.leafLevel));
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    if (h.hashTableSides[a] < 1 || h.hashTableSides[a] > PerfectSpatialHash::MaxSide)
+    {
+      BadField(path, "hash table sides", std::to_string(h.hashTableSides[a]), "1 to " + std::to_string(PerfectSpatialHash::MaxSide));
+    }
+    if (h.hashOffsetSides[a] < 1 || h.hashOffsetSides[a] > PerfectSpatialHash::MaxSide)
+    {
+      BadField(path, "hash offset sides", std::to_string(h.hashOffsetSides[a]), "1 to " + std::to_string(PerfectSpatialHash::MaxSide));
+    }
+  }
+  // Active flags of every layer, then the offset, cell and normal tables in pieces of at most
+  // ModelPieceBytes.
+  const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
+  const uint64_t offsets = uint64_t(h.hashOffsetSides[0]) * h.hashOffsetSides[1] * h.hashOffsetSides[2];
+  const uint64_t chunks = static_cast<uint64_t>(h.dims[2]) + ModelPieces(offsets * 6) + ModelPieces(slots * 8) +
+    ModelPieces(slots * 4);
+  if (h.modelChunkCount != chunks)
+  {
+    BadField(path, "model chunk count", std::to_string(h.modelChunkCount),
+      std::to_string(chunks) + " for " + std::to_string(h.dims[2]) + " layers and the hash's sides");
+  }
+  const uint64_t cells = static_cast<uint64_t>(h.dims[0] * h.dims[1] * h.dims[2]);
+  if (h.hashedCells < 1 || h.hashedCells > slots || h.hashedCells > cells)
+  {
+    BadField(path, "hashed cells", std::to_string(h.hashedCells),
+      "1 to the table's " + std::to_string(slots) + " slots and the grid's " + std::to_string(cells) + " cells");
+  }
+}
+
+/// One region record's fields against the header (chunks are checked by the caller).
+void CheckRecord(const RegionRecord& r, const MultiresolutionHeader& h, const std::string& place)
+{
+  const auto fail = [&](const std::string& what) { throw MultiresolutionFileError(place + ": " + what + " (corrupt)"); };
+  if (r.level < 0 || r.level > h.leafLevel || r.index < 0 || r.index >= (int64_t(2) << r.level))
+  {
+    fail("level or region index outside the hierarchy of leaf level " + std::to_string(h.leafLevel));
+  }
+  const int64_t layers = h.dims[2];
+  if (r.columns < 1 || r.columns > h.dims[0] * h.dims[1])
+  {
+    fail(std::to_string(r.columns) + " columns in a grid of " + std::to_string(h.dims[0] * h.dims[1]));
+  }
+  if (r.activeCells < 0 || r.activeCells > r.columns * layers)
+  {
+    fail(std::to_string(r.activeCells) + " active cells in " + std::to_string(r.columns) + " columns");
+  }
+  // Each column has four corner nodes, each node a vertex at every layer interface.
+  if (r.vertices < layers + 1 || r.vertices % (layers + 1) != 0 || r.vertices / (layers + 1) > 4 * r.columns)
+  {
+    fail(std::to_string(r.vertices) + " vertices for " + std::to_string(r.columns) + " columns of " +
+      std::to_string(layers) + " layers");
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!std::isfinite(r.bounds[a]) || !std::isfinite(r.bounds[a + 3]) || r.bounds[a] > r.bounds[a + 3])
+    {
+      fail("bounding volume is not finite or empty");
+    }
+  }
+  if (!std::isfinite(r.error) || !std::isfinite(r.ownError) || r.error < 0 || r.ownError < 0)
+  {
+    fail("error " + Number(r.error) + " or own error " + Number(r.ownError) + " is not finite and non-negative");
+  }
+  for (const auto* cone : { &r.topCone, &r.bottomCone })
+  {
+    const auto& c = *cone;
+    const bool finite = std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]) && std::isfinite(c[3]);
+    const double length = std::sqrt(double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2]);
+    if (!finite || !(c[3] == -2 || (c[3] >= -1 && c[3] <= 1 && std::fabs(length - 1) < 1e-3)))
+    {
+      fail("normal cone is not finite, its axis not of unit length or its cosine not in [-1, 1] (nor -2, empty)");
+    }
+  }
+}
+
+/// Model chunks against the header: every layer's active flags once, of nx ny bits; the hash
+/// arrays in whole pieces, of the sizes the hash's sides call for.
+void CheckModelChunks(const std::vector<ModelChunk>& model, const MultiresolutionHeader& h, const std::string& path)
+{
+  const uint64_t layer = static_cast<uint64_t>(h.dims[0] * h.dims[1]);
+  const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
+  const uint64_t offsets = uint64_t(h.hashOffsetSides[0]) * h.hashOffsetSides[1] * h.hashOffsetSides[2];
+  const uint64_t expected[5] = { 0, (layer + 7) / 8, offsets * 6, slots * 8, slots * 4 };
+  const char* const names[5] = { "", "active flags", "hash offset table", "hash cell table", "cell normal table" };
+  std::vector<uint8_t> layerSeen(static_cast<std::size_t>(h.dims[2]), 0);
+  uint64_t total[5] = {}, pieces[5] = {};
+  for (const ModelChunk& m : model)
+  {
+    const std::string place = path + ": model chunk " + names[m.kind] + " part " + std::to_string(m.part);
+    if (m.kind == ModelChunk::ActiveLayer)
+    {
+      if (m.part >= layerSeen.size() || layerSeen[m.part]++ != 0)
+      {
+        throw MultiresolutionFileError(place + ": no such layer, or a second chunk for it (corrupt)");
+      }
+      if (m.chunk.raw != expected[m.kind])
+      {
+        throw MultiresolutionFileError(place + ": " + std::to_string(m.chunk.raw) + " bytes for " +
+          std::to_string(layer) + " cells (corrupt)");
+      }
+      continue;
+    }
+    total[m.kind] += m.chunk.raw;
+    ++pieces[m.kind];
+  }
+  for (std::size_t k = 0; k < layerSeen.size(); ++k)
+  {
+    if (!layerSeen[k])
+    {
+      throw MultiresolutionFileError(path + ": no active flags for layer " + std::to_string(k + 1) + " (corrupt)");
+    }
+  }
+  for (uint32_t kind = ModelChunk::HashOffsets; kind <= ModelChunk::CellNormals; ++kind)
+  {
+    if (total[kind] != expected[kind] || pieces[kind] != ModelPieces(expected[kind]))
+    {
+      throw MultiresolutionFileError(path + ": " + names[kind] + " of " + std::to_string(total[kind]) + " bytes in " +
+        std::to_string(pieces[kind]) + " chunks, " + std::to_string(expected[kind]) +
+        " expected from the header's hash sides (corrupt)");
+    }
+  }
 }
 
 } // namespace
@@ -588,12 +824,17 @@ std::pair<uint64_t, uint64_t> ReadIndexTrailer(
   ByteReader tail(data + size - IndexTrailerBytes, IndexTrailerBytes, path + ": trailer");
   const uint64_t indexOffset = tail.Get<uint64_t>(), indexSize = tail.Get<uint64_t>();
   const uint32_t indexCrc = tail.Get<uint32_t>();
-  tail.Get<uint32_t>();
+  const uint32_t reserved = tail.Get<uint32_t>();
   char stored[8];
   tail.GetBytes(stored, 8);
   if (std::memcmp(stored, magic, 8) != 0)
   {
     throw MultiresolutionFileError(path + ": no index trailer at the end of the file (truncated or unfinished)");
+  }
+  if (reserved != 0)
+  {
+    throw MultiresolutionFileError(path + ": trailer bytes " + std::to_string(size - 12) + "-" + std::to_string(size - 9) +
+      " (reserved) are not zero (corrupt)");
   }
   const uint64_t indexEnd = size - IndexTrailerBytes;
   if (indexOffset < headerBytes || indexOffset > indexEnd || indexSize != indexEnd - indexOffset)
@@ -607,6 +848,21 @@ std::pair<uint64_t, uint64_t> ReadIndexTrailer(
       std::to_string(indexEnd) + " are corrupt)");
   }
   return { indexOffset, indexSize };
+}
+
+void GeometryDigest::Add(const RegionRecord& region)
+{
+  for (const ChunkRef& c : region.chunks)
+  {
+    this->A = Crc32(&c.crc, 4, Crc32(&c.raw, 4, this->A));
+    this->B = Crc32(&c.stored, 4, Crc32(&c.crc, 4, this->B));
+  }
+}
+
+void GeometryDigest::Add(const ModelChunk& chunk)
+{
+  this->A = Crc32(&chunk.chunk.crc, 4, Crc32(&chunk.kind, 4, this->A));
+  this->B = Crc32(&chunk.chunk.raw, 4, Crc32(&chunk.part, 4, this->B));
 }
 
 void ChooseLattice(const std::array<double, 6>& extent, MultiresolutionHeader& header)
@@ -740,25 +996,18 @@ void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader 
     }
     offset += size;
   };
-  // The geometry id digests every chunk's checksum and size, in index order: the same
-  // geometry gives the same id whatever the chunks' order in the file.
-  uint32_t digestA = 0, digestB = 0x5eed;
+  GeometryDigest digest;
   for (const auto& r : regions)
   {
-    for (const ChunkRef& c : r.record.chunks)
-    {
-      digestA = Crc32(&c.crc, 4, Crc32(&c.raw, 4, digestA));
-      digestB = Crc32(&c.stored, 4, Crc32(&c.crc, 4, digestB));
-    }
+    digest.Add(r.record);
   }
   for (const auto& m : model)
   {
-    digestA = Crc32(&m.record.chunk.crc, 4, Crc32(&m.record.kind, 4, digestA));
-    digestB = Crc32(&m.record.chunk.raw, 4, Crc32(&m.record.part, 4, digestB));
+    digest.Add(m.record);
   }
   header.regionCount = regions.size();
   header.modelChunkCount = model.size();
-  header.geometryId = (static_cast<uint64_t>(digestA) << 32) | digestB;
+  header.geometryId = digest.Id();
   ByteWriter head;
   PutHeader(head, header);
   write(head.Bytes.data(), head.Bytes.size(), "header");
@@ -863,7 +1112,12 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
     {
       throw MultiresolutionFileError(path + ": header checksum mismatch (bytes 0-" + std::to_string(HeaderBytes - 5) + " are corrupt)");
     }
-    head.Get<uint32_t>();
+    const uint32_t headerSize = head.Get<uint32_t>();
+    if (headerSize != HeaderBytes)
+    {
+      throw MultiresolutionFileError(path + ": header field 'header size' at byte 12 is " + std::to_string(headerSize) +
+        ", must be " + std::to_string(HeaderBytes) + " (corrupt)");
+    }
     head.Get(this->Head.dims);
     head.Get(this->Head.box);
     head.Get(this->Head.latticeOrigin);
@@ -880,79 +1134,98 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
     {
       this->ReadMapPlacement(head);
     }
-    const auto& d = this->Head.dims;
-    const auto& m = this->Head.hashTableSides;
-    const auto& r = this->Head.hashOffsetSides;
-    const uint64_t slots = uint64_t(m[0]) * m[1] * m[2];
-    bool sidesInRange = true;
-    for (int a = 0; a < 3; ++a)
-    {
-      sidesInRange = sidesInRange && m[a] >= 1 && r[a] >= 1 && m[a] <= PerfectSpatialHash::MaxSide &&
-        r[a] <= PerfectSpatialHash::MaxSide;
-    }
-    if (d[0] <= 0 || d[1] <= 0 || d[2] <= 0 || d[0] > (int64_t(1) << 24) || d[1] > (int64_t(1) << 24) ||
-      d[2] > (int64_t(1) << 24) || this->Head.leafLevel < 0 || this->Head.leafLevel > 40 ||
-      this->Head.regionCount > (uint64_t(1) << 40) || this->Head.modelChunkCount > (uint64_t(1) << 32) ||
-      !sidesInRange || this->Head.hashedCells > slots)
-    {
-      throw MultiresolutionFileError(path + ": header holds impossible dimensions, level or counts (corrupt)");
-    }
+    CheckHeader(this->Head, path);
 
     const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
     if (indexSize != this->Head.regionCount * RecordBytes + this->Head.modelChunkCount * ModelRecordBytes)
     {
       throw MultiresolutionFileError(path + ": index of " + std::to_string(indexSize) + " bytes at byte " +
         std::to_string(indexOffset) + " does not hold the header's " + std::to_string(this->Head.regionCount) +
-        " regions and " + std::to_string(this->Head.modelChunkCount) + " model chunks (corrupt)");
+        " regions and " + std::to_string(this->Head.modelChunkCount) + " model chunks (header field 'region count' or " +
+        "'model chunk count' corrupt)");
     }
-    ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
-    this->Records.reserve(this->Head.regionCount);
-    for (uint64_t i = 0; i < this->Head.regionCount; ++i)
-    {
-      RegionRecord r = GetRecord(index);
-      const std::string place = path + ": index record " + std::to_string(i) + " (level " + std::to_string(r.level) +
-        ", region " + std::to_string(r.index) + ")";
-      if (r.level < 0 || r.level > this->Head.leafLevel || r.index < 0 || r.index >= (int64_t(2) << r.level) ||
-        r.columns < 0 || r.vertices < 0 || !std::isfinite(r.error))
-      {
-        throw MultiresolutionFileError(place + ": impossible level, region, counts or error");
-      }
-      for (int c = 0; c < RegionRecord::ChunkCount; ++c)
-      {
-        const ChunkRef& chunk = r.chunks[c];
-        if (chunk.offset < HeaderBytes || chunk.offset > indexOffset || chunk.stored > indexOffset - chunk.offset ||
-          chunk.raw >= MaxRawChunk)
-        {
-          throw MultiresolutionFileError(place + ": " + ChunkNames[c] + " at byte " + std::to_string(chunk.offset) +
-            " of " + std::to_string(chunk.stored) + " bytes lies outside the data part of the file");
-        }
-      }
-      this->Records.push_back(r);
-    }
-    for (uint64_t i = 0; i < this->Head.modelChunkCount; ++i)
-    {
-      ModelChunk m;
-      m.kind = index.Get<uint32_t>();
-      m.part = index.Get<uint32_t>();
-      m.chunk.offset = index.Get<uint64_t>();
-      m.chunk.stored = index.Get<uint32_t>();
-      m.chunk.raw = index.Get<uint32_t>();
-      m.chunk.crc = index.Get<uint32_t>();
-      index.Get<uint32_t>();
-      if (m.chunk.offset < HeaderBytes || m.chunk.offset > indexOffset || m.chunk.stored > indexOffset - m.chunk.offset ||
-        m.chunk.raw >= MaxRawChunk || m.kind < ModelChunk::ActiveLayer || m.kind > ModelChunk::CellNormals)
-      {
-        throw MultiresolutionFileError(path + ": model chunk record " + std::to_string(i) + " (kind " +
-          std::to_string(m.kind) + ", part " + std::to_string(m.part) + ") lies outside the data part of the file");
-      }
-      this->Model.push_back(m);
-    }
+    this->ReadIndex(indexOffset, indexSize);
   }
   catch (...)
   {
     UnmapFile(this->Data, this->Size);
     CloseDescriptor(this->Descriptor);
     throw;
+  }
+}
+
+void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
+{
+  const std::string& path = this->FilePath;
+  ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
+  const auto checkChunk = [&](const ChunkRef& chunk, const std::string& what) {
+    if (chunk.offset < HeaderBytes || chunk.offset > indexOffset || chunk.stored > indexOffset - chunk.offset)
+    {
+      throw MultiresolutionFileError(what + " at byte " + std::to_string(chunk.offset) + " of " +
+        std::to_string(chunk.stored) + " bytes lies outside the data part of the file (corrupt)");
+    }
+    if (chunk.raw >= MaxRawChunk || chunk.raw > MaxExpansion(chunk.stored))
+    {
+      throw MultiresolutionFileError(what + " at byte " + std::to_string(chunk.offset) + ": " +
+        std::to_string(chunk.stored) + " bytes cannot decompress to " + std::to_string(chunk.raw) + " (corrupt)");
+    }
+  };
+  GeometryDigest digest;
+  std::set<std::pair<int32_t, int64_t>> seen;
+  int32_t deepest = -1;
+  this->Records.reserve(this->Head.regionCount);
+  for (uint64_t i = 0; i < this->Head.regionCount; ++i)
+  {
+    bool reservedZero = false;
+    RegionRecord r = GetRecord(index, reservedZero);
+    const std::string place = path + ": index record " + std::to_string(i) + " (level " + std::to_string(r.level) +
+      ", region " + std::to_string(r.index) + ")";
+    if (!reservedZero)
+    {
+      throw MultiresolutionFileError(place + ": reserved bytes are not zero (corrupt)");
+    }
+    CheckRecord(r, this->Head, place);
+    if (!seen.insert({ r.level, r.index }).second)
+    {
+      throw MultiresolutionFileError(place + ": a second record of the same region (corrupt)");
+    }
+    for (int c = 0; c < RegionRecord::ChunkCount; ++c)
+    {
+      checkChunk(r.chunks[c], place + ": " + ChunkNames[c]);
+    }
+    deepest = std::max(deepest, r.level);
+    digest.Add(r);
+    this->Records.push_back(r);
+  }
+  if (deepest != this->Head.leafLevel)
+  {
+    throw MultiresolutionFileError(path + ": header field 'leaf level' is " + std::to_string(this->Head.leafLevel) +
+      " but the deepest region of the index is at level " + std::to_string(deepest) + " (corrupt)");
+  }
+  for (uint64_t i = 0; i < this->Head.modelChunkCount; ++i)
+  {
+    ModelChunk m;
+    m.kind = index.Get<uint32_t>();
+    m.part = index.Get<uint32_t>();
+    m.chunk.offset = index.Get<uint64_t>();
+    m.chunk.stored = index.Get<uint32_t>();
+    m.chunk.raw = index.Get<uint32_t>();
+    m.chunk.crc = index.Get<uint32_t>();
+    const uint32_t reserved = index.Get<uint32_t>();
+    const std::string place = path + ": model chunk record " + std::to_string(i) + " (kind " + std::to_string(m.kind) +
+      ", part " + std::to_string(m.part) + ")";
+    if (m.kind < ModelChunk::ActiveLayer || m.kind > ModelChunk::CellNormals || reserved != 0)
+    {
+      throw MultiresolutionFileError(place + ": unknown kind or reserved bytes set (corrupt)");
+    }
+    checkChunk(m.chunk, place);
+    digest.Add(m);
+    this->Model.push_back(m);
+  }
+  CheckModelChunks(this->Model, this->Head, path);
+  if (digest.Id() != this->Head.geometryId)
+  {
+    throw MultiresolutionFileError(path + ": header field 'geometry id' does not match the chunks of the index (corrupt)");
   }
 }
 

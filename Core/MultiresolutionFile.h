@@ -120,6 +120,20 @@ struct ModelChunk
   ChunkRef chunk;
 };
 
+/// The geometry id (MultiresolutionHeader::geometryId): a digest of every chunk's checksum and
+/// sizes in index order (not of its offset), so the same geometry gives the same id whatever
+/// the chunks' order in the file. Add every region record, then every model chunk.
+class GeometryDigest
+{
+public:
+  void Add(const RegionRecord& region);
+  void Add(const ModelChunk& chunk);
+  uint64_t Id() const { return (static_cast<uint64_t>(this->A) << 32) | this->B; }
+
+private:
+  uint32_t A = 0, B = 0x5eed;
+};
+
 /// Position lattice for a model of this extent (x, y, depth min and max).
 void ChooseLattice(const std::array<double, 6>& extent, MultiresolutionHeader& header);
 
@@ -229,6 +243,8 @@ public:
 
 private:
   void ReadMapPlacement(ByteReader& head);
+  /// Reads and checks the index (every record against the header, the geometry id).
+  void ReadIndex(uint64_t indexOffset, uint64_t indexSize);
   std::vector<uint8_t> ReadChunk(const RegionRecord& record, int chunk) const;
   std::vector<uint8_t> ReadChunk(const ChunkRef& ref, const std::string& place) const;
   std::string FilePath;

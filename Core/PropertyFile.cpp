@@ -3,12 +3,14 @@
 #include "PropertyFile.h"
 
 #include "AtomicOutputFile.h"
+#include "PerfectSpatialHash.h"
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <set>
 #include <stdexcept>
 
 namespace resmr
@@ -118,6 +120,13 @@ std::vector<uint64_t> NearestActiveSources(const std::vector<uint64_t>& slotCell
   return sources;
 }
 
+/// Index bytes a table takes: name, step, report, days, range, then the packed table's chunk
+/// and one chunk a layer.
+uint64_t TableRecordBytes(int64_t layers)
+{
+  return NameBytes + 4 + 4 + 8 + 4 + 4 + 20 * (static_cast<uint64_t>(layers) + 1);
+}
+
 std::string TableName(const PropertyTable& t)
 {
   return t.step < 0 ? t.name : t.name + " of step " + std::to_string(t.step) + " (report " + std::to_string(t.reportNumber) + ")";
@@ -157,46 +166,17 @@ PropertyFile::PropertyFile(const std::string& path)
     head.Get(this->Dims);
     head.Get(this->TableSides);
     const uint32_t tables = head.Get<uint32_t>();
-
     const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
-    if (this->Dims[0] <= 0 || this->Dims[1] <= 0 || this->Dims[2] <= 0 || this->Dims[2] > (int64_t(1) << 24))
-    {
-      throw MultiresolutionFileError(path + ": impossible grid dimensions in the header (corrupt)");
-    }
+    this->CheckHeader(tables, indexSize);
     ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
+    std::set<std::pair<std::string, int32_t>> seen;
     for (uint32_t t = 0; t < tables; ++t)
     {
-      PropertyTable table;
-      char name[NameBytes];
-      for (char& c : name)
+      PropertyTable table = this->ReadTable(index, t, indexOffset);
+      if (!seen.insert({ table.name, table.step }).second)
       {
-        c = index.Get<char>();
-      }
-      table.name.assign(name, strnlen(name, NameBytes));
-      table.step = index.Get<int32_t>();
-      table.reportNumber = index.Get<int32_t>();
-      table.days = index.Get<double>();
-      table.minimum = index.Get<float>();
-      table.maximum = index.Get<float>();
-      table.packed = GetRef(index);
-      table.layers.resize(static_cast<std::size_t>(this->Dims[2]));
-      for (ChunkRef& layer : table.layers)
-      {
-        layer = GetRef(index);
-      }
-      for (const ChunkRef* c : { &table.packed })
-      {
-        if (c->offset < HeaderBytes || c->offset > indexOffset || c->stored > indexOffset - c->offset)
-        {
-          throw MultiresolutionFileError(path + ": table " + std::to_string(t) + " (" + TableName(table) + ") lies outside the file");
-        }
-      }
-      for (const ChunkRef& c : table.layers)
-      {
-        if (c.offset < HeaderBytes || c.offset > indexOffset || c.stored > indexOffset - c.offset)
-        {
-          throw MultiresolutionFileError(path + ": table " + std::to_string(t) + " (" + TableName(table) + ") lies outside the file");
-        }
+        throw MultiresolutionFileError(path + ": index table " + std::to_string(t) + " (" + TableName(table) +
+          "): a second table of the same name and step (corrupt)");
       }
       this->Entries.push_back(std::move(table));
     }
@@ -207,6 +187,106 @@ PropertyFile::PropertyFile(const std::string& path)
     CloseDescriptor(this->Descriptor);
     throw;
   }
+}
+
+void PropertyFile::CheckHeader(uint32_t tables, uint64_t indexSize) const
+{
+  const auto bad = [&](const std::string& field, const std::string& value, const std::string& must) {
+    throw MultiresolutionFileError(this->FilePath + ": header field '" + field + "' is " + value + ", must be " + must +
+      " (corrupt)");
+  };
+  const int64_t maxDim = int64_t(1) << 24;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (this->Dims[a] <= 0 || this->Dims[a] > maxDim)
+    {
+      bad(std::string("dimensions (n") + "xyz"[a] + ")", std::to_string(this->Dims[a]), "1 to " + std::to_string(maxDim));
+    }
+    if (this->TableSides[a] < 1 || this->TableSides[a] > PerfectSpatialHash::MaxSide)
+    {
+      bad("hash table sides", std::to_string(this->TableSides[a]), "1 to " + std::to_string(PerfectSpatialHash::MaxSide));
+    }
+  }
+  // A layer's and the packed table's values fit one chunk (their sizes are 32-bit).
+  const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
+  if (layer * 4 > std::numeric_limits<uint32_t>::max())
+  {
+    bad("dimensions", std::to_string(this->Dims[0]) + " x " + std::to_string(this->Dims[1]),
+      "at most 2^30 cells a layer");
+  }
+  if (uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2] * 4 > std::numeric_limits<uint32_t>::max())
+  {
+    bad("hash table sides", std::to_string(this->TableSides[0]) + " x " + std::to_string(this->TableSides[1]) + " x " +
+      std::to_string(this->TableSides[2]), "at most 2^30 slots");
+  }
+  for (std::size_t at = 60; at < HeaderBytes - 4; ++at)
+  {
+    if (this->Data[at] != 0)
+    {
+      bad("reserved bytes", "byte " + std::to_string(at) + " = " + std::to_string(this->Data[at]), "zero");
+    }
+  }
+  const uint64_t recordBytes = TableRecordBytes(this->Dims[2]);
+  if (indexSize != tables * recordBytes)
+  {
+    bad("table count", std::to_string(tables),
+      "what the index of " + std::to_string(indexSize) + " bytes holds (" + std::to_string(recordBytes) + " bytes a table)");
+  }
+}
+
+PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t indexOffset) const
+{
+  PropertyTable table;
+  char name[NameBytes];
+  index.GetBytes(name, NameBytes);
+  table.name.assign(name, strnlen(name, NameBytes));
+  table.step = index.Get<int32_t>();
+  table.reportNumber = index.Get<int32_t>();
+  table.days = index.Get<double>();
+  table.minimum = index.Get<float>();
+  table.maximum = index.Get<float>();
+  table.packed = GetRef(index);
+  table.layers.resize(static_cast<std::size_t>(this->Dims[2]));
+  for (ChunkRef& layer : table.layers)
+  {
+    layer = GetRef(index);
+  }
+  const std::string place = this->FilePath + ": index table " + std::to_string(t) + " (" + TableName(table) + ")";
+  const auto fail = [&](const std::string& what) { throw MultiresolutionFileError(place + ": " + what + " (corrupt)"); };
+  const bool text = std::all_of(table.name.begin(), table.name.end(), [](char c) { return c >= 0x20 && c <= 0x7e; });
+  const bool padded = std::all_of(name + std::min(table.name.size(), NameBytes), name + NameBytes, [](char c) { return c == 0; });
+  if (table.name.empty() || table.name.size() >= NameBytes || !text || !padded)
+  {
+    fail("the name is not 1 to 31 printable characters, NUL-padded");
+  }
+  if (table.step < -1 || table.reportNumber < 0 || !std::isfinite(table.days) ||
+    (table.step < 0 && (table.reportNumber != 0 || table.days != 0)))
+  {
+    fail("step " + std::to_string(table.step) + ", report " + std::to_string(table.reportNumber) + " or day " +
+      std::to_string(table.days) + " impossible");
+  }
+  // NaN both when no cell has a value, else an ordered range.
+  const bool none = std::isnan(table.minimum) && std::isnan(table.maximum);
+  if (!none && !(table.minimum <= table.maximum))
+  {
+    fail("value range " + std::to_string(table.minimum) + " to " + std::to_string(table.maximum) + " impossible");
+  }
+  const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
+  const uint64_t layerValues = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
+  for (int64_t k = -1; k < this->Dims[2]; ++k)
+  {
+    const ChunkRef& c = k < 0 ? table.packed : table.layers[static_cast<std::size_t>(k)];
+    const std::string what = k < 0 ? std::string("packed table") : "layer " + std::to_string(k + 1);
+    if (c.offset < HeaderBytes || c.offset > indexOffset || c.stored > indexOffset - c.offset)
+    {
+      fail(what + " at byte " + std::to_string(c.offset) + " of " + std::to_string(c.stored) + " bytes lies outside the file");
+    }
+    if (c.raw != (k < 0 ? slots : layerValues) * 4)
+    {
+      fail(what + " of " + std::to_string(c.raw) + " bytes for " + std::to_string(k < 0 ? slots : layerValues) + " values");
+    }
+  }
+  return table;
 }
 
 PropertyFile::~PropertyFile()
@@ -385,9 +465,17 @@ void PropertyFileWriter::Add(PropertyTable table, const std::vector<float>& cell
 
 std::size_t PropertyFileWriter::BeginTable(PropertyTable table)
 {
-  if (table.name.empty() || table.name.size() >= NameBytes)
+  // What PropertyFile accepts back.
+  const bool text = std::all_of(table.name.begin(), table.name.end(), [](char c) { return c >= 0x20 && c <= 0x7e; });
+  if (table.name.empty() || table.name.size() >= NameBytes || !text)
   {
-    throw std::invalid_argument(this->Output->Path() + ": property name '" + table.name + "' must hold 1 to 31 bytes");
+    throw std::invalid_argument(this->Output->Path() + ": property name '" + table.name +
+      "' must hold 1 to 31 printable characters");
+  }
+  if (table.step < -1 || table.reportNumber < 0 || !std::isfinite(table.days) ||
+    (table.step < 0 && (table.reportNumber != 0 || table.days != 0)))
+  {
+    throw std::invalid_argument(this->Output->Path() + ": " + TableName(table) + ": step, report number or days impossible");
   }
   OpenTable opened;
   opened.table = std::move(table);

@@ -15,8 +15,10 @@
 //   index (per table: name, step, report number, days, value range, packed chunk, nz layer
 //   chunks), trailer (index offset and size, index CRC, magic "RESMRPIX").
 // - A file is written under a temporary name and renamed; one that names another geometry
-//   is refused (CheckGeometry). Every offset and size is checked before use; failures throw
-//   MultiresolutionFileError naming the file and the place.
+//   is refused (CheckGeometry). Every header and index field is checked when the file is
+//   opened (dimensions, sides, the table count against the index size, names, steps, value
+//   ranges, every chunk inside the file and of the size its table calls for); failures throw
+//   MultiresolutionFileError naming the file and the field or place.
 #pragma once
 
 #include "MultiresolutionFile.h"
@@ -53,6 +55,9 @@ public:
 
   const std::string& Path() const { return this->FilePath; }
   uint64_t GeometryId() const { return this->Geometry; }
+  /// Grid dimensions and hash table sides of the geometry the file was made for.
+  const std::array<int64_t, 3>& Dimensions() const { return this->Dims; }
+  const std::array<uint32_t, 3>& HashTableSides() const { return this->TableSides; }
   const std::vector<PropertyTable>& Tables() const { return this->Entries; }
   /// Index of table (name, step) or -1.
   int Find(const std::string& name, int32_t step) const;
@@ -67,6 +72,8 @@ public:
   const uint8_t* ChunkBytes(const ChunkRef& ref) const { return this->Data + ref.offset; }
 
 private:
+  void CheckHeader(uint32_t tables, uint64_t indexSize) const;
+  PropertyTable ReadTable(ByteReader& index, uint32_t t, uint64_t indexOffset) const;
   std::vector<float> ReadValues(const ChunkRef& ref, uint64_t count, const std::string& place) const;
   std::string FilePath;
   const uint8_t* Data = nullptr;

@@ -5,6 +5,8 @@
 #
 # TARGET: FuzzGrdeclParser   GRDECL decks (grdecl.dict; corpus-work/corpus, artifacts)
 #         FuzzEclipseOutput  EGRID/INIT/UNRST keyword files (eclipse.dict; corpus-work/eclipse/)
+#         FuzzResmrFile      .resmr files and their regions (resmr.dict; corpus-work/resmr/)
+#         FuzzResmrpFile     .resmrp property files (resmr.dict; corpus-work/resmrp/)
 #
 # Environment:
 #   FUZZ_BUILD_DIR   where the fuzzer binary goes          (default /tmp/resmr-fuzz-build)
@@ -39,8 +41,20 @@ case "${target}" in
     dict="${here}/eclipse.dict"
     seeds="${here}/seeds/eclipse"
     ;;
+  FuzzResmrFile)
+    work="${here}/corpus-work/resmr"
+    max_len=65536
+    dict="${here}/resmr.dict"
+    seeds="${here}/seeds/resmr"
+    ;;
+  FuzzResmrpFile)
+    work="${here}/corpus-work/resmrp"
+    max_len=65536
+    dict="${here}/resmr.dict"
+    seeds="${here}/seeds/resmrp"
+    ;;
   *)
-    echo "run_fuzz.sh: unknown target '${target}' (FuzzGrdeclParser or FuzzEclipseOutput)" >&2
+    echo "run_fuzz.sh: unknown target '${target}' (FuzzGrdeclParser, FuzzEclipseOutput, FuzzResmrFile or FuzzResmrpFile)" >&2
     exit 2
     ;;
 esac

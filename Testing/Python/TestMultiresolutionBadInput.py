@@ -29,7 +29,12 @@ Cases, from a small synthetic model built with its properties:
   representation names the property file and PORO; the geometry draws in the solid colour;
 - cut while open: the .resmr cut in place after the roots loaded: the loader names the file
   (cut or rewritten in place) instead of reading past its end (SIGBUS before); the roots
-  still draw."""
+  still draw;
+- flat lattice: the .resmr's depth lattice step set to 0.0 and its header CRC recomputed (no
+  damage, nonsense): refused naming the field, nothing drawn (drawn flat before);
+- .resmrp of 0 tables: the property file's table count set to 0 and its header CRC
+  recomputed: refused naming the property file and the field (opened with no properties
+  before)."""
 import json
 import os
 import random
@@ -37,6 +42,7 @@ import shutil
 import struct
 import subprocess
 import sys
+import zlib
 
 CHILD = "--child" in sys.argv
 TIMEOUT_S = 120
@@ -171,6 +177,14 @@ print(f"{good}: {len(data)} bytes, {len(regions)} regions, {len(model)} model ch
       f"{leaf[0]} index {leaf[1]}, root: index {root[1]}")
 
 
+def with_field(blob, position, fmt, value, header_bytes):
+    """`blob` with a header field set and the header CRC (CRC-32, at its end) recomputed."""
+    out = bytearray(blob)
+    struct.pack_into(fmt, out, position, value)
+    struct.pack_into("<I", out, header_bytes - 4, zlib.crc32(bytes(out[:header_bytes - 4])))
+    return bytes(out)
+
+
 def flipped(blob, position):
     out = bytearray(blob)
     out[position] ^= 0x5A
@@ -219,6 +233,10 @@ cases = [
     ("damaged property table", write("poro", data, flipped(P, poro[0] + poro[1] // 2)), ".resmrp",
      ["PORO", f"at byte {poro[0]}", "checksum mismatch"], "display", "solid"),
     ("cut while open", write("cut", data, P), None, ["cut or rewritten in place"], "display", "roots"),
+    ("flat lattice", write("flat", with_field(data, 112, "<d", 0.0, 256), P), None,
+     ["header field 'lattice step (depth)' is 0"], "reader", "nothing"),
+    ("0 tables .resmrp", write("notables", data, with_field(P, 56, "<I", 0, 128)), ".resmrp",
+     ["header field 'table count' is 0"], "reader", "nothing"),
 ]
 
 
