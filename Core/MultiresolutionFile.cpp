@@ -547,7 +547,10 @@ void CheckHeader(const MultiresolutionHeader& h, const std::string& path)
       BadField(path, std::string("lattice step (") + axes[a] + ")", Number(h.latticeStep[a]), "positive and finite");
     }
   }
-  // The lattice's integers (int32) reach the whole box.
+  // The lattice's integers (int32) reach the whole box, and it resolves the box (the builder
+  // takes 2^-22 of the larger lateral extent, at least 1): a coarser lattice would put every
+  // position on a handful of points, or at infinity.
+  const double lateral = std::max({ h.box[2] - h.box[0], h.box[3] - h.box[1], 1.0 });
   for (int a = 0; a < 2; ++a)
   {
     const double reach = std::ldexp(h.latticeStep[a], 31);
@@ -555,6 +558,11 @@ void CheckHeader(const MultiresolutionHeader& h, const std::string& path)
     {
       BadField(path, std::string("lattice step (") + axes[a] + ")", Number(h.latticeStep[a]),
         "large enough for the lattice to reach the hierarchy box");
+    }
+    if (h.latticeStep[a] > lateral)
+    {
+      BadField(path, std::string("lattice step (") + axes[a] + ")", Number(h.latticeStep[a]),
+        "at most the hierarchy box's extent " + Number(lateral));
     }
   }
   if (h.leafLevel < 0 || h.leafLevel > DiamondHierarchy::MaxDepth)
@@ -1196,6 +1204,19 @@ void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
     deepest = std::max(deepest, r.level);
     digest.Add(r);
     this->Records.push_back(r);
+  }
+  // The depth step resolves the regions' depth range as the lateral steps do the box.
+  float top = std::numeric_limits<float>::infinity(), bottom = -top;
+  for (const RegionRecord& r : this->Records)
+  {
+    top = std::min(top, r.bounds[2]);
+    bottom = std::max(bottom, r.bounds[5]);
+  }
+  const double vertical = std::max(double(bottom) - double(top), 1.0);
+  if (this->Head.latticeStep[2] > vertical)
+  {
+    BadField(path, "lattice step (depth)", Number(this->Head.latticeStep[2]),
+      "at most the regions' depth range " + Number(vertical));
   }
   if (deepest != this->Head.leafLevel)
   {

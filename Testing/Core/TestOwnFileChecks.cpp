@@ -152,6 +152,10 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
   ExpectGeometryRefused("x step -1", valid, "'lattice step (x)' is -1", Set<double>(Step, -1.0));
   ExpectGeometryRefused("y step NaN", valid, "'lattice step (y)' is nan", Set<double>(Step + 8, NaN));
   ExpectGeometryRefused("x step too fine", valid, "'lattice step (x)'", Set<double>(Step, 1e-300));
+  ExpectGeometryRefused("x step 1e300", valid, "'lattice step (x)' is 1.0000000000000001e+300", Set<double>(Step, 1e300));
+  ExpectGeometryRefused("y step 2000", valid, "'lattice step (y)' is 2000, must be at most", Set<double>(Step + 8, 2000.0));
+  ExpectGeometryRefused("depth step 1e300", valid, "'lattice step (depth)' is 1.0000000000000001e+300, must be at most",
+    Set<double>(Step + 16, 1e300));
   ExpectGeometryRefused("leaf level -1", valid, "'leaf level' is -1", Set<int32_t>(LeafLevel, -1));
   ExpectGeometryRefused("leaf level 41", valid, "'leaf level' is 41", Set<int32_t>(LeafLevel, 41));
   // Leaf level 0 holds at most 2 regions; at level 2 no region of the index lies there.
