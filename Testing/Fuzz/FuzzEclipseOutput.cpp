@@ -570,24 +570,9 @@ bool GridSet(const std::string& path, std::string& set)
 
 } // namespace
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer)
-#define RESMR_FUZZ_SANITIZED 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__)
-#define RESMR_FUZZ_SANITIZED 1
-#endif
-
 int main(int argc, char** argv)
 {
-#ifndef RESMR_FUZZ_SANITIZED
-  // What libFuzzer's -rss_limit_mb / malloc limit do when fuzzing: a runaway allocation
-  // fails (std::bad_alloc, printed as the input's outcome) instead of filling the machine.
-  // Not under ASan, which reserves terabytes of address space for its shadow memory.
-  const rlimit limit{ rlim_t(4) << 30, rlim_t(4) << 30 };
-  setrlimit(RLIMIT_AS, &limit);
-#endif
+  resmr_fuzz::LimitAddressSpace(4);
   long count = 0;
   return resmr_fuzz::ReplayMain("FuzzEclipseOutputReplay", argc, argv, count,
     [&](const std::string& path, const std::string& contents) {

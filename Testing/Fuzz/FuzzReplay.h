@@ -10,7 +10,19 @@
 #include <dirent.h>
 #include <functional>
 #include <string>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <unistd.h>
+#include <vector>
+
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer)
+#define RESMR_FUZZ_SANITIZED 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define RESMR_FUZZ_SANITIZED 1
+#endif
 
 namespace resmr_fuzz
 {
@@ -93,6 +105,61 @@ inline int ForEachInput(const char* tool, const std::string& path, const InputRu
   }
   run(path, contents);
   return 0;
+}
+
+/// The file an input is written to, alone in a private directory made for this process and
+/// removed with it; reused from one input to the next.
+class ScratchInput
+{
+public:
+  explicit ScratchInput(const std::string& name)
+  {
+    const char* tmp = std::getenv("TMPDIR");
+    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/resmr-fuzz-XXXXXX";
+    if (!mkdtemp(pattern.data()))
+    {
+      std::perror("mkdtemp");
+      std::abort();
+    }
+    this->Directory = pattern;
+    this->Path = this->Directory + "/" + name;
+  }
+  ~ScratchInput()
+  {
+    std::remove(this->Path.c_str());
+    rmdir(this->Directory.c_str());
+  }
+  ScratchInput(const ScratchInput&) = delete;
+  ScratchInput& operator=(const ScratchInput&) = delete;
+
+  const std::string& Write(const std::vector<uint8_t>& bytes)
+  {
+    std::FILE* file = std::fopen(this->Path.c_str(), "wb");
+    if (!file || (!bytes.empty() && std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) ||
+      std::fclose(file) != 0)
+    {
+      std::perror(this->Path.c_str());
+      std::abort();
+    }
+    return this->Path;
+  }
+
+private:
+  std::string Directory;
+  std::string Path;
+};
+
+/// What libFuzzer's malloc and RSS limits do when fuzzing, for the replay: an allocation of a
+/// size taken from the input unchecked fails (std::bad_alloc) instead of filling the machine.
+/// Not under ASan, which reserves terabytes of address space for its shadow memory.
+inline void LimitAddressSpace(unsigned gibibytes)
+{
+#ifndef RESMR_FUZZ_SANITIZED
+  const rlimit limit{ rlim_t(gibibytes) << 30, rlim_t(gibibytes) << 30 };
+  setrlimit(RLIMIT_AS, &limit);
+#else
+  (void)gibibytes;
+#endif
 }
 
 /// The replay main: every argument through ForEachInput; `count` is incremented by the

@@ -38,47 +38,6 @@
 
 namespace
 {
-/// A private, initially empty directory holding the input file (one per process).
-class InputFile
-{
-public:
-  InputFile()
-  {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/resmr-fuzz-XXXXXX";
-    if (!mkdtemp(pattern.data()))
-    {
-      std::perror("mkdtemp");
-      std::abort();
-    }
-    this->Directory = pattern;
-    this->Path = this->Directory + "/input.resmr";
-  }
-  ~InputFile()
-  {
-    std::remove(this->Path.c_str());
-    rmdir(this->Directory.c_str());
-  }
-  InputFile(const InputFile&) = delete;
-  InputFile& operator=(const InputFile&) = delete;
-
-  const std::string& Write(const std::vector<uint8_t>& bytes)
-  {
-    std::FILE* file = std::fopen(this->Path.c_str(), "wb");
-    if (!file || (!bytes.empty() && std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) ||
-      std::fclose(file) != 0)
-    {
-      std::perror(this->Path.c_str());
-      std::abort();
-    }
-    return this->Path;
-  }
-
-private:
-  std::string Directory;
-  std::string Path;
-};
-
 #ifdef RESMR_FUZZ_STANDALONE
 std::string LastOutcome;
 bool MustBeValid = false; // the replayed file's name starts with "valid"
@@ -248,7 +207,7 @@ int ReadEverything(const resmr::MultiresolutionFile& file, std::string& firstErr
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
 {
-  static InputFile input;
+  static resmr_fuzz::ScratchInput input("input.resmr");
   static const resmr_fuzz::FileLayout layout = resmr_fuzz::ResmrLayout();
   const std::string& path = input.Write(resmr_fuzz::Repair(data, size, layout));
   try
@@ -283,48 +242,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
 }
 
 #ifdef RESMR_FUZZ_STANDALONE
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer)
-#define RESMR_FUZZ_SANITIZED 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__)
-#define RESMR_FUZZ_SANITIZED 1
-#endif
-
 int main(int argc, char** argv)
 {
-#ifndef RESMR_FUZZ_SANITIZED
-  // What libFuzzer's malloc limit does when fuzzing: an allocation of a size taken from the
-  // file unchecked fails (std::bad_alloc, a finding) instead of filling the machine. Not
-  // under ASan, which reserves terabytes of address space for its shadow memory.
-  const rlimit limit{ rlim_t(2) << 30, rlim_t(2) << 30 };
-  setrlimit(RLIMIT_AS, &limit);
-#endif
-  if (argc == 4 && std::string(argv[1]) == "--unpack")
-  {
-    std::string contents;
-    if (!resmr_fuzz::ReadWholeFile(argv[2], contents))
-    {
-      std::fprintf(stderr, "cannot read %s\n", argv[2]);
-      return 1;
-    }
-    const auto unpacked = resmr_fuzz::UnpackChunks(std::vector<uint8_t>(contents.begin(), contents.end()),
-      resmr_fuzz::ResmrLayout());
-    std::FILE* out = std::fopen(argv[3], "wb");
-    const bool ok = out && std::fwrite(unpacked.data(), 1, unpacked.size(), out) == unpacked.size();
-    return out && std::fclose(out) == 0 && ok ? 0 : 1;
-  }
-  long count = 0;
-  return resmr_fuzz::ReplayMain("FuzzResmrFileReplay", argc, argv, count,
-    [&](const std::string& path, const std::string& contents) {
-      std::printf("%s (%zu bytes): ", path.c_str(), contents.size());
-      std::fflush(stdout); // the name is out before a crash
-      LastOutcome.clear();
-      MustBeValid = path.substr(path.find_last_of('/') + 1).rfind("valid", 0) == 0;
-      LLVMFuzzerTestOneInput(reinterpret_cast<const uint8_t*>(contents.data()), contents.size());
-      std::printf("%s\n", LastOutcome.substr(0, 400).c_str());
-      ++count;
-    });
+  return resmr_fuzz::ResmrReplayMain("FuzzResmrFileReplay", argc, argv, resmr_fuzz::ResmrLayout(), MustBeValid,
+    LastOutcome, LLVMFuzzerTestOneInput);
 }
 #endif

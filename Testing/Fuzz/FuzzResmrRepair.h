@@ -10,11 +10,13 @@
 #pragma once
 
 #include "ByteStream.h"
+#include "FuzzReplay.h"
 #include "MultiresolutionFile.h"
 
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -289,6 +291,38 @@ inline FileLayout ResmrpLayout()
     return at;
   };
   return layout;
+}
+
+/// The standalone main of a .resmr/.resmrp target: `--unpack IN OUT` writes IN with its chunks
+/// stored uncompressed (how the unpacked seeds are made); otherwise every file named is
+/// replayed through `test`, which must accept it whole when its name starts with "valid".
+inline int ResmrReplayMain(const char* tool, int argc, char** argv, const FileLayout& layout,
+  bool& mustBeValid, std::string& lastOutcome, int (*test)(const uint8_t*, std::size_t))
+{
+  LimitAddressSpace(2);
+  if (argc == 4 && std::string(argv[1]) == "--unpack")
+  {
+    std::string contents;
+    if (!ReadWholeFile(argv[2], contents))
+    {
+      std::fprintf(stderr, "cannot read %s\n", argv[2]);
+      return 1;
+    }
+    const auto unpacked = UnpackChunks(std::vector<uint8_t>(contents.begin(), contents.end()), layout);
+    std::FILE* out = std::fopen(argv[3], "wb");
+    const bool ok = out && std::fwrite(unpacked.data(), 1, unpacked.size(), out) == unpacked.size();
+    return out && std::fclose(out) == 0 && ok ? 0 : 1;
+  }
+  long count = 0;
+  return ReplayMain(tool, argc, argv, count, [&](const std::string& path, const std::string& contents) {
+    std::printf("%s (%zu bytes): ", path.c_str(), contents.size());
+    std::fflush(stdout); // the name is out before a crash
+    lastOutcome.clear();
+    mustBeValid = path.substr(path.find_last_of('/') + 1).rfind("valid", 0) == 0;
+    test(reinterpret_cast<const uint8_t*>(contents.data()), contents.size());
+    std::printf("%s\n", lastOutcome.substr(0, 400).c_str());
+    ++count;
+  });
 }
 
 } // namespace resmr_fuzz
