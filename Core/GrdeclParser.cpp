@@ -1384,6 +1384,28 @@ private:
       this->CurrentSection != Section::Schedule;
   }
 
+  /// Section keywords (RUNSPEC ... SCHEDULE, END): true if `keyword` is one.
+  bool EnterSection(const std::string& keyword)
+  {
+    static const std::unordered_map<std::string, Section> sections = { { "RUNSPEC",
+                                                                         Section::Runspec },
+      { "GRID", Section::Grid }, { "EDIT", Section::Edit }, { "PROPS", Section::Props },
+      { "REGIONS", Section::Regions }, { "SOLUTION", Section::Solution },
+      { "SUMMARY", Section::Summary }, { "SCHEDULE", Section::Schedule },
+      { "END", Section::Schedule } };
+    const auto found = sections.find(keyword);
+    if (found == sections.end())
+    {
+      return false;
+    }
+    this->CurrentSection = found->second;
+    if (found->second == Section::Schedule)
+    {
+      this->Stopped = this->Options.stopAtSchedule || keyword == "END";
+    }
+    return true;
+  }
+
   void HandleKeyword(const std::string& keyword, int depth)
   {
     GrdeclTokenizer& tokens = *this->Tokens;
@@ -1491,38 +1513,8 @@ private:
         tokens.SkipRestOfLine();
       }
     }
-    else if (keyword == "RUNSPEC")
+    else if (this->EnterSection(keyword))
     {
-      this->CurrentSection = Section::Runspec;
-    }
-    else if (keyword == "GRID")
-    {
-      this->CurrentSection = Section::Grid;
-    }
-    else if (keyword == "EDIT")
-    {
-      this->CurrentSection = Section::Edit;
-    }
-    else if (keyword == "PROPS")
-    {
-      this->CurrentSection = Section::Props;
-    }
-    else if (keyword == "REGIONS")
-    {
-      this->CurrentSection = Section::Regions;
-    }
-    else if (keyword == "SOLUTION")
-    {
-      this->CurrentSection = Section::Solution;
-    }
-    else if (keyword == "SUMMARY")
-    {
-      this->CurrentSection = Section::Summary;
-    }
-    else if (keyword == "SCHEDULE" || keyword == "END")
-    {
-      this->CurrentSection = Section::Schedule;
-      this->Stopped = this->Options.stopAtSchedule || keyword == "END";
     }
     else if (this->CurrentSection == Section::Schedule)
     {
