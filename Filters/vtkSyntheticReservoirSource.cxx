@@ -16,7 +16,7 @@
 #include "ResMRExplicitGrid.h"
 
 #include "CornerPointGeometry.h"
-#include "GrdeclDeck.h"
+#include "CornerPointModel.h"
 #include "MemoryBudget.h"
 #include "SyntheticReservoir.h"
 
@@ -153,7 +153,7 @@ bool vtkSyntheticReservoirSource::BuildModelIfNeeded()
     internal.Model = std::make_unique<resmr::SyntheticReservoir>(p);
     const resmr::SyntheticReservoir& model = *internal.Model;
     const int64_t cells = p.CellCount(), columns = p.nx * p.ny;
-    resmr::GrdeclDeck deck;
+    resmr::CornerPointModel deck;
     deck.dims = { p.nx, p.ny, p.nz };
     deck.coord = model.Coord();
     for (double& value : deck.coord)

@@ -15,11 +15,12 @@
 #include "vtkStringArray.h"
 
 #include "CornerPointGeometry.h"
-#include "MemoryBudget.h"
+#include "DerivedArrays.h"
 #include "EclipseGrid.h"
 #include "EclipseKeywordFile.h"
 #include "EclipseResults.h"
-#include "GrdeclError.h"
+#include "Errors.h"
+#include "MemoryBudget.h"
 #include "ResMRExplicitGrid.h"
 
 #include <algorithm>
@@ -270,17 +271,16 @@ void vtkEGRIDReader::ListArraysAndTimes()
       [&](const resmr::EclipseResultArray& other) { return other.name == array.name; });
     internal.Arrays.push_back({ clash ? array.name + "_INIT" : array.name, array.name, false, array });
   }
-  bool hasWater = false, hasOil = false;
+  std::vector<std::string> dynamicNames;
   for (const resmr::EclipseResultArray& array : dynamicArrays)
   {
     internal.Arrays.push_back({ array.name, array.name, true, array });
-    hasWater |= array.name == "SWAT";
-    hasOil |= array.name == "SOIL";
+    dynamicNames.push_back(array.name);
   }
-  if (hasWater && !hasOil)
+  if (resmr::NeedsDerivedOil(dynamicNames))
   {
-    // OPM Flow and many ECLIPSE runs write SWAT and SGAS only; engineers expect SOIL.
-    SelectableArray oil{ "SOIL", "SOIL", true, { "SOIL", resmr::EclipseDataType::Real } };
+    SelectableArray oil{ resmr::DerivedOilName, resmr::DerivedOilName, true,
+      { resmr::DerivedOilName, resmr::EclipseDataType::Real } };
     oil.derivedOil = true;
     internal.Arrays.push_back(oil);
   }
@@ -367,16 +367,8 @@ vtkSmartPointer<vtkDataArray> ReadCellArray(const resmr::EclipseResults& results
   if (array.derivedOil)
   {
     bool found = true;
-    auto oil = resmr_readers::MakeCellArray<vtkFloatArray>("SOIL", order, [&](float* out) {
-      const std::size_t cells = static_cast<std::size_t>(order.nx * order.ny * order.nz);
-      const float nan = std::numeric_limits<float>::quiet_NaN();
-      std::vector<float> gas(cells, 0.0f);
-      found = results.ReadDynamic(step, "SWAT", out, nan);
-      results.ReadDynamic(step, "SGAS", gas.data(), nan); // two-phase runs have no SGAS
-      for (std::size_t cell = 0; cell < cells; ++cell)
-      {
-        out[cell] = 1.0f - out[cell] - gas[cell];
-      }
+    auto oil = resmr_readers::MakeCellArray<vtkFloatArray>(resmr::DerivedOilName, order, [&](float* out) {
+      found = resmr::ReadDerivedOil(results, step, out, int64_t(order.nx) * order.ny * order.nz);
     });
     return found ? oil : nullptr;
   }
@@ -412,7 +404,7 @@ vtkSmartPointer<vtkDataArray> ReadCellArrayOrExplain(const resmr::EclipseResults
   {
     return ReadCellArray(results, array, step, order);
   }
-  catch (const resmr::GrdeclError& error)
+  catch (const resmr::InputError& error)
   {
     why = std::string(error.what()) + "; " + array.shownName + " is not shown";
     return nullptr;

@@ -21,7 +21,7 @@
 #include "CornerPointGeometry.h"
 #include "MemoryBudget.h"
 #include "ResMRExplicitGrid.h"
-#include "GrdeclError.h"
+#include "Errors.h"
 #include "GrdeclParser.h"
 
 #include <cmath>
@@ -34,7 +34,7 @@ struct vtkGRDECLReader::Internals
   std::string FailedFile; ///< last file that failed to parse, to report it once
   long long FailedModificationTime = -1;
   std::string FailedMessage;
-  resmr::GrdeclDeck Deck;
+  resmr::CornerPointModel Deck;
   std::optional<resmr::CornerPointGeometry> Geometry;
 };
 
@@ -137,7 +137,7 @@ void vtkGRDECLReader::SetMemoryLimitMB(int megabytes)
     // Parse again under the new limit: a refusal may no longer hold, or a deck may no
     // longer fit.
     this->Internal->Geometry.reset();
-    this->Internal->Deck = resmr::GrdeclDeck();
+    this->Internal->Deck = resmr::CornerPointModel();
     this->Internal->ParsedFile.clear();
     this->Internal->FailedFile.clear();
     this->Modified();
@@ -170,12 +170,12 @@ bool vtkGRDECLReader::ParseIfNeeded()
     return false;
   }
   internal.Geometry.reset();
-  internal.Deck = resmr::GrdeclDeck();
+  internal.Deck = resmr::CornerPointModel();
   internal.ParsedFile.clear();
   internal.FailedFile.clear();
   this->Warnings.clear();
   const auto fail = [&](const std::string& message) {
-    internal.Deck = resmr::GrdeclDeck();
+    internal.Deck = resmr::CornerPointModel();
     internal.Geometry.reset();
     internal.FailedFile = this->FileName;
     internal.FailedModificationTime = modified;
@@ -255,7 +255,7 @@ int vtkGRDECLReader::RequestData(
   {
     return 0;
   }
-  const resmr::GrdeclDeck& deck = this->Internal->Deck;
+  const resmr::CornerPointModel& deck = this->Internal->Deck;
   resmr::CornerPointGeometry& geometry = *this->Internal->Geometry;
   geometry.SetMapAxesApplied(this->ApplyMapAxes);
   this->LeftHanded = geometry.IsLeftHanded();

@@ -6,7 +6,7 @@
 // the output size (8 bytes per value in coord, zcorn, dx/dy/dz and every cell array) and the
 // process peak RSS so far (VmHWM, bytes). Each run's deck is destroyed before the next one, so
 // the peak is that of one parse. Exit status 1 (with a JSON "error") if parsing fails.
-#include "GrdeclError.h"
+#include "Errors.h"
 #include "GrdeclParser.h"
 
 #include <sys/resource.h>
@@ -37,7 +37,7 @@ long long PeakRssBytes()
   return static_cast<long long>(usage.ru_maxrss) * 1024;
 }
 
-long long OutputBytes(const resmr::GrdeclDeck& deck)
+long long OutputBytes(const resmr::CornerPointModel& deck)
 {
   std::size_t values = deck.coord.size() + deck.zcorn.size() + deck.dxv.size() +
     deck.dyv.size() + deck.dzv.size();
@@ -49,7 +49,7 @@ long long OutputBytes(const resmr::GrdeclDeck& deck)
 }
 
 /// What a geometry-only loader keeps: COORD, ZCORN and ACTNUM.
-long long GeometryBytes(const resmr::GrdeclDeck& deck)
+long long GeometryBytes(const resmr::CornerPointModel& deck)
 {
   std::size_t values = deck.coord.size() + deck.zcorn.size();
   if (const resmr::CellArray* actnum = deck.FindArray("ACTNUM"))
@@ -105,7 +105,7 @@ int main(int argc, char** argv)
     try
     {
       const auto start = std::chrono::steady_clock::now();
-      resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(path);
+      resmr::CornerPointModel deck = resmr::ParseGrdeclFile(path);
       const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       std::size_t faces = 0;

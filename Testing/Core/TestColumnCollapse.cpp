@@ -9,7 +9,7 @@
 #include "CornerPointGeometry.h"
 #include "EclipseGrid.h"
 #include "MeshQuality.h"
-#include "GrdeclDeck.h"
+#include "CornerPointModel.h"
 #include "SyntheticReservoir.h"
 
 #include <algorithm>
@@ -744,7 +744,7 @@ void TestSyntheticEndGame()
   parameters.nx = parameters.ny = parameters.nz = 100;
   parameters.seed = 1;
   const resmr::SyntheticReservoir reservoir(parameters);
-  resmr::GrdeclDeck deck;
+  resmr::CornerPointModel deck;
   deck.dims = { parameters.nx, parameters.ny, parameters.nz };
   deck.coord = reservoir.Coord();
   deck.zcornSingle.resize(static_cast<std::size_t>(8 * parameters.CellCount()));

@@ -6,7 +6,7 @@
 #include "EclipseKeywordWriter.h"
 #include "EclipseResults.h"
 #include "CoreTesting.h"
-#include "GrdeclError.h"
+#include "Errors.h"
 
 #include <cmath>
 #include <csignal>
@@ -124,7 +124,7 @@ std::string Write(const std::string& name, const std::string& bytes)
 void ExpectError(const std::string& label, const std::function<void()>& action,
   const std::vector<std::string>& fragments)
 {
-  resmr_testing::ExpectError<resmr::GrdeclError>(label, action, fragments);
+  resmr_testing::ExpectError<resmr::InputError>(label, action, fragments);
 }
 
 // ------------------------------------------------------------------ tests

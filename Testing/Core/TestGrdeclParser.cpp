@@ -2,7 +2,7 @@
 // form, and every kind of bad input giving an error that names the file, line and keyword.
 #include "CornerPointGeometry.h"
 #include "CoreTesting.h"
-#include "GrdeclError.h"
+#include "Errors.h"
 #include "GrdeclParser.h"
 #include "GrdeclTokenizer.h"
 
@@ -29,24 +29,24 @@ std::string Write(const std::string& name, const std::string& text)
   return path;
 }
 
-resmr::GrdeclDeck Parse(const std::string& name, const std::string& text)
+resmr::CornerPointModel Parse(const std::string& name, const std::string& text)
 {
   return resmr::ParseGrdeclFile(Write(name, text));
 }
 
-/// Expects parsing to throw a GrdeclError whose message holds every fragment.
+/// Expects parsing to throw a InputError whose message holds every fragment.
 void ExpectError(const std::string& name, const std::string& text,
   const std::vector<std::string>& fragments, resmr::GrdeclParseOptions options = {})
 {
   const std::string path = Write(name, text);
   try
   {
-    resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(path, options);
+    resmr::CornerPointModel deck = resmr::ParseGrdeclFile(path, options);
     resmr::CornerPointGeometry::FromDeck(deck, true);
     std::fprintf(stderr, "expected an error for %s, got none\n", name.c_str());
     ++resmr_testing::Failures;
   }
-  catch (const resmr::GrdeclError& error)
+  catch (const resmr::InputError& error)
   {
     const std::string message = error.what();
     for (const std::string& fragment : fragments)
@@ -139,7 +139,7 @@ void TestTokenizer()
 
 void TestCornerPointDeck()
 {
-  resmr::GrdeclDeck deck = Parse("two.grdecl", std::string(TwoCells) +
+  resmr::CornerPointModel deck = Parse("two.grdecl", std::string(TwoCells) +
       "ACTNUM\n 1 0 /\nPORO\n 0.25 0.5 /\nSATNUM\n 2*3 /\nNTG\n 2* /\n");
   CHECK(deck.dims[0] == 2 && deck.dims[1] == 1 && deck.dims[2] == 1);
   CHECK(deck.zcorn.size() == 16 && deck.coord.size() == 36);
@@ -180,7 +180,7 @@ FAULTS
  'F2' 2 2 1 1 1 1 I- /
 /
 )";
-  resmr::GrdeclDeck deck = Parse("faulted.grdecl", faulted);
+  resmr::CornerPointModel deck = Parse("faulted.grdecl", faulted);
   CHECK(deck.faults.size() == 2 && deck.faults[0].name == "F1" && deck.faults[0].faces.size() == 2);
   CHECK(deck.faults[1].faces[0].face == resmr::FaultFace::IMinus);
   CHECK(deck.faults[0].faces[0].box[0] == 0 && deck.faults[0].faces[0].face == resmr::FaultFace::IPlus);
@@ -236,7 +236,7 @@ SCHEDULE
 PORO
  this would be an error if parsed /
 )";
-  resmr::GrdeclDeck deck = Parse("cartesian.DATA", deckText);
+  resmr::CornerPointModel deck = Parse("cartesian.DATA", deckText);
   CHECK(deck.dims[0] == 3 && deck.dims[2] == 2);
   const auto& poro = deck.FindArray("PORO")->values;
   CHECK(poro[0] == 0.3 + 0.01 && poro[6] == 0.3 && poro[1] == 0.2);
@@ -261,7 +261,7 @@ void TestIncludesAndMapAxes()
   std::system(("mkdir -p '" + Directory + "/sub'").c_str());
   Write("sub/nested.inc", "INCLUDE\n 'leaf.inc' /\n");
   Write("sub/leaf.inc", "NTG\n 2*0.9 /\n");
-  resmr::GrdeclDeck deck = Parse("includes.DATA",
+  resmr::CornerPointModel deck = Parse("includes.DATA",
     "MAPAXES\n 100 201 100 200 101 200 /\nGRIDUNIT\n 'METRES' ' ' /\n"
     "INCLUDE\n 'inc_grid.inc' /\nINCLUDE\n inc_props.INC /\nINCLUDE\n \"sub/nested.inc\" /\n");
   CHECK(deck.files.size() == 5);
@@ -317,7 +317,7 @@ void TestBinaryGrdecl()
   floats({ 100, 100, 100, 100, 100, 100, 100, 100, 101, 101, 101, 101, 101, 101, 101, 101 });
   header("PORO", 2, "REAL");
   floats({ 0.25f, 0.5f });
-  resmr::GrdeclDeck deck = Parse("binary.bgrdecl", bytes);
+  resmr::CornerPointModel deck = Parse("binary.bgrdecl", bytes);
   CHECK(deck.dims[0] == 2 && deck.zcorn.size() == 16 && deck.zcorn[15] == 101);
   CHECK(deck.FindArray("PORO") && deck.FindArray("PORO")->values[1] == 0.5);
   // Truncated copy: a clear error naming the byte offset.
@@ -382,13 +382,13 @@ void TestBadInput()
   ExpectError("strict.DATA", std::string(TwoCells) + "INCLUDE\n 'gone.inc' /\n",
     { "strict.DATA:13", "INCLUDE", "gone.inc", "not found" }, strict);
   resmr::GrdeclParseOptions lenient;
-  resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(
+  resmr::CornerPointModel deck = resmr::ParseGrdeclFile(
     Write("lenient.DATA", std::string(TwoCells) + "INCLUDE\n 'gone.inc' /\n"), lenient);
   CHECK(deck.warnings.size() == 1 && deck.warnings[0].find("gone.inc") != std::string::npos);
 }
 
 /// Counts the warnings holding every fragment.
-int WarningsWith(const resmr::GrdeclDeck& deck, const std::vector<std::string>& fragments)
+int WarningsWith(const resmr::CornerPointModel& deck, const std::vector<std::string>& fragments)
 {
   int count = 0;
   for (const std::string& warning : deck.warnings)
@@ -543,7 +543,7 @@ std::string LineOf(const char* deck, const char* text)
 void TestDeckEditsAndSkips()
 {
   const std::string path = Write("edited.DATA", EditedDeck);
-  const resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(path);
+  const resmr::CornerPointModel deck = resmr::ParseGrdeclFile(path);
   const auto values = [&](const char* name) {
     const resmr::CellArray* array = deck.FindArray(name);
     CHECK(array != nullptr);
@@ -625,7 +625,7 @@ void TestDeckEditsAndSkips()
   const std::string spoolFolder = Directory + "/spool";
   std::system(("mkdir -p '" + spoolFolder + "'").c_str());
   resmr::GrdeclGridSpool spool;
-  const resmr::GrdeclDeck streamed = resmr::ParseGrdeclGrid(path, spoolFolder, spool);
+  const resmr::CornerPointModel streamed = resmr::ParseGrdeclGrid(path, spoolFolder, spool);
   CHECK(streamed.warnings == deck.warnings);
 
   // Edits the viewer cannot honour on arrays it needs stay errors naming file, line, keyword.
@@ -647,7 +647,7 @@ void TestDeckEditsAndSkips()
 
   // A missing INCLUDE is a warning; when it held what the grid needs, the error names it.
   Write("grid_only.inc", twoCells);
-  const resmr::GrdeclDeck missingSolution = Parse("missing_solution.DATA",
+  const resmr::CornerPointModel missingSolution = Parse("missing_solution.DATA",
     "GRID\nINCLUDE\n 'grid_only.inc' /\nSOLUTION\nINCLUDE\n 'not_shipped.inc' /\n");
   CHECK(WarningsWith(missingSolution, { "missing_solution.DATA:5", "INCLUDE", "not_shipped.inc", "not found" }) == 1);
   CHECK(missingSolution.CellCount() == 2);

@@ -158,7 +158,7 @@ std::multiset<FaceKey> FacesOf(const RegionMesh& mesh)
 std::multiset<FaceKey> OriginalFaces(const SyntheticParameters& p)
 {
   SyntheticReservoir model(p);
-  GrdeclDeck deck;
+  CornerPointModel deck;
   deck.dims = { p.nx, p.ny, p.nz };
   deck.coord = model.Coord();
   deck.zcornSingle.resize(static_cast<std::size_t>(8 * p.CellCount()));
@@ -585,10 +585,10 @@ void TestHierarchyFile()
     out.write(content.data(), static_cast<std::streamsize>(content.size()));
   };
   writeBytes(bytes.substr(0, bytes.size() - 100));
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "truncated", [&] { MultiresolutionFile f(damaged); }, { damaged, "truncated" });
   writeBytes(bytes.substr(0, 100));
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "stub", [&] { MultiresolutionFile f(damaged); }, { damaged, "too short" });
   std::string flipped = bytes;
   const RegionRecord& victim = file.Regions()[file.Regions().size() / 2];
@@ -597,21 +597,21 @@ void TestHierarchyFile()
   {
     const MultiresolutionFile f(damaged); // the index is intact: opening works, the chunk does not
     const std::size_t at = file.Regions().size() / 2;
-    resmr_testing::ExpectError<MultiresolutionFileError>("flipped chunk", [&] { f.ReadRegion(at); },
+    resmr_testing::ExpectError<FileFormatError>("flipped chunk", [&] { f.ReadRegion(at); },
       { damaged, "level " + std::to_string(victim.level), "mesh", "checksum" });
   }
   flipped = bytes;
   flipped[bytes.size() - 32 - 192 + 20] ^= 0x01; // inside the last index record
   writeBytes(flipped);
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "flipped index", [&] { MultiresolutionFile f(damaged); }, { damaged, "index checksum" });
   flipped = bytes;
   flipped[40] ^= 0x10;
   writeBytes(flipped);
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "flipped header", [&] { MultiresolutionFile f(damaged); }, { damaged, "header checksum" });
   writeBytes("GRDECL file, not ours " + std::string(400, ' '));
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "not ours", [&] { MultiresolutionFile f(damaged); }, { damaged, "not a multiresolution" });
   std::remove(damaged.c_str());
   std::remove(path.c_str());
@@ -648,7 +648,7 @@ void TestMapAxesInFile()
     auto source = OpenLayerSource(deckPath, TempPath("map-spool"));
     BuildHierarchy(*source, path, options);
   }
-  GrdeclDeck deck;
+  CornerPointModel deck;
   std::vector<bool> active;
   ReadCornerPointModel(deckPath, deck, active);
   const MultiresolutionFile file(path);
@@ -663,7 +663,7 @@ void TestMapAxesInFile()
   std::array<double, 6> transform;
   CHECK(CornerPointGeometry::PlacementTransform(map, transform));
   CHECK(std::abs(transform[2] - std::sqrt(0.75)) < 1e-6 && std::abs(transform[3] - 0.5) < 1e-6);
-  GrdeclDeck mapDeck = deck;
+  CornerPointModel mapDeck = deck;
   const CornerPointGeometry grid = CornerPointGeometry::FromDeck(deck, false);
   const CornerPointGeometry placed = CornerPointGeometry::FromDeck(mapDeck, true);
   int64_t same = 0, corners = 0;
@@ -723,38 +723,38 @@ void TestMapAxesInFile()
   }
   // Versions this build does not know are refused by number.
   writeBytes(withVersion(2));
-  resmr_testing::ExpectError<MultiresolutionFileError>("version 2", [&] { MultiresolutionFile f(damaged); },
+  resmr_testing::ExpectError<FileFormatError>("version 2", [&] { MultiresolutionFile f(damaged); },
     { damaged, "format version 2", "versions 3 to 5", "resmr build" });
   writeBytes(withVersion(6));
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "version 6", [&] { MultiresolutionFile f(damaged); }, { damaged, "format version 6", "newer" });
   // A placement that cannot be right, under a good checksum, is named; a flipped byte there
   // fails the checksum.
   std::string broken = bytes;
   broken[184] = 7;
   writeBytes(WithHeaderCrc(broken));
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "flags", [&] { MultiresolutionFile f(damaged); }, { damaged, "map placement", "unknown flags" });
   broken = bytes;
   std::memcpy(&broken[188 + 32], &broken[188 + 16], 16); // x axis point onto the origin
   writeBytes(WithHeaderCrc(broken));
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "axes", [&] { MultiresolutionFile f(damaged); }, { damaged, "MAPAXES", "coincide" });
   broken = bytes;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::memcpy(&broken[188], &nan, 8);
   writeBytes(WithHeaderCrc(broken));
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "nan", [&] { MultiresolutionFile f(damaged); }, { damaged, "MAPAXES", "not finite" });
   broken = bytes;
   broken[240] = '\x01';
   writeBytes(WithHeaderCrc(broken));
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "units", [&] { MultiresolutionFile f(damaged); }, { damaged, "MAPUNITS", "not text" });
   broken = bytes;
   broken[200] ^= 0x04;
   writeBytes(broken);
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "flipped placement", [&] { MultiresolutionFile f(damaged); }, { damaged, "header checksum" });
   for (const std::string& p : { deckPath, path, inMapPath, inMap, damaged })
   {

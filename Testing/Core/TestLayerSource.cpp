@@ -2,13 +2,13 @@
 // layer, never held whole): OpenLayerSource on every real EGRID/FEGRID and deck of the shared
 // data gives exactly the layers and map placement (MAPAXES, units) of the in-memory path
 // (ReadCornerPointModel, FromDeck, CornerPointLayerSource); decks with ACTNUM/DZ edits match too; corrupt files and the
-// refused COPY into a spooled array fail with GrdeclError naming file and keyword; spool files
+// refused COPY into a spooled array fail with InputError naming file and keyword; spool files
 // never show in the folder.
 #include "CoreTesting.h"
 #include "CornerPointGeometry.h"
 #include "EclipseKeywordFile.h"
-#include "GrdeclDeck.h"
-#include "GrdeclError.h"
+#include "CornerPointModel.h"
+#include "Errors.h"
 #include "LayerSource.h"
 
 #include <cctype>
@@ -55,7 +55,7 @@ bool SameBits(const void* a, const void* b, std::size_t bytes)
 bool CompareWithInMemory(const std::string& path)
 {
   std::string memoryError, streamError;
-  resmr::GrdeclDeck deck;
+  resmr::CornerPointModel deck;
   std::vector<bool> flags;
   std::unique_ptr<resmr::CornerPointGeometry> geometry;
   std::unique_ptr<resmr::CornerPointLayerSource> memory;
@@ -65,7 +65,7 @@ bool CompareWithInMemory(const std::string& path)
     geometry.reset(new resmr::CornerPointGeometry(resmr::CornerPointGeometry::FromDeck(deck, false)));
     memory.reset(new resmr::CornerPointLayerSource(*geometry, flags, path, deck.Placement()));
   }
-  catch (const resmr::GrdeclError& error)
+  catch (const resmr::InputError& error)
   {
     memoryError = error.what();
   }
@@ -119,7 +119,7 @@ bool CompareWithInMemory(const std::string& path)
       CHECK(layers == memory->Dims()[2]);
     }
   }
-  catch (const resmr::GrdeclError& error)
+  catch (const resmr::InputError& error)
   {
     streamError = error.what();
   }
@@ -215,7 +215,7 @@ void TestCorruptEgrid(const std::string& data)
   // Cut in the middle of ZCORN: refused when opened, naming the file and keyword.
   const std::string truncated = Directory + "/TRUNCATED.EGRID";
   WriteAll(truncated, bytes.substr(0, static_cast<std::size_t>((zcorn->dataOffset + zcorn->endOffset) / 2)));
-  resmr_testing::ExpectError<resmr::GrdeclError>("truncated EGRID",
+  resmr_testing::ExpectError<resmr::InputError>("truncated EGRID",
     [&] { resmr::OpenLayerSource(truncated, SpoolDirectory); }, { truncated, "keyword ZCORN", "truncated" });
 
   // A data record's end marker broken deep inside ZCORN: found when that layer is read.
@@ -225,7 +225,7 @@ void TestCorruptEgrid(const std::string& data)
   broken[static_cast<std::size_t>(zcorn->dataOffset + block * blockBytes + blockBytes - 1)] ^= 0x40;
   const std::string marker = Directory + "/MARKER.EGRID";
   WriteAll(marker, broken);
-  resmr_testing::ExpectError<resmr::GrdeclError>("broken marker",
+  resmr_testing::ExpectError<resmr::InputError>("broken marker",
     [&] {
       auto source = resmr::OpenLayerSource(marker, SpoolDirectory);
       Drain(*source);
@@ -240,7 +240,7 @@ void TestCorruptEgrid(const std::string& data)
   std::memcpy(&nan[static_cast<std::size_t>(offset)], quiet, 4);
   const std::string nanPath = Directory + "/NAN.EGRID";
   WriteAll(nanPath, nan);
-  resmr_testing::ExpectError<resmr::GrdeclError>("NaN depth",
+  resmr_testing::ExpectError<resmr::InputError>("NaN depth",
     [&] {
       auto source = resmr::OpenLayerSource(nanPath, SpoolDirectory);
       Drain(*source);
@@ -333,7 +333,7 @@ EQUALS
   // By region when MULTNUM is given: resmr build does not keep region arrays, so refused.
   const std::string byRegion = Directory + "/BY_REGION.grdecl";
   WriteAll(byRegion, std::string(CornerPointGrid) + "MULTNUM\n 12*1 /\nEQUALREG\n ACTNUM 0 1 M /\n/\n");
-  resmr_testing::ExpectError<resmr::GrdeclError>("EQUALREG on ACTNUM",
+  resmr_testing::ExpectError<resmr::InputError>("EQUALREG on ACTNUM",
     [&] { resmr::OpenLayerSource(byRegion, SpoolDirectory); },
     { byRegion + ":", "keyword EQUALREG", "ACTNUM", "region" });
 
@@ -368,7 +368,7 @@ PORO
   // COPY of a dropped property into ACTNUM: refused, naming file, line and keyword.
   const std::string refused = Directory + "/COPY.grdecl";
   WriteAll(refused, std::string(CornerPointGrid) + "PORO\n 12*0.3 /\nCOPY\n 'PORO' 'ACTNUM' /\n/\n");
-  resmr_testing::ExpectError<resmr::GrdeclError>("COPY into ACTNUM",
+  resmr_testing::ExpectError<resmr::InputError>("COPY into ACTNUM",
     [&] { resmr::OpenLayerSource(refused, SpoolDirectory); }, { refused + ":", "keyword COPY", "ACTNUM" });
   CHECK(EntriesIn(SpoolDirectory) == 0);
 

@@ -2,7 +2,7 @@
 // test time (resmr synth, build, add-properties), then for each header and index field a copy
 // with that field set to nonsense and every checksum recomputed (chunk CRCs, index CRC,
 // trailer, geometry id, header CRC: Testing/Fuzz/FuzzResmrRepair.h, as the fuzz targets do),
-// which must be refused with a MultiresolutionFileError naming the file and the field. The
+// which must be refused with a FileFormatError naming the file and the field. The
 // depth lattice step 0.0 is also given to `resmr info`, which must fail with that message.
 #include "CoreTesting.h"
 
@@ -86,7 +86,7 @@ void ExpectGeometryRefused(const std::string& label, const Bytes& valid, const s
 {
   const std::string path = Temp + "/changed.resmr";
   Spill(path, Changed(valid, resmr_fuzz::ResmrLayout(), change, late));
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "resmr " + label, [&] { MultiresolutionFile file(path); }, { path, fragment });
 }
 
@@ -95,7 +95,7 @@ void ExpectPropertiesRefused(const std::string& label, const Bytes& valid, const
 {
   const std::string path = Temp + "/changed.resmrp";
   Spill(path, Changed(valid, resmr_fuzz::ResmrpLayout(), change, late));
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "resmrp " + label, [&] { PropertyFile file(path); }, { path, fragment });
 }
 
@@ -229,7 +229,7 @@ void ExpectRegionRefused(const std::string& label, const Bytes& file, std::size_
   Spill(path, file);
   const MultiresolutionFile opened(path);
   const auto& record = opened.Regions()[region];
-  resmr_testing::ExpectError<MultiresolutionFileError>("region " + label, [&] { opened.ReadRegion(region); },
+  resmr_testing::ExpectError<FileFormatError>("region " + label, [&] { opened.ReadRegion(region); },
     { path, "region (level " + std::to_string(record.level) + ", index " + std::to_string(record.index) + ")", fragment });
   for (std::size_t r = 0; r < opened.Regions().size(); ++r)
   {
@@ -347,7 +347,7 @@ void PropertyFields(const Bytes& valid, const std::string& validPath, const std:
   Spill(other, Changed(valid, resmr_fuzz::ResmrpLayout(), [](Bytes& f) { f[12] ^= 1; }));
   const PropertyFile otherFile(other);
   const MultiresolutionFile geometry(geometryPath);
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "resmrp other grid", [&] { otherFile.CheckGeometry(geometry); }, { other, "another geometry" });
 }
 

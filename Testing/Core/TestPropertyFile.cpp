@@ -330,7 +330,7 @@ int main(int argc, char** argv)
   {
     const MultiresolutionFile other(otherPath);
     const PropertyFile properties(propertyPath);
-    resmr_testing::ExpectError<MultiresolutionFileError>(
+    resmr_testing::ExpectError<FileFormatError>(
       "other geometry", [&] { properties.CheckGeometry(other); }, { propertyPath, "another geometry" });
   }
   CHECK(Run(resmrTool + " add-properties '" + otherPath + "' '" + egrid + "' -o '" + propertyPath + "' 2>/dev/null") != 0);
@@ -344,14 +344,14 @@ int main(int argc, char** argv)
     out.write(content.data(), static_cast<std::streamsize>(content.size()));
   };
   writeBytes(bytes.substr(0, bytes.size() - 10));
-  resmr_testing::ExpectError<MultiresolutionFileError>(
+  resmr_testing::ExpectError<FileFormatError>(
     "truncated", [&] { PropertyFile f(damaged); }, { damaged, "truncated" });
   std::string flipped = bytes;
   flipped[200] ^= 0x5a; // inside the first table's first chunk
   writeBytes(flipped);
   {
     const PropertyFile f(damaged);
-    resmr_testing::ExpectError<MultiresolutionFileError>("flipped chunk", [&] {
+    resmr_testing::ExpectError<FileFormatError>("flipped chunk", [&] {
       for (std::size_t t = 0; t < f.Tables().size(); ++t)
       {
         for (int64_t k = 0; k < 15; ++k)

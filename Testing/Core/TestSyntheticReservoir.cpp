@@ -7,7 +7,7 @@
 #include "CornerPointGeometry.h"
 #include "EclipseGrid.h"
 #include "EclipseResults.h"
-#include "GrdeclError.h"
+#include "Errors.h"
 #include "GrdeclParser.h"
 #include "SyntheticReservoir.h"
 #include "SyntheticReservoirWriter.h"
@@ -371,7 +371,7 @@ void TestDeterminismAndGrdecl()
   const resmr::SyntheticReservoir model(parameters);
   const std::string deckPath = Directory + "/SAME.GRDECL";
   resmr::WriteSyntheticGrdecl(model, deckPath);
-  const resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(deckPath);
+  const resmr::CornerPointModel deck = resmr::ParseGrdeclFile(deckPath);
   const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(first.egrid);
   CHECK(deck.dims == grid.deck.dims);
   CHECK(deck.zcorn.size() == grid.deck.zcornSingle.size());
@@ -417,7 +417,7 @@ void TestBadArguments()
   p.ny = 1000;
   p.nz = 269;
   const resmr::SyntheticReservoir big(p);
-  ExpectError<resmr::GrdeclError>("EGRID limit", [&] { resmr::WriteSyntheticEclipse(big, Directory + "/BIG.EGRID"); },
+  ExpectError<resmr::InputError>("EGRID limit", [&] { resmr::WriteSyntheticEclipse(big, Directory + "/BIG.EGRID"); },
     { "BIG.EGRID", "268,435,455", "269000000", "synth:1000x1000x269:1" });
   CHECK(CountFiles("BIG*") == 0);
 
@@ -426,9 +426,9 @@ void TestBadArguments()
   p.ny = 20;
   p.nz = 4;
   const resmr::SyntheticReservoir small(p);
-  ExpectError<resmr::GrdeclError>("unwritable folder",
+  ExpectError<resmr::InputError>("unwritable folder",
     [&] { resmr::WriteSyntheticEclipse(small, Directory + "/no/such/X.EGRID"); }, { "X.EGRID", "cannot create" });
-  ExpectError<resmr::GrdeclError>("steps in GRDECL", [&] {
+  ExpectError<resmr::InputError>("steps in GRDECL", [&] {
     resmr::SyntheticParameters stepped = p;
     stepped.steps = 2;
     resmr::WriteSyntheticGrdecl(resmr::SyntheticReservoir(stepped), Directory + "/STEPS.GRDECL");
@@ -452,9 +452,9 @@ void TestBadArguments()
   limited.rlim_cur = 256 << 10;
   std::signal(SIGXFSZ, SIG_IGN);
   setrlimit(RLIMIT_FSIZE, &limited);
-  ExpectError<resmr::GrdeclError>("disk full", [&] { resmr::WriteSyntheticEclipse(resmr::SyntheticReservoir(medium), target); },
+  ExpectError<resmr::InputError>("disk full", [&] { resmr::WriteSyntheticEclipse(resmr::SyntheticReservoir(medium), target); },
     { "FULL.EGRID", "write failed" });
-  ExpectError<resmr::GrdeclError>("disk full GRDECL",
+  ExpectError<resmr::InputError>("disk full GRDECL",
     [&] { resmr::WriteSyntheticGrdecl(resmr::SyntheticReservoir(noSteps), Directory + "/FULL.GRDECL"); },
     { "FULL.GRDECL", "write failed" });
   setrlimit(RLIMIT_FSIZE, &saved);

@@ -27,7 +27,7 @@
 // step read (double, float, int32_t); last the corner-point geometry of the grid is built
 // as the reader does (FromDeck, BuildSharedCorners).
 //
-// Expected outcomes: results, or a resmr::GrdeclError (or another std::exception) for bad
+// Expected outcomes: results, or a resmr::InputError (or another std::exception) for bad
 // input. Anything else -- a crash, a sanitizer report, a hang or a runaway allocation -- is
 // a finding.
 #include "CornerPointGeometry.h"
@@ -35,7 +35,7 @@
 #include "EclipseKeywordFile.h"
 #include "EclipseResults.h"
 #include "FuzzReplay.h"
-#include "GrdeclError.h"
+#include "Errors.h"
 #include "SyntheticReservoir.h"
 #include "SyntheticReservoirWriter.h"
 
@@ -319,7 +319,7 @@ std::string ReadEveryRecord(const std::string& path, std::string_view contents, 
           BrokenInvariant(path + ": numeric read accepted MESS record " + record.name);
         }
       }
-      catch (const resmr::GrdeclError&)
+      catch (const resmr::InputError&)
       {
         ++errors;
       }
@@ -330,9 +330,9 @@ std::string ReadEveryRecord(const std::string& path, std::string_view contents, 
       }
     }
   }
-  catch (const resmr::GrdeclError& error)
+  catch (const resmr::InputError& error)
   {
-    return std::string("index: GrdeclError: ") + error.what();
+    return std::string("index: InputError: ") + error.what();
   }
   return std::to_string(records) + " records (" + std::to_string(errors) + " unreadable)" + other;
 }
@@ -493,10 +493,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
     }
     outcome += "; geometry " + std::to_string(points) + " shared points";
   }
-  catch (const resmr::GrdeclError& error)
+  catch (const resmr::InputError& error)
   {
     // expected: bad input reported as such
-    outcome += std::string("; GrdeclError: ") + error.what();
+    outcome += std::string("; InputError: ") + error.what();
   }
   catch (const std::exception& error)
   {

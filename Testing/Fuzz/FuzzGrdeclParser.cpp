@@ -6,11 +6,11 @@
 // -DRESMR_FUZZ_STANDALONE; the executable runs the target over every file (or every file in
 // every directory) named on its command line.
 //
-// Expected outcomes: a parsed deck with its geometry, or a resmr::GrdeclError (or another
+// Expected outcomes: a parsed deck with its geometry, or a resmr::InputError (or another
 // std::exception) for bad input. Anything else -- a crash, a sanitizer report, a hang or a
 // runaway allocation -- is a finding.
 #include "CornerPointGeometry.h"
-#include "GrdeclError.h"
+#include "Errors.h"
 #include "GrdeclParser.h"
 #include "FuzzReplay.h"
 
@@ -107,7 +107,7 @@ bool NamesSpecialFiles(const uint8_t* data, std::size_t size)
 }
 using resmr_fuzz::InvariantsChecked;
 
-void CheckDeck(const resmr::GrdeclDeck& deck)
+void CheckDeck(const resmr::CornerPointModel& deck)
 {
   if (!InvariantsChecked())
   {
@@ -168,7 +168,7 @@ void CheckDeck(const resmr::GrdeclDeck& deck)
 }
 
 /// What the reader does with fault faces: the corners of every cell in each box (capped).
-void VisitFaultCells(const resmr::GrdeclDeck& deck, const resmr::CornerPointGeometry& geometry)
+void VisitFaultCells(const resmr::CornerPointModel& deck, const resmr::CornerPointGeometry& geometry)
 {
   int64_t budget = 100000;
   double corners[8][3];
@@ -207,7 +207,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
   options.maxCells = 2'000'000; // reject huge dimensions quickly
   try
   {
-    resmr::GrdeclDeck deck = resmr::ParseGrdeclFile(path, options);
+    resmr::CornerPointModel deck = resmr::ParseGrdeclFile(path, options);
     CheckDeck(deck);
     resmr::CornerPointGeometry geometry = resmr::CornerPointGeometry::FromDeck(deck, true);
     VisitFaultCells(deck, geometry);
@@ -225,10 +225,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
     RESMR_FUZZ_OUTCOME("parsed, " + std::to_string(geometry.CellCount()) + " cells, " +
       std::to_string(points) + " shared points");
   }
-  catch (const resmr::GrdeclError& error)
+  catch (const resmr::InputError& error)
   {
     // expected: bad input reported as such
-    RESMR_FUZZ_OUTCOME(std::string("GrdeclError: ") + error.what());
+    RESMR_FUZZ_OUTCOME(std::string("InputError: ") + error.what());
   }
   catch (const std::exception& error)
   {

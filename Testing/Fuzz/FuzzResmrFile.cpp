@@ -13,7 +13,7 @@
 // trailer, geometry id, header CRC; unpacked chunks compressed), the file is written to a
 // private folder and opened, and each region is decoded, its mesh checked against the header
 // and the index (the promises the viewer relies on) and its surfaces extracted again as the
-// reader does. Expected outcomes: data, or a resmr::MultiresolutionFileError (or another
+// reader does. Expected outcomes: data, or a resmr::FileFormatError (or another
 // std::exception) for bad input, a region's failure costing that region only. Anything else
 // -- a crash, a sanitizer report, a hang, a runaway allocation or a broken invariant -- is a
 // finding. Inputs whose name starts with "valid" must open and decode without an error.
@@ -169,7 +169,7 @@ int ReadEverything(const resmr::MultiresolutionFile& file, std::string& firstErr
       resmr::RegionSurface top, bottom, side;
       resmr::ExtractLayerSurfaces(mesh, 0, top, bottom, side);
     }
-    catch (const resmr::MultiresolutionFileError& error)
+    catch (const resmr::FileFormatError& error)
     {
       refuse(error);
     }
@@ -186,7 +186,7 @@ int ReadEverything(const resmr::MultiresolutionFile& file, std::string& firstErr
         BrokenInvariant("active flags of layer " + std::to_string(k) + ": " + std::to_string(flags.size()) + " cells");
       }
     }
-    catch (const resmr::MultiresolutionFileError& error)
+    catch (const resmr::FileFormatError& error)
     {
       refuse(error);
     }
@@ -197,7 +197,7 @@ int ReadEverything(const resmr::MultiresolutionFile& file, std::string& firstErr
     file.ReadModelArray(resmr::ModelChunk::HashCells);
     file.ReadModelArray(resmr::ModelChunk::CellNormals);
   }
-  catch (const resmr::MultiresolutionFileError& error)
+  catch (const resmr::FileFormatError& error)
   {
     refuse(error);
   }
@@ -234,7 +234,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
     {
       BrokenInvariant(std::string("a valid seed refused: ") + error.what());
     }
-    // expected: bad input reported as such (MultiresolutionFileError, or std::bad_alloc and
+    // expected: bad input reported as such (FileFormatError, or std::bad_alloc and
     // the like from the standard library)
     RESMR_FUZZ_OUTCOME(std::string("refused: ") + error.what());
   }

@@ -98,7 +98,7 @@ inline bool Decompresses(const std::vector<uint8_t>& file, uint64_t offset, uint
     resmr::DecompressChunk(file.data(), file.size(), ref, "repair");
     return true;
   }
-  catch (const resmr::MultiresolutionFileError&)
+  catch (const resmr::FileFormatError&)
   {
     return false;
   }
@@ -164,7 +164,7 @@ inline std::vector<uint8_t> UnpackChunks(const std::vector<uint8_t>& valid, cons
   uint64_t indexOffset = 0, indexSize = 0;
   if (!LocateIndex(file, layout, indexOffset, indexSize))
   {
-    throw resmr::MultiresolutionFileError("unpack: no index");
+    throw resmr::FileFormatError("unpack: no index");
   }
   std::vector<uint8_t> index(file.begin() + static_cast<std::ptrdiff_t>(indexOffset),
     file.begin() + static_cast<std::ptrdiff_t>(indexOffset + indexSize));

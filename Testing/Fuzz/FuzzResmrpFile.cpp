@@ -11,7 +11,7 @@
 // Per input: the checksums are made right again (FuzzResmrRepair.h: chunk CRCs, index CRC,
 // trailer, header CRC; unpacked chunks compressed), the file is written to a private folder
 // and opened, and every table read, packed and layer by layer, its values counted against
-// the header. Expected outcomes: tables, or a resmr::MultiresolutionFileError (or another
+// the header. Expected outcomes: tables, or a resmr::FileFormatError (or another
 // std::exception) for bad input, a table's failure costing that table only. Anything else --
 // a crash, a sanitizer report, a hang, a runaway allocation or a broken invariant -- is a
 // finding. Inputs whose name starts with "valid" must open and read without an error.
@@ -103,7 +103,7 @@ int ReadEverything(const resmr::PropertyFile& file, const std::array<int64_t, 3>
             std::to_string(values.size()) + " values for " + std::to_string(expected));
         }
       }
-      catch (const resmr::MultiresolutionFileError& error)
+      catch (const resmr::FileFormatError& error)
       {
         if (refused++ == 0)
         {
@@ -149,7 +149,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
     {
       BrokenInvariant(std::string("a valid seed refused: ") + error.what());
     }
-    // expected: bad input reported as such (MultiresolutionFileError, or std::bad_alloc and
+    // expected: bad input reported as such (FileFormatError, or std::bad_alloc and
     // the like from the standard library)
     RESMR_FUZZ_OUTCOME(std::string("refused: ") + error.what());
   }

@@ -1,0 +1,219 @@
+#include "ChunkStorage.h"
+
+#include "ByteStream.h"
+
+#include <lzo/lzo1x.h>
+
+#include <array>
+
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace resmr
+{
+namespace
+{
+void InitialiseLzo()
+{
+  static std::once_flag once;
+  std::call_once(once, [] {
+    if (lzo_init() != LZO_E_OK)
+    {
+      throw std::runtime_error("LZO library failed to initialise");
+    }
+  });
+}
+
+std::vector<uint8_t> Decompress(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
+{
+  if (ref.offset > size || ref.stored > size - ref.offset)
+  {
+    throw FileFormatError(place + ": lies outside the file");
+  }
+  if (Crc32(data + ref.offset, ref.stored) != ref.crc)
+  {
+    throw FileFormatError(place + ": checksum mismatch (corrupt data)");
+  }
+  if (ref.raw > MaxDecompressedBytes(ref.stored))
+  {
+    throw FileFormatError(place + ": " + std::to_string(ref.stored) + " bytes cannot decompress to " +
+      std::to_string(ref.raw) + " (corrupt)");
+  }
+  std::vector<uint8_t> raw(ref.raw);
+  lzo_uint length = ref.raw;
+  const int status = lzo1x_decompress_safe(data + ref.offset, ref.stored, raw.data(), &length, nullptr);
+  if (status != LZO_E_OK || length != ref.raw)
+  {
+    throw FileFormatError(place + ": does not decompress to its " + std::to_string(ref.raw) + " bytes");
+  }
+  return raw;
+}
+} // namespace
+
+/// Most bytes `stored` bytes of LZO1X can decompress to: a match's length grows by 255 a
+/// byte, so no byte stands for more than 255 (a margin for the stream's ends).
+uint64_t MaxDecompressedBytes(uint64_t stored)
+{
+  return 256 * stored + 64;
+}
+
+std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw)
+{
+  InitialiseLzo();
+  std::vector<uint8_t> stored(raw.size() + raw.size() / 16 + 64 + 3);
+  // LZO's dictionary, one a thread, never zeroed: it needs no initial contents.
+  thread_local std::unique_ptr<uint8_t[]> work(new uint8_t[LZO1X_1_MEM_COMPRESS]);
+  lzo_uint length = 0;
+  lzo1x_1_compress(raw.data(), raw.size(), stored.data(), &length, work.get());
+  stored.resize(length);
+  return stored;
+}
+
+std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
+{
+  InitialiseLzo();
+  return Decompress(data, size, ref, place);
+}
+
+const uint8_t* MapReadOnlyFile(const std::string& path, uint64_t& size, int* keep)
+{
+  if (keep)
+  {
+    *keep = -1;
+  }
+  const int descriptor = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (descriptor < 0)
+  {
+    throw FileFormatError(path + ": cannot open: " + std::strerror(errno));
+  }
+  struct stat info;
+  if (fstat(descriptor, &info) != 0 || !S_ISREG(info.st_mode))
+  {
+    close(descriptor);
+    throw FileFormatError(path + ": not a regular file");
+  }
+  size = static_cast<uint64_t>(info.st_size);
+  if (size == 0)
+  {
+    close(descriptor);
+    return nullptr;
+  }
+  void* map = mmap(nullptr, size, PROT_READ, MAP_SHARED, descriptor, 0);
+  const int mapError = errno;
+  if (map == MAP_FAILED || !keep)
+  {
+    close(descriptor);
+  }
+  if (map == MAP_FAILED)
+  {
+    throw FileFormatError(path + ": cannot map: " + std::strerror(mapError));
+  }
+  if (keep)
+  {
+    *keep = descriptor;
+  }
+  return static_cast<const uint8_t*>(map);
+}
+
+void CheckMappedSize(int descriptor, uint64_t size, const std::string& path)
+{
+  struct stat info;
+  if (descriptor >= 0 && fstat(descriptor, &info) == 0 && static_cast<uint64_t>(info.st_size) < size)
+  {
+    throw FileFormatError(path + ": the file is now " + std::to_string(info.st_size) + " bytes, " +
+      std::to_string(size) + " when it was opened (cut or rewritten in place while open)");
+  }
+}
+
+void CloseDescriptor(int& descriptor)
+{
+  if (descriptor >= 0)
+  {
+    close(descriptor);
+    descriptor = -1;
+  }
+}
+
+void UnmapFile(const uint8_t* data, uint64_t size)
+{
+  if (data)
+  {
+    munmap(const_cast<uint8_t*>(data), size);
+  }
+}
+
+uint32_t Crc32(const void* data, std::size_t size, uint32_t crc)
+{
+  static const auto table = [] {
+    std::array<uint32_t, 256> t{};
+    for (uint32_t i = 0; i < 256; ++i)
+    {
+      uint32_t c = i;
+      for (int k = 0; k < 8; ++k)
+      {
+        c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+      }
+      t[i] = c;
+    }
+    return t;
+  }();
+  crc = ~crc;
+  const auto* bytes = static_cast<const uint8_t*>(data);
+  for (std::size_t i = 0; i < size; ++i)
+  {
+    crc = table[(crc ^ bytes[i]) & 0xFF] ^ (crc >> 8);
+  }
+  return ~crc;
+}
+
+std::vector<uint8_t> IndexTrailer(uint64_t indexOffset, const std::vector<uint8_t>& index, const char (&magic)[8])
+{
+  ByteWriter trailer;
+  trailer.Put(indexOffset);
+  trailer.Put(static_cast<uint64_t>(index.size()));
+  trailer.Put(Crc32(index.data(), index.size()));
+  trailer.Put(static_cast<uint32_t>(0));
+  trailer.PutBytes(magic, 8);
+  return std::move(trailer.Bytes);
+}
+
+std::pair<uint64_t, uint64_t> ReadIndexTrailer(
+  const uint8_t* data, uint64_t size, uint64_t headerBytes, const char (&magic)[8], const std::string& path)
+{
+  ByteReader tail(data + size - IndexTrailerBytes, IndexTrailerBytes, path + ": trailer");
+  const uint64_t indexOffset = tail.Get<uint64_t>(), indexSize = tail.Get<uint64_t>();
+  const uint32_t indexCrc = tail.Get<uint32_t>();
+  const uint32_t reserved = tail.Get<uint32_t>();
+  char stored[8];
+  tail.GetBytes(stored, 8);
+  if (std::memcmp(stored, magic, 8) != 0)
+  {
+    throw FileFormatError(path + ": no index trailer at the end of the file (truncated or unfinished)");
+  }
+  if (reserved != 0)
+  {
+    throw FileFormatError(path + ": trailer bytes " + std::to_string(size - 12) + "-" + std::to_string(size - 9) +
+      " (reserved) are not zero (corrupt)");
+  }
+  const uint64_t indexEnd = size - IndexTrailerBytes;
+  if (indexOffset < headerBytes || indexOffset > indexEnd || indexSize != indexEnd - indexOffset)
+  {
+    throw FileFormatError(path + ": index at byte " + std::to_string(indexOffset) + " of " +
+      std::to_string(indexSize) + " bytes does not fit a file of " + std::to_string(size) + " bytes (truncated or corrupt)");
+  }
+  if (Crc32(data + indexOffset, indexSize) != indexCrc)
+  {
+    throw FileFormatError(path + ": index checksum mismatch (bytes " + std::to_string(indexOffset) + "-" +
+      std::to_string(indexEnd) + " are corrupt)");
+  }
+  return { indexOffset, indexSize };
+}
+
+} // namespace resmr

@@ -1,0 +1,637 @@
+// Property tables apart from geometry, packed through the perfect spatial hash (paper Sec.
+// 5.2, 5.4, 5.5).
+#include "PropertyFile.h"
+
+#include "AtomicOutputFile.h"
+#include "PerfectSpatialHash.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <set>
+#include <stdexcept>
+
+namespace resmr
+{
+namespace
+{
+constexpr char Magic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'R', 'P' };
+constexpr char TrailerMagic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'I', 'X' };
+constexpr uint32_t Version = 2;
+constexpr std::size_t HeaderBytes = 128;
+constexpr std::size_t NameBytes = 32;
+
+void PutRef(ByteWriter& out, const ChunkRef& c)
+{
+  out.Put(c.offset);
+  out.Put(c.stored);
+  out.Put(c.raw);
+  out.Put(c.crc);
+}
+
+ChunkRef GetRef(ByteReader& in)
+{
+  ChunkRef c;
+  c.offset = in.Get<uint64_t>();
+  c.stored = in.Get<uint32_t>();
+  c.raw = in.Get<uint32_t>();
+  c.crc = in.Get<uint32_t>();
+  return c;
+}
+
+std::vector<uint8_t> HeaderOf(
+  uint64_t geometry, const std::array<int64_t, 3>& dims, const std::array<uint32_t, 3>& tableSides, uint32_t tables)
+{
+  ByteWriter head;
+  head.PutBytes(Magic, 8);
+  head.Put(Version);
+  head.Put(geometry);
+  head.Put(dims);
+  head.Put(tableSides);
+  head.Put(tables);
+  head.Bytes.resize(HeaderBytes - 4, 0);
+  head.Put(Crc32(head.Bytes.data(), head.Bytes.size()));
+  return std::move(head.Bytes);
+}
+
+/// The cell whose value each hash slot holds: its own cell when active, else the nearest
+/// active cell of the same layer (fewest i/j steps; ~0 if the layer has none). Coarse levels'
+/// faces reach over inactive cells (Sec. 4.1 simplifies them with the rest); padding their
+/// slots the way texture atlases pad charts paints them like their surroundings instead of in
+/// the NaN colour. Finest-level faces belong to active cells only, so exact views are unchanged.
+std::vector<uint64_t> NearestActiveSources(const std::vector<uint64_t>& slotCells,
+  const std::vector<std::vector<uint8_t>>& active, const std::array<int64_t, 3>& dims)
+{
+  const uint64_t nx = static_cast<uint64_t>(dims[0]), ny = static_cast<uint64_t>(dims[1]);
+  const uint64_t layer = nx * ny;
+  std::vector<uint64_t> sources = slotCells;
+  std::vector<std::vector<std::size_t>> inactiveSlotsByLayer(active.size());
+  for (std::size_t s = 0; s < slotCells.size(); ++s)
+  {
+    const uint64_t cell = slotCells[s];
+    if (cell != ~uint64_t(0) && !active[cell / layer][cell % layer])
+    {
+      inactiveSlotsByLayer[cell / layer].push_back(s);
+    }
+  }
+  std::vector<uint32_t> nearest;
+  std::vector<uint32_t> queue;
+  for (std::size_t k = 0; k < active.size(); ++k)
+  {
+    if (inactiveSlotsByLayer[k].empty())
+    {
+      continue;
+    }
+    // Breadth-first from every active column at once: each column learns its nearest one.
+    const uint32_t unknown = ~uint32_t(0);
+    nearest.assign(layer, unknown);
+    queue.clear();
+    for (uint64_t c = 0; c < layer; ++c)
+    {
+      if (active[k][c])
+      {
+        nearest[c] = static_cast<uint32_t>(c);
+        queue.push_back(static_cast<uint32_t>(c));
+      }
+    }
+    for (std::size_t head = 0; head < queue.size(); ++head)
+    {
+      const uint32_t c = queue[head];
+      const uint64_t i = c % nx, j = c / nx;
+      const uint64_t next[4] = { i > 0 ? c - 1 : layer, i + 1 < nx ? c + 1 : layer, j > 0 ? c - nx : layer,
+        j + 1 < ny ? c + nx : layer };
+      for (uint64_t n : next)
+      {
+        if (n < layer && nearest[n] == unknown)
+        {
+          nearest[n] = nearest[c];
+          queue.push_back(static_cast<uint32_t>(n));
+        }
+      }
+    }
+    for (std::size_t s : inactiveSlotsByLayer[k])
+    {
+      const uint32_t source = nearest[slotCells[s] % layer];
+      sources[s] = source == unknown ? ~uint64_t(0) : k * layer + source;
+    }
+  }
+  return sources;
+}
+
+/// Index bytes a table takes: name, step, report, days, range, then the packed table's chunk
+/// and one chunk a layer.
+uint64_t TableRecordBytes(int64_t layers)
+{
+  return NameBytes + 4 + 4 + 8 + 4 + 4 + 20 * (static_cast<uint64_t>(layers) + 1);
+}
+
+std::string TableName(const PropertyTable& t)
+{
+  return t.step < 0 ? t.name : t.name + " of step " + std::to_string(t.step) + " (report " + std::to_string(t.reportNumber) + ")";
+}
+} // namespace
+
+PropertyFile::PropertyFile(const std::string& path)
+  : FilePath(path)
+{
+  this->Data = MapReadOnlyFile(path, this->Size, &this->Descriptor);
+  if (this->Size < HeaderBytes + IndexTrailerBytes)
+  {
+    UnmapFile(this->Data, this->Size);
+    CloseDescriptor(this->Descriptor);
+    throw FileFormatError(path + ": " + std::to_string(this->Size) + " bytes, too short for a property file (truncated?)");
+  }
+  try
+  {
+    if (std::memcmp(this->Data, Magic, 8) != 0)
+    {
+      throw FileFormatError(path + ": not a property (.resmrp) file (bad magic at byte 0)");
+    }
+    uint32_t crc;
+    std::memcpy(&crc, this->Data + HeaderBytes - 4, 4);
+    if (Crc32(this->Data, HeaderBytes - 4) != crc)
+    {
+      throw FileFormatError(path + ": header checksum mismatch (bytes 0-127 are corrupt)");
+    }
+    ByteReader head(this->Data + 8, HeaderBytes - 12, path + ": header");
+    const uint32_t version = head.Get<uint32_t>();
+    if (version != Version)
+    {
+      throw FileFormatError(path + ": format version " + std::to_string(version) + "; this build reads version " +
+        std::to_string(Version));
+    }
+    this->Geometry = head.Get<uint64_t>();
+    head.Get(this->Dims);
+    head.Get(this->TableSides);
+    const uint32_t tables = head.Get<uint32_t>();
+    const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
+    this->CheckHeader(tables, indexSize);
+    ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
+    std::set<std::pair<std::string, int32_t>> seen;
+    for (uint32_t t = 0; t < tables; ++t)
+    {
+      PropertyTable table = this->ReadTable(index, t, indexOffset);
+      if (!seen.insert({ table.name, table.step }).second)
+      {
+        throw FileFormatError(path + ": index table " + std::to_string(t) + " (" + TableName(table) +
+          "): a second table of the same name and step (corrupt)");
+      }
+      this->Entries.push_back(std::move(table));
+    }
+  }
+  catch (...)
+  {
+    UnmapFile(this->Data, this->Size);
+    CloseDescriptor(this->Descriptor);
+    throw;
+  }
+}
+
+void PropertyFile::CheckHeader(uint32_t tables, uint64_t indexSize) const
+{
+  const auto bad = [&](const std::string& field, const std::string& value, const std::string& must) {
+    throw FileFormatError(this->FilePath + ": header field '" + field + "' is " + value + ", must be " + must +
+      " (corrupt)");
+  };
+  const int64_t maxDim = int64_t(1) << 24;
+  for (int a = 0; a < 3; ++a)
+  {
+    if (this->Dims[a] <= 0 || this->Dims[a] > maxDim)
+    {
+      bad(std::string("dimensions (n") + "xyz"[a] + ")", std::to_string(this->Dims[a]), "1 to " + std::to_string(maxDim));
+    }
+    if (this->TableSides[a] < 1 || this->TableSides[a] > PerfectSpatialHash::MaxSide)
+    {
+      bad("hash table sides", std::to_string(this->TableSides[a]), "1 to " + std::to_string(PerfectSpatialHash::MaxSide));
+    }
+  }
+  // A layer's and the packed table's values fit one chunk (their sizes are 32-bit).
+  const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
+  if (layer * 4 > std::numeric_limits<uint32_t>::max())
+  {
+    bad("dimensions", std::to_string(this->Dims[0]) + " x " + std::to_string(this->Dims[1]),
+      "at most 2^30 cells a layer");
+  }
+  if (uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2] * 4 > std::numeric_limits<uint32_t>::max())
+  {
+    bad("hash table sides", std::to_string(this->TableSides[0]) + " x " + std::to_string(this->TableSides[1]) + " x " +
+      std::to_string(this->TableSides[2]), "at most 2^30 slots");
+  }
+  for (std::size_t at = 60; at < HeaderBytes - 4; ++at)
+  {
+    if (this->Data[at] != 0)
+    {
+      bad("reserved bytes", "byte " + std::to_string(at) + " = " + std::to_string(this->Data[at]), "zero");
+    }
+  }
+  const uint64_t recordBytes = TableRecordBytes(this->Dims[2]);
+  if (indexSize != tables * recordBytes)
+  {
+    bad("table count", std::to_string(tables),
+      "what the index of " + std::to_string(indexSize) + " bytes holds (" + std::to_string(recordBytes) + " bytes a table)");
+  }
+}
+
+PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t indexOffset) const
+{
+  PropertyTable table;
+  char name[NameBytes];
+  index.GetBytes(name, NameBytes);
+  table.name.assign(name, strnlen(name, NameBytes));
+  table.step = index.Get<int32_t>();
+  table.reportNumber = index.Get<int32_t>();
+  table.days = index.Get<double>();
+  table.minimum = index.Get<float>();
+  table.maximum = index.Get<float>();
+  table.packed = GetRef(index);
+  table.layers.resize(static_cast<std::size_t>(this->Dims[2]));
+  for (ChunkRef& layer : table.layers)
+  {
+    layer = GetRef(index);
+  }
+  const std::string place = this->FilePath + ": index table " + std::to_string(t) + " (" + TableName(table) + ")";
+  const auto fail = [&](const std::string& what) { throw FileFormatError(place + ": " + what + " (corrupt)"); };
+  const bool text = std::all_of(table.name.begin(), table.name.end(), [](char c) { return c >= 0x20 && c <= 0x7e; });
+  const bool padded = std::all_of(name + std::min(table.name.size(), NameBytes), name + NameBytes, [](char c) { return c == 0; });
+  if (table.name.empty() || table.name.size() >= NameBytes || !text || !padded)
+  {
+    fail("the name is not 1 to 31 printable characters, NUL-padded");
+  }
+  if (table.step < -1 || table.reportNumber < 0 || !std::isfinite(table.days) ||
+    (table.step < 0 && (table.reportNumber != 0 || table.days != 0)))
+  {
+    fail("step " + std::to_string(table.step) + ", report " + std::to_string(table.reportNumber) + " or day " +
+      std::to_string(table.days) + " impossible");
+  }
+  // NaN both when no cell has a value, else an ordered range.
+  const bool none = std::isnan(table.minimum) && std::isnan(table.maximum);
+  if (!none && !(table.minimum <= table.maximum))
+  {
+    fail("value range " + std::to_string(table.minimum) + " to " + std::to_string(table.maximum) + " impossible");
+  }
+  const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
+  const uint64_t layerValues = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
+  for (int64_t k = -1; k < this->Dims[2]; ++k)
+  {
+    const ChunkRef& c = k < 0 ? table.packed : table.layers[static_cast<std::size_t>(k)];
+    const std::string what = k < 0 ? std::string("packed table") : "layer " + std::to_string(k + 1);
+    if (c.offset < HeaderBytes || c.offset > indexOffset || c.stored > indexOffset - c.offset)
+    {
+      fail(what + " at byte " + std::to_string(c.offset) + " of " + std::to_string(c.stored) + " bytes lies outside the file");
+    }
+    if (c.raw != (k < 0 ? slots : layerValues) * 4)
+    {
+      fail(what + " of " + std::to_string(c.raw) + " bytes for " + std::to_string(k < 0 ? slots : layerValues) + " values");
+    }
+  }
+  return table;
+}
+
+PropertyFile::~PropertyFile()
+{
+  UnmapFile(this->Data, this->Size);
+  CloseDescriptor(this->Descriptor);
+}
+
+int PropertyFile::Find(const std::string& name, int32_t step) const
+{
+  for (std::size_t t = 0; t < this->Entries.size(); ++t)
+  {
+    if (this->Entries[t].name == name && this->Entries[t].step == step)
+    {
+      return static_cast<int>(t);
+    }
+  }
+  return -1;
+}
+
+void PropertyFile::CheckGeometry(const MultiresolutionFile& geometry) const
+{
+  if (geometry.Header().geometryId != this->Geometry || geometry.Header().dims != this->Dims ||
+    geometry.Header().hashTableSides != this->TableSides)
+  {
+    throw FileFormatError(this->FilePath + ": made for another geometry than " + geometry.Path() +
+      " (geometry id or grid differs): rebuild it with resmr add-properties");
+  }
+}
+
+std::vector<float> PropertyFile::ReadValues(const ChunkRef& ref, uint64_t count, const std::string& place) const
+{
+  CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
+  const auto raw = DecompressChunk(this->Data, this->Size, ref, place);
+  if (raw.size() != count * 4)
+  {
+    throw FileFormatError(place + ": " + std::to_string(raw.size()) + " bytes, " + std::to_string(count * 4) + " expected");
+  }
+  std::vector<float> values(count);
+  std::memcpy(values.data(), raw.data(), raw.size());
+  return values;
+}
+
+std::vector<float> PropertyFile::ReadPacked(std::size_t table) const
+{
+  const PropertyTable& t = this->Entries.at(table);
+  const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
+  return this->ReadValues(t.packed, slots, this->FilePath + ": packed table of " + TableName(t) + " at byte " +
+    std::to_string(t.packed.offset));
+}
+
+std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
+{
+  const PropertyTable& t = this->Entries.at(table);
+  if (k < 0 || k >= this->Dims[2])
+  {
+    throw std::out_of_range(this->FilePath + ": no layer " + std::to_string(k + 1));
+  }
+  return this->ReadValues(t.layers[static_cast<std::size_t>(k)], static_cast<uint64_t>(this->Dims[0] * this->Dims[1]),
+    this->FilePath + ": layer " + std::to_string(k + 1) + " of " + TableName(t) + " at byte " +
+      std::to_string(t.layers[static_cast<std::size_t>(k)].offset));
+}
+
+PropertyFileWriter::PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry)
+  : Output(new AtomicOutputFile(path))
+  , Geometry(geometry.Header().geometryId)
+  , Dims(geometry.Header().dims)
+  , TableSides(geometry.Header().hashTableSides)
+{
+  const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
+  std::vector<uint64_t> slotCells;
+  {
+    const auto cells = geometry.ReadModelArray(ModelChunk::HashCells);
+    if (cells.size() != slots * 8)
+    {
+      throw FileFormatError(geometry.Path() + ": hash cells hold " + std::to_string(cells.size()) +
+        " bytes for a table of " + std::to_string(slots) + " slots");
+    }
+    slotCells.resize(cells.size() / 8);
+    std::memcpy(slotCells.data(), cells.data(), cells.size());
+  }
+  const uint64_t total = static_cast<uint64_t>(this->Dims[0] * this->Dims[1] * this->Dims[2]);
+  for (uint64_t cell : slotCells)
+  {
+    if (cell != ~uint64_t(0) && cell >= total)
+    {
+      throw FileFormatError(geometry.Path() + ": a hash slot names cell " + std::to_string(cell) + " of " +
+        std::to_string(total));
+    }
+  }
+  for (int64_t k = 0; k < this->Dims[2]; ++k)
+  {
+    this->Active.push_back(geometry.ReadActiveLayer(k));
+  }
+  this->SlotSources = NearestActiveSources(slotCells, this->Active, this->Dims);
+  slotCells = std::vector<uint64_t>();
+  // The slots each layer fills (those whose source lies in it), for tables given by layers.
+  const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
+  this->LayerSlotStart.assign(static_cast<std::size_t>(this->Dims[2]) + 1, 0);
+  for (uint64_t source : this->SlotSources)
+  {
+    if (source != ~uint64_t(0))
+    {
+      ++this->LayerSlotStart[source / layer + 1];
+    }
+  }
+  for (std::size_t k = 1; k < this->LayerSlotStart.size(); ++k)
+  {
+    this->LayerSlotStart[k] += this->LayerSlotStart[k - 1];
+  }
+  this->SlotsByLayer.resize(this->LayerSlotStart.back());
+  std::vector<uint64_t> next(this->LayerSlotStart.begin(), this->LayerSlotStart.end() - 1);
+  for (uint64_t s = 0; s < this->SlotSources.size(); ++s)
+  {
+    if (this->SlotSources[s] != ~uint64_t(0))
+    {
+      this->SlotsByLayer[next[this->SlotSources[s] / layer]++] = s;
+    }
+  }
+  // The table count is patched in at Commit.
+  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, 0);
+  this->Write(head.data(), head.size(), "header");
+}
+
+PropertyFileWriter::~PropertyFileWriter() = default;
+
+void PropertyFileWriter::Write(const void* data, std::size_t size, const std::string& what)
+{
+  if (!this->Output->Write(data, size))
+  {
+    throw FileFormatError(this->Output->Path() + ": writing the " + what + " at byte " +
+      std::to_string(this->Offset) + " failed: " + std::strerror(errno));
+  }
+  this->Offset += size;
+}
+
+ChunkRef PropertyFileWriter::PutChunk(const std::vector<uint8_t>& raw, const std::string& what)
+{
+  const std::vector<uint8_t> stored = CompressChunk(raw);
+  ChunkRef ref;
+  ref.offset = this->Offset;
+  ref.stored = static_cast<uint32_t>(stored.size());
+  ref.raw = static_cast<uint32_t>(raw.size());
+  ref.crc = Crc32(stored.data(), stored.size());
+  this->Write(stored.data(), stored.size(), what);
+  return ref;
+}
+
+ChunkRef PropertyFileWriter::CopyChunk(const PropertyFile& from, const ChunkRef& ref)
+{
+  if (Crc32(from.ChunkBytes(ref), ref.stored) != ref.crc)
+  {
+    throw FileFormatError(from.Path() + ": chunk at byte " + std::to_string(ref.offset) + ": checksum mismatch (corrupt data)");
+  }
+  ChunkRef moved = ref;
+  moved.offset = this->Offset;
+  this->Write(from.ChunkBytes(ref), ref.stored, "copied table");
+  return moved;
+}
+
+void PropertyFileWriter::Add(PropertyTable table, const std::vector<float>& cellValues)
+{
+  const int64_t layer = this->Dims[0] * this->Dims[1];
+  if (static_cast<int64_t>(cellValues.size()) != layer * this->Dims[2])
+  {
+    throw std::invalid_argument(this->Output->Path() + ": " + TableName(table) + " has " + std::to_string(cellValues.size()) +
+      " values for " + std::to_string(layer * this->Dims[2]) + " cells");
+  }
+  const std::size_t handle = this->BeginTable(std::move(table));
+  for (int64_t k = 0; k < this->Dims[2]; ++k)
+  {
+    this->AddLayer(handle, cellValues.data() + k * layer);
+  }
+  this->EndTable(handle);
+}
+
+std::size_t PropertyFileWriter::BeginTable(PropertyTable table)
+{
+  // What PropertyFile accepts back.
+  const bool text = std::all_of(table.name.begin(), table.name.end(), [](char c) { return c >= 0x20 && c <= 0x7e; });
+  if (table.name.empty() || table.name.size() >= NameBytes || !text)
+  {
+    throw std::invalid_argument(this->Output->Path() + ": property name '" + table.name +
+      "' must hold 1 to 31 printable characters");
+  }
+  if (table.step < -1 || table.reportNumber < 0 || !std::isfinite(table.days) ||
+    (table.step < 0 && (table.reportNumber != 0 || table.days != 0)))
+  {
+    throw std::invalid_argument(this->Output->Path() + ": " + TableName(table) + ": step, report number or days impossible");
+  }
+  OpenTable opened;
+  opened.table = std::move(table);
+  opened.table.layers.clear();
+  opened.low = std::numeric_limits<float>::infinity();
+  opened.high = -opened.low;
+  // Slots without a source (empty, or inactive in a layer with no active cell) stay NaN.
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  opened.packed.resize(this->SlotSources.size() * 4);
+  for (std::size_t s = 0; s < this->SlotSources.size(); ++s)
+  {
+    std::memcpy(&opened.packed[s * 4], &none, 4);
+  }
+  opened.open = true;
+  for (std::size_t handle = 0; handle < this->Open.size(); ++handle)
+  {
+    if (!this->Open[handle].open)
+    {
+      this->Open[handle] = std::move(opened);
+      return handle;
+    }
+  }
+  this->Open.push_back(std::move(opened));
+  return this->Open.size() - 1;
+}
+
+PropertyFileWriter::OpenTable& PropertyFileWriter::Opened(std::size_t handle)
+{
+  if (handle >= this->Open.size() || !this->Open[handle].open)
+  {
+    throw std::invalid_argument(this->Output->Path() + ": no open table " + std::to_string(handle));
+  }
+  return this->Open[handle];
+}
+
+void PropertyFileWriter::AddLayer(std::size_t handle, const float* layerValues)
+{
+  OpenTable& t = this->Opened(handle);
+  const int64_t k = static_cast<int64_t>(t.table.layers.size());
+  if (k >= this->Dims[2])
+  {
+    throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) + " given more than its " +
+      std::to_string(this->Dims[2]) + " layers");
+  }
+  const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
+  const std::vector<uint8_t>& active = this->Active[static_cast<std::size_t>(k)];
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  std::vector<uint8_t> raw(static_cast<std::size_t>(layer) * 4);
+  for (uint64_t c = 0; c < layer; ++c)
+  {
+    const float v = active[c] ? layerValues[c] : none;
+    if (!std::isnan(v))
+    {
+      t.low = std::min(t.low, v);
+      t.high = std::max(t.high, v);
+    }
+    std::memcpy(&raw[static_cast<std::size_t>(c) * 4], &v, 4);
+  }
+  t.table.layers.push_back(this->PutChunk(raw, TableName(t.table) + " layer " + std::to_string(k + 1)));
+  for (uint64_t at = this->LayerSlotStart[static_cast<std::size_t>(k)];
+       at < this->LayerSlotStart[static_cast<std::size_t>(k) + 1]; ++at)
+  {
+    const uint64_t s = this->SlotsByLayer[at];
+    const uint64_t c = this->SlotSources[s] % layer;
+    const float v = active[c] ? layerValues[c] : none;
+    std::memcpy(&t.packed[s * 4], &v, 4);
+  }
+}
+
+void PropertyFileWriter::EndTable(std::size_t handle)
+{
+  OpenTable& t = this->Opened(handle);
+  if (static_cast<int64_t>(t.table.layers.size()) != this->Dims[2])
+  {
+    throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) + " ended after " +
+      std::to_string(t.table.layers.size()) + " of its " + std::to_string(this->Dims[2]) + " layers");
+  }
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  PropertyTable table = std::move(t.table);
+  table.minimum = t.low <= t.high ? t.low : none;
+  table.maximum = t.low <= t.high ? t.high : none;
+  table.packed = this->PutChunk(t.packed, TableName(table) + " packed table");
+  t.packed = std::vector<uint8_t>();
+  t.open = false;
+  for (auto& old : this->Entries)
+  {
+    if (old.name == table.name && old.step == table.step)
+    {
+      old = std::move(table); // replaced: the older chunks stay unreferenced in this file
+      return;
+    }
+  }
+  this->Entries.push_back(std::move(table));
+}
+
+void PropertyFileWriter::CopyFrom(const PropertyFile& older)
+{
+  if (older.GeometryId() != this->Geometry)
+  {
+    throw FileFormatError(older.Path() + ": made for another geometry; not merged");
+  }
+  for (const PropertyTable& table : older.Tables())
+  {
+    const bool held = std::any_of(this->Entries.begin(), this->Entries.end(),
+      [&](const PropertyTable& t) { return t.name == table.name && t.step == table.step; });
+    if (held)
+    {
+      continue;
+    }
+    PropertyTable copy = table;
+    copy.packed = this->CopyChunk(older, table.packed);
+    for (ChunkRef& layer : copy.layers)
+    {
+      layer = this->CopyChunk(older, layer);
+    }
+    this->Entries.push_back(std::move(copy));
+  }
+}
+
+void PropertyFileWriter::Commit()
+{
+  for (const OpenTable& t : this->Open)
+  {
+    if (t.open)
+    {
+      throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) + " was never ended");
+    }
+  }
+  ByteWriter index;
+  for (const PropertyTable& t : this->Entries)
+  {
+    char name[NameBytes] = {};
+    std::memcpy(name, t.name.data(), std::min(t.name.size(), NameBytes - 1));
+    index.PutBytes(name, NameBytes);
+    index.Put(t.step);
+    index.Put(t.reportNumber);
+    index.Put(t.days);
+    index.Put(t.minimum);
+    index.Put(t.maximum);
+    PutRef(index, t.packed);
+    for (const ChunkRef& layer : t.layers)
+    {
+      PutRef(index, layer);
+    }
+  }
+  const uint64_t indexOffset = this->Offset;
+  this->Write(index.Bytes.data(), index.Bytes.size(), "index");
+  const auto trailer = IndexTrailer(indexOffset, index.Bytes, TrailerMagic);
+  this->Write(trailer.data(), trailer.size(), "trailer");
+  // The table count goes in the header, which was written first: rewrite it in place.
+  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, static_cast<uint32_t>(this->Entries.size()));
+  if (!this->Output->WriteAt(head.data(), head.size(), 0))
+  {
+    throw FileFormatError(this->Output->Path() + ": rewriting the header failed: " + std::strerror(errno));
+  }
+  this->Output->Commit();
+}
+
+} // namespace resmr

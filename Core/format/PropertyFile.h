@@ -1,0 +1,140 @@
+// Property tables kept apart from geometry (paper Sec. 5.2, 5.4 and 5.5): one .resmrp file
+// holds any number of properties and time steps of one simulation, for the geometry of one
+// .resmr file, so adding a property, a step or another simulation of the same grid never
+// rewrites the geometry.
+//
+// Contract:
+// - A table is one value a cell, float32 (integer arrays are exact up to 2^24), NaN where the
+//   cell is inactive in the geometry or has no value. Each table is stored twice, LZO-
+//   compressed with a CRC-32 a chunk: packed through the geometry's perfect spatial hash
+//   (m^3 values, slot s holding the cell the geometry's HashCells names; the whole-model
+//   view's 3D texture, Sec. 5.4) and one chunk a layer (nx ny values, i fastest; the single-
+//   layer view's 2D texture, Sec. 5.2).
+// - Layout (little-endian): header (128 bytes, CRC-32 at its end: magic, version, the
+//   geometry id of the .resmr file, grid dimensions, hash table side, table count), chunks,
+//   index (per table: name, step, report number, days, value range, packed chunk, nz layer
+//   chunks), trailer (index offset and size, index CRC, magic "RESMRPIX").
+// - A file is written under a temporary name and renamed; one that names another geometry
+//   is refused (CheckGeometry). Every header and index field is checked when the file is
+//   opened (dimensions, sides, the table count against the index size, names, steps, value
+//   ranges, every chunk inside the file and of the size its table calls for); failures throw
+//   FileFormatError naming the file and the field or place.
+#pragma once
+
+#include "MultiresolutionFile.h"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace resmr
+{
+
+class AtomicOutputFile;
+
+struct PropertyTable
+{
+  std::string name;      ///< at most 31 bytes
+  int32_t step = -1;     ///< index of the report step; -1 for a static array
+  int32_t reportNumber = 0;
+  double days = 0;       ///< simulated time of the step
+  float minimum = 0, maximum = 0; ///< over the cells with a value (NaN if none)
+  ChunkRef packed;
+  std::vector<ChunkRef> layers;
+};
+
+/// A .resmrp file opened for reading (memory-mapped).
+class PropertyFile
+{
+public:
+  explicit PropertyFile(const std::string& path);
+  ~PropertyFile();
+  PropertyFile(const PropertyFile&) = delete;
+  PropertyFile& operator=(const PropertyFile&) = delete;
+
+  const std::string& Path() const { return this->FilePath; }
+  uint64_t GeometryId() const { return this->Geometry; }
+  /// Grid dimensions and hash table sides of the geometry the file was made for.
+  const std::array<int64_t, 3>& Dimensions() const { return this->Dims; }
+  const std::array<uint32_t, 3>& HashTableSides() const { return this->TableSides; }
+  const std::vector<PropertyTable>& Tables() const { return this->Entries; }
+  /// Index of table (name, step) or -1.
+  int Find(const std::string& name, int32_t step) const;
+  /// Throws FileFormatError if this file was not made for `geometry`.
+  void CheckGeometry(const MultiresolutionFile& geometry) const;
+
+  /// The packed table (m0 m1 m2 values, Sec. 5.4).
+  std::vector<float> ReadPacked(std::size_t table) const;
+  /// Layer k of the table (nx ny values).
+  std::vector<float> ReadLayer(std::size_t table, int64_t k) const;
+  /// The stored bytes of a chunk (for copying into a new file).
+  const uint8_t* ChunkBytes(const ChunkRef& ref) const { return this->Data + ref.offset; }
+
+private:
+  void CheckHeader(uint32_t tables, uint64_t indexSize) const;
+  PropertyTable ReadTable(ByteReader& index, uint32_t t, uint64_t indexOffset) const;
+  std::vector<float> ReadValues(const ChunkRef& ref, uint64_t count, const std::string& place) const;
+  std::string FilePath;
+  const uint8_t* Data = nullptr;
+  uint64_t Size = 0;
+  int Descriptor = -1; ///< kept open to notice a file cut while mapped
+  uint64_t Geometry = 0;
+  std::array<int64_t, 3> Dims{};
+  std::array<uint32_t, 3> TableSides{};
+  std::vector<PropertyTable> Entries;
+};
+
+/// Writes a .resmrp file for `geometry` under a temporary name; Commit() puts it in place.
+class PropertyFileWriter
+{
+public:
+  PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry);
+  ~PropertyFileWriter();
+
+  /// Adds a table from one value a cell (nx ny nz, ECLIPSE order; NaN: no value); cells
+  /// inactive in the geometry get NaN in the layer tables, and in the packed table the value
+  /// of the nearest active cell of their layer (coarse faces reach over them). Replaces an
+  /// earlier table of the same name and step.
+  void Add(PropertyTable table, const std::vector<float>& cellValues);
+  /// The same for values that come a layer at a time (a generator's stream), so that no
+  /// whole array is held: BeginTable, then AddLayer for k = 0 .. nz-1 in order, then EndTable
+  /// stores what Add would store from the same values. Several tables may be open at once
+  /// (their layer chunks interleave in the file); each holds its packed table (m0 m1 m2
+  /// values, 4 bytes each) until EndTable. BeginTable returns the table's handle.
+  std::size_t BeginTable(PropertyTable table);
+  /// The next layer of open table `handle`: nx ny values, i fastest.
+  void AddLayer(std::size_t handle, const float* layerValues);
+  void EndTable(std::size_t handle);
+  /// Copies every table of `older` (same geometry) that this writer does not hold yet.
+  void CopyFrom(const PropertyFile& older);
+  /// Writes the index and trailer and renames the file into place.
+  void Commit();
+  std::size_t TableCount() const { return this->Entries.size(); }
+
+private:
+  struct OpenTable
+  {
+    PropertyTable table;
+    std::vector<uint8_t> packed; ///< m0 m1 m2 floats, filled as the layers come
+    float low = 0, high = 0;     ///< value range so far
+    bool open = false;
+  };
+  OpenTable& Opened(std::size_t handle);
+  ChunkRef PutChunk(const std::vector<uint8_t>& raw, const std::string& what);
+  ChunkRef CopyChunk(const PropertyFile& from, const ChunkRef& ref);
+  void Write(const void* data, std::size_t size, const std::string& what);
+  std::unique_ptr<AtomicOutputFile> Output;
+  uint64_t Offset = 0;
+  uint64_t Geometry = 0;
+  std::array<int64_t, 3> Dims{};
+  std::array<uint32_t, 3> TableSides{};
+  std::vector<uint64_t> SlotSources;       ///< the cell whose value a slot holds (see Add)
+  std::vector<std::vector<uint8_t>> Active; ///< per layer
+  std::vector<uint64_t> LayerSlotStart;    ///< nz + 1: where each layer's slots start below
+  std::vector<uint64_t> SlotsByLayer;      ///< slots with a source, by their source's layer
+  std::vector<OpenTable> Open;
+  std::vector<PropertyTable> Entries;
+};
+
+} // namespace resmr

@@ -1,0 +1,1639 @@
+// Out-of-core, multi-threaded build of the diamond hierarchy, paper Sec. 4.2 (with 4.3 and 6.2).
+#include "HierarchyBuilder.h"
+
+#include "ByteStream.h"
+#include "ColumnCollapse.h"
+#include "ColumnMesh.h"
+#include "DiamondHierarchy.h"
+#include "HashMix.h"
+#include "LeafPartition.h"
+#include "MemoryBudget.h"
+#include "MultiresolutionFile.h"
+#include "NormalQuantization.h"
+#include "PerfectSpatialHash.h"
+#include "RegionMesh.h"
+#include "SideSurfaceSimplification.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <dirent.h>
+#include <exception>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+#include <sys/stat.h>
+#include <thread>
+#include <unistd.h>
+#include <unordered_map>
+
+namespace resmr
+{
+namespace
+{
+/// A region's mesh between levels: the column mesh with quadrics, which edges border another
+/// region and which side faces are external.
+struct ScratchRegion
+{
+  ColumnMeshData mesh;
+  std::vector<uint8_t> cutEdges; ///< per column, bit e
+  std::vector<uint8_t> openSides; ///< per cell, bit e: side face e is external (see RegionMesh)
+};
+
+std::string RegionPath(const std::string& folder, int level, int64_t index)
+{
+  return folder + "/region-" + std::to_string(level) + "-" + std::to_string(index) + ".bin";
+}
+
+template <typename T>
+void PutVector(std::FILE* file, const std::vector<T>& values, bool& ok)
+{
+  const uint64_t count = values.size();
+  ok = ok && std::fwrite(&count, sizeof(count), 1, file) == 1;
+  ok = ok && (count == 0 || std::fwrite(values.data(), sizeof(T), values.size(), file) == values.size());
+}
+
+template <typename T>
+void GetVector(std::FILE* file, std::vector<T>& values, bool& ok)
+{
+  uint64_t count = 0;
+  ok = ok && std::fread(&count, sizeof(count), 1, file) == 1 && count < (uint64_t(1) << 40);
+  if (ok)
+  {
+    values.resize(count);
+    ok = count == 0 || std::fread(values.data(), sizeof(T), values.size(), file) == values.size();
+  }
+}
+
+void SaveRegion(const std::string& path, const ScratchRegion& region)
+{
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (!file)
+  {
+    throw std::runtime_error(path + ": cannot create scratch file: " + std::strerror(errno));
+  }
+  bool ok = std::fwrite(&region.mesh.layers, sizeof(int32_t), 1, file) == 1;
+  PutVector(file, region.mesh.positions, ok);
+  PutVector(file, region.mesh.quadrics, ok);
+  PutVector(file, region.mesh.topology, ok);
+  PutVector(file, region.mesh.corners, ok);
+  PutVector(file, region.mesh.activeCells, ok);
+  PutVector(file, region.mesh.origin, ok);
+  PutVector(file, region.cutEdges, ok);
+  PutVector(file, region.openSides, ok);
+  ok = (std::fclose(file) == 0) && ok;
+  if (!ok)
+  {
+    unlink(path.c_str());
+    throw std::runtime_error(path + ": scratch write failed (disk full?)");
+  }
+}
+
+bool LoadRegion(const std::string& path, ScratchRegion& region)
+{
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file)
+  {
+    return false; // an empty region saves nothing
+  }
+  bool ok = std::fread(&region.mesh.layers, sizeof(int32_t), 1, file) == 1;
+  GetVector(file, region.mesh.positions, ok);
+  GetVector(file, region.mesh.quadrics, ok);
+  GetVector(file, region.mesh.topology, ok);
+  GetVector(file, region.mesh.corners, ok);
+  GetVector(file, region.mesh.activeCells, ok);
+  GetVector(file, region.mesh.origin, ok);
+  GetVector(file, region.cutEdges, ok);
+  GetVector(file, region.openSides, ok);
+  std::fclose(file);
+  if (!ok)
+  {
+    throw std::runtime_error(path + ": scratch file is truncated or corrupt");
+  }
+  return true;
+}
+
+/// The column across edge e (corner e to e + 1) of a column, or -1.
+int32_t Across(const ColumnMesh& mesh, int32_t column, int e)
+{
+  const auto& q = mesh.ColumnCorners(column);
+  const int32_t a = q[e], b = q[(e + 1) % 4];
+  for (int32_t other : mesh.NodeColumns(a))
+  {
+    if (other == column || !mesh.IsColumnAlive(other))
+    {
+      continue;
+    }
+    const auto& o = mesh.ColumnCorners(other);
+    for (int f = 0; f < 4; ++f)
+    {
+      if (o[f] == b && o[(f + 1) % 4] == a)
+      {
+        return other;
+      }
+    }
+  }
+  return -1;
+}
+
+/// Open sides of every alive column's cells, from the columns across; edges flagged in `cut`
+/// (one mask a column slot) keep the flags in `openSides` (one byte a cell slot), since the
+/// cells across them lie in another region.
+void UpdateOpenSides(const ColumnMesh& mesh, const std::vector<uint8_t>& cut, std::vector<uint8_t>& openSides)
+{
+  const std::size_t layers = static_cast<std::size_t>(mesh.Layers());
+  openSides.resize(static_cast<std::size_t>(mesh.ColumnSlots()) * layers, 0);
+  for (int32_t c = 0; c < mesh.ColumnSlots(); ++c)
+  {
+    if (!mesh.IsColumnAlive(c))
+    {
+      continue;
+    }
+    for (int e = 0; e < 4; ++e)
+    {
+      if (cut[c] & (1u << e))
+      {
+        continue;
+      }
+      const int32_t other = Across(mesh, c, e);
+      for (std::size_t k = 0; k < layers; ++k)
+      {
+        uint8_t& flags = openSides[c * layers + k];
+        const bool open = other < 0 || !mesh.IsCellActive(other, static_cast<int32_t>(k));
+        flags = static_cast<uint8_t>(open ? flags | (1u << e) : flags & ~(1u << e));
+      }
+    }
+  }
+}
+
+/// The cells of the columns flagged in `keep`, in order.
+std::vector<uint8_t> KeptCells(const std::vector<uint8_t>& perCell, const std::vector<uint8_t>& keep, std::size_t layers)
+{
+  std::vector<uint8_t> out;
+  for (std::size_t c = 0; c < keep.size(); ++c)
+  {
+    if (keep[c])
+    {
+      out.insert(out.end(), perCell.begin() + c * layers, perCell.begin() + (c + 1) * layers);
+    }
+  }
+  return out;
+}
+
+RegionMesh ToRegionMesh(
+  const ScratchRegion& region, const MultiresolutionHeader& header, float ownError, double sideError)
+{
+  RegionMesh out;
+  out.layers = region.mesh.layers;
+  out.positions = region.mesh.positions;
+  // What readers will decode: pinch-outs are sealed by thickness, and a run the builder seals
+  // must be the one every reader seals.
+  RoundToLattice(out.positions, header);
+  out.topology.resize(region.mesh.topology.size());
+  for (std::size_t n = 0; n < out.topology.size(); ++n)
+  {
+    out.topology[n] = { static_cast<float>(region.mesh.topology[n][0]), static_cast<float>(region.mesh.topology[n][1]) };
+  }
+  out.corners.resize(region.mesh.corners.size());
+  for (std::size_t c = 0; c < out.corners.size(); ++c)
+  {
+    for (int q = 0; q < 4; ++q)
+    {
+      out.corners[c][q] = static_cast<uint32_t>(region.mesh.corners[c][q]);
+    }
+  }
+  out.active = region.mesh.activeCells;
+  out.cutEdges = region.cutEdges;
+  out.openSides = region.openSides;
+  out.sealedPinchThickness = ownError;
+  ExtractSurfaces(out);
+  // Sec. 4.3: side faces simplified up to the error of the hexahedral mesh they bound.
+  out.sideTriangles = SimplifySideSurface(out, sideError);
+  return out;
+}
+
+std::array<double, 6> BoxOf(const std::vector<double>& positions)
+{
+  const double inf = std::numeric_limits<double>::infinity();
+  std::array<double, 6> box{ inf, inf, inf, -inf, -inf, -inf };
+  for (std::size_t p = 0; p < positions.size(); p += 3)
+  {
+    for (int d = 0; d < 3; ++d)
+    {
+      box[d] = std::min(box[d], positions[p + d]);
+      box[3 + d] = std::max(box[3 + d], positions[p + d]);
+    }
+  }
+  return box;
+}
+
+/// Model-space error of a region mesh in units of distance (Sec. 6.2): over its vertices, the
+/// largest root-mean-square distance to the original faces merged into the vertex. A quadric
+/// sums weight x squared distance and the trace of its 3 x 3 part sums the weights (unit
+/// normals), so their ratio is the weighted mean squared distance; the raw quadric error
+/// would grow with the number of faces merged, not with the distance.
+double QuadricDistance(const ColumnMeshData& mesh)
+{
+  double largest = 0;
+  for (std::size_t v = 0; v < mesh.quadrics.size(); ++v)
+  {
+    const Quadric& q = mesh.quadrics[v];
+    const double weight = q.q[0] + q.q[4] + q.q[7];
+    if (weight > 0)
+    {
+      const glm::dvec3 p(mesh.positions[v * 3], mesh.positions[v * 3 + 1], mesh.positions[v * 3 + 2]);
+      largest = std::max(largest, q.Error(p) / weight);
+    }
+  }
+  return std::sqrt(largest);
+}
+
+/// Default Cmax: 4096 columns a region (a 64 x 64 patch: top and bottom surfaces of about 16k
+/// triangles, the batch size at which GPUs reach full speed, while a diamond's merged mesh
+/// stays a few hundred MB for 100 layers), but at most a 32nd of the model's columns (and at
+/// least 256), so that small models get five or more levels, not a single one.
+int64_t AutomaticCmax(int64_t columns)
+{
+  return std::max<int64_t>(256, std::min<int64_t>(4096, columns / 32));
+}
+
+/// Runs task(i) for i in [0, count) on `threads` threads; rethrows the first failure.
+void ParallelFor(int64_t count, int threads, const std::function<void(int64_t)>& task)
+{
+  std::atomic<int64_t> next{ 0 };
+  std::exception_ptr failure;
+  std::mutex failureLock;
+  auto work = [&] {
+    for (;;)
+    {
+      const int64_t i = next++;
+      if (i >= count)
+      {
+        return;
+      }
+      try
+      {
+        task(i);
+      }
+      catch (...)
+      {
+        std::lock_guard<std::mutex> guard(failureLock);
+        if (!failure)
+        {
+          failure = std::current_exception();
+        }
+        next = count;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t)
+  {
+    pool.emplace_back(work);
+  }
+  work();
+  for (auto& thread : pool)
+  {
+    thread.join();
+  }
+  if (failure)
+  {
+    std::rethrow_exception(failure);
+  }
+}
+
+/// SplitMix64's step and finaliser: the seeds of each diamond's simplification.
+uint64_t Mix(uint64_t x)
+{
+  return HashMix(x + GoldenGamma);
+}
+
+/// Little binary files that record a build's progress (resuming, MPI ranks).
+class ManifestOut : public ByteWriter
+{
+public:
+  /// Written under a temporary name and renamed: a manifest is there whole or not at all.
+  void Save(const std::string& path) const
+  {
+    const std::string temporary = path + ".part";
+    std::FILE* file = std::fopen(temporary.c_str(), "wb");
+    bool ok = file && std::fwrite(this->Bytes.data(), 1, this->Bytes.size(), file) == this->Bytes.size();
+    ok = file && (std::fflush(file) == 0) && (fsync(fileno(file)) == 0) && ok;
+    ok = file && (std::fclose(file) == 0) && ok;
+    if (!ok || std::rename(temporary.c_str(), path.c_str()) != 0)
+    {
+      unlink(temporary.c_str());
+      throw std::runtime_error(path + ": cannot write the build manifest: " + std::strerror(errno));
+    }
+  }
+};
+
+class ManifestIn : public ByteReader
+{
+public:
+  /// False if the file is absent.
+  bool Load(const std::string& path)
+  {
+    std::FILE* file = std::fopen(path.c_str(), "rb");
+    if (!file)
+    {
+      return false;
+    }
+    uint8_t block[65536];
+    std::size_t got = 0;
+    while ((got = std::fread(block, 1, sizeof(block), file)) > 0)
+    {
+      this->Bytes.insert(this->Bytes.end(), block, block + got);
+    }
+    std::fclose(file);
+    this->Path = path;
+    this->Reset(this->Bytes.data(), this->Bytes.size(), path + ": build manifest");
+    return true;
+  }
+  std::vector<uint8_t> Bytes;
+  std::string Path;
+};
+
+constexpr uint64_t BuildManifestMagic = 0x31444c4252534552ull; // "RESRBLD1"
+
+bool Exists(const std::string& path)
+{
+  struct stat info;
+  return stat(path.c_str(), &info) == 0;
+}
+
+void RemoveTree(const std::string& path)
+{
+  DIR* folder = opendir(path.c_str());
+  if (!folder)
+  {
+    unlink(path.c_str());
+    return;
+  }
+  while (const dirent* entry = readdir(folder))
+  {
+    const std::string name = entry->d_name;
+    if (name != "." && name != "..")
+    {
+      RemoveTree(path + "/" + name);
+    }
+  }
+  closedir(folder);
+  rmdir(path.c_str());
+}
+
+/// The cells (natural index) an extracted face of the region may sample through its
+/// interpolated topological coordinates (Sec. 5.2): every cell of the face's box in (i, j,
+/// k) space, on the inner side of a top or bottom face and on both sides of a side face.
+void MarkTouchedCells(const RegionMesh& mesh, const std::array<int64_t, 3>& dims, std::vector<std::atomic<uint64_t>>& bits)
+{
+  const uint32_t interfaces = static_cast<uint32_t>(mesh.layers + 1);
+  const auto mark = [&](const uint32_t* vertices, int count, int kind) {
+    std::array<double, 3> low{ 1e300, 1e300, 1e300 }, high{ -1e300, -1e300, -1e300 };
+    for (int v = 0; v < count; ++v)
+    {
+      const uint32_t node = vertices[v] / interfaces;
+      const double t[3] = { mesh.topology[node][0], mesh.topology[node][1], double(vertices[v] % interfaces) };
+      for (int a = 0; a < 3; ++a)
+      {
+        low[a] = std::min(low[a], t[a]);
+        high[a] = std::max(high[a], t[a]);
+      }
+    }
+    std::array<int64_t, 3> first{}, last{};
+    for (int a = 0; a < 3; ++a)
+    {
+      if (high[a] - low[a] < 1e-6)
+      {
+        // Constant coordinate: the cell below a top face, above a bottom face, either side
+        // of a side face.
+        const int64_t t = static_cast<int64_t>(std::llround(low[a]));
+        first[a] = (a == 2 && kind == 0) ? t : t - 1;
+        last[a] = (a == 2 && kind == 1) ? t - 1 : t;
+      }
+      else
+      {
+        first[a] = static_cast<int64_t>(std::floor(low[a]));
+        last[a] = static_cast<int64_t>(std::ceil(high[a])) - 1;
+      }
+      first[a] = std::max<int64_t>(first[a], 0);
+      last[a] = std::min<int64_t>(last[a], dims[a] - 1);
+    }
+    for (int64_t k = first[2]; k <= last[2]; ++k)
+    {
+      for (int64_t j = first[1]; j <= last[1]; ++j)
+      {
+        for (int64_t i = first[0]; i <= last[0]; ++i)
+        {
+          const uint64_t n = static_cast<uint64_t>(i + dims[0] * (j + dims[1] * k));
+          bits[n >> 6].fetch_or(uint64_t(1) << (n & 63), std::memory_order_relaxed);
+        }
+      }
+    }
+  };
+  for (const auto& q : mesh.top.quads)
+  {
+    mark(q.data(), 4, 0);
+  }
+  for (const auto& q : mesh.bottom.quads)
+  {
+    mark(q.data(), 4, 1);
+  }
+  for (const auto& t : mesh.sideTriangles)
+  {
+    mark(t.data(), 3, 2);
+  }
+  for (const auto& q : mesh.side.quads)
+  {
+    mark(q.data(), 4, 2);
+  }
+}
+
+/// Merges sibling regions into one column mesh (with their cut edges, open sides and
+/// column count): nodes the children share (never moved since they were split apart) are
+/// bitwise equal, topological coordinate and whole vertex stack. Only nodes of different
+/// children are joined: one child may hold two distinct nodes with equal data (where faults
+/// cross, the diagonal columns at a pillar can agree while their edge neighbours do not).
+ColumnMesh MergeRegions(const std::vector<ScratchRegion>& children, std::vector<uint8_t>& childCut,
+  std::vector<uint8_t>& openSides, int64_t& inputColumns)
+{
+  const int32_t layers = children.front().mesh.layers;
+  const std::size_t interfaces = static_cast<std::size_t>(layers) + 1;
+  ColumnMeshData merged;
+  merged.layers = layers;
+  std::unordered_multimap<uint64_t, int32_t> nodeByKey;
+  std::vector<int> nodeChild; // the last child a merged node was taken from
+  inputColumns = 0;
+  for (std::size_t which = 0; which < children.size(); ++which)
+  {
+    const ColumnMeshData& m = children[which].mesh;
+    const ScratchRegion& child = children[which];
+    std::vector<int32_t> map(m.topology.size());
+    for (std::size_t n = 0; n < m.topology.size(); ++n)
+    {
+      const double* stack = &m.positions[n * interfaces * 3];
+      uint64_t key = Mix(std::hash<double>()(m.topology[n][0]) ^ Mix(std::hash<double>()(m.topology[n][1])));
+      key = Mix(key ^ std::hash<double>()(stack[0]) ^ Mix(std::hash<double>()(stack[interfaces * 3 - 1])));
+      int32_t found = -1;
+      const auto range = nodeByKey.equal_range(key);
+      for (auto it = range.first; it != range.second && found < 0; ++it)
+      {
+        const int32_t candidate = it->second;
+        if (nodeChild[candidate] != static_cast<int>(which) && merged.topology[candidate] == m.topology[n] &&
+          std::equal(stack, stack + interfaces * 3, &merged.positions[static_cast<std::size_t>(candidate) * interfaces * 3]))
+        {
+          found = candidate;
+        }
+      }
+      if (found < 0)
+      {
+        found = static_cast<int32_t>(merged.topology.size());
+        merged.topology.push_back(m.topology[n]);
+        merged.positions.insert(merged.positions.end(), stack, stack + interfaces * 3);
+        merged.quadrics.insert(merged.quadrics.end(), m.quadrics.begin() + n * interfaces,
+          m.quadrics.begin() + (n + 1) * interfaces);
+        nodeByKey.emplace(key, found);
+        nodeChild.push_back(-1);
+      }
+      nodeChild[found] = static_cast<int>(which);
+      map[n] = found;
+    }
+    for (std::size_t c = 0; c < m.corners.size(); ++c)
+    {
+      merged.corners.push_back({ map[m.corners[c][0]], map[m.corners[c][1]], map[m.corners[c][2]], map[m.corners[c][3]] });
+    }
+    merged.activeCells.insert(merged.activeCells.end(), m.activeCells.begin(), m.activeCells.end());
+    merged.origin.insert(merged.origin.end(), m.origin.begin(), m.origin.end());
+    childCut.insert(childCut.end(), child.cutEdges.begin(), child.cutEdges.end());
+    openSides.insert(openSides.end(), child.openSides.begin(), child.openSides.end());
+    inputColumns += m.ColumnCount();
+  }
+  return ColumnMesh::FromData(std::move(merged));
+}
+
+/// Cut edges stay cut only where the merged mesh has no column across; their nodes border
+/// another diamond and must not move, so every column touching one is locked.
+void LockCutColumns(ColumnMesh& mesh, std::vector<uint8_t>& childCut)
+{
+  const int32_t slots = mesh.ColumnSlots();
+  std::vector<uint8_t> external(static_cast<std::size_t>(mesh.NodeCount()), 0);
+  for (int32_t c = 0; c < slots; ++c)
+  {
+    for (int e = 0; e < 4; ++e)
+    {
+      if ((childCut[c] & (1u << e)) && !mesh.IsBoundaryEdge(c, e))
+      {
+        childCut[c] &= static_cast<uint8_t>(~(1u << e));
+      }
+      if (childCut[c] & (1u << e))
+      {
+        external[mesh.ColumnCorners(c)[e]] = 1;
+        external[mesh.ColumnCorners(c)[(e + 1) % 4]] = 1;
+      }
+    }
+  }
+  for (int32_t c = 0; c < slots; ++c)
+  {
+    const auto& q = mesh.ColumnCorners(c);
+    if (external[q[0]] || external[q[1]] || external[q[2]] || external[q[3]])
+    {
+      mesh.SetLocked(c, true);
+    }
+  }
+}
+
+class Builder
+{
+public:
+  Builder(LayerSource& source, const std::string& output, const HierarchyOptions& options, const BuildProgress& progress)
+    : Source(source)
+    , Output(output)
+    , Options(options)
+    , Progress(progress)
+    , Scratch(ScratchFolder(output, options))
+  {
+    if (this->Options.cmax != 0 && this->Options.cmax < 16)
+    {
+      throw std::invalid_argument("--cmax must be at least 16 columns (or 0: chosen from the model)");
+    }
+    if (this->Options.ranks < 1 || this->Options.rank < 0 || this->Options.rank >= this->Options.ranks ||
+      (this->Options.ranks > 1 && !this->Options.barrier))
+    {
+      throw std::invalid_argument("hierarchy build: rank " + std::to_string(this->Options.rank) + " of " +
+        std::to_string(this->Options.ranks) + " (several ranks need a barrier)");
+    }
+  }
+
+  HierarchyReport Run();
+
+private:
+  /// One leaf of the hierarchy and its columns (i + j nx).
+  using Leaf = std::pair<int64_t, std::vector<int64_t>>;
+  /// Scratch bytes a vertex of a column mesh costs while a region is built.
+  static constexpr int64_t VertexBytes = 24 + 80 + 40;
+  int PrepareScratch(MultiresolutionHeader& header, HierarchyReport& report);
+  void Resume(int finished, const MultiresolutionHeader& header);
+  void PartitionInput();
+  std::vector<Leaf> PlanLeaves(MultiresolutionHeader& header, HierarchyReport& report);
+  void BuildLeaves(const std::vector<Leaf>& leaves, int leafLevel, HierarchyReport& report);
+  std::vector<std::size_t> Share(std::size_t count) const;
+  void SimplifyLevels(int finished, HierarchyReport& report);
+  void WriteFile(MultiresolutionHeader& header, HierarchyReport& report);
+  void Report(const char* phase, double fraction)
+  {
+    if (this->Progress)
+    {
+      std::lock_guard<std::mutex> guard(this->ProgressLock);
+      this->Progress(phase, fraction);
+    }
+  }
+  void BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns);
+  void BuildDiamond(const DiamondHierarchy::Diamond& diamond);
+  std::vector<ScratchRegion> LoadChildren(const DiamondHierarchy::Diamond& diamond) const;
+  void SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const ColumnMesh& mesh,
+    const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides);
+  void Emit(int level, int64_t index, const ScratchRegion& region, bool keepScratch);
+  int ThreadsFor(int64_t bytesPerTask) const;
+  void Barrier()
+  {
+    if (this->Options.ranks > 1)
+    {
+      this->Options.barrier();
+    }
+  }
+  /// Runs `work` on every rank; if it fails on any, every rank throws (no rank is left
+  /// waiting at a barrier for one that failed).
+  void Collective(const std::function<void()>& work);
+  std::string LevelManifest(int level, int rank) const
+  {
+    return this->Scratch + "/level-" + std::to_string(level) + ".rank-" + std::to_string(rank);
+  }
+  std::string ChunkPath(int rank) const { return this->Scratch + "/chunks-" + std::to_string(rank) + ".bin"; }
+  std::string NormalsPath(int64_t leaf) const { return this->Scratch + "/normals-" + std::to_string(leaf) + ".bin"; }
+  void SaveLevel(int level);
+  void LoadLevel(int level);
+  bool ReadBuildManifest(MultiresolutionHeader& header, HierarchyReport& report);
+  void WriteBuildManifest(const MultiresolutionHeader& header, const HierarchyReport& report) const;
+  void FinishBoundsAndErrors(int leafLevel);
+  void BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& report, std::vector<ModelChunk>& model);
+
+  LayerSource& Source;
+  std::string Output;
+  HierarchyOptions Options;
+  BuildProgress Progress;
+  std::string Scratch;
+  std::mutex ProgressLock;
+  std::unique_ptr<LeafPartition> Partition;
+  DiamondHierarchy Tree;
+  MultiresolutionHeader Header;
+  std::unique_ptr<ChunkFile> Chunks;
+  std::vector<ModelChunk> ActiveLayers; ///< rank 0's
+  std::mutex RecordLock;
+  std::map<std::pair<int, int64_t>, RegionRecord> Records;
+  std::map<std::pair<int, int64_t>, int> Parts; ///< the rank whose chunk file holds a region
+  std::map<std::pair<int, int64_t>, std::array<double, 6>> OwnBoxes;
+  std::atomic<int64_t> WorkDone{ 0 };
+  int64_t WorkTotal = 1;
+  double WorkStart = 0, WorkSpan = 1;
+  const char* Phase = "";
+  int64_t CellCount = 0;
+};
+
+int Builder::ThreadsFor(int64_t bytesPerTask) const
+{
+  constexpr int64_t cellsPerThread = 16384;
+  int threads = this->Options.threads > 0 ? this->Options.threads : static_cast<int>(std::min<int64_t>(
+    std::thread::hardware_concurrency(), (this->CellCount + cellsPerThread - 1) / cellsPerThread));
+  threads = std::max(threads, 1);
+  const int64_t budget = this->Options.memoryBytes > 0 ? this->Options.memoryBytes : DefaultBuildMemoryBytes();
+  const int64_t fit = std::max<int64_t>(1, budget / std::max<int64_t>(bytesPerTask, 1));
+  return static_cast<int>(std::min<int64_t>(threads, fit));
+}
+
+void Builder::Collective(const std::function<void()>& work)
+{
+  std::string failure;
+  try
+  {
+    work();
+  }
+  catch (const std::exception& error)
+  {
+    failure = error.what();
+    if (this->Options.ranks == 1)
+    {
+      throw;
+    }
+    ManifestOut note;
+    note.PutString(failure);
+    try
+    {
+      note.Save(this->Scratch + "/failed.rank-" + std::to_string(this->Options.rank));
+    }
+    catch (const std::exception&)
+    {
+    }
+  }
+  this->Barrier();
+  if (!failure.empty())
+  {
+    throw std::runtime_error(failure);
+  }
+  for (int r = 0; r < this->Options.ranks; ++r)
+  {
+    ManifestIn note;
+    if (note.Load(this->Scratch + "/failed.rank-" + std::to_string(r)))
+    {
+      throw std::runtime_error("rank " + std::to_string(r) + " failed: " + note.GetString());
+    }
+  }
+}
+
+void Builder::Emit(int level, int64_t index, const ScratchRegion& region, bool keepScratch)
+{
+  if (keepScratch)
+  {
+    SaveRegion(RegionPath(this->Scratch, level, index), region);
+  }
+  RegionRecord record;
+  record.level = level;
+  record.index = index;
+  const double ownError = QuadricDistance(region.mesh);
+  record.ownError = static_cast<float>(ownError);
+  // The file rounds positions to its lattice after simplification: allow one step more.
+  const auto& step = this->Header.latticeStep;
+  const RegionMesh mesh = ToRegionMesh(region, this->Header, level == this->Header.leafLevel ? 0.f : record.ownError,
+    ownError + std::sqrt(step[0] * step[0] + step[1] * step[1] + step[2] * step[2]));
+  this->Chunks->AddRegion(mesh, this->Header, record);
+  std::lock_guard<std::mutex> guard(this->RecordLock);
+  this->Records[{ level, index }] = record;
+  this->Parts[{ level, index }] = this->Options.rank;
+  this->OwnBoxes[{ level, index }] = BoxOf(region.mesh.positions);
+}
+
+void Builder::SaveLevel(int level)
+{
+  ManifestOut out;
+  out.Put(BuildManifestMagic);
+  out.Put(static_cast<int32_t>(level));
+  out.Put(static_cast<int32_t>(this->Options.rank));
+  out.Put(this->Chunks->Sync());
+  std::vector<std::pair<int, int64_t>> mine;
+  for (const auto& entry : this->Parts)
+  {
+    if (entry.first.first == level && entry.second == this->Options.rank)
+    {
+      mine.push_back(entry.first);
+    }
+  }
+  out.Put(static_cast<uint64_t>(mine.size()));
+  for (const auto& key : mine)
+  {
+    out.Put(this->Records[key]);
+    out.Put(this->OwnBoxes[key]);
+  }
+  out.Save(this->LevelManifest(level, this->Options.rank));
+}
+
+void Builder::LoadLevel(int level)
+{
+  for (int r = 0; r < this->Options.ranks; ++r)
+  {
+    ManifestIn in;
+    if (!in.Load(this->LevelManifest(level, r)))
+    {
+      throw std::runtime_error(this->LevelManifest(level, r) + ": missing (rank " + std::to_string(r) +
+        " did not finish level " + std::to_string(level) + ")");
+    }
+    if (in.Get<uint64_t>() != BuildManifestMagic || in.Get<int32_t>() != level || in.Get<int32_t>() != r)
+    {
+      throw std::runtime_error(in.Path + ": not the manifest of this level and rank");
+    }
+    in.Get<uint64_t>();
+    const uint64_t count = in.Get<uint64_t>();
+    for (uint64_t n = 0; n < count; ++n)
+    {
+      const RegionRecord record = in.Get<RegionRecord>();
+      const auto box = in.Get<std::array<double, 6>>();
+      const std::pair<int, int64_t> key{ record.level, record.index };
+      this->Records[key] = record;
+      this->Parts[key] = r;
+      this->OwnBoxes[key] = box;
+    }
+  }
+}
+
+void Builder::WriteBuildManifest(const MultiresolutionHeader& header, const HierarchyReport& report) const
+{
+  ManifestOut out;
+  out.Put(BuildManifestMagic);
+  out.PutString(this->Source.Name());
+  out.Put(this->Source.Dims());
+  out.Put(this->Options.cmax);
+  out.Put(this->Options.seed);
+  out.Put(static_cast<int32_t>(this->Options.ranks));
+  out.Put(header.dims);
+  out.Put(header.box);
+  out.Put(header.latticeOrigin);
+  out.Put(header.latticeStep);
+  out.Put(header.leafLevel);
+  out.Put(header.cmax);
+  out.Put(report.cells);
+  out.Put(report.activeCells);
+  out.Put(report.columns);
+  out.Put(static_cast<uint64_t>(this->ActiveLayers.size()));
+  for (const ModelChunk& m : this->ActiveLayers)
+  {
+    out.Put(m);
+  }
+  out.Save(this->Scratch + "/build.manifest");
+}
+
+/// True if the scratch folder holds a build of the same input and options to resume.
+bool Builder::ReadBuildManifest(MultiresolutionHeader& header, HierarchyReport& report)
+{
+  ManifestIn in;
+  if (!this->Options.resume || !in.Load(this->Scratch + "/build.manifest"))
+  {
+    return false;
+  }
+  try
+  {
+    if (in.Get<uint64_t>() != BuildManifestMagic || in.GetString() != this->Source.Name() ||
+      in.Get<std::array<int64_t, 3>>() != this->Source.Dims() || in.Get<int64_t>() != this->Options.cmax ||
+      in.Get<uint64_t>() != this->Options.seed || in.Get<int32_t>() != this->Options.ranks)
+    {
+      return false;
+    }
+    header.dims = in.Get<std::array<int64_t, 3>>();
+    header.box = in.Get<std::array<double, 4>>();
+    header.latticeOrigin = in.Get<std::array<double, 3>>();
+    header.latticeStep = in.Get<std::array<double, 3>>();
+    header.leafLevel = in.Get<int32_t>();
+    header.cmax = in.Get<int32_t>();
+    report.cells = in.Get<int64_t>();
+    report.activeCells = in.Get<int64_t>();
+    report.columns = in.Get<int64_t>();
+    const uint64_t layers = in.Get<uint64_t>();
+    this->ActiveLayers.clear();
+    for (uint64_t k = 0; k < layers; ++k)
+    {
+      this->ActiveLayers.push_back(in.Get<ModelChunk>());
+    }
+  }
+  catch (const std::runtime_error&)
+  {
+    return false;
+  }
+  return true;
+}
+
+void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
+{
+  const auto& dims = this->Partition->Dims();
+  const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
+  int64_t i0 = nx, i1 = 0, j0 = ny, j1 = 0;
+  for (int64_t column : columns)
+  {
+    const int64_t i = column % nx, j = column / nx;
+    i0 = std::min(i0, i);
+    i1 = std::max(i1, i + 1);
+    j0 = std::min(j0, j);
+    j1 = std::max(j1, j + 1);
+  }
+  // One column of halo all round: the nodes and quadrics of the leaf's border come out as in
+  // the whole model, and edges shared with the halo are the leaf's cut edges.
+  i0 = std::max<int64_t>(i0 - 1, 0);
+  j0 = std::max<int64_t>(j0 - 1, 0);
+  i1 = std::min(i1 + 1, nx);
+  j1 = std::min(j1 + 1, ny);
+  const int64_t w = i1 - i0, h = j1 - j0;
+  std::vector<uint8_t> selected(static_cast<std::size_t>(w * h), 0);
+  const auto& hasActive = this->Partition->ColumnHasActive();
+  for (int64_t column : columns)
+  {
+    const int64_t i = column % nx - i0, j = column / nx - j0;
+    selected[static_cast<std::size_t>(j * w + i)] = 2;
+  }
+  for (int64_t column : columns)
+  {
+    const int64_t ci = column % nx, cj = column / nx;
+    for (int64_t dj = -1; dj <= 1; ++dj)
+    {
+      for (int64_t di = -1; di <= 1; ++di)
+      {
+        const int64_t i = ci + di, j = cj + dj;
+        if (i < i0 || j < j0 || i >= i1 || j >= j1 || !hasActive[static_cast<std::size_t>(j * nx + i)])
+        {
+          continue;
+        }
+        uint8_t& flag = selected[static_cast<std::size_t>((j - j0) * w + (i - i0))];
+        flag = std::max<uint8_t>(flag, 1);
+      }
+    }
+  }
+  std::vector<float> zcorn;
+  std::vector<uint8_t> activeBytes;
+  this->Partition->ReadBox(i0, i1, j0, j1, zcorn, activeBytes);
+  std::vector<bool> active(activeBytes.size());
+  for (std::size_t c = 0; c < activeBytes.size(); ++c)
+  {
+    active[c] = activeBytes[c] != 0;
+  }
+  const LeafPartition& partition = *this->Partition;
+  const auto corners = [&](int64_t i, int64_t j, int64_t k, double out[8][3]) {
+    const float* z = &zcorn[static_cast<std::size_t>(((k * h + j) * w + i) * 8)];
+    for (int c = 0; c < 8; ++c)
+    {
+      partition.PillarPoint(i0 + i + (c & 1), j0 + j + ((c >> 1) & 1), z[c], out[c]);
+    }
+  };
+  // Sec. 5.3: the original top and bottom face normals of every cell (z up), 2 bytes each.
+  {
+    ManifestOut normals;
+    normals.Put(static_cast<uint64_t>(columns.size()));
+    double p[8][3];
+    for (int64_t column : columns)
+    {
+      normals.Put(column);
+      for (int64_t k = 0; k < nz; ++k)
+      {
+        corners(column % nx - i0, column / nx - j0, k, p);
+        for (int face = 0; face < 2; ++face)
+        {
+          const auto at = [&](int c) { return glm::dvec3(p[4 * face + c][0], p[4 * face + c][1], -p[4 * face + c][2]); };
+          glm::dvec3 n = glm::cross(at(1) - at(0) + at(3) - at(2), at(2) - at(0) + at(3) - at(1));
+          if ((face == 0 && n.z < 0) || (face == 1 && n.z > 0))
+          {
+            n = -n; // top faces look up, bottom faces down, whichever way the grid turns
+          }
+          if (!(glm::length(n) > 0))
+          {
+            n = glm::dvec3(0, 0, face == 0 ? 1 : -1); // a face of no area: level
+          }
+          normals.Put(EncodeUnitNormal(n.x, n.y, n.z));
+        }
+      }
+    }
+    normals.Save(this->NormalsPath(leaf));
+  }
+  const ColumnMesh halo = ColumnMesh::FromCells({ w, h, nz }, corners, active, 0, w, 0, h, &selected);
+  std::vector<uint8_t> keep(static_cast<std::size_t>(halo.ColumnSlots()), 0);
+  for (int32_t c = 0; c < halo.ColumnSlots(); ++c)
+  {
+    const auto& origin = halo.ColumnOrigin(c);
+    keep[c] = selected[static_cast<std::size_t>(origin[1] * w + origin[0])] == 2;
+  }
+  ScratchRegion region;
+  region.mesh = halo.Export(&keep);
+  std::vector<uint8_t> openSides;
+  UpdateOpenSides(halo, std::vector<uint8_t>(static_cast<std::size_t>(halo.ColumnSlots()), 0), openSides);
+  region.openSides = KeptCells(openSides, keep, static_cast<std::size_t>(nz));
+  for (int32_t c = 0; c < halo.ColumnSlots(); ++c)
+  {
+    if (!keep[c])
+    {
+      continue;
+    }
+    uint8_t cut = 0;
+    for (int e = 0; e < 4; ++e)
+    {
+      const int32_t other = Across(halo, c, e);
+      if (other >= 0 && !keep[other])
+      {
+        cut |= static_cast<uint8_t>(1u << e);
+      }
+    }
+    region.cutEdges.push_back(cut);
+  }
+  for (auto& t : region.mesh.topology)
+  {
+    t[0] += static_cast<double>(i0);
+    t[1] += static_cast<double>(j0);
+  }
+  for (auto& o : region.mesh.origin)
+  {
+    o[0] += static_cast<int32_t>(i0);
+    o[1] += static_cast<int32_t>(j0);
+  }
+  this->Emit(this->Tree.LeafLevel(), leaf, region, this->Tree.LeafLevel() > 0);
+  this->WorkDone += static_cast<int64_t>(columns.size());
+  this->Report(this->Phase, this->WorkStart + this->WorkSpan * static_cast<double>(this->WorkDone) / this->WorkTotal);
+}
+
+/// The finished regions of a diamond's children (level + 1), read back from scratch.
+std::vector<ScratchRegion> Builder::LoadChildren(const DiamondHierarchy::Diamond& diamond) const
+{
+  const int childLevel = diamond.level + 1;
+  std::vector<ScratchRegion> children;
+  for (int64_t triangle : { diamond.first, diamond.second })
+  {
+    if (triangle < 0)
+    {
+      continue;
+    }
+    for (int64_t child : { 2 * triangle, 2 * triangle + 1 })
+    {
+      ScratchRegion region;
+      const std::string path = RegionPath(this->Scratch, childLevel, child);
+      if (LoadRegion(path, region)) // removed once the level is finished (resuming needs it)
+      {
+        children.push_back(std::move(region));
+      }
+    }
+  }
+  return children;
+}
+
+/// Splits the simplified diamond along its hypotenuse by column centre and emits each
+/// triangle's region with the edges cut towards the other triangle and other diamonds.
+void Builder::SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const ColumnMesh& mesh,
+  const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides)
+{
+  const int32_t slots = mesh.ColumnSlots();
+  const int32_t layers = mesh.Layers();
+  const std::size_t interfaces = static_cast<std::size_t>(layers) + 1;
+  const int triangles = diamond.second >= 0 ? 2 : 1;
+  std::vector<uint8_t> side(static_cast<std::size_t>(slots), 0);
+  for (int32_t c = 0; c < slots; ++c)
+  {
+    if (!mesh.IsColumnAlive(c))
+    {
+      continue;
+    }
+    double x = 0, y = 0;
+    for (int32_t node : mesh.ColumnCorners(c))
+    {
+      for (int32_t k : { 0, layers })
+      {
+        const glm::dvec3 p = mesh.Position(node, k);
+        x += p.x / 8;
+        y += p.y / 8;
+      }
+    }
+    side[c] = this->Tree.OnFirstSide(diamond, x, y) ? 1 : 2;
+  }
+  for (int which = 1; which <= triangles; ++which)
+  {
+    std::vector<uint8_t> keep(static_cast<std::size_t>(slots), 0);
+    bool any = false;
+    for (int32_t c = 0; c < slots; ++c)
+    {
+      keep[c] = side[c] == which;
+      any = any || keep[c];
+    }
+    if (!any)
+    {
+      continue;
+    }
+    ScratchRegion region;
+    region.mesh = mesh.Export(&keep);
+    region.openSides = KeptCells(openSides, keep, interfaces - 1);
+    for (int32_t c = 0; c < slots; ++c)
+    {
+      if (!keep[c])
+      {
+        continue;
+      }
+      // Locked columns keep their corners, so their cut edges are still cut; the rest have
+      // none but those facing the other triangle.
+      uint8_t cut = mesh.IsLocked(c) ? childCut[c] : 0;
+      for (int e = 0; e < 4; ++e)
+      {
+        const int32_t other = Across(mesh, c, e);
+        if (other >= 0 && side[other] != which)
+        {
+          cut |= static_cast<uint8_t>(1u << e);
+        }
+      }
+      region.cutEdges.push_back(cut);
+    }
+    const int64_t index = which == 1 ? diamond.first : diamond.second;
+    this->Emit(diamond.level, index, region, diamond.level > 0);
+  }
+}
+
+void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond)
+{
+  const std::vector<ScratchRegion> children = this->LoadChildren(diamond);
+  if (children.empty())
+  {
+    return;
+  }
+  std::vector<uint8_t> childCut, openSides;
+  int64_t inputColumns = 0;
+  ColumnMesh mesh = MergeRegions(children, childCut, openSides, inputColumns);
+  LockCutColumns(mesh, childCut);
+  const int triangles = diamond.second >= 0 ? 2 : 1;
+  const int64_t target = std::min<int64_t>(this->Options.cmax * triangles, (inputColumns + 1) / 2);
+  if (mesh.AliveColumns() > target)
+  {
+    ColumnCollapse collapse(mesh, Mix(this->Options.seed ^ Mix(static_cast<uint64_t>(diamond.level) << 48 ^
+                                                             static_cast<uint64_t>(diamond.first))));
+    collapse.Simplify(target);
+  }
+  // Cut edges left are on the diamond's boundary, where columns are locked and unchanged.
+  UpdateOpenSides(mesh, childCut, openSides);
+  this->SplitAndEmit(diamond, mesh, childCut, openSides);
+  this->WorkDone += inputColumns;
+  this->Report(this->Phase, this->WorkStart + this->WorkSpan * static_cast<double>(this->WorkDone) / this->WorkTotal);
+}
+
+double Seconds()
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+void Builder::FinishBoundsAndErrors(int leafLevel)
+{
+  // Bounding volumes and errors: equal within a diamond, monotone up the tree (Sec. 6.2).
+  std::map<std::pair<int, int64_t>, std::array<double, 6>> boxes;
+  std::map<std::pair<int, int64_t>, double> errors;
+  for (int level = leafLevel; level >= 0; --level)
+  {
+    for (const auto& d : this->Tree.Diamonds(level))
+    {
+      const double inf = std::numeric_limits<double>::infinity();
+      std::array<double, 6> box{ inf, inf, inf, -inf, -inf, -inf };
+      double error = 0;
+      bool any = false;
+      for (int64_t triangle : { d.first, d.second })
+      {
+        if (triangle < 0 || !this->Records.count({ level, triangle }))
+        {
+          continue;
+        }
+        any = true;
+        const auto& own = this->OwnBoxes[{ level, triangle }];
+        error = std::max<double>(error, this->Records[{ level, triangle }].ownError);
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          box[axis] = std::min(box[axis], own[axis]);
+          box[3 + axis] = std::max(box[3 + axis], own[3 + axis]);
+        }
+        if (level < leafLevel)
+        {
+          for (int64_t child : { 2 * triangle, 2 * triangle + 1 })
+          {
+            const auto found = boxes.find({ level + 1, child });
+            if (found == boxes.end())
+            {
+              continue;
+            }
+            error = std::max(error, errors[{ level + 1, child }]);
+            for (int axis = 0; axis < 3; ++axis)
+            {
+              box[axis] = std::min(box[axis], found->second[axis]);
+              box[3 + axis] = std::max(box[3 + axis], found->second[3 + axis]);
+            }
+          }
+        }
+      }
+      if (!any)
+      {
+        continue;
+      }
+      for (int64_t triangle : { d.first, d.second })
+      {
+        if (triangle < 0 || !this->Records.count({ level, triangle }))
+        {
+          continue;
+        }
+        boxes[{ level, triangle }] = box;
+        errors[{ level, triangle }] = error;
+        RegionRecord& record = this->Records[{ level, triangle }];
+        record.error = static_cast<float>(error);
+        for (int i = 0; i < 6; ++i)
+        {
+          // Rounded outward, so the float box still encloses the double one.
+          record.bounds[i] = static_cast<float>(box[i]);
+          record.bounds[i] = i < 3 ? std::nextafter(record.bounds[i], -std::numeric_limits<float>::infinity())
+                                   : std::nextafter(record.bounds[i], std::numeric_limits<float>::infinity());
+        }
+      }
+    }
+  }
+}
+
+void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& report, std::vector<ModelChunk>& model)
+{
+  const auto& dims = header.dims;
+  const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
+  const uint64_t cells = static_cast<uint64_t>(nx * ny * nz);
+
+  // The cells that any extracted face of any level may sample (Sec. 5.4): read back from
+  // the chunk files, one region a task.
+  std::vector<std::atomic<uint64_t>> touched((cells + 63) / 64);
+  std::vector<std::unique_ptr<MappedChunkFile>> parts;
+  for (int r = 0; r < this->Options.ranks; ++r)
+  {
+    parts.emplace_back(new MappedChunkFile(this->ChunkPath(r)));
+  }
+  std::vector<std::pair<int, int64_t>> keys;
+  for (const auto& entry : this->Records)
+  {
+    if (entry.second.columns > 0)
+    {
+      keys.push_back(entry.first);
+    }
+  }
+  const int threads = this->ThreadsFor(4 * this->Options.cmax * (nz + 1) * 64);
+  this->Phase = "property side";
+  ParallelFor(static_cast<int64_t>(keys.size()), threads, [&](int64_t n) {
+    const auto& key = keys[static_cast<std::size_t>(n)];
+    RegionMesh mesh = parts[static_cast<std::size_t>(this->Parts[key])]->ReadRegion(this->Records[key], header);
+    ExtractSurfaces(mesh); // the exact side faces, which views draw for regions of small error
+    MarkTouchedCells(mesh, dims, touched);
+    this->Report(this->Phase, 0.95 + 0.03 * static_cast<double>(n + 1) / static_cast<double>(keys.size()));
+  });
+  parts.clear();
+
+  // Perfect spatial hash over them (Lefebvre and Hoppe), the cell of each slot.
+  std::vector<std::array<uint32_t, 3>> hashed;
+  for (uint64_t word = 0; word < touched.size(); ++word)
+  {
+    uint64_t bits = touched[word].load(std::memory_order_relaxed);
+    while (bits)
+    {
+      const int bit = __builtin_ctzll(bits);
+      bits &= bits - 1;
+      const uint64_t n = word * 64 + static_cast<uint64_t>(bit);
+      const uint64_t layer = static_cast<uint64_t>(nx * ny);
+      hashed.push_back({ static_cast<uint32_t>(n % layer % static_cast<uint64_t>(nx)),
+        static_cast<uint32_t>(n % layer / static_cast<uint64_t>(nx)), static_cast<uint32_t>(n / layer) });
+    }
+  }
+  std::vector<std::atomic<uint64_t>>().swap(touched);
+  const PerfectSpatialHash hash = BuildPerfectSpatialHash(hashed);
+  header.hashTableSides = hash.tableSides;
+  header.hashOffsetSides = hash.offsetSides;
+  header.hashedCells = hashed.size();
+  report.hashedCells = hashed.size();
+  report.hashSlots = hash.TableSize();
+  report.hashOffsets = static_cast<uint64_t>(hash.offsets.size());
+  const std::size_t slots = static_cast<std::size_t>(hash.TableSize());
+  std::vector<uint64_t> slotCell(slots, ~uint64_t(0));
+  std::vector<std::array<uint16_t, 2>> slotNormals(slots, { 0, 0 });
+  // Cells by column, to gather normals leaf by leaf.
+  std::vector<std::pair<uint64_t, uint64_t>> byColumn(hashed.size()); // (column, k) , slot
+  for (std::size_t c = 0; c < hashed.size(); ++c)
+  {
+    const auto& p = hashed[c];
+    const uint64_t slot = hash.Slot(p[0], p[1], p[2]);
+    slotCell[static_cast<std::size_t>(slot)] = p[0] + static_cast<uint64_t>(nx) * (p[1] + static_cast<uint64_t>(ny) * p[2]);
+    byColumn[c] = { (p[0] + static_cast<uint64_t>(nx) * p[1]) * static_cast<uint64_t>(nz) + p[2], slot };
+  }
+  std::vector<std::array<uint32_t, 3>>().swap(hashed);
+  std::sort(byColumn.begin(), byColumn.end());
+  for (const auto& entry : this->Records)
+  {
+    if (entry.first.first != header.leafLevel || entry.second.columns == 0)
+    {
+      continue;
+    }
+    ManifestIn in;
+    if (!in.Load(this->NormalsPath(entry.first.second)))
+    {
+      throw std::runtime_error(this->NormalsPath(entry.first.second) + ": missing scratch file of cell normals");
+    }
+    const uint64_t count = in.Get<uint64_t>();
+    for (uint64_t c = 0; c < count; ++c)
+    {
+      const uint64_t column = static_cast<uint64_t>(in.Get<int64_t>());
+      const uint8_t* stack = in.Skip(static_cast<std::size_t>(nz) * 4);
+      auto it = std::lower_bound(byColumn.begin(), byColumn.end(), std::make_pair(column * static_cast<uint64_t>(nz), uint64_t(0)));
+      for (; it != byColumn.end() && it->first / static_cast<uint64_t>(nz) == column; ++it)
+      {
+        const uint64_t k = it->first % static_cast<uint64_t>(nz);
+        std::memcpy(slotNormals[static_cast<std::size_t>(it->second)].data(), stack + k * 4, 4);
+      }
+    }
+  }
+  std::vector<uint16_t> offsets;
+  for (const auto& o : hash.offsets)
+  {
+    offsets.insert(offsets.end(), o.begin(), o.end());
+  }
+  this->Chunks->AddModelArray(ModelChunk::HashOffsets, offsets.data(), offsets.size() * 2, model);
+  this->Chunks->AddModelArray(ModelChunk::HashCells, slotCell.data(), slotCell.size() * 8, model);
+  this->Chunks->AddModelArray(ModelChunk::CellNormals, slotNormals.data(), slotNormals.size() * 4, model);
+}
+
+/// Creates the scratch folder, or finds in it the last level every rank finished (-1: none,
+/// start over) and clears what an unfinished level left.
+int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& report)
+{
+  const bool lead = this->Options.rank == 0;
+  if (mkdir(this->Scratch.c_str(), 0755) != 0 && errno != EEXIST)
+  {
+    throw std::runtime_error(this->Scratch + ": cannot create the scratch folder: " + std::strerror(errno));
+  }
+  int finished = -1;
+  if (this->ReadBuildManifest(header, report))
+  {
+    for (int level = header.leafLevel; level >= 0; --level)
+    {
+      bool all = true;
+      for (int r = 0; r < this->Options.ranks; ++r)
+      {
+        all = all && Exists(this->LevelManifest(level, r));
+      }
+      if (!all)
+      {
+        break;
+      }
+      finished = level;
+    }
+  }
+  this->Barrier();
+  if (lead)
+  {
+    // Start over, or clear what the unfinished level left (other ranks wait below).
+    if (finished < 0)
+    {
+      RemoveTree(this->Scratch);
+      if (mkdir(this->Scratch.c_str(), 0755) != 0 && errno != EEXIST)
+      {
+        throw std::runtime_error(this->Scratch + ": cannot create the scratch folder: " + std::strerror(errno));
+      }
+    }
+    for (int r = 0; r < this->Options.ranks; ++r)
+    {
+      unlink((this->Scratch + "/failed.rank-" + std::to_string(r)).c_str());
+    }
+  }
+  this->Barrier();
+  return finished;
+}
+
+/// Reloads the levels a killed build finished and reopens this rank's chunk file at the
+/// size it had then.
+void Builder::Resume(int finished, const MultiresolutionHeader& header)
+{
+  this->Tree = DiamondHierarchy(header.box[0], header.box[1], header.box[2], header.box[3], header.leafLevel);
+  this->Options.cmax = header.cmax;
+  for (int level = header.leafLevel; level >= finished; --level)
+  {
+    this->LoadLevel(level);
+  }
+  ManifestIn own;
+  own.Load(this->LevelManifest(finished, this->Options.rank));
+  own.Get<uint64_t>();
+  own.Get<int32_t>();
+  own.Get<int32_t>();
+  this->Header = header;
+  this->Chunks.reset(new ChunkFile(this->ChunkPath(this->Options.rank), static_cast<int64_t>(own.Get<uint64_t>())));
+}
+
+/// The streaming pass (Sec. 4.2 and 7, "partitioning"): rank 0 reads the input once, layer by
+/// layer, into scratch tiles and stores each layer's active flags; the other ranks open its
+/// tiles.
+void Builder::PartitionInput()
+{
+  const bool lead = this->Options.rank == 0;
+  const auto dims = this->Source.Dims();
+  this->Chunks.reset(new ChunkFile(this->ChunkPath(this->Options.rank)));
+  // Tiles of about 64 x 64 columns, fewer and bigger for very wide grids (at most ~1000
+  // files).
+  const int64_t tile =
+    std::max<int64_t>(64, static_cast<int64_t>(std::ceil(std::sqrt(double(dims[0]) * dims[1] / 1000.0))));
+  this->Collective([&] {
+    if (!lead)
+    {
+      return;
+    }
+    std::vector<uint8_t> bits;
+    this->Partition.reset(new LeafPartition(
+      this->Source, this->Scratch + "/tiles", tile, [this](double f) { this->Report("partition", 0.1 * f); },
+      [&](int64_t k, const std::vector<uint8_t>& active) {
+        bits.assign((active.size() + 7) / 8, 0);
+        for (std::size_t c = 0; c < active.size(); ++c)
+        {
+          bits[c >> 3] |= static_cast<uint8_t>((active[c] ? 1 : 0) << (c & 7));
+        }
+        ModelChunk chunk;
+        chunk.kind = ModelChunk::ActiveLayer;
+        chunk.part = static_cast<uint32_t>(k);
+        chunk.chunk = this->Chunks->Put(bits, "active flags of layer " + std::to_string(k + 1));
+        this->ActiveLayers.push_back(chunk);
+      }));
+    this->Partition->SaveState();
+  });
+  if (!lead)
+  {
+    this->Partition.reset(new LeafPartition(this->Scratch + "/tiles"));
+  }
+}
+
+/// The hierarchy over the pillars' extent, its leaf level chosen for Cmax columns a leaf, and
+/// the columns of each leaf (by column centre); fills the header and writes the build
+/// manifest.
+std::vector<Builder::Leaf> Builder::PlanLeaves(MultiresolutionHeader& header, HierarchyReport& report)
+{
+  const auto dims = this->Source.Dims();
+  const int64_t nx = dims[0], ny = dims[1];
+  const auto& extent = this->Partition->Extent();
+  const auto& hasActive = this->Partition->ColumnHasActive();
+  std::vector<int64_t> columns;
+  for (int64_t c = 0; c < nx * ny; ++c)
+  {
+    if (hasActive[static_cast<std::size_t>(c)])
+    {
+      columns.push_back(c);
+    }
+  }
+  if (columns.empty())
+  {
+    throw std::runtime_error(this->Source.Name() + ": the model has no active cell");
+  }
+  report.columns = static_cast<int64_t>(columns.size());
+  DiamondHierarchy locator(extent[0], extent[1], extent[3], extent[4], 0);
+  std::vector<std::pair<uint64_t, int64_t>> coded(columns.size());
+  std::vector<uint64_t> codes(columns.size());
+  for (std::size_t n = 0; n < columns.size(); ++n)
+  {
+    const auto centre = this->Partition->ColumnCentre(columns[n] % nx, columns[n] / nx);
+    codes[n] = locator.Code(centre[0], centre[1]);
+    coded[n] = { codes[n], columns[n] };
+  }
+  const int64_t cmax = this->Options.cmax == 0 ? AutomaticCmax(report.columns) : this->Options.cmax;
+  const int leafLevel = DiamondHierarchy::ChooseLeafLevel(codes, cmax);
+  this->Tree = DiamondHierarchy(extent[0], extent[1], extent[3], extent[4], leafLevel);
+  std::sort(coded.begin(), coded.end());
+  std::vector<Leaf> leaves;
+  for (const auto& entry : coded)
+  {
+    const int64_t leaf = static_cast<int64_t>(entry.first >> (DiamondHierarchy::MaxDepth - leafLevel));
+    if (leaves.empty() || leaves.back().first != leaf)
+    {
+      leaves.push_back({ leaf, {} });
+    }
+    leaves.back().second.push_back(entry.second);
+  }
+
+  header.dims = dims;
+  header.box = { extent[0], extent[1], extent[3], extent[4] };
+  ChooseLattice(extent, header);
+  header.leafLevel = leafLevel;
+  header.cmax = static_cast<int32_t>(cmax);
+  this->Header = header;
+  if (this->Options.rank == 0)
+  {
+    this->WriteBuildManifest(header, report);
+  }
+  this->Options.cmax = cmax;
+  return leaves;
+}
+
+/// Leaf meshes (Sec. 4.2's finest level), this rank's share on worker threads, then the
+/// partition's tiles are removed.
+void Builder::BuildLeaves(const std::vector<Leaf>& leaves, int leafLevel, HierarchyReport& report)
+{
+  const int64_t nz = this->Source.Dims()[2];
+  const int64_t cmax = this->Options.cmax;
+  // Work: leaf columns once, then the columns merged at each level (about halving).
+  this->WorkTotal = std::max<int64_t>(1, report.columns / this->Options.ranks);
+  this->WorkStart = 0.1;
+  this->WorkSpan = 0.1;
+  this->Phase = "leaves";
+  const double leafStart = Seconds();
+  const int64_t leafTask = (cmax * 2) * (nz + 1) * VertexBytes * 2 + cmax * 2 * nz * 40;
+  const int leafThreads = this->ThreadsFor(leafTask);
+  report.threadsUsed = leafThreads;
+  const std::vector<std::size_t> mine = this->Share(leaves.size());
+  this->Collective([&] {
+    ParallelFor(static_cast<int64_t>(mine.size()), leafThreads, [&](int64_t n) {
+      const auto& leaf = leaves[mine[static_cast<std::size_t>(n)]];
+      this->BuildLeaf(leaf.first, leaf.second);
+    });
+    this->SaveLevel(leafLevel);
+  });
+  this->LoadLevel(leafLevel);
+  report.leafSeconds = Seconds() - leafStart;
+  // Tiles are no longer needed: other ranks close theirs before rank 0 removes them.
+  if (this->Options.rank != 0)
+  {
+    this->Partition.reset();
+  }
+  this->Barrier();
+  this->Partition.reset();
+}
+
+/// The items of `count` this rank builds (round robin over ranks).
+std::vector<std::size_t> Builder::Share(std::size_t count) const
+{
+  std::vector<std::size_t> mine;
+  for (std::size_t n = 0; n < count; ++n)
+  {
+    if (static_cast<int>(n % static_cast<std::size_t>(this->Options.ranks)) == this->Options.rank)
+    {
+      mine.push_back(n);
+    }
+  }
+  return mine;
+}
+
+/// Sec. 4.1-4.3 bottom-up: each level's diamonds merge and simplify their children's meshes;
+/// a level's scratch regions are removed once the next level holds them.
+void Builder::SimplifyLevels(int finished, HierarchyReport& report)
+{
+  const int64_t nz = this->Source.Dims()[2];
+  const double simplifyStart = Seconds();
+  this->Phase = "simplify";
+  this->WorkDone = 0;
+  this->WorkTotal = std::max<int64_t>(1, 2 * report.columns / this->Options.ranks);
+  this->WorkStart = 0.2;
+  this->WorkSpan = 0.75;
+  const int64_t diamondTask = 4 * this->Options.cmax * (nz + 1) * VertexBytes * 3;
+  const int diamondThreads = this->ThreadsFor(diamondTask);
+  report.threadsUsed = std::max(report.threadsUsed, diamondThreads);
+  for (int level = finished - 1; level >= 0; --level)
+  {
+    std::vector<DiamondHierarchy::Diamond> busy;
+    for (const auto& d : this->Tree.Diamonds(level))
+    {
+      const int64_t children[4] = { 2 * d.first, 2 * d.first + 1, d.second >= 0 ? 2 * d.second : -1,
+        d.second >= 0 ? 2 * d.second + 1 : -1 };
+      for (int64_t child : children)
+      {
+        if (child >= 0 && this->Records.count({ level + 1, child }))
+        {
+          busy.push_back(d);
+          break;
+        }
+      }
+    }
+    const std::vector<std::size_t> mine = this->Share(busy.size());
+    this->Collective([&] {
+      ParallelFor(static_cast<int64_t>(mine.size()), diamondThreads,
+        [&](int64_t n) { this->BuildDiamond(busy[mine[static_cast<std::size_t>(n)]]); });
+      this->SaveLevel(level);
+    });
+    this->LoadLevel(level);
+    if (this->Options.rank == 0)
+    {
+      for (const auto& entry : this->Records)
+      {
+        if (entry.first.first == level + 1)
+        {
+          unlink(RegionPath(this->Scratch, level + 1, entry.first.second).c_str());
+        }
+      }
+    }
+  }
+  report.simplifySeconds = Seconds() - simplifyStart;
+}
+
+/// Rank 0: errors and bounds, the property side, then the file from every rank's chunks.
+void Builder::WriteFile(MultiresolutionHeader& header, HierarchyReport& report)
+{
+  this->Collective([&] {
+    if (this->Options.rank != 0)
+    {
+      return;
+    }
+    this->FinishBoundsAndErrors(header.leafLevel);
+    std::vector<ModelChunk> model = this->ActiveLayers;
+    this->BuildPropertySide(header, report, model);
+    this->Chunks->Sync();
+    std::vector<std::string> paths;
+    for (int r = 0; r < this->Options.ranks; ++r)
+    {
+      paths.push_back(this->ChunkPath(r));
+    }
+    std::vector<PartRecord<RegionRecord>> regions;
+    for (const auto& entry : this->Records)
+    {
+      regions.push_back({ this->Parts[entry.first], entry.second });
+      report.nonEmptyRegions += entry.second.columns > 0 ? 1 : 0;
+    }
+    std::vector<PartRecord<ModelChunk>> modelParts;
+    for (const ModelChunk& m : model)
+    {
+      modelParts.push_back({ 0, m });
+    }
+    report.regions = static_cast<int64_t>(regions.size());
+    header.map = this->Source.Placement(); // recorded only: positions stay in grid coordinates
+    this->Report("writing", 0.99);
+    AssembleMultiresolutionFile(this->Output, header, paths, regions, modelParts);
+    struct stat info;
+    report.fileBytes = stat(this->Output.c_str(), &info) == 0 ? static_cast<uint64_t>(info.st_size) : 0;
+  });
+}
+
+HierarchyReport Builder::Run()
+{
+  HierarchyReport report;
+  const double start = Seconds();
+  const auto dims = this->Source.Dims();
+  report.cells = dims[0] * dims[1] * dims[2];
+  this->CellCount = report.cells;
+  MultiresolutionHeader header;
+  int finished = this->PrepareScratch(header, report);
+  bool keepScratch = false;
+  try
+  {
+    if (finished >= 0)
+    {
+      report.resumedFromLevel = finished;
+      this->Resume(finished, header);
+    }
+    else
+    {
+      this->PartitionInput();
+      report.partitionSeconds = Seconds() - start;
+      report.activeCells = this->Partition->ActiveCells();
+      const std::vector<Leaf> leaves = this->PlanLeaves(header, report);
+      this->BuildLeaves(leaves, header.leafLevel, report);
+      finished = header.leafLevel;
+    }
+    keepScratch = true;
+    report.leafLevel = header.leafLevel;
+    this->SimplifyLevels(finished, report);
+    this->WriteFile(header, report);
+  }
+  catch (const std::exception& error)
+  {
+    this->Chunks.reset();
+    this->Partition.reset();
+    if (!keepScratch)
+    {
+      if (this->Options.rank == 0)
+      {
+        RemoveTree(this->Scratch);
+      }
+      throw;
+    }
+    throw std::runtime_error(std::string(error.what()) + " (finished levels are kept in " + this->Scratch +
+      ": run the same build again to resume)");
+  }
+  this->Chunks.reset();
+  this->Barrier();
+  if (this->Options.rank == 0)
+  {
+    RemoveTree(this->Scratch);
+  }
+  report.totalSeconds = Seconds() - start;
+  this->Report("done", 1.0);
+  return report;
+}
+} // namespace
+
+std::string ScratchFolder(const std::string& output, const HierarchyOptions& options)
+{
+  return options.scratch.empty() ? output + ".scratch" : options.scratch;
+}
+
+HierarchyReport BuildHierarchy(
+  LayerSource& source, const std::string& output, const HierarchyOptions& options, const BuildProgress& progress)
+{
+  Builder builder(source, output, options, progress);
+  return builder.Run();
+}
+
+} // namespace resmr

@@ -1,0 +1,99 @@
+# The plugin's tests: pvpython, pvbatch under MPI, pvserver and the GUI (included from
+# CMakeLists.txt when the plugin is built).
+set(plugin_file "$<TARGET_FILE:ReservoirMultiresolution>")
+find_program(PVPYTHON_EXECUTABLE pvpython REQUIRED)
+
+# Two MPI ranks (mpirun -np 2 pvbatch --symmetric) build the file one process builds.
+find_program(MPIEXEC_EXECUTABLE NAMES mpirun mpiexec)
+find_program(PVBATCH_EXECUTABLE pvbatch REQUIRED)
+add_test(NAME Multiresolution.MPIBuild
+  COMMAND "${MPIEXEC_EXECUTABLE}" --allow-run-as-root --oversubscribe -np 2
+          "${PVBATCH_EXECUTABLE}" --symmetric --force-offscreen-rendering
+          "${CMAKE_CURRENT_SOURCE_DIR}/Python/TestBuildHierarchyMPI.py"
+          --plugin "${plugin_file}" --temp "${CMAKE_CURRENT_BINARY_DIR}/Temporary/mpi"
+          --resmr "$<TARGET_FILE:resmr>")
+set_tests_properties(Multiresolution.MPIBuild PROPERTIES
+  ENVIRONMENT "PYTHONPATH=${CMAKE_CURRENT_SOURCE_DIR}/Python;OMPI_MCA_rmaps_base_oversubscribe=1"
+  FAIL_REGULAR_EXPRESSION "FAIL;Traceback"
+  PASS_REGULAR_EXPRESSION "MPI build equivalent"
+  TIMEOUT 600)
+
+# pvpython tests through the plugin's GRDECLReader proxy.
+function (resmr_add_pvpython_test name script)
+  add_test(NAME ${name}
+    COMMAND "${PVPYTHON_EXECUTABLE}" --force-offscreen-rendering
+            "${CMAKE_CURRENT_SOURCE_DIR}/Python/${script}"
+            --plugin "${plugin_file}" --data "${RESMR_DATA_DIR}"
+            --baselines "${CMAKE_CURRENT_SOURCE_DIR}/Data/Baseline"
+            --temp "${CMAKE_CURRENT_BINARY_DIR}/Temporary")
+  set_tests_properties(${name} PROPERTIES
+    ENVIRONMENT "PYTHONPATH=${CMAKE_CURRENT_SOURCE_DIR}/Python"
+    FAIL_REGULAR_EXPRESSION "FAIL;Traceback"
+    TIMEOUT 600)
+endfunction ()
+resmr_add_pvpython_test(Reader.CornersAgainstOPM TestCornersAgainstOPM.py)
+resmr_add_pvpython_test(Reader.BadInput TestReaderBadInput.py)
+resmr_add_pvpython_test(Reader.Images TestReaderImages.py)
+# Edit and skipped keywords of every class inserted into Reek's and SPE9's decks: equal to
+# OPM's EclipseState, one warning each, resmr info and build open them.
+resmr_add_pvpython_test(Reader.DeckEditsAgainstOPM TestDeckEditsAgainstOPM.py)
+set_property(TEST Reader.DeckEditsAgainstOPM APPEND PROPERTY
+  ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+resmr_add_pvpython_test(EGRIDReader.AgainstOPM TestEGRIDAgainstOPM.py)
+# The same with every record of 1000+ values read by several threads.
+resmr_add_pvpython_test(EGRIDReader.AgainstOPMParallelReads TestEGRIDAgainstOPM.py)
+set_property(TEST EGRIDReader.AgainstOPMParallelReads APPEND PROPERTY
+  ENVIRONMENT "RESMR_PARALLEL_MIN_VALUES=1000")
+resmr_add_pvpython_test(EGRIDReader.Images TestEGRIDReaderImages.py)
+resmr_add_pvpython_test(EGRIDReader.StepMemory TestEGRIDStepMemory.py)
+resmr_add_pvpython_test(EGRIDReader.BadInput TestEGRIDReaderBadInput.py)
+# A run still being written: ReloadFiles offers each step as it completes (EGRIDReader, and
+# the .resmrp resmr add-properties extends, through the Multiresolution Surface).
+resmr_add_pvpython_test(EGRIDReader.RunBeingWritten TestRunBeingWritten.py)
+set_property(TEST EGRIDReader.RunBeingWritten APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+
+# Generated models: resmr synth's files in our reader, OPM and (when given a Python with
+# resdata from PyPI) resdata; the SyntheticReservoir source; memory refusals; images.
+set(RESMR_RESDATA_PYTHON "" CACHE FILEPATH
+  "A Python with resdata (PyPI) to cross-check generated EGRIDs; empty: not checked")
+resmr_add_pvpython_test(Synthetic.EndToEnd TestSyntheticReservoir.py)
+set_property(TEST Synthetic.EndToEnd APPEND PROPERTY ENVIRONMENT
+  "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>" "RESMR_RESDATA_PYTHON=${RESMR_RESDATA_PYTHON}")
+
+resmr_add_pvpython_test(Simplify.Reek TestSimplifyReservoirGrid.py)
+
+resmr_add_pvpython_test(Multiresolution.ExtractLevel TestExtractMultiresolutionLevel.py)
+set_property(TEST Multiresolution.ExtractLevel APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+
+resmr_add_pvpython_test(Multiresolution.Reader TestMultiresolutionReader.py)
+set_property(TEST Multiresolution.Reader APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+# The Multiresolution Surface against stock ParaView, pixel by pixel (cell ids, cracks, colours).
+resmr_add_pvpython_test(Multiresolution.Surface TestMultiresolutionSurface.py)
+set_property(TEST Multiresolution.Surface APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+# Its single-layer mode (Layer = K) against stock ParaView's layer K (Threshold), pixel by pixel.
+resmr_add_pvpython_test(Multiresolution.Layer TestMultiresolutionLayer.py)
+set_property(TEST Multiresolution.Layer APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+# Resident memory within the budget over 1,000 frames of an orbit, zoom and low flight on a
+# 10M-cell synthetic model (built once, about 4 minutes on 2 cores, then reused from
+# Temporary/budget); no leak, no error.
+resmr_add_pvpython_test(Multiresolution.Budget TestMultiresolutionBudget.py)
+set_property(TEST Multiresolution.Budget APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+set_tests_properties(Multiresolution.Budget PROPERTIES TIMEOUT 1800)
+# Damaged .resmr/.resmrp files (truncated, garbage or damaged header, index, region, hash and
+# property chunks, empty, missing, cut while open) through the reader and the representation,
+# one pvpython process each: a clear error naming the file, no crash, no hang.
+resmr_add_pvpython_test(Multiresolution.BadInput TestMultiresolutionBadInput.py)
+set_property(TEST Multiresolution.BadInput APPEND PROPERTY ENVIRONMENT
+  "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>" "PVPYTHON_EXECUTABLE=${PVPYTHON_EXECUTABLE}")
+# The same through pvserver (plugin on both sides): the server renders, the client gets the image.
+find_program(PVSERVER_EXECUTABLE pvserver REQUIRED)
+resmr_add_pvpython_test(Multiresolution.ClientServer TestMultiresolutionClientServer.py)
+set_property(TEST Multiresolution.ClientServer APPEND PROPERTY ENVIRONMENT
+  "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>" "PVSERVER_EXECUTABLE=${PVSERVER_EXECUTABLE}")
+# The GUI: progressive refresh while meshes load and the readout dock (skipped without paraview).
+find_program(PARAVIEW_EXECUTABLE paraview)
+resmr_add_pvpython_test(Multiresolution.GUI TestMultiresolutionGUI.py)
+set_property(TEST Multiresolution.GUI APPEND PROPERTY ENVIRONMENT
+  "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>" "PARAVIEW_EXECUTABLE=${PARAVIEW_EXECUTABLE}")
+set_property(TEST Multiresolution.GUI PROPERTY SKIP_RETURN_CODE 125)
+
