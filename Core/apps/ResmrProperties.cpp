@@ -101,22 +101,31 @@ int AddSyntheticProperties(const std::string& spec, const resmr::Multiresolution
   const resmr::SyntheticReservoir model(parameters);
   const auto& arrays = resmr::SyntheticInitArrays();
   // Every table, in the order of an add-properties of the files: the INIT's arrays, then
-  // PRESSURE and SWAT of each step (array -1).
+  // PRESSURE, SWAT and the derived SOIL of each step (array -1).
+  enum class Quantity
+  {
+    Init,
+    Pressure,
+    Water,
+    Oil
+  };
   struct Job
   {
     int array = -1;
     int step = 0;
-    bool pressure = false;
+    Quantity quantity = Quantity::Init;
   };
   std::vector<Job> jobs;
   for (std::size_t a = 0; a < arrays.size(); ++a)
   {
-    jobs.push_back({ static_cast<int>(a), 0, false });
+    jobs.push_back({ static_cast<int>(a), 0, Quantity::Init });
   }
   for (int step = 1; step <= parameters.steps; ++step)
   {
-    jobs.push_back({ -1, step, true });
-    jobs.push_back({ -1, step, false });
+    for (Quantity quantity : { Quantity::Pressure, Quantity::Water, Quantity::Oil })
+    {
+      jobs.push_back({ -1, step, quantity });
+    }
   }
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
   const uint64_t cells = static_cast<uint64_t>(parameters.CellCount());
@@ -138,7 +147,8 @@ int AddSyntheticProperties(const std::string& spec, const resmr::Multiresolution
       }
       else
       {
-        table.name = jobs[j].pressure ? "PRESSURE" : "SWAT";
+        const Quantity quantity = jobs[j].quantity;
+        table.name = quantity == Quantity::Pressure ? "PRESSURE" : quantity == Quantity::Water ? "SWAT" : resmr::DerivedOilName;
         table.step = jobs[j].step - 1;
         table.reportNumber = jobs[j].step;
         table.days = model.StepDays(jobs[j].step);
@@ -180,7 +190,17 @@ int AddSyntheticProperties(const std::string& spec, const resmr::Multiresolution
           model.FillStep(job.step, layer, pressure.data(), swat.data());
           filledStep = job.step;
         }
-        writer.AddLayer(handles[j - first], job.pressure ? pressure.data() : swat.data());
+        if (job.quantity == Quantity::Oil)
+        {
+          // What ReadDerivedOil gives for a run without gas: 1 - SWAT.
+          for (std::size_t c = 0; c < swat.size(); ++c)
+          {
+            values[c] = 1.0f - swat[c];
+          }
+        }
+        writer.AddLayer(handles[j - first], job.quantity == Quantity::Pressure ? pressure.data()
+            : job.quantity == Quantity::Water                                 ? swat.data()
+                                                                               : values.data());
       }
     }
     ++passes;

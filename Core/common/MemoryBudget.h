@@ -12,8 +12,8 @@ namespace resmr
 {
 
 /// Bytes a cell of a full-resolution vtkExplicitStructuredGrid costs while it is read and
-/// shown: 161 measured for the grid itself (points, hexahedra, I/J/K, ACTNUM), 225 at the
-/// reader's peak, plus a few arrays and ParaView's surface for rendering.
+/// shown: the grid itself (points, hexahedra, I/J/K, ACTNUM), the reader's peak above it, a
+/// few arrays and ParaView's surface for rendering (bench/results/egrid_load.md).
 constexpr int64_t FullResolutionBytesPerCell = 300;
 
 /// Memory the system can give without swapping (MemAvailable), else physical memory.

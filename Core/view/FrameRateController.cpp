@@ -18,8 +18,8 @@ double FrameRateController::Update(double frameSeconds, bool complete, const Cut
   {
     return this->Pixels;
   }
-  // Frame times jitter by a fifth from frame to frame (loads, uploads, the system), so the
-  // tolerance is held where frames take 60-85% of the target, and the slow tail stays inside it.
+  // Frame times jitter from frame to frame (loads, uploads, the system), so the tolerance is
+  // held in a band below the target, and the slow tail stays inside it.
   const double ratio = frameSeconds / this->TargetSeconds;
   double factor = 1;
   if (ratio > HighFraction)
@@ -44,8 +44,8 @@ double FrameRateController::Update(double frameSeconds, bool complete, const Cut
   {
     // At most a quarter a frame: the range is this view's, and the next may be another (a
     // cut in a camera path, from a close look where only a far diamond can still split, to
-    // a low flight): straight to the far diamond's 0.6 px, the flight began at 0.5 px, 850k
-    // triangles at 90-100 ms for 60 frames while the tolerance climbed back.
+    // a low flight); refining straight to the far diamond's tolerance would start the flight
+    // far over budget for many frames while the tolerance climbed back.
     next = std::max(next, this->Pixels * MaxRefineStep);
   }
   this->Pixels = std::clamp(next, MinimumPixels, MaximumPixels);

@@ -83,9 +83,8 @@ int TopologyHandedness(const MultiresolutionFile& file);
 
 /// Replaces the file's simplified side triangles (Sec. 4.3) by the side faces of the region's
 /// own column mesh, two triangles a quad. The simplified side keeps the geometry within the
-/// region's error but not the layer boundaries its topological coordinates interpolate: on
-/// Reek they move by up to 4 layers, which paints side faces with the wrong cells (2% of the
-/// pixels of a side view at 1 px). Column collapse keeps every layer interface, so the
+/// region's error but not the layer boundaries its topological coordinates interpolate, so
+/// side faces would be painted with the wrong cells. Column collapse keeps every layer interface, so the
 /// mesh's side faces carry exact k; what they cost is triangles.
 void UseOriginalSideFaces(RegionMesh& mesh);
 
@@ -123,9 +122,8 @@ struct DrawPiece
 /// The piece of `buffers` from index `first` (a multiple of 3, below indices.size()): whole
 /// triangles while the piece's vertex range and indices take at most maxBytes, at least one.
 /// Top and bottom vertices are numbered as their quads come and side triangles have their own,
-/// so a piece's range is compact: pieces of 64 KB or more copy exactly the buffers' bytes on
-/// the Reek, test and 10M-cell models; 4 KB pieces repeat shared vertices (4-16% more), and
-/// so do 1 MB pieces on the 100M-cell model (0.09% more in all, 1.2% on one region).
+/// so a piece's range is compact: pieces repeat few shared vertices (Core.ViewSelection
+/// checks the total).
 DrawPiece NextDrawPiece(const RegionDrawBuffers& buffers, std::size_t first, std::size_t maxBytes);
 
 struct PropertyTableData

@@ -1,9 +1,8 @@
 // Bounding the time a frame spends copying newly loaded meshes to the GPU, paper Sec. 6.1 and
 // 6.3: the loader prepares meshes off the render thread, but the copy into GPU buffers happens
-// on it, and its cost per byte is not steady. Measured on llvmpipe in a VM, a buffer whose
-// storage is fresh (the driver allocates and zeroes it, the kernel faults its pages in) costs
-// about 4.4 ms a MB, while memory the process already touched costs under 0.1 ms a MB; during a
-// zoom the fresh case held frames of 6-17 MB of uploads at 20-70 ms. A byte cap alone cannot
+// on it, and its cost per byte is not steady: a buffer whose storage is fresh (the driver
+// allocates and zeroes it, the kernel faults its pages in) costs tens of times more a byte
+// than memory the process already touched (bench/results/view.md). A byte cap alone cannot
 // tell the two apart, so the pacer predicts each copy's time from what the last copies cost.
 //
 // Contract:

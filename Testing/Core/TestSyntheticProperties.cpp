@@ -93,8 +93,8 @@ uint64_t CompareWithFiles(const std::string& resmrTool, const std::string& temp,
   const PropertyFile files(fromFiles), generated(fromSpec);
   generated.CheckGeometry(geometry);
   const auto& h = geometry.Header();
-  // Every INIT array, and PRESSURE and SWAT of each step.
-  const std::size_t tables = 10 + 2 * static_cast<std::size_t>(steps);
+  // Every INIT array, and PRESSURE, SWAT and the derived SOIL of each step.
+  const std::size_t tables = 10 + 3 * static_cast<std::size_t>(steps);
   CHECK(files.Tables().size() == tables);
   CHECK(generated.Tables().size() == tables);
   for (const char* name : { "PORV", "DEPTH", "DX", "DY", "DZ", "PORO", "PERMX", "PERMY", "PERMZ", "NTG" })
@@ -103,7 +103,8 @@ uint64_t CompareWithFiles(const std::string& resmrTool, const std::string& temp,
   }
   for (int32_t step = 0; step < steps; ++step)
   {
-    CHECK(generated.Find("PRESSURE", step) >= 0 && generated.Find("SWAT", step) >= 0);
+    CHECK(generated.Find("PRESSURE", step) >= 0 && generated.Find("SWAT", step) >= 0 &&
+      generated.Find("SOIL", step) >= 0);
   }
   // As many tables a pass as their packed tables fit in one whole array.
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
@@ -206,7 +207,7 @@ int main(int argc, char** argv)
           "' 2>/dev/null >/dev/null") == 0);
   {
     const PropertyFile generated(fromSpec);
-    CHECK(generated.Tables().size() == 10 + 2 * 3);
+    CHECK(generated.Tables().size() == 10 + 3 * 3);
   }
 
   // Another grid, another seed (other active cells), a malformed spec: refused, nothing written.
