@@ -231,6 +231,150 @@ void StepBytes(const resmr::EclipseResults& results, std::size_t step,
     }
   }
 }
+/// (c) Sequential read of `files` from the page cache (warm-up read, then best of `runs`),
+/// and the same bytes read into fresh memory: the floor for a loader keeping them all.
+void MeasureSequentialReads(const std::vector<std::string>& files, double loadBytes, int runs)
+{
+  for (const std::size_t chunk : { std::size_t(1) << 20, std::size_t(16) << 20 })
+  {
+    std::vector<char> buffer(chunk, 1);
+    ReadFiles(files, buffer);
+    double best = 1e30;
+    for (int run = 0; run < std::max(runs, 3); ++run)
+    {
+      best = std::min(best, ReadFiles(files, buffer));
+    }
+    std::printf("{\"kind\": \"seqread\", \"chunk_bytes\": %zu, \"bytes\": %.0f, "
+                "\"seconds\": %.6f, \"mb_per_s\": %.1f}\n",
+      chunk, loadBytes, best, loadBytes / best / 1e6);
+  }
+  for (const bool huge : { false, true })
+  {
+    double best = 1e30;
+    for (int run = 0; run < std::max(runs, 3); ++run)
+    {
+      best = std::min(best, ReadFilesFresh(files, huge));
+    }
+    std::printf("{\"kind\": \"seqread_fresh\", \"huge_pages\": %s, \"bytes\": %.0f, "
+                "\"seconds\": %.6f, \"mb_per_s\": %.1f}\n",
+      huge ? "true" : "false", loadBytes, best, loadBytes / best / 1e6);
+  }
+  std::fflush(stdout);
+
+}
+
+/// (a) EGRID + INIT open, `runs` times; returns the last load, kept for the step switches.
+Loaded MeasureLoads(const std::string& path, double loadBytes, long long egridBytes, long long initBytes, int runs)
+{
+  Loaded kept;
+  for (int run = 1; run <= runs; ++run)
+  {
+    kept = Loaded(); // free the previous run's grid and arrays first
+    const long long faultsBefore = MinorFaults();
+    const auto start = Clock::now();
+    Loaded loaded;
+    loaded.grid = resmr::ReadEclipseGrid(path);
+    const double gridSeconds = Since(start);
+    auto mark = Clock::now();
+    loaded.results = std::make_unique<resmr::EclipseResults>(path, loaded.grid);
+    const double indexSeconds = Since(mark);
+    mark = Clock::now();
+    const std::size_t cells = static_cast<std::size_t>(loaded.grid.deck.CellCount());
+    for (const resmr::EclipseResultArray& array : loaded.results->StaticArrays())
+    {
+      CellValues values;
+      values.name = array.name;
+      if (array.IsInteger())
+      {
+        // As the VTK reader allocates its arrays: malloc'd, huge pages advised.
+        values.integer.reset(new int32_t[cells]);
+        resmr::AdviseHugePages(values.integer.get(), cells * sizeof(int32_t));
+        loaded.results->ReadStatic(array.name, values.integer.get(), int32_t(0));
+      }
+      else
+      {
+        values.real.reset(new float[cells]);
+        resmr::AdviseHugePages(values.real.get(), cells * sizeof(float));
+        loaded.results->ReadStatic(array.name, values.real.get(), 0.0f);
+      }
+      loaded.arrays.push_back(std::move(values));
+    }
+    const double initSeconds = Since(mark);
+    const double seconds = Since(start);
+    const long long faults = MinorFaults() - faultsBefore;
+    std::string names;
+    for (const CellValues& values : loaded.arrays)
+    {
+      names += (names.empty() ? "\"" : ", \"") + JsonEscape(values.name) + "\"";
+    }
+    const auto& d = loaded.grid.deck.dims;
+    std::printf("{\"kind\": \"load\", \"run\": %d, \"bytes\": %.0f, \"egrid_bytes\": %lld, "
+                "\"init_bytes\": %lld, \"seconds\": %.6f, \"grid_seconds\": %.6f, "
+                "\"index_seconds\": %.6f, \"init_seconds\": %.6f, \"mb_per_s\": %.1f, "
+                "\"minor_faults\": %lld, \"peak_rss_bytes\": %lld, \"dims\": [%lld, %lld, %lld], "
+                "\"cells\": %zu, \"active\": %lld, \"steps\": %zu, \"unified\": %s, "
+                "\"init_arrays\": [%s]}\n",
+      run, loadBytes, egridBytes, initBytes, seconds, gridSeconds, indexSeconds, initSeconds,
+      loadBytes / seconds / 1e6, faults, PeakRssBytes(), static_cast<long long>(d[0]),
+      static_cast<long long>(d[1]), static_cast<long long>(d[2]), cells,
+      static_cast<long long>(loaded.grid.activeCells), loaded.results->Steps().size(),
+      loaded.results->UnifiedRestart() ? "true" : "false", names.c_str());
+    std::fflush(stdout);
+    kept = std::move(loaded);
+  }
+
+  return kept;
+}
+
+/// (b) Step switches on a kept load: PRESSURE, SWAT and SGAS of the next step read into the
+/// shown arrays, `switches` times.
+void MeasureStepSwitches(const Loaded& kept, int switches)
+{
+  const resmr::EclipseResults& results = *kept.results;
+  const std::size_t steps = results.Steps().size();
+  if (steps < 2 || switches == 0)
+  {
+    return;
+  }
+  const std::size_t cells = static_cast<std::size_t>(kept.grid.deck.CellCount());
+  std::vector<std::string> names;
+  for (const char* name : { "PRESSURE", "SWAT", "SGAS" })
+  {
+    names.emplace_back(name);
+  }
+  std::vector<std::vector<float>> shown(names.size(), std::vector<float>(cells, 0.0f));
+  const auto readStep = [&](std::size_t step) {
+    int found = 0;
+    for (std::size_t a = 0; a < names.size(); ++a)
+    {
+      found += results.ReadDynamic(step, names[a], shown[a].data(), 0.0f);
+    }
+    return found;
+  };
+  readStep(0); // the step shown before the first switch
+  std::size_t current = 0;
+  for (int s = 1; s <= switches; ++s)
+  {
+    const std::size_t next = (current + 1) % steps;
+    long long stepBytes = 0, arrayBytes = 0;
+    StepBytes(results, next, names, stepBytes, arrayBytes);
+    const long long faultsBefore = MinorFaults();
+    const auto start = Clock::now();
+    const int found = readStep(next);
+    const double seconds = Since(start);
+    const long long faults = MinorFaults() - faultsBefore;
+    std::printf("{\"kind\": \"switch\", \"switch\": %d, \"from\": %d, \"to\": %d, "
+                "\"arrays\": %d, \"seconds\": %.6f, \"array_bytes\": %lld, \"step_bytes\": %lld, "
+                "\"restart_file_bytes\": %lld, \"mb_per_s\": %.1f, \"minor_faults\": %lld, "
+                "\"peak_rss_bytes\": %lld}\n",
+      s, results.Steps()[current].reportNumber, results.Steps()[next].reportNumber, found,
+      seconds, arrayBytes, stepBytes, FileBytes(results.RestartPaths()[results.Steps()[next].file]),
+      static_cast<double>(arrayBytes) / seconds / 1e6, faults, PeakRssBytes());
+    std::fflush(stdout);
+    current = next;
+  }
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -249,153 +393,19 @@ int main(int argc, char** argv)
     const long long egridBytes = FileBytes(path);
     const long long initBytes = initPath.empty() ? 0 : FileBytes(initPath);
     const double loadBytes = static_cast<double>(egridBytes + initBytes);
-
-    // (c) Sequential read from the page cache: warm-up read, then best of `runs`.
-    std::vector<std::string> files{ path };
-    if (!initPath.empty())
-    {
-      files.push_back(initPath);
-    }
     // BENCH_LOAD_ONLY=1 leaves the references out (for profiling the loads alone).
     const char* loadOnlyVariable = std::getenv("BENCH_LOAD_ONLY");
-    const bool references = !(loadOnlyVariable && std::string(loadOnlyVariable) == "1");
-    for (const std::size_t chunk : { std::size_t(1) << 20, std::size_t(16) << 20 })
+    if (!(loadOnlyVariable && std::string(loadOnlyVariable) == "1"))
     {
-      if (!references)
+      std::vector<std::string> files{ path };
+      if (!initPath.empty())
       {
-        break;
+        files.push_back(initPath);
       }
-      std::vector<char> buffer(chunk, 1);
-      ReadFiles(files, buffer);
-      double best = 1e30;
-      for (int run = 0; run < std::max(runs, 3); ++run)
-      {
-        best = std::min(best, ReadFiles(files, buffer));
-      }
-      std::printf("{\"kind\": \"seqread\", \"chunk_bytes\": %zu, \"bytes\": %.0f, "
-                  "\"seconds\": %.6f, \"mb_per_s\": %.1f}\n",
-        chunk, loadBytes, best, loadBytes / best / 1e6);
+      MeasureSequentialReads(files, loadBytes, runs);
     }
-    // The same bytes read into fresh memory: the floor for a loader keeping them all.
-    for (const bool huge : { false, true })
-    {
-      if (!references)
-      {
-        break;
-      }
-      double best = 1e30;
-      for (int run = 0; run < std::max(runs, 3); ++run)
-      {
-        best = std::min(best, ReadFilesFresh(files, huge));
-      }
-      std::printf("{\"kind\": \"seqread_fresh\", \"huge_pages\": %s, \"bytes\": %.0f, "
-                  "\"seconds\": %.6f, \"mb_per_s\": %.1f}\n",
-        huge ? "true" : "false", loadBytes, best, loadBytes / best / 1e6);
-    }
-    std::fflush(stdout);
-
-    // (a) EGRID + INIT open, `runs` times; the last load is kept for the step switches.
-    Loaded kept;
-    for (int run = 1; run <= runs; ++run)
-    {
-      kept = Loaded(); // free the previous run's grid and arrays first
-      const long long faultsBefore = MinorFaults();
-      const auto start = Clock::now();
-      Loaded loaded;
-      loaded.grid = resmr::ReadEclipseGrid(path);
-      const double gridSeconds = Since(start);
-      auto mark = Clock::now();
-      loaded.results = std::make_unique<resmr::EclipseResults>(path, loaded.grid);
-      const double indexSeconds = Since(mark);
-      mark = Clock::now();
-      const std::size_t cells = static_cast<std::size_t>(loaded.grid.deck.CellCount());
-      for (const resmr::EclipseResultArray& array : loaded.results->StaticArrays())
-      {
-        CellValues values;
-        values.name = array.name;
-        if (array.IsInteger())
-        {
-          // As the VTK reader allocates its arrays: malloc'd, huge pages advised.
-          values.integer.reset(new int32_t[cells]);
-          resmr::AdviseHugePages(values.integer.get(), cells * sizeof(int32_t));
-          loaded.results->ReadStatic(array.name, values.integer.get(), int32_t(0));
-        }
-        else
-        {
-          values.real.reset(new float[cells]);
-          resmr::AdviseHugePages(values.real.get(), cells * sizeof(float));
-          loaded.results->ReadStatic(array.name, values.real.get(), 0.0f);
-        }
-        loaded.arrays.push_back(std::move(values));
-      }
-      const double initSeconds = Since(mark);
-      const double seconds = Since(start);
-      const long long faults = MinorFaults() - faultsBefore;
-      std::string names;
-      for (const CellValues& values : loaded.arrays)
-      {
-        names += (names.empty() ? "\"" : ", \"") + JsonEscape(values.name) + "\"";
-      }
-      const auto& d = loaded.grid.deck.dims;
-      std::printf("{\"kind\": \"load\", \"run\": %d, \"bytes\": %.0f, \"egrid_bytes\": %lld, "
-                  "\"init_bytes\": %lld, \"seconds\": %.6f, \"grid_seconds\": %.6f, "
-                  "\"index_seconds\": %.6f, \"init_seconds\": %.6f, \"mb_per_s\": %.1f, "
-                  "\"minor_faults\": %lld, \"peak_rss_bytes\": %lld, \"dims\": [%lld, %lld, %lld], "
-                  "\"cells\": %zu, \"active\": %lld, \"steps\": %zu, \"unified\": %s, "
-                  "\"init_arrays\": [%s]}\n",
-        run, loadBytes, egridBytes, initBytes, seconds, gridSeconds, indexSeconds, initSeconds,
-        loadBytes / seconds / 1e6, faults, PeakRssBytes(), static_cast<long long>(d[0]),
-        static_cast<long long>(d[1]), static_cast<long long>(d[2]), cells,
-        static_cast<long long>(loaded.grid.activeCells), loaded.results->Steps().size(),
-        loaded.results->UnifiedRestart() ? "true" : "false", names.c_str());
-      std::fflush(stdout);
-      kept = std::move(loaded);
-    }
-
-    // (b) Step switches on the kept load.
-    const resmr::EclipseResults& results = *kept.results;
-    const std::size_t steps = results.Steps().size();
-    if (steps < 2 || switches == 0)
-    {
-      return 0;
-    }
-    const std::size_t cells = static_cast<std::size_t>(kept.grid.deck.CellCount());
-    std::vector<std::string> names;
-    for (const char* name : { "PRESSURE", "SWAT", "SGAS" })
-    {
-      names.emplace_back(name);
-    }
-    std::vector<std::vector<float>> shown(names.size(), std::vector<float>(cells, 0.0f));
-    const auto readStep = [&](std::size_t step) {
-      int found = 0;
-      for (std::size_t a = 0; a < names.size(); ++a)
-      {
-        found += results.ReadDynamic(step, names[a], shown[a].data(), 0.0f);
-      }
-      return found;
-    };
-    readStep(0); // the step shown before the first switch
-    std::size_t current = 0;
-    for (int s = 1; s <= switches; ++s)
-    {
-      const std::size_t next = (current + 1) % steps;
-      long long stepBytes = 0, arrayBytes = 0;
-      StepBytes(results, next, names, stepBytes, arrayBytes);
-      const long long faultsBefore = MinorFaults();
-      const auto start = Clock::now();
-      const int found = readStep(next);
-      const double seconds = Since(start);
-      const long long faults = MinorFaults() - faultsBefore;
-      std::printf("{\"kind\": \"switch\", \"switch\": %d, \"from\": %d, \"to\": %d, "
-                  "\"arrays\": %d, \"seconds\": %.6f, \"array_bytes\": %lld, \"step_bytes\": %lld, "
-                  "\"restart_file_bytes\": %lld, \"mb_per_s\": %.1f, \"minor_faults\": %lld, "
-                  "\"peak_rss_bytes\": %lld}\n",
-        s, results.Steps()[current].reportNumber, results.Steps()[next].reportNumber, found,
-        seconds, arrayBytes, stepBytes, FileBytes(results.RestartPaths()[results.Steps()[next].file]),
-        static_cast<double>(arrayBytes) / seconds / 1e6, faults, PeakRssBytes());
-      std::fflush(stdout);
-      current = next;
-    }
+    const Loaded kept = MeasureLoads(path, loadBytes, egridBytes, initBytes, runs);
+    MeasureStepSwitches(kept, switches);
   }
   catch (const std::exception& error)
   {

@@ -39,9 +39,12 @@ ColumnMesh ColumnMesh::FromCornerPoints(const CornerPointGeometry& geometry, con
     i0, i1, j0, j1);
 }
 
-ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims, const CellCornersFunction& cellCorners,
-  const std::vector<bool>& active, int64_t i0, int64_t i1, int64_t j0, int64_t j1,
-  const std::vector<uint8_t>* selected)
+namespace
+{
+/// FromCells' arguments checked: a non-empty box inside the grid, one active flag a cell, one
+/// selection flag a column of the box.
+void CheckCellBox(const std::array<int64_t, 3>& dims, const std::vector<bool>& active, int64_t i0, int64_t i1,
+  int64_t j0, int64_t j1, const std::vector<uint8_t>* selected)
 {
   const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
   if (i0 < 0 || j0 < 0 || i1 > nx || j1 > ny || i0 >= i1 || j0 >= j1 || nz < 1)
@@ -61,6 +64,16 @@ ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims, const CellC
     throw std::invalid_argument("column mesh: selection of " + std::to_string(selected->size()) +
       " flags for a box of " + std::to_string(width * height) + " columns");
   }
+}
+} // namespace
+
+ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims, const CellCornersFunction& cellCorners,
+  const std::vector<bool>& active, int64_t i0, int64_t i1, int64_t j0, int64_t j1,
+  const std::vector<uint8_t>* selected)
+{
+  CheckCellBox(dims, active, i0, i1, j0, j1, selected);
+  const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
+  const int64_t width = i1 - i0, height = j1 - j0;
   ColumnMesh mesh;
   mesh.LayerCount = static_cast<int32_t>(nz);
   const int64_t interfaces = nz + 1;
