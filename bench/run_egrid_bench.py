@@ -290,119 +290,77 @@ def write_report(result, out_dir):
 
 
 # ------------------------------------------------------------------------------- main
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--tiled", required=True, help="the >= 1 GB tiled EGRID")
-    parser.add_argument("--bench-exe", required=True)
-    parser.add_argument("--build-dir", required=True)
-    parser.add_argument("--venv-python", default="")
-    parser.add_argument("--runs", type=int, default=5, help="loads per process, tiled model")
-    parser.add_argument("--runs-small", type=int, default=20, help="loads per process, real models")
-    parser.add_argument("--switches", type=int, default=6)
-    parser.add_argument("--timeout", type=float, default=900)
-    parser.add_argument("--mem-limit-gb", type=float, default=20)
-    parser.add_argument("--out-dir", default=os.path.join(HERE, "results"))
-    parser.add_argument("--skip", nargs="*", default=[], help="peers to skip: opm resdata")
-    parser.add_argument("--no-real", action="store_true", help="tiled model only")
-    parser.add_argument("--no-profile", action="store_true",
-                        help="skip the perf profile and huge-page run on the tiled model")
-    args = parser.parse_args()
-    mem_limit = int(args.mem_limit_gb * 1e9)
+def measure_model(name, egrid, runs, args, mem_limit, result, peers):
+    """resmr and each peer on one model: loads, step switches, the page-cache references."""
+    files = model_files(egrid)
+    print(f"{name}: {egrid}: warming the page cache ({len(files)} files)", file=sys.stderr)
+    for path in files:
+        common.warm_cache(path)
+    model = {"name": name, "egrid": egrid, "files": [os.path.basename(p) for p in files],
+             "file_bytes": {os.path.basename(p): os.path.getsize(p) for p in files},
+             "runs": runs, "tools": []}
 
-    models = [("Tiled Reek (make_tiled_egrid.py)", os.path.abspath(args.tiled), args.runs)]
-    if not args.no_real:
-        models += [(name, os.path.join(DATA, rel), args.runs_small) for name, rel in REAL_MODELS
-                   if os.path.exists(os.path.join(DATA, rel))]
-
-    result = {
-        "machine": common.machine_info(args.build_dir),
-        "version": common.git_version(),
-        "commit": git_commit(),
-        "conditions": {"busy_at_start": busy_processes()},
-        "caps": {"mem_limit_gb": args.mem_limit_gb, "timeout_s": args.timeout},
-        "models": [],
-        "notes": [],
+    print(f"  resmr: {runs} loads, {args.switches} switches", file=sys.stderr)
+    run, records = run_tool([args.bench_exe, egrid, str(runs), str(args.switches)], args,
+                            mem_limit)
+    # Only switches to steps not read before in the process count (the peers keep what
+    # they loaded): at most steps - 1 of them, the first step being read before.
+    steps = next((r["steps"] for r in records if r.get("kind") == "load"), 0)
+    switches = max(0, min(args.switches, steps - 1))
+    model["switches"] = switches
+    row = tool_row("resmr", result["version"], run, records, switches)
+    result["models"].append(model)
+    model["tools"].append(row)
+    loads = row["loads"]
+    if loads:
+        first = loads[0]
+        model.update(load_bytes=first["bytes"], cells=first["cells"], active=first["active"],
+                     dims=first["dims"], steps=first["steps"], unified=first["unified"])
+        best = lambda xs: min(xs) if xs else None  # noqa: E731
+        model["resmr_phases_best"] = {
+            k: best([r[k] for r in loads]) for k in
+            ("grid_seconds", "index_seconds", "init_seconds")}
+        model["resmr_phases_median"] = {
+            k: statistics.median([r[k] for r in loads]) for k in
+            ("grid_seconds", "index_seconds", "init_seconds")}
+    seq = [r for r in records if r.get("kind") == "seqread"]
+    fresh = [r for r in records if r.get("kind") == "seqread_fresh"]
+    model["reference"] = {
+        "seqread_mb_per_s": max((r["mb_per_s"] for r in seq), default=None),
+        "seqread": seq, "fresh": fresh,
+        "fresh_4k_mb_per_s": next((r["mb_per_s"] for r in fresh if not r["huge_pages"]), None),
+        "fresh_huge_mb_per_s": next((r["mb_per_s"] for r in fresh if r["huge_pages"]), None),
     }
-    peers = [
-        ("opm", "/usr/bin/python3", "opm_eclio_peer.py"),
-        ("resdata", args.venv_python, "resdata_egrid_peer.py"),
-    ]
-    for name, egrid, runs in models:
-        files = model_files(egrid)
-        print(f"{name}: {egrid}: warming the page cache ({len(files)} files)", file=sys.stderr)
-        for path in files:
-            common.warm_cache(path)
-        model = {"name": name, "egrid": egrid, "files": [os.path.basename(p) for p in files],
-                 "file_bytes": {os.path.basename(p): os.path.getsize(p) for p in files},
-                 "runs": runs, "tools": []}
+    sw = row["switches"]
+    if sw:
+        model["step_array_bytes"] = statistics.median([r["array_bytes"] for r in sw])
+        model["step_bytes"] = statistics.median([r["step_bytes"] for r in sw])
+        model["restart_file_bytes"] = max(r["restart_file_bytes"] for r in sw)
+    unrst = [p for p in files if p.upper().endswith(".UNRST")]
+    per_step = [p for p in files if not p.upper().endswith((".EGRID", ".INIT", ".UNRST"))]
+    model["restart_desc"] = (f"UNRST {os.path.getsize(unrst[0]) / 1e6:,.1f} MB" if unrst else
+                             f"{len(per_step)} X files, "
+                             f"{sum(os.path.getsize(p) for p in per_step) / 1e6:,.1f} MB")
 
-        print(f"  resmr: {runs} loads, {args.switches} switches", file=sys.stderr)
-        run, records = run_tool([args.bench_exe, egrid, str(runs), str(args.switches)], args,
-                                mem_limit)
-        # Only switches to steps not read before in the process count (the peers keep what
-        # they loaded): at most steps - 1 of them, the first step being read before.
-        steps = next((r["steps"] for r in records if r.get("kind") == "load"), 0)
-        switches = max(0, min(args.switches, steps - 1))
-        model["switches"] = switches
-        row = tool_row("resmr", result["version"], run, records, switches)
-        result["models"].append(model)
-        model["tools"].append(row)
-        loads = row["loads"]
-        if loads:
-            first = loads[0]
-            model.update(load_bytes=first["bytes"], cells=first["cells"], active=first["active"],
-                         dims=first["dims"], steps=first["steps"], unified=first["unified"])
-            best = lambda xs: min(xs) if xs else None  # noqa: E731
-            model["resmr_phases_best"] = {
-                k: best([r[k] for r in loads]) for k in
-                ("grid_seconds", "index_seconds", "init_seconds")}
-            model["resmr_phases_median"] = {
-                k: statistics.median([r[k] for r in loads]) for k in
-                ("grid_seconds", "index_seconds", "init_seconds")}
-        seq = [r for r in records if r.get("kind") == "seqread"]
-        fresh = [r for r in records if r.get("kind") == "seqread_fresh"]
-        model["reference"] = {
-            "seqread_mb_per_s": max((r["mb_per_s"] for r in seq), default=None),
-            "seqread": seq, "fresh": fresh,
-            "fresh_4k_mb_per_s": next((r["mb_per_s"] for r in fresh if not r["huge_pages"]), None),
-            "fresh_huge_mb_per_s": next((r["mb_per_s"] for r in fresh if r["huge_pages"]), None),
-        }
-        sw = row["switches"]
-        if sw:
-            model["step_array_bytes"] = statistics.median([r["array_bytes"] for r in sw])
-            model["step_bytes"] = statistics.median([r["step_bytes"] for r in sw])
-            model["restart_file_bytes"] = max(r["restart_file_bytes"] for r in sw)
-        unrst = [p for p in files if p.upper().endswith(".UNRST")]
-        per_step = [p for p in files if not p.upper().endswith((".EGRID", ".INIT", ".UNRST"))]
-        model["restart_desc"] = (f"UNRST {os.path.getsize(unrst[0]) / 1e6:,.1f} MB" if unrst else
-                                 f"{len(per_step)} X files, "
-                                 f"{sum(os.path.getsize(p) for p in per_step) / 1e6:,.1f} MB")
+    for peer, python, script in peers:
+        if peer in args.skip:
+            continue
+        if not python or not os.path.exists(python):
+            result["notes"].append(f"{peer}: not run, no Python at '{python}'.")
+            continue
+        print(f"  {peer}: {runs} loads, {switches} switches", file=sys.stderr)
+        run, records = run_tool([python, os.path.join(HERE, "peers", script), egrid,
+                                 str(runs), str(switches)], args, mem_limit)
+        loads = [r for r in records if r.get("kind") == "load"]
+        version = loads[0]["version"] if loads else "?"
+        tool = loads[0]["tool"] if loads else peer
+        model["tools"].append(tool_row(tool, version, run, records, switches))
+        print(f"    {run['status']}", file=sys.stderr)
 
-        for peer, python, script in peers:
-            if peer in args.skip:
-                continue
-            if not python or not os.path.exists(python):
-                result["notes"].append(f"{peer}: not run, no Python at '{python}'.")
-                continue
-            print(f"  {peer}: {runs} loads, {switches} switches", file=sys.stderr)
-            run, records = run_tool([python, os.path.join(HERE, "peers", script), egrid,
-                                     str(runs), str(switches)], args, mem_limit)
-            loads = [r for r in records if r.get("kind") == "load"]
-            version = loads[0]["version"] if loads else "?"
-            tool = loads[0]["tool"] if loads else peer
-            model["tools"].append(tool_row(tool, version, run, records, switches))
-            print(f"    {run['status']}", file=sys.stderr)
 
-    if not args.no_profile and result["models"]:
-        print("profiling resmr on the tiled model", file=sys.stderr)
-        result["profile"] = profile_tiled(args, result["models"][0]["egrid"])
-
-    result["conditions"]["loadavg_at_end"] = " ".join(f"{x:.2f}" for x in os.getloadavg())
-    result["conditions"]["busy_at_end"] = busy_processes()
-    result["machine"]["date_utc"] = datetime.datetime.now(datetime.timezone.utc).strftime(
-        "%Y-%m-%d %H:%M")
-
-    # ---- verdict
+def verdict(result):
+    """The benchmark's checks: open speed against sequential reads, step switches in
+    proportion to their bytes, faster than every peer."""
     checks = []
     tiled = result["models"][0]
     ours = tiled["tools"][0]
@@ -460,9 +418,14 @@ def main():
                                f"{compared} comparisons" +
                                (f"; slower: {'; '.join(lost)}" if lost else "") + ")",
                        "pass": compared > 0 and not lost})
-    result["checks"] = checks
+    return checks
 
-    # ---- analysis of the tiled open
+
+def analyse(result, args):
+    """What the tiled open's time is made of (phases, page faults, perf, huge pages)."""
+    tiled = result["models"][0]
+    ours = tiled["tools"][0]
+    ref = tiled["reference"].get("seqread_mb_per_s")
     analysis = []
     ph = tiled.get("resmr_phases_median")
     if ph and ours.get("load_seconds"):
@@ -504,6 +467,60 @@ def main():
             (f"; switch best {fmt_s(hp['switch_seconds']['best'])} / median "
              f"{fmt_s(hp['switch_seconds']['median'])}, {hp['switch_minor_faults']:,} faults"
              if hp.get("switch_seconds") else "") + ".")
+    return analysis
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--tiled", required=True, help="the >= 1 GB tiled EGRID")
+    parser.add_argument("--bench-exe", required=True)
+    parser.add_argument("--build-dir", required=True)
+    parser.add_argument("--venv-python", default="")
+    parser.add_argument("--runs", type=int, default=5, help="loads per process, tiled model")
+    parser.add_argument("--runs-small", type=int, default=20, help="loads per process, real models")
+    parser.add_argument("--switches", type=int, default=6)
+    parser.add_argument("--timeout", type=float, default=900)
+    parser.add_argument("--mem-limit-gb", type=float, default=20)
+    parser.add_argument("--out-dir", default=os.path.join(HERE, "results"))
+    parser.add_argument("--skip", nargs="*", default=[], help="peers to skip: opm resdata")
+    parser.add_argument("--no-real", action="store_true", help="tiled model only")
+    parser.add_argument("--no-profile", action="store_true",
+                        help="skip the perf profile and huge-page run on the tiled model")
+    args = parser.parse_args()
+    mem_limit = int(args.mem_limit_gb * 1e9)
+
+    models = [("Tiled Reek (make_tiled_egrid.py)", os.path.abspath(args.tiled), args.runs)]
+    if not args.no_real:
+        models += [(name, os.path.join(DATA, rel), args.runs_small) for name, rel in REAL_MODELS
+                   if os.path.exists(os.path.join(DATA, rel))]
+
+    result = {
+        "machine": common.machine_info(args.build_dir),
+        "version": common.git_version(),
+        "commit": git_commit(),
+        "conditions": {"busy_at_start": busy_processes()},
+        "caps": {"mem_limit_gb": args.mem_limit_gb, "timeout_s": args.timeout},
+        "models": [],
+        "notes": [],
+    }
+    peers = [
+        ("opm", "/usr/bin/python3", "opm_eclio_peer.py"),
+        ("resdata", args.venv_python, "resdata_egrid_peer.py"),
+    ]
+    for name, egrid, runs in models:
+        measure_model(name, egrid, runs, args, mem_limit, result, peers)
+
+    if not args.no_profile and result["models"]:
+        print("profiling resmr on the tiled model", file=sys.stderr)
+        result["profile"] = profile_tiled(args, result["models"][0]["egrid"])
+
+    result["conditions"]["loadavg_at_end"] = " ".join(f"{x:.2f}" for x in os.getloadavg())
+    result["conditions"]["busy_at_end"] = busy_processes()
+    result["machine"]["date_utc"] = datetime.datetime.now(datetime.timezone.utc).strftime(
+        "%Y-%m-%d %H:%M")
+
+    result["checks"] = verdict(result)
+    analysis = analyse(result, args)
     result["analysis"] = analysis + [
         note for note in [
             "Tiled set: the Reek run tiled by `bench/make_tiled_egrid.py` (INIT: 12 per-cell "

@@ -340,6 +340,80 @@ def write_report(result, out_dir):
 
 
 # ------------------------------------------------------------------------------- main
+def verdict(result, steps):
+    """The checks: cells a minute at 1M, 10M and 100M, memory independent of the layer
+    count; and the cost of report steps, as a note."""
+    by_key = {c["key"]: c for c in result["cases"] if "seconds" in c}
+    checks = []
+    for k in ("1M", "10M", "100M"):
+        c = by_key.get(k)
+        if not c:
+            continue
+        cpm = c["cells_per_minute"]
+        checks.append({
+            "what": f">= 50 M cells/min to EGRID at {k} ({fmt_dims(c['dims'])}): median "
+                    f"{cpm['median'] / 1e6:,.1f} M, best {cpm['best'] / 1e6:,.1f} M cells/min "
+                    f"({c['seconds']['median']:.2f} s median over {c['seconds']['n']} runs); "
+                    f"peak RSS {c['peak_rss_mib_time_v']:,.1f} MiB",
+            "pass": cpm["median"] >= TARGET_CELLS_PER_MINUTE})
+    for few, many in (("1000x1000x10", "100M"), ("1M", "100x100x1000")):
+        a, b = by_key.get(few), by_key.get(many)
+        if not (a and b):
+            continue
+        ra, rb = a["peak_rss_mib_time_v"], b["peak_rss_mib_time_v"]
+        checks.append({
+            "what": f"O(nx*ny) memory: peak RSS {fmt_dims(a['dims'])} {ra:,.1f} MiB vs "
+                    f"{fmt_dims(b['dims'])} (10x the layers) {rb:,.1f} MiB: ratio "
+                    f"{rb / ra:.2f}, +{rb - ra:,.1f} MiB (pass: within 1.25x or +8 MiB, the "
+                    "calibration sample's fixed cap)",
+            "pass": rb <= 1.25 * ra or rb - ra <= 8.0})
+    ten, st = by_key.get("10M"), by_key.get("10M+steps10")
+    if ten and st:
+        extra = st["bytes"] - ten["bytes"]
+        dt = st["seconds"]["median"] - ten["seconds"]["median"]
+        result["steps_cost"] = {"extra_bytes": extra, "extra_seconds": dt,
+                                "seconds_per_step": dt / steps,
+                                "mb_per_s_of_steps": extra / dt / 1e6 if dt > 0 else None}
+        result["notes"].append(
+            f"Report steps: 10M cells with --steps {steps} wrote {st['bytes'] / 1e6:,.0f} MB "
+            f"({extra / 1e6:,.0f} MB of UNRST) in {st['seconds']['median']:.2f} s vs "
+            f"{ten['seconds']['median']:.2f} s without: {dt:.2f} s more, "
+            f"{dt / steps * 1e3:,.0f} ms a step"
+            + (f", the UNRST at {extra / dt / 1e6:,.0f} MB/s" if dt > 0 else "") + ".")
+    return checks
+
+
+def explain(result, checks):
+    """Notes on where the time goes (CPU against the disk's write bandwidth)."""
+    by_key = {c["key"]: c for c in result["cases"] if "seconds" in c}
+    big = by_key.get("100M")
+    dd_sync = max((d["mb_per_s"] for d in result["write_bandwidth"] if d["fsync"]), default=None)
+    if big and dd_sync:
+        result["notes"].append(
+            f"100M: {big['bytes'] / 1e9:,.2f} GB in {big['seconds']['median']:.1f} s = "
+            f"{big['mb_per_s']['median']:,.0f} MB/s median, {100 * big['mb_per_s']['median'] / dd_sync:.0f}% "
+            f"of dd's {dd_sync:,.0f} MB/s with fsync; CPU {big['cpu_percent']['median']:.0f}% "
+            f"(user {big['user_seconds']['median']:.1f} s + sys {big['system_seconds']['median']:.1f} s).")
+    cpu = [c["cpu_percent"]["median"] for c in result["cases"] if c.get("cpu_percent")]
+    rates = [c["mb_per_s"]["median"] for c in result["cases"] if c.get("mb_per_s")]
+    if cpu and rates and dd_sync:
+        result["notes"].append(
+            f"Where the time goes: every run kept one core busy ({min(cpu):.0f}-{max(cpu):.0f}% "
+            f"CPU, mostly user time) while writing {min(rates):,.0f}-{max(rates):,.0f} MB/s, "
+            f"{100 * max(rates) / dd_sync:.0f}% or less of what dd writes to the same disk with "
+            "fsync: on this machine the writer is bound by its single-threaded computation of "
+            "the model, not by write bandwidth.")
+    nz_checks = [ch for ch in checks if ch["what"].startswith("O(nx*ny)")]
+    if any(not ch["pass"] for ch in nz_checks):
+        result["notes"].append(
+            "Peak RSS grows with nz at a fixed nx*ny beyond the calibration sample's fixed cap "
+            "(see the sweep): look at SyntheticReservoir::Calibrate, which should keep at most "
+            "2^18 values a quantile, and at the per-layer tables (16 bytes a layer).")
+    result["notes"].append(
+        "Both peak RSS columns agree when resmr's getrusage and time -v see the same process; "
+        "time -v's figure is the one taken from outside.")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--resmr", default=os.path.join(REPO, "build", "bin", "resmr"))
@@ -437,73 +511,8 @@ def main():
     result["machine"]["date_utc"] = datetime.datetime.now(datetime.timezone.utc).strftime(
         "%Y-%m-%d %H:%M")
 
-    # ---- verdict
-    by_key = {c["key"]: c for c in result["cases"] if "seconds" in c}
-    checks = []
-    for k in ("1M", "10M", "100M"):
-        c = by_key.get(k)
-        if not c:
-            continue
-        cpm = c["cells_per_minute"]
-        checks.append({
-            "what": f">= 50 M cells/min to EGRID at {k} ({fmt_dims(c['dims'])}): median "
-                    f"{cpm['median'] / 1e6:,.1f} M, best {cpm['best'] / 1e6:,.1f} M cells/min "
-                    f"({c['seconds']['median']:.2f} s median over {c['seconds']['n']} runs); "
-                    f"peak RSS {c['peak_rss_mib_time_v']:,.1f} MiB",
-            "pass": cpm["median"] >= TARGET_CELLS_PER_MINUTE})
-    for few, many in (("1000x1000x10", "100M"), ("1M", "100x100x1000")):
-        a, b = by_key.get(few), by_key.get(many)
-        if not (a and b):
-            continue
-        ra, rb = a["peak_rss_mib_time_v"], b["peak_rss_mib_time_v"]
-        checks.append({
-            "what": f"O(nx*ny) memory: peak RSS {fmt_dims(a['dims'])} {ra:,.1f} MiB vs "
-                    f"{fmt_dims(b['dims'])} (10x the layers) {rb:,.1f} MiB: ratio "
-                    f"{rb / ra:.2f}, +{rb - ra:,.1f} MiB (pass: within 1.25x or +8 MiB, the "
-                    "calibration sample's fixed cap)",
-            "pass": rb <= 1.25 * ra or rb - ra <= 8.0})
-    ten, st = by_key.get("10M"), by_key.get("10M+steps10")
-    if ten and st:
-        extra = st["bytes"] - ten["bytes"]
-        dt = st["seconds"]["median"] - ten["seconds"]["median"]
-        result["steps_cost"] = {"extra_bytes": extra, "extra_seconds": dt,
-                                "seconds_per_step": dt / steps,
-                                "mb_per_s_of_steps": extra / dt / 1e6 if dt > 0 else None}
-        result["notes"].append(
-            f"Report steps: 10M cells with --steps {steps} wrote {st['bytes'] / 1e6:,.0f} MB "
-            f"({extra / 1e6:,.0f} MB of UNRST) in {st['seconds']['median']:.2f} s vs "
-            f"{ten['seconds']['median']:.2f} s without: {dt:.2f} s more, "
-            f"{dt / steps * 1e3:,.0f} ms a step"
-            + (f", the UNRST at {extra / dt / 1e6:,.0f} MB/s" if dt > 0 else "") + ".")
-    result["checks"] = checks
-
-    # ---- notes: where the time goes
-    big = by_key.get("100M")
-    dd_sync = max((d["mb_per_s"] for d in result["write_bandwidth"] if d["fsync"]), default=None)
-    if big and dd_sync:
-        result["notes"].append(
-            f"100M: {big['bytes'] / 1e9:,.2f} GB in {big['seconds']['median']:.1f} s = "
-            f"{big['mb_per_s']['median']:,.0f} MB/s median, {100 * big['mb_per_s']['median'] / dd_sync:.0f}% "
-            f"of dd's {dd_sync:,.0f} MB/s with fsync; CPU {big['cpu_percent']['median']:.0f}% "
-            f"(user {big['user_seconds']['median']:.1f} s + sys {big['system_seconds']['median']:.1f} s).")
-    cpu = [c["cpu_percent"]["median"] for c in result["cases"] if c.get("cpu_percent")]
-    rates = [c["mb_per_s"]["median"] for c in result["cases"] if c.get("mb_per_s")]
-    if cpu and rates and dd_sync:
-        result["notes"].append(
-            f"Where the time goes: every run kept one core busy ({min(cpu):.0f}-{max(cpu):.0f}% "
-            f"CPU, mostly user time) while writing {min(rates):,.0f}-{max(rates):,.0f} MB/s, "
-            f"{100 * max(rates) / dd_sync:.0f}% or less of what dd writes to the same disk with "
-            "fsync: on this machine the writer is bound by its single-threaded computation of "
-            "the model, not by write bandwidth.")
-    nz_checks = [ch for ch in checks if ch["what"].startswith("O(nx*ny)")]
-    if any(not ch["pass"] for ch in nz_checks):
-        result["notes"].append(
-            "Peak RSS grows with nz at a fixed nx*ny beyond the calibration sample's fixed cap "
-            "(see the sweep): look at SyntheticReservoir::Calibrate, which should keep at most "
-            "2^18 values a quantile, and at the per-layer tables (16 bytes a layer).")
-    result["notes"].append(
-        "Both peak RSS columns agree when resmr's getrusage and time -v see the same process; "
-        "time -v's figure is the one taken from outside.")
+    checks = result["checks"] = verdict(result, steps)
+    explain(result, checks)
     write_report(result, args.out_dir)
     print(f"wrote {os.path.join(args.out_dir, 'synth.md')} and synth.json", file=sys.stderr)
 
