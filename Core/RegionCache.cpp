@@ -649,8 +649,9 @@ bool RegionCache::WaitIdle(std::chrono::milliseconds timeout) const
 
 bool RegionCache::RootsMissingLocked() const
 {
-  return this->Error.empty() &&
-    std::any_of(this->Pinned.begin(), this->Pinned.end(), [&](Key key) { return this->MissingLocked(key); });
+  return this->Error.empty() && std::any_of(this->Pinned.begin(),
+                                  this->Pinned.end(),
+                                  [&](Key key) { return this->MissingLocked(key); });
 }
 
 bool RegionCache::RootsMissing() const

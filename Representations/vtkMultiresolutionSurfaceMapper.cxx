@@ -50,7 +50,8 @@ namespace
 {
 double ElapsedMs(std::chrono::steady_clock::time_point since)
 {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
+    .count();
 }
 
 /// GPU time of a frame, from a timer query read back a frame or more later (never waits).
@@ -327,8 +328,12 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   {
     return; // hardware picking: the descriptor has no cells to name
   }
-  if (!ReadSource(this->GetInputDataObject(0, 0), frame.filePath, frame.propertyPath, frame.step,
-        frame.applyMapAxes, frame.propertyStamp))
+  if (!ReadSource(this->GetInputDataObject(0, 0),
+        frame.filePath,
+        frame.propertyPath,
+        frame.step,
+        frame.applyMapAxes,
+        frame.propertyStamp))
   {
     return; // an empty piece (another rank) or no file yet
   }
@@ -380,7 +385,10 @@ void vtkMultiresolutionSurfaceMapper::BeginFrame(Frame& frame)
   // The whole frame is what the user waits for: the renderer's time for the last frame, and
   // while frames come back to back the interval between them (resmr::MeasuredFrameMs).
   frame.rendererMs = frame.renderer->GetLastRenderTimeInSeconds() * 1000;
-  frame.intervalMs = in.HaveFrameStart ? std::chrono::duration<double, std::milli>(frame.start - in.FrameStart).count() : 0;
+  frame.intervalMs =
+    in.HaveFrameStart
+      ? std::chrono::duration<double, std::milli>(frame.start - in.FrameStart).count()
+      : 0;
   in.FrameStart = frame.start;
   in.HaveFrameStart = true;
   // The renderer's time and the interval both still hold the last frame.
@@ -415,7 +423,7 @@ bool vtkMultiresolutionSurfaceMapper::OpenFiles(Frame& frame)
   // (Re)open the files when the descriptor names others, or the property file was rewritten
   // (steps added to a run still being written).
   if (frame.filePath != in.FilePath || frame.propertyPath != in.PropertyPath ||
-    frame.propertyStamp != in.PropertyStamp || !in.Cache)
+      frame.propertyStamp != in.PropertyStamp || !in.Cache)
   {
     in.Close();
     in.ReleaseGpu();
@@ -430,7 +438,8 @@ bool vtkMultiresolutionSurfaceMapper::OpenFiles(Frame& frame)
         in.Properties = properties;
       }
       in.Selector.reset(new resmr::ViewSelector(*in.File));
-      in.Cache.reset(new resmr::RegionCache(in.File, in.Properties, resmr::MainMemoryShare(this->MemoryBudgetMB)));
+      in.Cache.reset(new resmr::RegionCache(
+        in.File, in.Properties, resmr::MainMemoryShare(this->MemoryBudgetMB)));
       in.FilePath = frame.filePath;
       in.PropertyPath = frame.propertyPath;
       in.PropertyStamp = frame.propertyStamp;
@@ -478,7 +487,8 @@ bool vtkMultiresolutionSurfaceMapper::SelectLayer(Frame& frame)
 void vtkMultiresolutionSurfaceMapper::RequestProperty(Frame& frame)
 {
   Internals& in = *this->Internal;
-  const resmr::PropertyFile* properties = this->ColorMode == PropertyColors ? in.Properties.get() : nullptr;
+  const resmr::PropertyFile* properties =
+    this->ColorMode == PropertyColors ? in.Properties.get() : nullptr;
   frame.property =
     resmr::RequestFor(properties, this->ArrayName ? this->ArrayName : "", frame.step, frame.layer);
   if (frame.property.wanted)
@@ -494,7 +504,8 @@ void vtkMultiresolutionSurfaceMapper::ComputeView(Frame& frame)
   // projection, in double (map coordinates are large).
   resmr::Matrix4 mapAxes = resmr::IdentityMatrix();
   std::array<double, 6> map;
-  if (frame.applyMapAxes && resmr::CornerPointGeometry::PlacementTransform(in.File->Header().map, map))
+  if (frame.applyMapAxes &&
+      resmr::CornerPointGeometry::PlacementTransform(in.File->Header().map, map))
   {
     mapAxes = resmr::PlacementMatrix(map);
   }
@@ -562,7 +573,8 @@ void vtkMultiresolutionSurfaceMapper::SelectRegions(Frame& frame)
   if (in.HavePreviousView)
   {
     const auto all = [](std::size_t) { return true; };
-    predicted = in.Selector->Select(resmr::PredictNextView(in.PreviousView, frame.view), all).wanted;
+    predicted =
+      in.Selector->Select(resmr::PredictNextView(in.PreviousView, frame.view), all).wanted;
   }
   cache.Request(frame.selection.wanted, predicted);
   // The roots stand in for everything, so a frame missing them (the first of a file or a
@@ -616,7 +628,8 @@ void vtkMultiresolutionSurfaceMapper::StreamTables(Frame& frame)
   std::size_t budget = resmr::TableBytesPerFrame;
   frame.tablesStart = std::chrono::steady_clock::now();
   in.Tables.StreamHash(frame.window, *in.Cache, budget, !frame.bounded);
-  std::shared_ptr<const resmr::PropertyTableData> loaded = frame.property.wanted ? in.Cache->Property() : nullptr;
+  std::shared_ptr<const resmr::PropertyTableData> loaded =
+    frame.property.wanted ? in.Cache->Property() : nullptr;
   if (!resmr::IsRequested(loaded.get(), frame.property))
   {
     loaded.reset(); // still the previous property
@@ -643,9 +656,14 @@ void vtkMultiresolutionSurfaceMapper::UploadMeshes(Frame& frame)
   in.Pacer.Spend(frame.tableBytes, ElapsedMs(frame.tablesStart));
   std::vector<std::size_t> order = in.Selector->Roots();
   order.insert(order.end(), frame.selection.wanted.begin(), frame.selection.wanted.end());
-  in.UploadsDeferred = in.Regions.Upload(*in.Cache, order, in.Selector->Roots().size(), frame.bounded, in.Pacer,
-                         resmr::GpuShare(this->MemoryBudgetMB), frame.program) ||
-    in.Tables.Busy();
+  in.UploadsDeferred = in.Regions.Upload(*in.Cache,
+                         order,
+                         in.Selector->Roots().size(),
+                         frame.bounded,
+                         in.Pacer,
+                         resmr::GpuShare(this->MemoryBudgetMB),
+                         frame.program) ||
+                       in.Tables.Busy();
   // Drawn: what is on the GPU, ancestors standing in for the rest.
   const auto onGpu = [&in](std::size_t region) { return in.Regions.Ready(region); };
   frame.selection = in.Selector->Select(frame.view, onGpu);
@@ -664,8 +682,10 @@ void vtkMultiresolutionSurfaceMapper::SetUniforms(Frame& frame)
   program->SetUniformMatrix4x4("modelToView", packed.data());
   std::array<float, 9> normal = resmr::NormalMatrix(frame.modelToView);
   program->SetUniformMatrix3x3("normalToView", normal.data());
-  glUniform3i(glGetUniformLocation(static_cast<GLuint>(program->GetHandle()), "gridDims"), int(header.dims[0]),
-    int(header.dims[1]), int(header.dims[2]));
+  glUniform3i(glGetUniformLocation(static_cast<GLuint>(program->GetHandle()), "gridDims"),
+    int(header.dims[0]),
+    int(header.dims[1]),
+    int(header.dims[2]));
   in.Tables.Bind(program, header);
   program->SetUniformi("layer", frame.layer);
   vtkProperty* look = frame.actor->GetProperty();
@@ -718,13 +738,14 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
 
   for (const resmr::DrawnRegion& drawn : frame.selection.drawn)
   {
-    const resmr::RegionDrawBuffers* buffers = in.Regions.Prepare(drawn.region, *in.Cache, frame.program);
+    const resmr::RegionDrawBuffers* buffers =
+      in.Regions.Prepare(drawn.region, *in.Cache, frame.program);
     if (!buffers || buffers->indices.empty())
     {
       continue;
     }
-    const std::array<resmr::DrawPart, 3> parts =
-      resmr::PartsToDraw(*buffers, drawn, frame.layer >= 0, in.File->Regions()[drawn.region], frame.view);
+    const std::array<resmr::DrawPart, 3> parts = resmr::PartsToDraw(
+      *buffers, drawn, frame.layer >= 0, in.File->Regions()[drawn.region], frame.view);
     in.Triangles += static_cast<vtkIdType>(in.Regions.Draw(drawn.region, parts, frame.program));
     ++in.Drawn;
   }
@@ -745,17 +766,20 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
   // (tables, the property, wanted meshes), and the next frame will copy. Without it a render
   // could report nothing pending and leave the GUI (and scripts waiting on LoadsPending) with
   // the picture before the property arrived.
-  const auto arrivedLate = [&]() {
+  const auto arrivedLate = [&]()
+  {
     if (!in.Tables.HashReady() && cache.Tables())
     {
       return true;
     }
-    const std::shared_ptr<const resmr::PropertyTableData> now = frame.property.wanted ? cache.Property() : nullptr;
+    const std::shared_ptr<const resmr::PropertyTableData> now =
+      frame.property.wanted ? cache.Property() : nullptr;
     if (now && now != in.Tables.UploadedProperty() && resmr::IsRequested(now.get(), frame.property))
     {
       return true;
     }
-    return std::any_of(frame.selection.wanted.begin(), frame.selection.wanted.end(),
+    return std::any_of(frame.selection.wanted.begin(),
+      frame.selection.wanted.end(),
       [&](std::size_t region) { return !in.Regions.Ready(region) && cache.IsResident(region); });
   };
   in.Pending = cache.Pending() || in.UploadsDeferred || arrivedLate();

@@ -7,11 +7,12 @@
  * loader thread for what is missing (resmr::RegionCache, under a memory budget) and draws
  * what is resident, standing in an ancestor for any region not loaded yet, so the render
  * thread never waits on disk for detail (only for the roots, the first frame of a file or
- * layer, and for everything when WaitForDetailMs asks). Fragments find their original cell from the topological
- * coordinate and paint its property through the perfect-hash tables and the lookup table,
- * the original grid lines and the cell's face normal. With a target frame rate the pixel
- * tolerance follows the measured frame times (resmr::FrameRateController). With Layer set,
- * the same regions show one layer alone (Sec. 4.1, 5.2, 6.1), painted from its 2D tables.
+ * layer, and for everything when WaitForDetailMs asks). Fragments find their original cell
+ * from the topological coordinate and paint its property through the perfect-hash tables and
+ * the lookup table, the original grid lines and the cell's face normal. With a target frame
+ * rate the pixel tolerance follows the measured frame times (resmr::FrameRateController).
+ * With Layer set, the same regions show one layer alone (Sec. 4.1, 5.2, 6.1), painted from
+ * its 2D tables.
  *
  * The input is a copy of the descriptor vtkMultiresolutionReader writes (its bounds are the
  * model's) with a string field array (SourceArrayName) naming the .resmr file, the property

@@ -12,10 +12,11 @@
 #include "Residency.h"
 #include "ViewTransforms.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <string>
-#include <sys/stat.h>
+#include <sys/wait.h>
 
 using namespace resmr;
 
