@@ -6,11 +6,13 @@
  * against a pixel tolerance, frustum and normal-cone culling; resmr::ViewSelector), asks a
  * loader thread for what is missing (resmr::RegionCache, under a memory budget) and draws
  * what is resident, standing in an ancestor for any region not loaded yet, so the render
- * thread never waits on disk. Fragments find their original cell from the topological
- * coordinate and paint its property through the perfect-hash tables and the lookup table,
- * the original grid lines and the cell's face normal. With a target frame rate the pixel
- * tolerance follows the measured frame times (resmr::FrameRateController). With Layer set,
- * the same regions show one layer alone (Sec. 4.1, 5.2, 6.1), painted from its 2D tables.
+ * thread never waits on disk for detail (only for the roots, the first frame of a file or
+ * layer, and for everything when WaitForDetailMs asks). Fragments find their original cell
+ * from the topological coordinate and paint its property through the perfect-hash tables and
+ * the lookup table, the original grid lines and the cell's face normal. With a target frame
+ * rate the pixel tolerance follows the measured frame times (resmr::FrameRateController).
+ * With Layer set, the same regions show one layer alone (Sec. 4.1, 5.2, 6.1), painted from
+ * its 2D tables.
  *
  * The input is a copy of the descriptor vtkMultiresolutionReader writes (its bounds are the
  * model's) with a string field array (SourceArrayName) naming the .resmr file, the property
@@ -24,6 +26,8 @@
 
 #include <memory>
 #include <string>
+
+class vtkShaderProgram;
 
 class RESMRREPRESENTATIONS_EXPORT vtkMultiresolutionSurfaceMapper : public vtkMapper
 {
@@ -130,6 +134,29 @@ private:
 
   struct Internals;
   std::unique_ptr<Internals> Internal;
+
+  /// One frame's state, passed from stage to stage of Render.
+  struct Frame;
+  void BeginFrame(Frame& frame);
+  /// (Re)opens the files the descriptor names; false when there is nothing to draw.
+  bool OpenFiles(Frame& frame);
+  /// Closes the files with `message` as the error (reported once while it stays the same).
+  void Fail(const Frame& frame, const std::string& message);
+  /// The layer shown; false (nothing drawn, LastError says why) when out of range.
+  bool SelectLayer(Frame& frame);
+  void RequestProperty(Frame& frame);
+  /// The camera in model coordinates, and the tolerance.
+  void ComputeView(Frame& frame);
+  void ChooseTolerance();
+  /// Selects, asks the loader for what is missing, and waits where the frame must.
+  void SelectRegions(Frame& frame);
+  vtkShaderProgram* ReadyProgram(Frame& frame, int colorMode);
+  void StreamTables(Frame& frame);
+  void UploadMeshes(Frame& frame);
+  void SetUniforms(Frame& frame);
+  void DrawRegions(Frame& frame);
+  /// Loads pending, errors, readout and the frame-rate controller.
+  void FinishFrame(Frame& frame);
 };
 
 #endif

@@ -647,6 +647,38 @@ bool RegionCache::WaitIdle(std::chrono::milliseconds timeout) const
   return true;
 }
 
+bool RegionCache::RootsMissingLocked() const
+{
+  return this->Error.empty() && std::any_of(this->Pinned.begin(),
+                                  this->Pinned.end(),
+                                  [&](Key key) { return this->MissingLocked(key); });
+}
+
+bool RegionCache::RootsMissing() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->RootsMissingLocked();
+}
+
+bool RegionCache::WaitForRoots(std::chrono::milliseconds timeout) const
+{
+  std::unique_lock<std::mutex> lock(this->Lock);
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  // Each load ends with Idle notified, so every root that arrives wakes this wait.
+  while (this->RootsMissingLocked())
+  {
+    this->RescueIfStarvedLocked();
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= deadline)
+    {
+      return false;
+    }
+    const std::chrono::steady_clock::duration slice = this->StarvationWindow / 2;
+    this->Idle.wait_for(lock, std::min<std::chrono::steady_clock::duration>(deadline - now, slice));
+  }
+  return true;
+}
+
 void RegionCache::SetStarvationWindow(std::chrono::milliseconds window)
 {
   std::lock_guard<std::mutex> lock(this->Lock);

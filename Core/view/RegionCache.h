@@ -1,7 +1,8 @@
 // Out-of-core loading of region meshes, paper Sec. 6.2 (Fig. 10): a loader thread receives
 // each frame's wanted regions, decompresses their meshes from the memory-mapped file,
 // prepares draw buffers and marks them resident; a least-recently-used budget bounds what
-// stays resident. The render thread only ever looks up what is ready: it never waits on disk.
+// stays resident. The render thread looks up what is ready; it waits on disk only when it
+// asks to (WaitForRoots: the first frame of a file or layer; WaitIdle: still renders).
 //
 // Contract:
 // - Draw buffers (RegionDrawBuffers): per vertex x, y, z (z = -depth, relative to the
@@ -186,6 +187,12 @@ public:
   bool Pending() const;
   /// Waits until nothing is pending or `timeout` passes; true if nothing is pending.
   bool WaitIdle(std::chrono::milliseconds timeout) const;
+  /// Whether a root of the current layer is neither loaded nor failed while no error was met
+  /// (roots are what a frame draws when nothing else is resident).
+  bool RootsMissing() const;
+  /// Waits while RootsMissing(), at most `timeout`, blocked on the loader rather than
+  /// polling; true when no root is missing any more.
+  bool WaitForRoots(std::chrono::milliseconds timeout) const;
 
   void SetBudget(std::size_t bytes);
   std::size_t Budget() const;
@@ -222,6 +229,7 @@ private:
   /// blocked when an entry whose size is known cannot fit. Lock held.
   int64_t NextRegionLocked();
   bool PendingLocked() const;
+  bool RootsMissingLocked() const;
   /// Neither loaded nor failed (it may be being read). Lock held.
   bool MissingLocked(Key key) const;
   /// The current layer's roots are pinned. Lock held.

@@ -1,0 +1,85 @@
+// Per-frame upload and timing plan (paper Sec. 6.1, 6.3); see FramePlanning.h.
+#include "FramePlanning.h"
+
+#include <algorithm>
+
+namespace resmr
+{
+
+double UploadBudgetMs(double targetFramesPerSecond)
+{
+  return targetFramesPerSecond > 0 ? UploadShareOfFrame * 1000 / targetFramesPerSecond
+                                   : UploadMsAtFixedTolerance;
+}
+
+uint32_t SlicesThisFrame(uint32_t slicesLeft,
+  std::size_t sliceBytes,
+  std::size_t& budget,
+  bool unbounded)
+{
+  if (slicesLeft == 0 || (!unbounded && budget == 0))
+  {
+    return 0;
+  }
+  uint32_t slices = slicesLeft;
+  if (!unbounded && sliceBytes > 0)
+  {
+    slices = static_cast<uint32_t>(
+      std::min<std::size_t>(std::max<std::size_t>(budget / sliceBytes, 1), slicesLeft));
+  }
+  budget -= std::min(budget, slices * sliceBytes);
+  return slices;
+}
+
+DrawPieceCursor::DrawPieceCursor(const RegionDrawBuffers& buffers, std::size_t maxBytes)
+  : Buffers(&buffers)
+  , MaxBytes(maxBytes)
+{
+}
+
+const DrawPiece& DrawPieceCursor::Next()
+{
+  if (!this->Done() && this->Piece.first != this->Copied)
+  {
+    this->Piece = NextDrawPiece(*this->Buffers, this->Copied, this->MaxBytes);
+  }
+  return this->Piece;
+}
+
+std::size_t DrawPieceCursor::Advance()
+{
+  const DrawPiece& piece = this->Next();
+  this->Copied = piece.end;
+  return piece.bytes;
+}
+
+bool MayCopyPiece(bool bounded,
+  bool root,
+  const UploadPacer& pacer,
+  std::size_t pieceBytes,
+  std::size_t gpuBytes,
+  std::size_t gpuShare)
+{
+  return !(bounded && !root && !pacer.Admit(pieceBytes)) && gpuBytes + pieceBytes <= gpuShare;
+}
+
+double ControllerStartTolerance(double pixelTolerance)
+{
+  return std::max(pixelTolerance, ControllerStartPixels);
+}
+
+double MeasuredFrameMs(double frameMs,
+  double rendererMs,
+  double intervalMs,
+  double targetFramesPerSecond,
+  bool afterAllocation)
+{
+  double measured = afterAllocation ? frameMs : std::max(frameMs, rendererMs);
+  if (intervalMs < 3000 / targetFramesPerSecond && !afterAllocation)
+  {
+    measured = std::max(measured, intervalMs);
+  }
+  return measured;
+}
+
+} // namespace resmr

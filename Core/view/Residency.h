@@ -1,0 +1,89 @@
+// What stays resident and what stands in, paper Sec. 6.2: one memory budget holds the meshes
+// in main memory (the loader, RegionCache) and their GPU mirror together, and data not
+// resident yet is replaced by what is (an ancestor for a region, an earlier time step for a
+// property table). Ours: the split of the budget, which GPU copies go when the mirror would
+// pass its share, which property table is asked for and which is drawn, and which parts of a
+// region's buffers are drawn (its simplified side, Sec. 4.3, past a few pixels of error).
+#pragma once
+
+#include "PropertyFile.h"
+#include "RegionCache.h"
+#include "ViewSelection.h"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace resmr
+{
+
+/// The loader's share of a budget of `budgetMB` MB: the GPU mirrors at most what is resident,
+/// so half each keeps both together within the budget.
+std::size_t MainMemoryShare(int budgetMB);
+/// The GPU mirror's share: the rest of the budget.
+std::size_t GpuShare(int budgetMB);
+
+/// GPU copies to release, in order, before a piece of `pieceBytes` can be copied: copies not
+/// `wanted` this frame (the cache still has them), taken from `mirrored` (region, bytes on the
+/// GPU) in its order until `gpuBytes` plus the piece fit `gpuShare`. The result may not be
+/// enough: then uploads wait.
+std::vector<std::size_t> CopiesToRelease(
+  const std::vector<std::pair<std::size_t, std::size_t>>& mirrored,
+  const std::set<std::size_t>& wanted,
+  std::size_t gpuBytes,
+  std::size_t pieceBytes,
+  std::size_t gpuShare);
+
+/// The property table a frame asks for.
+struct PropertyRequest
+{
+  bool wanted = false; ///< the property exists (at `step` or as a static table)
+  std::string name;
+  int32_t step = -1; ///< the table's step: the frame's, or -1 for a static property
+  int32_t layer = -1;
+};
+
+/// The table for property `name` at `step` in the single-layer `layer` (-1: whole model): a
+/// static property has one table, step -1, for every step. Not wanted when `properties` is
+/// null, `name` empty or the file has no such table.
+PropertyRequest RequestFor(const PropertyFile* properties,
+  const std::string& name,
+  int32_t step,
+  int32_t layer);
+
+/// Whether `table` is the one `request` asks for.
+bool IsRequested(const PropertyTableData* table, const PropertyRequest& request);
+
+/// Whether `table` (the one on the GPU) may be drawn for `request`: the requested table, or an
+/// earlier time step of the same property and layer standing in until it arrives. Another
+/// property is never drawn through this one's colour map.
+bool MayStandIn(const PropertyTableData* table, const PropertyRequest& request);
+
+/// Projected error (pixels) past which a region's simplified side replaces its exact one.
+constexpr double CoarseSidePixels = 2.0;
+
+/// A run of a region's indices drawn as one kind of face (0 top, 1 bottom, 2 side).
+struct DrawPart
+{
+  bool shown = false;
+  uint32_t first = 0, count = 0;
+  int kind = 0;
+};
+
+/// The top, bottom and side index runs of `buffers` for a region drawn as `drawn`. The whole
+/// model's top and bottom are culled by the selection (`drawn`); a layer's own top and bottom
+/// (`layerView`) by their own cones against `region` and `view`. Where the region's error
+/// already shows (over CoarseSidePixels) its simplified side is drawn, when it has one: the
+/// geometry is no closer than that error anyway, and on models of many layers it is most of
+/// the triangles.
+std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers,
+  const DrawnRegion& drawn,
+  bool layerView,
+  const RegionRecord& region,
+  const ViewParameters& view);
+
+} // namespace resmr

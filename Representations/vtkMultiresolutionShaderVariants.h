@@ -1,0 +1,40 @@
+// The Multiresolution Surface's shader programs, one a painting state (paper Sec. 5): the
+// fragment shader (MultiresolutionSurfaceFS.glsl) is compiled with the state's switches
+// defined, so a frame's shader carries no branches for what it does not paint. Sources are
+// kept by state; VTK's shader cache keeps the compiled programs. Private to the
+// Multiresolution Surface mapper.
+#ifndef vtkMultiresolutionShaderVariants_h
+#define vtkMultiresolutionShaderVariants_h
+
+#include <map>
+#include <string>
+
+class vtkOpenGLRenderWindow;
+class vtkShaderProgram;
+
+class vtkMultiresolutionShaderVariants
+{
+public:
+  /// A painting state: the switches of the fragment shader.
+  struct Painting
+  {
+    int colorMode = 0; ///< vtkMultiresolutionSurfaceMapper::ColorModes
+    bool layerView = false;
+    bool logScale = false;
+    bool gridLines = false;
+    bool specular = false;
+  };
+
+  /// The fragment shader's source for `painting`: its switches defined after the version line
+  /// VTK puts in.
+  static std::string FragmentSource(const Painting& painting);
+
+  /// The program for `painting` in `window`'s shader cache, compiled the first time and bound;
+  /// null when it does not compile.
+  vtkShaderProgram* Ready(vtkOpenGLRenderWindow* window, const Painting& painting);
+
+private:
+  std::map<int, std::string> Sources; ///< by the state's switches as bits
+};
+
+#endif
