@@ -29,7 +29,9 @@ long long FileModificationTime(const char* path)
 }
 
 CellOrder BuildExplicitGrid(const resmr::CornerPointGeometry& geometry,
-  const std::vector<int32_t>& actnum, const std::vector<bool>& active, bool showInactive,
+  const std::vector<int32_t>& actnum,
+  const std::vector<bool>& active,
+  bool showInactive,
   vtkExplicitStructuredGrid* grid)
 {
   CellOrder order;

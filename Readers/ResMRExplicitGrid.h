@@ -1,6 +1,6 @@
-// Shared by the Eclipse readers and the synthetic reservoir source: turns a Core corner-point grid into the plugin's
-// vtkExplicitStructuredGrid contract (paper Sec. 3): z up, corners shared where ECLIPSE
-// connects cells, I/J/K from 1, ACTNUM, HIDDENCELL for inactive cells, face connectivity
+// Shared by the Eclipse readers and the synthetic reservoir source: turns a Core corner-point grid
+// into the plugin's vtkExplicitStructuredGrid contract (paper Sec. 3): z up, corners shared where
+// ECLIPSE connects cells, I/J/K from 1, ACTNUM, HIDDENCELL for inactive cells, face connectivity
 // flags; and maps per-cell arrays from ECLIPSE cell order to VTK cell order.
 #ifndef ResMRExplicitGrid_h
 #define ResMRExplicitGrid_h
@@ -9,7 +9,7 @@
 #include "vtkSmartPointer.h"
 #include "vtkType.h"
 
-#include "LargeArrays.h"         // for resmr::AdviseHugePages
+#include "LargeArrays.h"        // for resmr::AdviseHugePages
 #include "ResMRReadersModule.h" // for export macro
 
 #include <cstdint>
@@ -54,13 +54,15 @@ struct CellOrder
 /// `actnum` holds ACTNUM as given (one per cell, ECLIPSE order), `active` which cells are
 /// shown; inactive cells get HIDDENCELL unless showInactive. Throws std::bad_alloc.
 RESMRREADERS_EXPORT CellOrder BuildExplicitGrid(const resmr::CornerPointGeometry& geometry,
-  const std::vector<int32_t>& actnum, const std::vector<bool>& active, bool showInactive,
+  const std::vector<int32_t>& actnum,
+  const std::vector<bool>& active,
+  bool showInactive,
   vtkExplicitStructuredGrid* grid);
 
 /// A new array of `cells` tuples named `name`, VTKArray (vtkFloatArray, vtkIntArray ...);
 /// `fill(pointer)` writes values in ECLIPSE cell order into the pointer, which is the
 /// array's own storage unless the grid is mirrored (then a scratch buffer, permuted after).
-template <typename VTKArray, typename Fill>
+template<typename VTKArray, typename Fill>
 vtkSmartPointer<VTKArray> MakeCellArray(const char* name, const CellOrder& order, Fill&& fill)
 {
   using Value = typename VTKArray::ValueType;

@@ -19,10 +19,10 @@
 #include "vtkUnsignedCharArray.h"
 
 #include "CornerPointGeometry.h"
-#include "MemoryBudget.h"
-#include "ResMRExplicitGrid.h"
 #include "Errors.h"
 #include "GrdeclParser.h"
+#include "MemoryBudget.h"
+#include "ResMRExplicitGrid.h"
 
 #include <cmath>
 #include <optional>
@@ -66,8 +66,8 @@ void vtkGRDECLReader::PrintSelf(ostream& os, vtkIndent indent)
 
 int vtkGRDECLReader::FillOutputPortInformation(int port, vtkInformation* info)
 {
-  info->Set(vtkDataObject::DATA_TYPE_NAME(),
-    port == 0 ? "vtkExplicitStructuredGrid" : "vtkPolyData");
+  info->Set(
+    vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkExplicitStructuredGrid" : "vtkPolyData");
   return 1;
 }
 
@@ -95,7 +95,7 @@ int vtkGRDECLReader::GetCellArrayStatus(const char* name)
 void vtkGRDECLReader::SetCellArrayStatus(const char* name, int status)
 {
   if (this->CellArraySelection->ArrayIsEnabled(name) != (status != 0) ||
-    !this->CellArraySelection->ArrayExists(name))
+      !this->CellArraySelection->ArrayExists(name))
   {
     this->CellArraySelection->SetArraySetting(name, status);
     this->Modified();
@@ -121,7 +121,7 @@ int vtkGRDECLReader::GetFaultArrayStatus(const char* name)
 void vtkGRDECLReader::SetFaultArrayStatus(const char* name, int status)
 {
   if (this->FaultSelection->ArrayIsEnabled(name) != (status != 0) ||
-    !this->FaultSelection->ArrayExists(name))
+      !this->FaultSelection->ArrayExists(name))
   {
     this->FaultSelection->SetArraySetting(name, status);
     this->Modified();
@@ -160,7 +160,7 @@ bool vtkGRDECLReader::ParseIfNeeded()
   const long long modified = resmr_readers::FileModificationTime(this->FileName);
   Internals& internal = *this->Internal;
   if (internal.Geometry && internal.ParsedFile == this->FileName &&
-    internal.ParsedModificationTime == modified)
+      internal.ParsedModificationTime == modified)
   {
     return true;
   }
@@ -174,7 +174,8 @@ bool vtkGRDECLReader::ParseIfNeeded()
   internal.ParsedFile.clear();
   internal.FailedFile.clear();
   this->Warnings.clear();
-  const auto fail = [&](const std::string& message) {
+  const auto fail = [&](const std::string& message)
+  {
     internal.Deck = resmr::CornerPointModel();
     internal.Geometry.reset();
     internal.FailedFile = this->FileName;
@@ -208,7 +209,8 @@ bool vtkGRDECLReader::ParseIfNeeded()
   }
   for (const resmr::CellArray& array : internal.Deck.arrays)
   {
-    if (!resmr::IsGeometryArrayName(array.name) && !this->CellArraySelection->ArrayExists(array.name.c_str()))
+    if (!resmr::IsGeometryArrayName(array.name) &&
+        !this->CellArraySelection->ArrayExists(array.name.c_str()))
     {
       this->CellArraySelection->AddArray(array.name.c_str(), true);
     }
@@ -223,8 +225,9 @@ bool vtkGRDECLReader::ParseIfNeeded()
   return true;
 }
 
-int vtkGRDECLReader::RequestInformation(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+int vtkGRDECLReader::RequestInformation(vtkInformation*,
+  vtkInformationVector**,
+  vtkInformationVector* outputVector)
 {
   this->LastError.clear();
   if (!this->ParseIfNeeded())
@@ -236,15 +239,17 @@ int vtkGRDECLReader::RequestInformation(
     return 1;
   }
   const auto& dims = this->Internal->Geometry->Dims();
-  int extent[6] = { 0, static_cast<int>(dims[0]), 0, static_cast<int>(dims[1]), 0,
-    static_cast<int>(dims[2]) };
+  int extent[6] = {
+    0, static_cast<int>(dims[0]), 0, static_cast<int>(dims[1]), 0, static_cast<int>(dims[2])
+  };
   outputVector->GetInformationObject(0)->Set(
     vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
   return 1;
 }
 
-int vtkGRDECLReader::RequestData(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+int vtkGRDECLReader::RequestData(vtkInformation*,
+  vtkInformationVector**,
+  vtkInformationVector* outputVector)
 {
   vtkExplicitStructuredGrid* grid = vtkExplicitStructuredGrid::GetData(outputVector, 0);
   vtkPolyData* faults = vtkPolyData::GetData(outputVector, 1);
@@ -281,15 +286,17 @@ int vtkGRDECLReader::RequestData(
     for (const resmr::CellArray& property : deck.arrays)
     {
       if (resmr::IsGeometryArrayName(property.name) ||
-        !this->CellArraySelection->ArrayIsEnabled(property.name.c_str()))
+          !this->CellArraySelection->ArrayIsEnabled(property.name.c_str()))
       {
         continue;
       }
       const std::vector<double>& values = property.values;
       if (property.isInteger)
       {
-        cellData->AddArray(resmr_readers::MakeCellArray<vtkIntArray>(
-          property.name.c_str(), order, [&](int* out) {
+        cellData->AddArray(resmr_readers::MakeCellArray<vtkIntArray>(property.name.c_str(),
+          order,
+          [&](int* out)
+          {
             for (int64_t cell = 0; cell < cellCount; ++cell)
             {
               const double value = values[static_cast<std::size_t>(cell)];
@@ -299,10 +306,9 @@ int vtkGRDECLReader::RequestData(
       }
       else
       {
-        cellData->AddArray(resmr_readers::MakeCellArray<vtkDoubleArray>(
-          property.name.c_str(), order, [&](double* out) {
-            std::copy(values.begin(), values.end(), out);
-          }));
+        cellData->AddArray(resmr_readers::MakeCellArray<vtkDoubleArray>(property.name.c_str(),
+          order,
+          [&](double* out) { std::copy(values.begin(), values.end(), out); }));
       }
     }
 
@@ -314,8 +320,9 @@ int vtkGRDECLReader::RequestData(
     faultIndex->SetName("FaultIndex");
     vtkNew<vtkStringArray> faultNames;
     faultNames->SetName("FaultNames");
-    static const int faceCorners[6][4] = { { 0, 2, 6, 4 }, { 1, 5, 7, 3 }, { 0, 4, 5, 1 },
-      { 2, 3, 7, 6 }, { 0, 1, 3, 2 }, { 4, 6, 7, 5 } };
+    static const int faceCorners[6][4] = {
+      { 0, 2, 6, 4 }, { 1, 5, 7, 3 }, { 0, 4, 5, 1 }, { 2, 3, 7, 6 }, { 0, 1, 3, 2 }, { 4, 6, 7, 5 }
+    };
     for (std::size_t f = 0; f < deck.faults.size(); ++f)
     {
       const resmr::Fault& fault = deck.faults[f];

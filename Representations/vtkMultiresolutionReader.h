@@ -79,7 +79,7 @@ private:
   std::string ResolvedPropertyFile;
   std::string PropertyFileStamp;
   std::string LastError;
-  std::string InformationFailed; ///< why RequestInformation failed (the file did not open)
+  std::string InformationFailed;    ///< why RequestInformation failed (the file did not open)
   std::vector<double> StepDays;     ///< per report step, from the property file
   std::vector<int32_t> StepNumbers; ///< the property file's step of each
 };

@@ -300,13 +300,17 @@ void vtkMultiresolutionSurfaceMapper::ReleaseGraphicsResources(vtkWindow* window
 namespace
 {
 /// (.resmr path, .resmrp path, step, map axes) from the descriptor; false if it has none.
-bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties, int32_t& step, bool& mapAxes,
+bool ReadSource(vtkDataObject* input,
+  std::string& file,
+  std::string& properties,
+  int32_t& step,
+  bool& mapAxes,
   std::string& propertiesStamp)
 {
   vtkFieldData* fields = input ? input->GetFieldData() : nullptr;
-  vtkStringArray* source =
-    fields ? vtkStringArray::SafeDownCast(fields->GetAbstractArray(vtkMultiresolutionSurfaceMapper::SourceArrayName()))
-           : nullptr;
+  vtkStringArray* source = fields ? vtkStringArray::SafeDownCast(fields->GetAbstractArray(
+                                      vtkMultiresolutionSurfaceMapper::SourceArrayName()))
+                                  : nullptr;
   if (!source || source->GetNumberOfValues() < 3)
   {
     return false;
@@ -467,9 +471,10 @@ bool vtkMultiresolutionSurfaceMapper::SelectLayer(Frame& frame)
   // not ask for.
   if (this->Layer < 0 || this->Layer > header.dims[2])
   {
-    const std::string message = "Layer " + std::to_string(this->Layer) + " is out of range: " + in.FilePath +
-      " has " + std::to_string(header.dims[2]) + " layers (1 to " + std::to_string(header.dims[2]) +
-      "; 0 draws the whole model)";
+    const std::string message = "Layer " + std::to_string(this->Layer) +
+                                " is out of range: " + in.FilePath + " has " +
+                                std::to_string(header.dims[2]) + " layers (1 to " +
+                                std::to_string(header.dims[2]) + "; 0 draws the whole model)";
     if (message != in.LayerError)
     {
       vtkWarningMacro(<< message);
@@ -588,10 +593,12 @@ void vtkMultiresolutionSurfaceMapper::SelectRegions(Frame& frame)
   // Still renders (scripts, screenshots) wait for the wanted set, as long as they asked.
   if (this->WaitForDetailMs > 0)
   {
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(this->WaitForDetailMs);
+    const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::milliseconds(this->WaitForDetailMs);
     while (cache.Pending() && std::chrono::steady_clock::now() < deadline)
     {
-      cache.WaitIdle(std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()));
+      cache.WaitIdle(std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now()));
       frame.selection = in.Selector->Select(frame.view, resident);
       cache.Request(frame.selection.wanted, predicted);
     }
@@ -707,10 +714,13 @@ void vtkMultiresolutionSurfaceMapper::SetUniforms(Frame& frame)
   program->SetUniform3f("solidColor", look->GetDiffuseColor());
   program->SetUniformf("gridLineWidth", static_cast<float>(this->GridLineWidth));
   program->SetUniform3f("gridLineColor", this->GridLineColor);
-  program->SetUniformf("ambient", static_cast<float>(look->GetAmbient() + (look->GetLighting() ? 0 : 1)));
+  program->SetUniformf(
+    "ambient", static_cast<float>(look->GetAmbient() + (look->GetLighting() ? 0 : 1)));
   program->SetUniformf("diffuse", static_cast<float>(look->GetLighting() ? look->GetDiffuse() : 0));
-  program->SetUniformf("specular", static_cast<float>(look->GetLighting() ? look->GetSpecular() : 0));
-  program->SetUniformf("specularPower", static_cast<float>(std::max(1.0, look->GetSpecularPower())));
+  program->SetUniformf(
+    "specular", static_cast<float>(look->GetLighting() ? look->GetSpecular() : 0));
+  program->SetUniformf(
+    "specularPower", static_cast<float>(std::max(1.0, look->GetSpecularPower())));
 }
 
 void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
@@ -791,8 +801,11 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
     in.Reported = loadError;
     vtkErrorMacro(<< loadError);
   }
-  vtkLogF(TRACE, "multiresolution surface: %d regions, %lld triangles at %.2f px", in.Drawn,
-    static_cast<long long>(in.Triangles), in.Tolerance);
+  vtkLogF(TRACE,
+    "multiresolution surface: %d regions, %lld triangles at %.2f px",
+    in.Drawn,
+    static_cast<long long>(in.Triangles),
+    in.Tolerance);
   in.FrameMs = ElapsedMs(frame.start) + in.Timer.Ms();
   if (this->TargetFrameRate > 0)
   {

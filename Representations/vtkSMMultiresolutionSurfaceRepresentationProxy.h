@@ -29,7 +29,8 @@ protected:
   void UpdatePropertyInformationInternal(vtkSMProperty* property = nullptr) override;
 
 private:
-  vtkSMMultiresolutionSurfaceRepresentationProxy(const vtkSMMultiresolutionSurfaceRepresentationProxy&) = delete;
+  vtkSMMultiresolutionSurfaceRepresentationProxy(
+    const vtkSMMultiresolutionSurfaceRepresentationProxy&) = delete;
   void operator=(const vtkSMMultiresolutionSurfaceRepresentationProxy&) = delete;
 };
 

@@ -39,8 +39,8 @@ long long PeakRssBytes()
 
 long long OutputBytes(const resmr::CornerPointModel& deck)
 {
-  std::size_t values = deck.coord.size() + deck.zcorn.size() + deck.dxv.size() +
-    deck.dyv.size() + deck.dzv.size();
+  std::size_t values =
+    deck.coord.size() + deck.zcorn.size() + deck.dxv.size() + deck.dyv.size() + deck.dzv.size();
   for (const auto& array : deck.arrays)
   {
     values += array.values.size();
@@ -117,13 +117,22 @@ int main(int argc, char** argv)
                   "\"mb_per_s\": %.1f, \"output_bytes\": %lld, \"geometry_bytes\": %lld, "
                   "\"peak_rss_bytes\": %lld, "
                   "\"cells\": %lld, \"arrays\": %zu, \"fault_faces\": %zu}\n",
-        run, fileBytes, seconds, fileBytes / seconds / 1e6, OutputBytes(deck), GeometryBytes(deck), PeakRssBytes(),
-        static_cast<long long>(deck.CellCount()), deck.arrays.size(), faces);
+        run,
+        fileBytes,
+        seconds,
+        fileBytes / seconds / 1e6,
+        OutputBytes(deck),
+        GeometryBytes(deck),
+        PeakRssBytes(),
+        static_cast<long long>(deck.CellCount()),
+        deck.arrays.size(),
+        faces);
       std::fflush(stdout);
     }
     catch (const std::exception& error)
     {
-      std::printf("{\"tool\": \"resmr\", \"run\": %d, \"error\": \"%s\"}\n", run,
+      std::printf("{\"tool\": \"resmr\", \"run\": %d, \"error\": \"%s\"}\n",
+        run,
         JsonEscape(error.what()).c_str());
       return 1;
     }

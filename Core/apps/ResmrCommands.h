@@ -58,4 +58,3 @@ int MultiresolutionInfo(const char* path, bool listRegions = false);
 
 /// resmr add-properties FILE.resmr RESULTS... [-o FILE.resmrp]; argv[1] is "add-properties".
 int AddPropertiesCommand(int argc, char** argv);
-

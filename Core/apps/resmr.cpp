@@ -58,24 +58,38 @@ int GridInfo(const char* path)
   }
   const auto& d = grid.deck.dims;
   std::printf("{\"file\": %s, \"kind\": \"egrid\", \"dims\": [%lld, %lld, %lld], \"cells\": %lld, "
-              "\"active\": %lld, \"nonzero_actnum\": %lld, \"dual_porosity\": %s, \"fracture_cells\": %lld, \"lgrs\": %zu, "
+              "\"active\": %lld, \"nonzero_actnum\": %lld, \"dual_porosity\": %s, "
+              "\"fracture_cells\": %lld, \"lgrs\": %zu, "
               "\"nnc\": %lld, \"units\": %s, \"init\": %s, \"init_arrays\": %s, \"restarts\": %zu, "
               "\"unified\": %s, \"restart_arrays\": %s, \"steps\": [",
-    JsonString(path).c_str(), static_cast<long long>(d[0]), static_cast<long long>(d[1]),
-    static_cast<long long>(d[2]), static_cast<long long>(grid.deck.CellCount()),
+    JsonString(path).c_str(),
+    static_cast<long long>(d[0]),
+    static_cast<long long>(d[1]),
+    static_cast<long long>(d[2]),
+    static_cast<long long>(grid.deck.CellCount()),
     static_cast<long long>(grid.activeCells),
-    static_cast<long long>(std::count_if(grid.actnum.begin(), grid.actnum.end(), [](int32_t v) { return v > 0; })),
+    static_cast<long long>(
+      std::count_if(grid.actnum.begin(), grid.actnum.end(), [](int32_t v) { return v > 0; })),
     grid.dualPorosity ? "true" : "false",
-    static_cast<long long>(grid.fractureCells), grid.localGridNames.size(),
-    static_cast<long long>(grid.nonNeighbourConnections), JsonString(grid.units).c_str(),
-    JsonString(results.InitPath()).c_str(), JsonNames(results.StaticArrays()).c_str(),
-    results.RestartPaths().size(), results.UnifiedRestart() ? "true" : "false",
+    static_cast<long long>(grid.fractureCells),
+    grid.localGridNames.size(),
+    static_cast<long long>(grid.nonNeighbourConnections),
+    JsonString(grid.units).c_str(),
+    JsonString(results.InitPath()).c_str(),
+    JsonNames(results.StaticArrays()).c_str(),
+    results.RestartPaths().size(),
+    results.UnifiedRestart() ? "true" : "false",
     JsonNames(results.DynamicArrays()).c_str());
   for (std::size_t s = 0; s < results.Steps().size(); ++s)
   {
     const resmr::EclipseReportStep& step = results.Steps()[s];
     std::printf("%s{\"report\": %d, \"days\": %.17g, \"date\": \"%04d-%02d-%02d\", \"arrays\": [",
-      s ? ", " : "", step.reportNumber, step.days, step.date[0], step.date[1], step.date[2]);
+      s ? ", " : "",
+      step.reportNumber,
+      step.days,
+      step.date[0],
+      step.date[1],
+      step.date[2]);
     for (std::size_t a = 0; a < step.names.size(); ++a)
     {
       std::printf("%s%s", a ? ", " : "", JsonString(step.names[a]).c_str());
@@ -83,12 +97,16 @@ int GridInfo(const char* path)
     std::printf("]}");
   }
   // Steps of a run cut short (or still being written) that are not offered, and why.
-  std::printf("], \"init_used\": %s, \"steps_left_out\": [", results.InitUsable() ? "true" : "false");
+  std::printf(
+    "], \"init_used\": %s, \"steps_left_out\": [", results.InitUsable() ? "true" : "false");
   for (std::size_t s = 0; s < results.SkippedSteps().size(); ++s)
   {
     const resmr::EclipseSkippedStep& skipped = results.SkippedSteps()[s];
-    std::printf("%s{\"file\": %s, \"report\": %d, \"offset\": %lld, \"reason\": %s}", s ? ", " : "",
-      JsonString(skipped.file).c_str(), skipped.reportNumber, static_cast<long long>(skipped.offset),
+    std::printf("%s{\"file\": %s, \"report\": %d, \"offset\": %lld, \"reason\": %s}",
+      s ? ", " : "",
+      JsonString(skipped.file).c_str(),
+      skipped.reportNumber,
+      static_cast<long long>(skipped.offset),
       JsonString(skipped.reason).c_str());
   }
   std::printf("]}\n");
@@ -103,10 +121,10 @@ int Info(const char* path, bool skipMissingIncludes)
     c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   }
   const bool keywordFile = resmr::EclipseKeywordFile::LooksLikeUnformatted(path) ||
-    resmr::EclipseKeywordFile::LooksLikeFormatted(path);
+                           resmr::EclipseKeywordFile::LooksLikeFormatted(path);
   if (resmr::LooksLikeEclipseGridFile(path) ||
-    (keywordFile &&
-      (extension == ".EGRID" || extension == ".FEGRID" || extension == ".GRID" || extension == ".FGRID")))
+      (keywordFile && (extension == ".EGRID" || extension == ".FEGRID" || extension == ".GRID" ||
+                        extension == ".FGRID")))
   {
     return GridInfo(path);
   }
@@ -143,10 +161,15 @@ int Info(const char* path, bool skipMissingIncludes)
   }
   std::printf("{\"file\": %s, \"dims\": [%lld, %lld, %lld], \"cells\": %lld, \"active\": %lld, "
               "\"geometry\": \"%s\", \"left_handed\": %s, \"fault_records\": %lld, \"faults\": [",
-    JsonString(path).c_str(), static_cast<long long>(deck.dims[0]),
-    static_cast<long long>(deck.dims[1]), static_cast<long long>(deck.dims[2]),
-    static_cast<long long>(cells), static_cast<long long>(active), geometry.c_str(),
-    leftHanded ? "true" : "false", static_cast<long long>(faultRecords));
+    JsonString(path).c_str(),
+    static_cast<long long>(deck.dims[0]),
+    static_cast<long long>(deck.dims[1]),
+    static_cast<long long>(deck.dims[2]),
+    static_cast<long long>(cells),
+    static_cast<long long>(active),
+    geometry.c_str(),
+    leftHanded ? "true" : "false",
+    static_cast<long long>(faultRecords));
   for (std::size_t f = 0; f < deck.faults.size(); ++f)
   {
     std::printf("%s%s", f ? ", " : "", JsonString(deck.faults[f].name).c_str());
@@ -201,7 +224,8 @@ int main(int argc, char** argv)
     return AddPropertiesCommand(argc, argv);
   }
   const bool listRegions = argc == 4 && std::strcmp(argv[2], "--regions") == 0;
-  if ((argc == 3 || listRegions) && std::strcmp(argv[1], "info") == 0 && LooksLikeMultiresolutionFile(argv[argc - 1]))
+  if ((argc == 3 || listRegions) && std::strcmp(argv[1], "info") == 0 &&
+      LooksLikeMultiresolutionFile(argv[argc - 1]))
   {
     try
     {
@@ -226,18 +250,19 @@ int main(int argc, char** argv)
       return 1;
     }
   }
-  std::fprintf(stderr, "usage: resmr info [--skip-missing-includes] DECK|GRID.EGRID\n"
-                       "  prints dimensions, active cells, arrays and faults of an Eclipse deck,\n"
-                       "  or of an EGRID with its INIT arrays and restart steps\n"
-                       "usage: resmr synth NX NY NZ -o FILE.EGRID|FILE.GRDECL [options]\n"
-                       "  writes a synthetic faulted reservoir model (resmr synth --help)\n"
-                       "usage: resmr simplify MODEL [--fraction F | --columns N | --uniform B]\n"
-                       "  column-collapse simplification and its quality (resmr simplify --help)\n"
-                       "usage: resmr build INPUT -o OUT.resmr [--cmax N] [--threads N] [--memory SIZE]\n"
-                       "  builds the multiresolution file (resmr build --help)\n"
-                       "usage: resmr info [--regions] FILE.resmr\n"
-                       "  levels, regions, sizes, errors and bytes per cell of a multiresolution file\n"
-                       "usage: resmr add-properties FILE.resmr RESULTS... [-o FILE.resmrp]\n"
-                       "  stores properties of every step apart from the geometry (resmr add-properties --help)\n");
+  std::fprintf(stderr,
+    "usage: resmr info [--skip-missing-includes] DECK|GRID.EGRID\n"
+    "  prints dimensions, active cells, arrays and faults of an Eclipse deck,\n"
+    "  or of an EGRID with its INIT arrays and restart steps\n"
+    "usage: resmr synth NX NY NZ -o FILE.EGRID|FILE.GRDECL [options]\n"
+    "  writes a synthetic faulted reservoir model (resmr synth --help)\n"
+    "usage: resmr simplify MODEL [--fraction F | --columns N | --uniform B]\n"
+    "  column-collapse simplification and its quality (resmr simplify --help)\n"
+    "usage: resmr build INPUT -o OUT.resmr [--cmax N] [--threads N] [--memory SIZE]\n"
+    "  builds the multiresolution file (resmr build --help)\n"
+    "usage: resmr info [--regions] FILE.resmr\n"
+    "  levels, regions, sizes, errors and bytes per cell of a multiresolution file\n"
+    "usage: resmr add-properties FILE.resmr RESULTS... [-o FILE.resmrp]\n"
+    "  stores properties of every step apart from the geometry (resmr add-properties --help)\n");
   return 2;
 }

@@ -35,7 +35,7 @@ inline void AdviseHugePages(void* data, std::size_t bytes)
 
 /// Resizes an empty vector to `count` elements, advising huge pages before the memory is
 /// first touched.
-template <typename T>
+template<typename T>
 void ResizeLarge(std::vector<T>& values, std::size_t count)
 {
   if (values.empty() && count * sizeof(T) >= (std::size_t(8) << 20))

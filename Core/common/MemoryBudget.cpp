@@ -56,7 +56,8 @@ int64_t MaxFullResolutionCells(int64_t limitBytes)
 std::string MultiresolutionAdvice(const std::string& path)
 {
   return "open it through the multiresolution path instead, which loads only what the view "
-         "needs: resmr build " + path + " -o MODEL.resmr, then open MODEL.resmr";
+         "needs: resmr build " +
+         path + " -o MODEL.resmr, then open MODEL.resmr";
 }
 
 } // namespace resmr

@@ -28,18 +28,18 @@ public:
   const std::string& Name() const { return this->ArrayName; }
 
   /// values[0 .. count) to elements [first, first + count) of T.
-  template <typename T>
+  template<typename T>
   void Write(int64_t first, const T* values, int64_t count)
   {
     this->WriteBytes(first * int64_t(sizeof(T)), values, count * int64_t(sizeof(T)));
   }
-  template <typename T>
+  template<typename T>
   void Read(int64_t first, T* values, int64_t count) const
   {
     this->ReadBytes(first * int64_t(sizeof(T)), values, count * int64_t(sizeof(T)));
   }
   /// Elements [first, first + count) of T all set to `value`.
-  template <typename T>
+  template<typename T>
   void Fill(int64_t first, int64_t count, T value)
   {
     T block[4096];

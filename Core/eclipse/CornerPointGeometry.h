@@ -47,7 +47,10 @@ public:
   void SetMapAxesApplied(bool apply);
 
   const std::array<int64_t, 3>& Dims() const { return this->Dimensions; }
-  int64_t CellCount() const { return this->Dimensions[0] * this->Dimensions[1] * this->Dimensions[2]; }
+  int64_t CellCount() const
+  {
+    return this->Dimensions[0] * this->Dimensions[1] * this->Dimensions[2];
+  }
 
   /// The 8 corners (x, y, depth) of cell (i, j, k), 0-based, ECLIPSE corner order.
   void CellCorners(int64_t i, int64_t j, int64_t k, double corners[8][3]) const;

@@ -74,7 +74,7 @@ struct CornerPointModel
   MapAxes mapAxes;
   std::string mapUnits;
   std::string gridUnit;
-  bool gridUnitIsMap = false; ///< GRIDUNIT 'METRES' 'MAP': COORD already in map coordinates
+  bool gridUnitIsMap = false;        ///< GRIDUNIT 'METRES' 'MAP': COORD already in map coordinates
   std::vector<std::string> gdorient; ///< GDORIENT record, as written
   std::vector<std::array<int32_t, 2>> coordsysLayers; ///< COORDSYS k1 k2 (1-based)
 
@@ -83,7 +83,7 @@ struct CornerPointModel
   std::vector<CellArray> arrays;
 
   std::vector<Fault> faults;
-  std::vector<std::string> files; ///< every file read, the deck first
+  std::vector<std::string> files;    ///< every file read, the deck first
   std::vector<std::string> warnings; ///< problems that did not stop the parse
 
   int64_t CellCount() const { return this->dims[0] * this->dims[1] * this->dims[2]; }

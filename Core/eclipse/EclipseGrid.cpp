@@ -30,14 +30,14 @@ bool LooksLikeEclipseGridFile(const std::string& path)
     name = std::strchr(head, '\'') + 1;
   }
   return name && name + 8 <= head + got &&
-    (std::strncmp(name, "FILEHEAD", 8) == 0 || std::strncmp(name, "GRIDHEAD", 8) == 0);
+         (std::strncmp(name, "FILEHEAD", 8) == 0 || std::strncmp(name, "GRIDHEAD", 8) == 0);
 }
 
 namespace
 {
 /// True if no value is NaN or infinite: an exponent of all ones, tested on the bits so the
 /// loop vectorizes (a floating-point sum would be a serial dependency chain).
-template <typename Real>
+template<typename Real>
 bool AllFinite(const Real* values, std::size_t count)
 {
   using Bits = std::conditional_t<sizeof(Real) == 4, uint32_t, uint64_t>;
@@ -56,9 +56,8 @@ bool AllFinite(const Real* values, std::size_t count)
 EclipseGridLayout LocateEclipseGrid(const EclipseKeywordFile& file, int64_t maxCells)
 {
   const std::string& path = file.Path();
-  const auto fail = [&](const EclipseRecord* record, const std::string& what) -> void {
-    file.Fail(record, record ? record->headerOffset : 0, what);
-  };
+  const auto fail = [&](const EclipseRecord* record, const std::string& what) -> void
+  { file.Fail(record, record ? record->headerOffset : 0, what); };
   const auto& records = file.Records();
 
   // Old-style GRID files carry DIMENS + COORDS/CORNERS per cell instead of GRIDHEAD.
@@ -133,7 +132,8 @@ EclipseGridLayout LocateEclipseGrid(const EclipseKeywordFile& file, int64_t maxC
       file.Read(record, integers.data());
       if (integers[0] != 1)
       {
-        fail(&record, "grid type " + std::to_string(integers[0]) +
+        fail(&record,
+          "grid type " + std::to_string(integers[0]) +
             " is not a corner-point grid (only type 1 is supported)");
       }
       const std::array<int64_t, 3> dims{ integers[1], integers[2], integers[3] };
@@ -172,22 +172,25 @@ EclipseGridLayout LocateEclipseGrid(const EclipseKeywordFile& file, int64_t maxC
         fail(&record, "appears before GRIDHEAD");
       }
       const int64_t nx = deck.dims[0], ny = deck.dims[1], nz = deck.dims[2];
-      const int64_t expected = name == "COORD" ? 6 * (nx + 1) * (ny + 1)
-        : name == "ZCORN"                      ? 8 * nx * ny * nz
-                                               : nx * ny * nz;
+      const int64_t expected = name == "COORD"   ? 6 * (nx + 1) * (ny + 1)
+                               : name == "ZCORN" ? 8 * nx * ny * nz
+                                                 : nx * ny * nz;
       if (!record.IsNumeric() || record.count != expected)
       {
-        fail(&record, "expected " + std::to_string(expected) + " numbers for a " +
-            std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) +
-            " grid, file has " + std::to_string(record.count) + " of type " + record.typeName);
+        fail(&record,
+          "expected " + std::to_string(expected) + " numbers for a " + std::to_string(nx) + " x " +
+            std::to_string(ny) + " x " + std::to_string(nz) + " grid, file has " +
+            std::to_string(record.count) + " of type " + record.typeName);
       }
       (name == "COORD" ? layout.coord : name == "ZCORN" ? layout.zcorn : layout.actnum) = &record;
     }
   }
   if (!sawGridHead || !layout.coord || !layout.zcorn)
   {
-    fail(nullptr, std::string("the global grid lacks ") +
-        (!sawGridHead ? "GRIDHEAD" : !layout.coord ? "COORD" : "ZCORN"));
+    fail(nullptr,
+      std::string("the global grid lacks ") + (!sawGridHead     ? "GRIDHEAD"
+                                                : !layout.coord ? "COORD"
+                                                                : "ZCORN"));
   }
   return layout;
 }
@@ -195,8 +198,10 @@ EclipseGridLayout LocateEclipseGrid(const EclipseKeywordFile& file, int64_t maxC
 namespace
 {
 /// Reads a COORD or ZCORN record whole into `target`; every value must be finite.
-template <typename Real>
-void ReadFiniteRecord(const EclipseKeywordFile& file, const EclipseRecord& record, std::vector<Real>& target)
+template<typename Real>
+void ReadFiniteRecord(const EclipseKeywordFile& file,
+  const EclipseRecord& record,
+  std::vector<Real>& target)
 {
   target.clear();
   ResizeLarge(target, static_cast<std::size_t>(record.count));
@@ -207,7 +212,8 @@ void ReadFiniteRecord(const EclipseKeywordFile& file, const EclipseRecord& recor
     {
       if (!std::isfinite(target[v]))
       {
-        file.Fail(&record, record.headerOffset, "value " + std::to_string(v + 1) + " is not finite");
+        file.Fail(
+          &record, record.headerOffset, "value " + std::to_string(v + 1) + " is not finite");
       }
     }
   }
@@ -234,7 +240,8 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells, EclipseGr
     ReadFiniteRecord(file, *layout.coord, deck.coord);
     if (layout.zcorn->type == EclipseDataType::Real)
     {
-      ReadFiniteRecord(file, *layout.zcorn, deck.zcornSingle); // EGRID's float32 depths, kept as they are
+      ReadFiniteRecord(
+        file, *layout.zcorn, deck.zcornSingle); // EGRID's float32 depths, kept as they are
     }
     else
     {
@@ -264,8 +271,8 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells, EclipseGr
   if (grid.dualPorosity)
   {
     deck.warnings.push_back(path + ": dual-porosity grid: showing the matrix grid (" +
-      std::to_string(grid.activeCells) + " matrix cells; " + std::to_string(grid.fractureCells) +
-      " fracture cells not shown)");
+                            std::to_string(grid.activeCells) + " matrix cells; " +
+                            std::to_string(grid.fractureCells) + " fracture cells not shown)");
   }
   if (!grid.localGridNames.empty())
   {
@@ -275,7 +282,7 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells, EclipseGr
       names += (names.empty() ? "" : ", ") + lgr;
     }
     deck.warnings.push_back(path + ": " + std::to_string(grid.localGridNames.size()) +
-      " local grid refinement(s) not shown, only the global grid: " + names);
+                            " local grid refinement(s) not shown, only the global grid: " + names);
   }
   return grid;
 }

@@ -62,8 +62,8 @@ struct EclipseRecord
 
 enum class KeywordFileIndexing
 {
-  WholeFile,            ///< any damage throws (grids)
-  UpToLastWholeRecord   ///< stop before the first cut or damaged record (results)
+  WholeFile,          ///< any damage throws (grids)
+  UpToLastWholeRecord ///< stop before the first cut or damaged record (results)
 };
 
 class EclipseKeywordFile
@@ -71,8 +71,8 @@ class EclipseKeywordFile
 public:
   /// Opens and indexes the file; throws InputError if it is not a valid keyword file (with
   /// UpToLastWholeRecord: only if it does not start like one).
-  explicit EclipseKeywordFile(
-    const std::string& path, KeywordFileIndexing indexing = KeywordFileIndexing::WholeFile);
+  explicit EclipseKeywordFile(const std::string& path,
+    KeywordFileIndexing indexing = KeywordFileIndexing::WholeFile);
   ~EclipseKeywordFile();
   EclipseKeywordFile(const EclipseKeywordFile&) = delete;
   EclipseKeywordFile& operator=(const EclipseKeywordFile&) = delete;
@@ -99,7 +99,7 @@ public:
 
   /// Reads a numeric record (any of INTE, REAL, DOUB, LOGI) into out[0 .. count), converting
   /// to T. Defined for int32_t, float and double.
-  template <typename T>
+  template<typename T>
   void Read(const EclipseRecord& record, T* out) const;
 
   /// Reads a numeric record piece by piece, with no buffer the size of the record:
@@ -107,9 +107,9 @@ public:
   /// Large records call the sink from several threads at once, each with its own ranges in
   /// increasing order; the sink must only write where `first` says. Defined for int32_t,
   /// float and double.
-  template <typename T>
-  void ReadInPieces(
-    const EclipseRecord& record, const std::function<void(const T*, int64_t, int64_t)>& sink) const;
+  template<typename T>
+  void ReadInPieces(const EclipseRecord& record,
+    const std::function<void(const T*, int64_t, int64_t)>& sink) const;
 
   /// Records of at least this many values are read by several threads (one per core, at
   /// most 8), each converting its own range of blocks: on a workstation the conversion and
@@ -124,7 +124,9 @@ public:
   std::vector<std::string> ReadStrings(const EclipseRecord& record) const;
 
   /// Throws InputError for `record` at byte `offset`.
-  [[noreturn]] void Fail(const EclipseRecord* record, int64_t offset, const std::string& what) const;
+  [[noreturn]] void Fail(const EclipseRecord* record,
+    int64_t offset,
+    const std::string& what) const;
 
 private:
   friend class EclipseRecordCursor;
@@ -135,13 +137,15 @@ private:
   void IndexLeniently(void (EclipseKeywordFile::*pass)());
   int64_t WalkBlocks(const EclipseRecord& record) const;
   void ReadRaw(int64_t offset, void* data, int64_t size, const EclipseRecord* record) const;
-  template <typename T>
+  template<typename T>
   void ReadFormatted(const EclipseRecord& record, T* out) const;
   std::vector<std::string> ReadFormattedStrings(const EclipseRecord& record) const;
-  template <typename Consumer>
-  void ForEachBlock(const EclipseRecord& record, Consumer&& consume, int64_t firstBlock = 0,
+  template<typename Consumer>
+  void ForEachBlock(const EclipseRecord& record,
+    Consumer&& consume,
+    int64_t firstBlock = 0,
     int64_t endBlock = -1) const;
-  template <typename Consumer>
+  template<typename Consumer>
   void ForEachBlockInParallel(const EclipseRecord& record, Consumer&& consume) const;
 
   std::string FilePath;
@@ -176,7 +180,7 @@ public:
   EclipseRecordCursor& operator=(const EclipseRecordCursor&) = delete;
 
   /// Defined for int32_t, float and double.
-  template <typename T>
+  template<typename T>
   void Read(int64_t count, T* out);
   /// Values read so far: the index of the next one.
   int64_t Position() const { return this->Done; }
@@ -189,9 +193,9 @@ private:
   const EclipseKeywordFile& File;
   EclipseRecord Header;
   int64_t Done = 0;
-  int64_t NextBlock = 0;  ///< byte offset of the next data record's start marker
-  int64_t BlockData = 0;  ///< byte offset of the next unread element of the current one
-  int64_t BlockLeft = 0;  ///< elements left in the current data record
+  int64_t NextBlock = 0; ///< byte offset of the next data record's start marker
+  int64_t BlockData = 0; ///< byte offset of the next unread element of the current one
+  int64_t BlockLeft = 0; ///< elements left in the current data record
   std::vector<unsigned char> Buffer;
   int64_t BufferStart = 0, BufferEnd = 0; ///< absolute offsets of the bytes held in Buffer
   std::unique_ptr<Text> Formatted;        ///< formatted files: the token cursor

@@ -44,7 +44,7 @@ public:
   void Append(const std::vector<std::string>& values);
 
   /// Begin + Append of a whole keyword.
-  template <typename T>
+  template<typename T>
   void Write(const std::string& name, const std::string& type, const std::vector<T>& values)
   {
     this->Begin(name, type, static_cast<int64_t>(values.size()));
@@ -58,7 +58,7 @@ public:
   const std::string& Path() const { return this->Output.Path(); }
 
 private:
-  template <typename T>
+  template<typename T>
   void AppendNumbers(const T* values, int64_t count);
   void PutBytes(const void* data, std::size_t size);
   void PutMarker(uint32_t value);
@@ -68,9 +68,9 @@ private:
   std::string Keyword;
   EclipseDataType Type = EclipseDataType::Message;
   int32_t ElementSize = 0;
-  int64_t Remaining = 0;      ///< elements the current keyword still needs
-  int64_t LeftInBlock = 0;    ///< elements left in the open data record
-  int64_t BlockBytes = 0;     ///< size of the open data record
+  int64_t Remaining = 0;   ///< elements the current keyword still needs
+  int64_t LeftInBlock = 0; ///< elements left in the open data record
+  int64_t BlockBytes = 0;  ///< size of the open data record
   std::vector<unsigned char> Scratch;
 };
 

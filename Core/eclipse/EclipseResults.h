@@ -48,11 +48,11 @@ struct EclipseResultArray
 
 struct EclipseReportStep
 {
-  int reportNumber = 0;           ///< SEQNUM, or the nnnn of Xnnnn
-  double days = 0;                ///< simulated time since the start
-  std::array<int, 3> date{};      ///< year, month, day; 0 if unknown
-  std::size_t file = 0;           ///< index into RestartPaths()
-  std::vector<std::string> names; ///< arrays this step holds, one per shown cell
+  int reportNumber = 0;             ///< SEQNUM, or the nnnn of Xnnnn
+  double days = 0;                  ///< simulated time since the start
+  std::array<int, 3> date{};        ///< year, month, day; 0 if unknown
+  std::size_t file = 0;             ///< index into RestartPaths()
+  std::vector<std::string> names;   ///< arrays this step holds, one per shown cell
   std::vector<std::size_t> records; ///< their record index in the file
 };
 
@@ -88,11 +88,11 @@ public:
 
   /// Fills cellValues[0 .. nx ny nz) with INIT array `name`; cells without a value get
   /// `fill`. False if there is no such array.
-  template <typename T>
+  template<typename T>
   bool ReadStatic(const std::string& name, T* cellValues, T fill) const;
 
   /// Same for array `name` of report step `step` (index into Steps()).
-  template <typename T>
+  template<typename T>
   bool ReadDynamic(std::size_t step, const std::string& name, T* cellValues, T fill) const;
 
   /// Companion paths of an EGRID, for tests and tools.
@@ -106,12 +106,21 @@ private:
   /// Indexes one restart file's steps and leaves out its last one if it is not whole.
   void IndexRestart(std::size_t fileIndex, const EclipseKeywordFile& file, int fileReportNumber);
   struct RestartScan;
-  void ScanRestart(std::size_t fileIndex, const EclipseKeywordFile& file, int fileReportNumber, RestartScan& scan);
-  void LeaveOut(const std::string& path, int reportNumber, int64_t offset, const std::string& reason);
+  void ScanRestart(std::size_t fileIndex,
+    const EclipseKeywordFile& file,
+    int fileReportNumber,
+    RestartScan& scan);
+  void LeaveOut(const std::string& path,
+    int reportNumber,
+    int64_t offset,
+    const std::string& reason);
   void ListDynamicArrays();
   bool FitsGrid(int64_t count) const;
-  template <typename T>
-  void Scatter(const EclipseKeywordFile& file, const EclipseRecord& record, T* cellValues, T fill) const;
+  template<typename T>
+  void Scatter(const EclipseKeywordFile& file,
+    const EclipseRecord& record,
+    T* cellValues,
+    T fill) const;
 
   /// Runs of consecutive active (matrix) cells: first cell, length. Values of active-cell
   /// arrays go to these cells in order.

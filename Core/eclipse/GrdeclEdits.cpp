@@ -13,7 +13,8 @@ namespace
 bool EndsWith(const std::string& text, const char* suffix)
 {
   const std::string tail(suffix);
-  return text.size() > tail.size() && text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
+  return text.size() > tail.size() &&
+         text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
 }
 
 bool StartsWith(const std::string& text, const char* prefix)
@@ -48,8 +49,8 @@ std::string SimulatorArrayKind(const std::string& name)
   {
     return "diffusivity multiplier";
   }
-  if (name == "SIGMAV" || name == "DZMTRXV" || name == "DZMATRIX" || name == "LX" ||
-    name == "LY" || name == "LZ")
+  if (name == "SIGMAV" || name == "DZMTRXV" || name == "DZMATRIX" || name == "LX" || name == "LY" ||
+      name == "LZ")
   {
     return "dual-porosity coupling factor";
   }
@@ -58,17 +59,63 @@ std::string SimulatorArrayKind(const std::string& name)
 
 bool IsViewerArray(const std::string& name)
 {
-  static const std::unordered_set<std::string> names = { "ACTNUM", "DX", "DY", "DZ", "TOPS",
-    "PORO", "PERMX", "PERMY", "PERMZ", "PERMXY", "PERMYZ", "PERMZX", "PERMR", "PERMTHT", "NTG",
-    "SWATINIT", "SWL", "SWLPC", "SWCR", "SWU", "SGL", "SGLPC", "SGCR", "SGU", "SOWCR", "SOGCR",
-    "KRW", "KRWR", "KRO", "KRORW", "KRORG", "KRG", "KRGR", "PCW", "PCG", "PRESSURE", "SWAT",
-    "SGAS", "SOIL", "RS", "RV", "PBUB", "PDEW", "TEMPI", "SALT", "FACIES", "THCONR", "THCONSF",
-    "SPOLY", "SFOAM", "SSOL" };
+  static const std::unordered_set<std::string> names = { "ACTNUM",
+    "DX",
+    "DY",
+    "DZ",
+    "TOPS",
+    "PORO",
+    "PERMX",
+    "PERMY",
+    "PERMZ",
+    "PERMXY",
+    "PERMYZ",
+    "PERMZX",
+    "PERMR",
+    "PERMTHT",
+    "NTG",
+    "SWATINIT",
+    "SWL",
+    "SWLPC",
+    "SWCR",
+    "SWU",
+    "SGL",
+    "SGLPC",
+    "SGCR",
+    "SGU",
+    "SOWCR",
+    "SOGCR",
+    "KRW",
+    "KRWR",
+    "KRO",
+    "KRORW",
+    "KRORG",
+    "KRG",
+    "KRGR",
+    "PCW",
+    "PCG",
+    "PRESSURE",
+    "SWAT",
+    "SGAS",
+    "SOIL",
+    "RS",
+    "RV",
+    "PBUB",
+    "PDEW",
+    "TEMPI",
+    "SALT",
+    "FACIES",
+    "THCONR",
+    "THCONSF",
+    "SPOLY",
+    "SFOAM",
+    "SSOL" };
   return names.count(name) > 0 || EndsWith(name, "NUM");
 }
 
-std::function<double(double, double)> ArrayOperation(
-  const std::string& operation, double alpha, double beta)
+std::function<double(double, double)> ArrayOperation(const std::string& operation,
+  double alpha,
+  double beta)
 {
   using Op = std::function<double(double, double)>;
   // ECLIPSE's OPERATE table: R is the target's value, X the source's.
@@ -140,24 +187,27 @@ SkippedShape SkippedKeyword(const std::string& keyword, std::string& why)
     { "EDITNNC", { SkippedShape::Records, "non-neighbour connection multipliers" } },
     { "EDITNNCR", { SkippedShape::Records, "non-neighbour connection transmissibilities" } },
     { "NNC", { SkippedShape::Records, "non-neighbour connections" } },
-    { "AQUNUM", { SkippedShape::Records,
-                  "numerical aquifers (the simulator gives their cells the aquifer's porosity "
-                  "and permeability; the viewer shows the grid's)" } },
+    { "AQUNUM",
+      { SkippedShape::Records,
+        "numerical aquifers (the simulator gives their cells the aquifer's porosity "
+        "and permeability; the viewer shows the grid's)" } },
     { "AQUCON", { SkippedShape::Records, "aquifer connections" } },
     { "AQUCT", { SkippedShape::Records, "Carter-Tracy aquifers" } },
     { "AQUFETP", { SkippedShape::Records, "Fetkovich aquifers" } },
     { "AQUANCON", { SkippedShape::Records, "analytic aquifer connections" } },
     { "THPRES", { SkippedShape::Records, "threshold pressures between regions" } },
     { "AMALGAM", { SkippedShape::Records, "amalgamated local grids" } },
-    { "MINPV", { SkippedShape::OneRecord,
-                 "the minimum pore volume under which the simulator makes cells inactive "
-                 "(it shows the cells ACTNUM makes active)" } },
-    { "MINPORV", { SkippedShape::OneRecord,
-                   "the minimum pore volume under which the simulator makes cells inactive "
-                   "(it shows the cells ACTNUM makes active)" } },
+    { "MINPV",
+      { SkippedShape::OneRecord,
+        "the minimum pore volume under which the simulator makes cells inactive "
+        "(it shows the cells ACTNUM makes active)" } },
+    { "MINPORV",
+      { SkippedShape::OneRecord,
+        "the minimum pore volume under which the simulator makes cells inactive "
+        "(it shows the cells ACTNUM makes active)" } },
     { "MINPVFIL", { SkippedShape::OneRecord, "the minimum pore volume for filling pinch-outs" } },
-    { "PINCH", { SkippedShape::OneRecord,
-                 "connections the simulator makes across pinched-out layers" } },
+    { "PINCH",
+      { SkippedShape::OneRecord, "connections the simulator makes across pinched-out layers" } },
     { "CARFIN", { SkippedShape::LocalGrid, "a local grid refinement" } },
     { "RADFIN", { SkippedShape::LocalGrid, "a radial local grid refinement" } },
     { "RADFIN4", { SkippedShape::LocalGrid, "a radial local grid refinement" } },

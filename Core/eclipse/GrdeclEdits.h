@@ -29,8 +29,9 @@ std::string SimulatorArrayKind(const std::string& name);
 
 /// The OPERATE / OPERATER operations (ECLIPSE's names): result = f(target, source), where
 /// alpha and beta are the record's parameters. Empty function for an unknown name.
-std::function<double(double target, double source)> ArrayOperation(
-  const std::string& operation, double alpha, double beta);
+std::function<double(double target, double source)> ArrayOperation(const std::string& operation,
+  double alpha,
+  double beta);
 
 /// True for operations whose result depends on the target's old value (POLY, MULTIPLY).
 bool OperationReadsTarget(const std::string& operation);
@@ -42,10 +43,10 @@ std::string RegionArrayName(const std::string& given);
 /// How a keyword that does not touch the viewer's arrays is laid out, to read it to its end.
 enum class SkippedShape
 {
-  None,         ///< not a skipped keyword
-  OneRecord,    ///< one record ended by '/'
-  Records,      ///< records ended by an empty record
-  LocalGrid     ///< a local grid block: CARFIN/RADFIN/REFINE ... ENDFIN
+  None,      ///< not a skipped keyword
+  OneRecord, ///< one record ended by '/'
+  Records,   ///< records ended by an empty record
+  LocalGrid  ///< a local grid block: CARFIN/RADFIN/REFINE ... ENDFIN
 };
 
 /// The layout of a skipped keyword and, in `why`, what the simulator does with it that the

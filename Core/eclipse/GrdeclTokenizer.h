@@ -22,17 +22,17 @@ namespace resmr
 
 enum class TokenKind
 {
-  End,     ///< end of file
-  Word,    ///< bare word: keyword, number, T/F, `N*value` ...
-  String,  ///< quoted string, quotes removed
-  Slash,   ///< record terminator `/`
+  End,    ///< end of file
+  Word,   ///< bare word: keyword, number, T/F, `N*value` ...
+  String, ///< quoted string, quotes removed
+  Slash,  ///< record terminator `/`
 };
 
 struct Token
 {
   TokenKind kind = TokenKind::End;
-  std::string_view text; ///< valid until the next call to Next()
-  int64_t line = 0;      ///< 1-based line of the token's first character
+  std::string_view text;    ///< valid until the next call to Next()
+  int64_t line = 0;         ///< 1-based line of the token's first character
   bool atLineStart = false; ///< token starts in column 1 (ECLIPSE keywords must)
 };
 

@@ -22,9 +22,9 @@
 //
 // Positions are stored on one lattice for the whole model (origin + integer * step), so a
 // vertex two regions share decodes to the same bits in both, at every level (no cracks);
-// steps are 2^-22 of the lateral extent and 2^-20 of the depth range (see ChooseLattice). Topological coordinates are
-// stored as floats: integers are exact and rounding never carries a value across one, so no
-// coordinate moves into another cell.
+// steps are 2^-22 of the lateral extent and 2^-20 of the depth range (see ChooseLattice).
+// Topological coordinates are stored as floats: integers are exact and rounding never carries a
+// value across one, so no coordinate moves into another cell.
 //
 // Positions keep depth down (Core's convention); the viewer shows z = -depth. They stay in
 // grid coordinates: MAPAXES is only recorded, for viewers to apply as the grid readers do.
@@ -53,7 +53,7 @@ struct MultiresolutionHeader
   static constexpr uint32_t OldestVersion = 3; ///< older files are refused
   uint32_t version = Version;                  ///< the file's, when read
   std::array<int64_t, 3> dims{};
-  std::array<double, 4> box{};          ///< hierarchy box: xmin, ymin, xmax, ymax
+  std::array<double, 4> box{};           ///< hierarchy box: xmin, ymin, xmax, ymax
   std::array<double, 3> latticeOrigin{}; ///< x, y, depth
   std::array<double, 3> latticeStep{ 1, 1, 1 };
   int32_t leafLevel = 0;
@@ -64,7 +64,7 @@ struct MultiresolutionHeader
   std::array<uint32_t, 3> hashTableSides{ 1, 1, 1 };
   /// r: the offset table holds r0 r1 r2 entries
   std::array<uint32_t, 3> hashOffsetSides{ 1, 1, 1 };
-  uint64_t hashedCells = 0;    ///< cells the extracted faces touch (filled slots)
+  uint64_t hashedCells = 0; ///< cells the extracted faces touch (filled slots)
   /// Identifies the geometry (a digest of every chunk's checksum): property files name it.
   uint64_t geometryId = 0;
   /// The input's MAPAXES, MAPUNITS and GRIDUNIT (units: 8 characters at most); apply with
@@ -155,7 +155,10 @@ public:
   /// cones (bounds and errors are the caller's).
   void AddRegion(const RegionMesh& mesh, const MultiresolutionHeader& header, RegionRecord& record);
   /// Appends a long array as model chunks of at most ModelPieceBytes each.
-  void AddModelArray(uint32_t kind, const void* data, std::size_t bytes, std::vector<ModelChunk>& out);
+  void AddModelArray(uint32_t kind,
+    const void* data,
+    std::size_t bytes,
+    std::vector<ModelChunk>& out);
   /// Flushes to disk; the bytes written so far.
   uint64_t Sync();
   const std::string& Path() const { return this->FilePath; }
@@ -168,7 +171,7 @@ private:
 };
 
 /// Where a record's chunks lie: which part (ChunkFile) of the assembly.
-template <typename Record>
+template<typename Record>
 struct PartRecord
 {
   int part = 0;
@@ -179,8 +182,10 @@ struct PartRecord
 /// temporary name renamed into place (an older file stays untouched until then). Chunk
 /// offsets are moved from their part to the file. Sets header.regionCount,
 /// modelChunkCount and geometryId.
-void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader header,
-  const std::vector<std::string>& parts, const std::vector<PartRecord<RegionRecord>>& regions,
+void AssembleMultiresolutionFile(const std::string& path,
+  MultiresolutionHeader header,
+  const std::vector<std::string>& parts,
+  const std::vector<PartRecord<RegionRecord>>& regions,
   const std::vector<PartRecord<ModelChunk>>& model);
 
 /// A ChunkFile mapped for reading back regions before the file is assembled (the builder's
@@ -247,6 +252,5 @@ private:
   std::vector<RegionRecord> Records;
   std::vector<ModelChunk> Model;
 };
-
 
 } // namespace resmr

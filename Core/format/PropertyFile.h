@@ -35,10 +35,10 @@ class AtomicOutputFile;
 
 struct PropertyTable
 {
-  std::string name;      ///< at most 31 bytes
-  int32_t step = -1;     ///< index of the report step; -1 for a static array
+  std::string name;  ///< at most 31 bytes
+  int32_t step = -1; ///< index of the report step; -1 for a static array
   int32_t reportNumber = 0;
-  double days = 0;       ///< simulated time of the step
+  double days = 0;                ///< simulated time of the step
   float minimum = 0, maximum = 0; ///< over the cells with a value (NaN if none)
   ChunkRef packed;
   std::vector<ChunkRef> layers;
@@ -74,7 +74,9 @@ public:
 private:
   void CheckHeader(uint32_t tables, uint64_t indexSize) const;
   PropertyTable ReadTable(ByteReader& index, uint32_t t, uint64_t indexOffset) const;
-  std::vector<float> ReadValues(const ChunkRef& ref, uint64_t count, const std::string& place) const;
+  std::vector<float> ReadValues(const ChunkRef& ref,
+    uint64_t count,
+    const std::string& place) const;
   std::string FilePath;
   const uint8_t* Data = nullptr;
   uint64_t Size = 0;
@@ -129,10 +131,10 @@ private:
   uint64_t Geometry = 0;
   std::array<int64_t, 3> Dims{};
   std::array<uint32_t, 3> TableSides{};
-  std::vector<uint64_t> SlotSources;       ///< the cell whose value a slot holds (see Add)
+  std::vector<uint64_t> SlotSources;        ///< the cell whose value a slot holds (see Add)
   std::vector<std::vector<uint8_t>> Active; ///< per layer
-  std::vector<uint64_t> LayerSlotStart;    ///< nz + 1: where each layer's slots start below
-  std::vector<uint64_t> SlotsByLayer;      ///< slots with a source, by their source's layer
+  std::vector<uint64_t> LayerSlotStart;     ///< nz + 1: where each layer's slots start below
+  std::vector<uint64_t> SlotsByLayer;       ///< slots with a source, by their source's layer
   std::vector<OpenTable> Open;
   std::vector<PropertyTable> Entries;
 };

@@ -50,8 +50,8 @@ struct HierarchyOptions
   /// 0: every core, but one a 16,384 cells (models that small build in milliseconds, less
   /// than threads cost to start and join)
   int threads = 0;
-  int64_t memoryBytes = 0;  ///< 0: half the available memory
-  std::string scratch;      ///< scratch folder (default: OUTPUT.scratch, beside the output)
+  int64_t memoryBytes = 0; ///< 0: half the available memory
+  std::string scratch;     ///< scratch folder (default: OUTPUT.scratch, beside the output)
   uint64_t seed = 1;
   /// Continue a build killed in the same scratch folder (same input and options) from its
   /// last finished level; false: start over.
@@ -88,7 +88,9 @@ std::string ScratchFolder(const std::string& output, const HierarchyOptions& opt
 /// Builds `output` (.resmr) from the layers of `source`. Throws std::runtime_error (or a
 /// subclass) naming the input or file on failure; the output is then not created and any
 /// older file of that name is left as it was.
-HierarchyReport BuildHierarchy(
-  LayerSource& source, const std::string& output, const HierarchyOptions& options, const BuildProgress& progress = {});
+HierarchyReport BuildHierarchy(LayerSource& source,
+  const std::string& output,
+  const HierarchyOptions& options,
+  const BuildProgress& progress = {});
 
 } // namespace resmr

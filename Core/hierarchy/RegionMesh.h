@@ -46,11 +46,11 @@ struct RegionSurface
 struct RegionMesh
 {
   int32_t layers = 0;
-  std::vector<double> positions;             ///< [node][interface][xyz]
+  std::vector<double> positions;              ///< [node][interface][xyz]
   std::vector<std::array<float, 2>> topology; ///< (ti, tj) per node
   std::vector<std::array<uint32_t, 4>> corners;
-  std::vector<uint8_t> active;   ///< [column][layer]
-  std::vector<uint8_t> cutEdges; ///< per column, bit e
+  std::vector<uint8_t> active;    ///< [column][layer]
+  std::vector<uint8_t> cutEdges;  ///< per column, bit e
   std::vector<uint8_t> openSides; ///< [column][layer], bit e
   RegionSurface top, bottom, side;
   /// Thickest inactive run (model units, at every corner) that ExtractSurfaces() seals: the
@@ -80,7 +80,10 @@ void ExtractSurfaces(RegionMesh& mesh);
 
 /// The single-layer view of layer k (Sec. 6.1): the top and bottom faces of its active cells
 /// and their side faces where the neighbour across is absent or inactive in that layer.
-void ExtractLayerSurfaces(const RegionMesh& mesh, int32_t layer, RegionSurface& top, RegionSurface& bottom,
+void ExtractLayerSurfaces(const RegionMesh& mesh,
+  int32_t layer,
+  RegionSurface& top,
+  RegionSurface& bottom,
   RegionSurface& side);
 
 /// +1 if the columns turn counter-clockwise in (x, y) seen from above, -1 otherwise.

@@ -26,8 +26,8 @@ bool HexInverted(const glm::dvec3 corners[8], int orientation);
 struct HexQuality
 {
   int64_t cells = 0;
-  int64_t degenerate = 0;    ///< cells with a zero-length edge (pinched out): not measured
-  int64_t inverted = 0;      ///< cells with a negative corner Jacobian (folded or inverted)
+  int64_t degenerate = 0; ///< cells with a zero-length edge (pinched out): not measured
+  int64_t inverted = 0;   ///< cells with a negative corner Jacobian (folded or inverted)
   double minScaledJacobian = 1;
   double meanScaledJacobian = 0;
 };

@@ -67,12 +67,12 @@ enum class SyntheticCellState : uint8_t
 struct SyntheticLayer
 {
   int64_t k = -1;
-  std::vector<float> zcorn;                ///< 8 nx ny: top face block then bottom face block
-  std::vector<SyntheticCellState> state;   ///< nx ny
-  std::vector<float> depth;                ///< cell centre depth, metres
-  std::vector<float> thickness;            ///< mean corner thickness (DZ), metres
-  std::vector<float> poro, ntg, permx;     ///< fraction, fraction, mD
-  std::vector<float> poreVolume;           ///< rm3, 0 for inactive cells
+  std::vector<float> zcorn;              ///< 8 nx ny: top face block then bottom face block
+  std::vector<SyntheticCellState> state; ///< nx ny
+  std::vector<float> depth;              ///< cell centre depth, metres
+  std::vector<float> thickness;          ///< mean corner thickness (DZ), metres
+  std::vector<float> poro, ntg, permx;   ///< fraction, fraction, mD
+  std::vector<float> poreVolume;         ///< rm3, 0 for inactive cells
   int64_t activeCells = 0;
 };
 
@@ -135,18 +135,18 @@ private:
 
   SyntheticParameters Params;
   double Dx = 0, Dy = 0, Gross = 0;
-  std::vector<double> LayerThickness; ///< nominal, per layer (nz values)
-  std::vector<double> LayerQuality;   ///< 0 (shale) .. 1 (clean sand), per layer
-  std::vector<double> TopDepth;       ///< per pillar
-  std::vector<float> Throw;           ///< 4 per column: downthrow of each corner (faults)
-  std::vector<uint8_t> Inside;        ///< per column: inside the field outline
+  std::vector<double> LayerThickness;  ///< nominal, per layer (nz values)
+  std::vector<double> LayerQuality;    ///< 0 (shale) .. 1 (clean sand), per layer
+  std::vector<double> TopDepth;        ///< per pillar
+  std::vector<float> Throw;            ///< 4 per column: downthrow of each corner (faults)
+  std::vector<uint8_t> Inside;         ///< per column: inside the field outline
   std::vector<float> InjectorDistance; ///< per column, metres to the nearest injector
-  std::vector<float> WellPressure;    ///< per column, injector support minus producer drawdown
+  std::vector<float> WellPressure;     ///< per column, injector support minus producer drawdown
   std::vector<FaultPlane> Faults;
-  double PinchLevel = 0;  ///< noise level under which a layer has zero thickness
+  double PinchLevel = 0; ///< noise level under which a layer has zero thickness
   double ThicknessScale = 1;
-  double Contact = 0;     ///< oil-water contact depth
-  double FrontReach = 0;  ///< metres the water front travels by the last step
+  double Contact = 0;    ///< oil-water contact depth
+  double FrontReach = 0; ///< metres the water front travels by the last step
   int64_t FaultFacesInLayer = 0;
 };
 
@@ -163,8 +163,8 @@ public:
 private:
   const SyntheticReservoir& Model;
   int64_t K = 0;
-  std::vector<double> Interface; ///< depth of the current layer's top, per pillar (no throw)
-  std::vector<double> Below;     ///< the same for its bottom
+  std::vector<double> Interface;  ///< depth of the current layer's top, per pillar (no throw)
+  std::vector<double> Below;      ///< the same for its bottom
   std::vector<double> LayerNoise; ///< per pillar
   std::vector<double> LatticePlane;
   SyntheticStatistics Counts;

@@ -33,7 +33,8 @@ public:
   {
     if (this->Progress)
     {
-      this->Progress((this->Done + static_cast<double>(k + 1) / static_cast<double>(this->Layers)) / this->Passes);
+      this->Progress((this->Done + static_cast<double>(k + 1) / static_cast<double>(this->Layers)) /
+                     this->Passes);
     }
   }
   void EndPass() { ++this->Done; }
@@ -46,7 +47,7 @@ private:
 };
 
 /// Runs one pass over the model's layers.
-template <typename Visit>
+template<typename Visit>
 SyntheticStatistics EachLayer(const SyntheticReservoir& model, PassCounter& counter, Visit visit)
 {
   SyntheticLayerStream stream(model);
@@ -117,8 +118,11 @@ std::vector<int32_t> Intehead(const SyntheticReservoir& model, int64_t active, S
   return head;
 }
 
-void WriteHeaders(EclipseKeywordWriter& out, const SyntheticReservoir& model, int64_t active,
-  SyntheticDate date, double days)
+void WriteHeaders(EclipseKeywordWriter& out,
+  const SyntheticReservoir& model,
+  int64_t active,
+  SyntheticDate date,
+  double days)
 {
   out.Write("INTEHEAD", "INTE", Intehead(model, active, date));
   out.Write("LOGIHEAD", "LOGI", std::vector<int32_t>(121, 0));
@@ -130,53 +134,89 @@ void WriteHeaders(EclipseKeywordWriter& out, const SyntheticReservoir& model, in
 
 const std::vector<SyntheticInitArray>& SyntheticInitArrays()
 {
-  static const std::vector<SyntheticInitArray> arrays = { { "PORV", true }, { "DEPTH", false },
-    { "DX", false }, { "DY", false }, { "DZ", false }, { "PORO", false }, { "PERMX", false },
-    { "PERMY", false }, { "PERMZ", false }, { "NTG", false } };
+  static const std::vector<SyntheticInitArray> arrays = { { "PORV", true },
+    { "DEPTH", false },
+    { "DX", false },
+    { "DY", false },
+    { "DZ", false },
+    { "PORO", false },
+    { "PERMX", false },
+    { "PERMY", false },
+    { "PERMZ", false },
+    { "NTG", false } };
   return arrays;
 }
 
-void FillSyntheticInitArray(
-  const SyntheticReservoir& model, std::size_t index, const SyntheticLayer& layer, float* values)
+void FillSyntheticInitArray(const SyntheticReservoir& model,
+  std::size_t index,
+  const SyntheticLayer& layer,
+  float* values)
 {
   const std::size_t cells = layer.state.size();
-  const auto copy = [&](const std::vector<float>& from, float scale) {
+  const auto copy = [&](const std::vector<float>& from, float scale)
+  {
     for (std::size_t c = 0; c < cells; ++c)
     {
       values[c] = from[c] * scale;
     }
   };
-  const auto fill = [&](double size) { std::fill(values, values + cells, static_cast<float>(size)); };
+  const auto fill = [&](double size)
+  { std::fill(values, values + cells, static_cast<float>(size)); };
   switch (index)
   {
-    case 0: copy(layer.poreVolume, 1); break;
-    case 1: copy(layer.depth, 1); break;
-    case 2: fill(model.CellSizeX()); break;
-    case 3: fill(model.CellSizeY()); break;
-    case 4: copy(layer.thickness, 1); break;
-    case 5: copy(layer.poro, 1); break;
-    case 6: copy(layer.permx, 1); break;
-    case 7: copy(layer.permx, 1); break; // isotropic in the bedding plane
-    case 8: copy(layer.permx, 0.1f); break;
-    case 9: copy(layer.ntg, 1); break;
-    default: throw std::out_of_range("no synthetic INIT array " + std::to_string(index));
+    case 0:
+      copy(layer.poreVolume, 1);
+      break;
+    case 1:
+      copy(layer.depth, 1);
+      break;
+    case 2:
+      fill(model.CellSizeX());
+      break;
+    case 3:
+      fill(model.CellSizeY());
+      break;
+    case 4:
+      copy(layer.thickness, 1);
+      break;
+    case 5:
+      copy(layer.poro, 1);
+      break;
+    case 6:
+      copy(layer.permx, 1);
+      break;
+    case 7:
+      copy(layer.permx, 1);
+      break; // isotropic in the bedding plane
+    case 8:
+      copy(layer.permx, 0.1f);
+      break;
+    case 9:
+      copy(layer.ntg, 1);
+      break;
+    default:
+      throw std::out_of_range("no synthetic INIT array " + std::to_string(index));
   }
 }
 
-SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model, const std::string& egridPath,
+SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model,
+  const std::string& egridPath,
   const SyntheticProgress& progress)
 {
   const SyntheticParameters& p = model.Parameters();
   if (p.CellCount() > MaxEgridCells)
   {
-    throw InputError(egridPath, 0, "",
+    throw InputError(egridPath,
+      0,
+      "",
       "an EGRID holds at most 268,435,455 cells (ZCORN's 8 values a cell must fit the 32-bit "
-      "count of an ECLIPSE keyword header), and " + std::to_string(p.nx) + " x " +
-      std::to_string(p.ny) + " x " + std::to_string(p.nz) + " = " + std::to_string(p.CellCount()) +
-      " cells were asked for. Models this large are not written to files: the hierarchy builder "
-      "streams them straight from the generator (input synth:" + std::to_string(p.nx) + "x" +
-      std::to_string(p.ny) + "x" + std::to_string(p.nz) + ":" + std::to_string(p.seed) +
-      "), or write GRDECL for an ASCII deck");
+      "count of an ECLIPSE keyword header), and " +
+        std::to_string(p.nx) + " x " + std::to_string(p.ny) + " x " + std::to_string(p.nz) + " = " +
+        std::to_string(p.CellCount()) +
+        " cells were asked for. Models this large are not written to files: the hierarchy builder "
+        "streams them straight from the generator (input synth:" +
+        std::to_string(p.nx) + "x" + std::to_string(p.ny) + "x" + std::to_string(p.nz) + ":" +
+        std::to_string(p.seed) + "), or write GRDECL for an ASCII deck");
   }
   const int64_t nz = p.nz;
   const int passes = 2 + static_cast<int>(SyntheticInitArrays().size()) + 2 * p.steps;
@@ -200,19 +240,23 @@ SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model, const std
   grid.Write("GRIDHEAD", "INTE", gridhead);
   grid.Write("COORD", "REAL", model.Coord());
   grid.Begin("ZCORN", "REAL", 8 * p.CellCount());
-  output.statistics = EachLayer(model, counter, [&](const SyntheticLayer& layer) {
-    grid.Append(layer.zcorn.data(), static_cast<int64_t>(layer.zcorn.size()));
-  });
+  output.statistics = EachLayer(model,
+    counter,
+    [&](const SyntheticLayer& layer)
+    { grid.Append(layer.zcorn.data(), static_cast<int64_t>(layer.zcorn.size())); });
   grid.Begin("ACTNUM", "INTE", p.CellCount());
   std::vector<int32_t> actnum;
-  EachLayer(model, counter, [&](const SyntheticLayer& layer) {
-    actnum.resize(layer.state.size());
-    for (std::size_t c = 0; c < actnum.size(); ++c)
+  EachLayer(model,
+    counter,
+    [&](const SyntheticLayer& layer)
     {
-      actnum[c] = layer.state[c] == SyntheticCellState::Active ? 1 : 0;
-    }
-    grid.Append(actnum.data(), static_cast<int64_t>(actnum.size()));
-  });
+      actnum.resize(layer.state.size());
+      for (std::size_t c = 0; c < actnum.size(); ++c)
+      {
+        actnum[c] = layer.state[c] == SyntheticCellState::Active ? 1 : 0;
+      }
+      grid.Append(actnum.data(), static_cast<int64_t>(actnum.size()));
+    });
   grid.Write("ENDGRID", "INTE", std::vector<int32_t>());
   const int64_t active = output.statistics.active;
 
@@ -225,19 +269,22 @@ SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model, const std
   {
     const SyntheticInitArray& array = SyntheticInitArrays()[a];
     init.Begin(array.name, "REAL", array.everyCell ? p.CellCount() : active);
-    EachLayer(model, counter, [&](const SyntheticLayer& layer) {
-      values.resize(layer.state.size());
-      FillSyntheticInitArray(model, a, layer, values.data());
-      if (array.everyCell)
+    EachLayer(model,
+      counter,
+      [&](const SyntheticLayer& layer)
       {
-        init.Append(values.data(), static_cast<int64_t>(values.size()));
-      }
-      else
-      {
-        const std::vector<float> written = ActiveValues(layer, values);
-        init.Append(written.data(), static_cast<int64_t>(written.size()));
-      }
-    });
+        values.resize(layer.state.size());
+        FillSyntheticInitArray(model, a, layer, values.data());
+        if (array.everyCell)
+        {
+          init.Append(values.data(), static_cast<int64_t>(values.size()));
+        }
+        else
+        {
+          const std::vector<float> written = ActiveValues(layer, values);
+          init.Append(written.data(), static_cast<int64_t>(written.size()));
+        }
+      });
   }
 
   // UNRST: PRESSURE and SWAT per report step.
@@ -256,13 +303,16 @@ SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model, const std
       {
         const bool isPressure = name[0] == 'P';
         restart->Begin(name, "REAL", active);
-        EachLayer(model, counter, [&](const SyntheticLayer& layer) {
-          pressure.resize(layer.state.size());
-          swat.resize(layer.state.size());
-          model.FillStep(step, layer, pressure.data(), swat.data());
-          const std::vector<float> values = ActiveValues(layer, isPressure ? pressure : swat);
-          restart->Append(values.data(), static_cast<int64_t>(values.size()));
-        });
+        EachLayer(model,
+          counter,
+          [&](const SyntheticLayer& layer)
+          {
+            pressure.resize(layer.state.size());
+            swat.resize(layer.state.size());
+            model.FillStep(step, layer, pressure.data(), swat.data());
+            const std::vector<float> values = ActiveValues(layer, isPressure ? pressure : swat);
+            restart->Append(values.data(), static_cast<int64_t>(values.size()));
+          });
       }
       restart->Begin("ENDSOL", "MESS", 0);
     }
@@ -342,8 +392,9 @@ private:
       this->Buffer.append(text, std::to_chars(text, text + sizeof(text), this->Count).ptr);
       this->Buffer += '*';
     }
-    char* end = this->Integer ? std::to_chars(text, text + sizeof(text), static_cast<int64_t>(this->Last)).ptr
-                              : std::to_chars(text, text + sizeof(text), static_cast<float>(this->Last)).ptr;
+    char* end = this->Integer
+                  ? std::to_chars(text, text + sizeof(text), static_cast<int64_t>(this->Last)).ptr
+                  : std::to_chars(text, text + sizeof(text), static_cast<float>(this->Last)).ptr;
     this->Buffer.append(text, end);
     this->Buffer += ++this->OnLine % 10 == 0 ? '\n' : ' ';
     this->Count = 0;
@@ -362,7 +413,10 @@ private:
     {
       const int error = errno;
       this->Output.Discard();
-      throw InputError(this->Output.Path(), 0, "", std::string("write failed (disk full?): ") + std::strerror(error));
+      throw InputError(this->Output.Path(),
+        0,
+        "",
+        std::string("write failed (disk full?): ") + std::strerror(error));
     }
     this->Buffer.clear();
   }
@@ -376,26 +430,40 @@ private:
 };
 } // namespace
 
-SyntheticOutput WriteSyntheticGrdecl(const SyntheticReservoir& model, const std::string& path,
+SyntheticOutput WriteSyntheticGrdecl(const SyntheticReservoir& model,
+  const std::string& path,
   const SyntheticProgress& progress)
 {
   const SyntheticParameters& p = model.Parameters();
   if (p.steps > 0)
   {
-    throw InputError(path, 0, "", "report steps need EGRID output (they go to an UNRST beside "
-                                   "it); a GRDECL deck holds the grid and static properties only");
+    throw InputError(path,
+      0,
+      "",
+      "report steps need EGRID output (they go to an UNRST beside "
+      "it); a GRDECL deck holds the grid and static properties only");
   }
   PassCounter counter(progress, 7, p.nz);
   SyntheticOutput output;
   GrdeclTextWriter out(path);
   char header[512];
-  std::snprintf(header, sizeof(header),
+  std::snprintf(header,
+    sizeof(header),
     "-- Synthetic reservoir written by resmr synth: %lld x %lld x %lld cells, seed %llu,\n"
     "-- %d faults, throw %g, dip %g deg, pinched %g, water %g, outside %g.\n\n"
     "SPECGRID\n%lld %lld %lld 1 F /\n\nCOORD\n",
-    static_cast<long long>(p.nx), static_cast<long long>(p.ny), static_cast<long long>(p.nz),
-    static_cast<unsigned long long>(p.seed), p.faults, p.maxThrow, p.dipDegrees, p.pinchedFraction,
-    p.waterFraction, p.outsideFraction, static_cast<long long>(p.nx), static_cast<long long>(p.ny),
+    static_cast<long long>(p.nx),
+    static_cast<long long>(p.ny),
+    static_cast<long long>(p.nz),
+    static_cast<unsigned long long>(p.seed),
+    p.faults,
+    p.maxThrow,
+    p.dipDegrees,
+    p.pinchedFraction,
+    p.waterFraction,
+    p.outsideFraction,
+    static_cast<long long>(p.nx),
+    static_cast<long long>(p.ny),
     static_cast<long long>(p.nz));
   out.Text(header);
   for (double value : model.Coord())
@@ -404,20 +472,26 @@ SyntheticOutput WriteSyntheticGrdecl(const SyntheticReservoir& model, const std:
   }
   out.EndKeyword();
   out.Text("ZCORN\n");
-  output.statistics = EachLayer(model, counter, [&](const SyntheticLayer& layer) {
-    for (float value : layer.zcorn)
+  output.statistics = EachLayer(model,
+    counter,
+    [&](const SyntheticLayer& layer)
     {
-      out.Value(value, false);
-    }
-  });
+      for (float value : layer.zcorn)
+      {
+        out.Value(value, false);
+      }
+    });
   out.EndKeyword();
   out.Text("ACTNUM\n");
-  EachLayer(model, counter, [&](const SyntheticLayer& layer) {
-    for (SyntheticCellState state : layer.state)
+  EachLayer(model,
+    counter,
+    [&](const SyntheticLayer& layer)
     {
-      out.Value(state == SyntheticCellState::Active ? 1 : 0, true);
-    }
-  });
+      for (SyntheticCellState state : layer.state)
+      {
+        out.Value(state == SyntheticCellState::Active ? 1 : 0, true);
+      }
+    });
   out.EndKeyword();
   struct Array
   {
@@ -425,17 +499,22 @@ SyntheticOutput WriteSyntheticGrdecl(const SyntheticReservoir& model, const std:
     std::vector<float> SyntheticLayer::*values;
     float scale;
   };
-  for (const Array& array : { Array{ "PORO", &SyntheticLayer::poro, 1 }, Array{ "PERMX", &SyntheticLayer::permx, 1 },
-         Array{ "PERMY", &SyntheticLayer::permx, 1 }, Array{ "PERMZ", &SyntheticLayer::permx, 0.1f },
+  for (const Array& array : { Array{ "PORO", &SyntheticLayer::poro, 1 },
+         Array{ "PERMX", &SyntheticLayer::permx, 1 },
+         Array{ "PERMY", &SyntheticLayer::permx, 1 },
+         Array{ "PERMZ", &SyntheticLayer::permx, 0.1f },
          Array{ "NTG", &SyntheticLayer::ntg, 1 } })
   {
     out.Text(std::string(array.name) + "\n");
-    EachLayer(model, counter, [&](const SyntheticLayer& layer) {
-      for (float value : layer.*(array.values))
+    EachLayer(model,
+      counter,
+      [&](const SyntheticLayer& layer)
       {
-        out.Value(value * array.scale, false);
-      }
-    });
+        for (float value : layer.*(array.values))
+        {
+          out.Value(value * array.scale, false);
+        }
+      });
     out.EndKeyword();
   }
   out.Commit();

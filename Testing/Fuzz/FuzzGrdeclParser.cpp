@@ -11,8 +11,8 @@
 // runaway allocation -- is a finding.
 #include "CornerPointGeometry.h"
 #include "Errors.h"
-#include "GrdeclParser.h"
 #include "FuzzReplay.h"
+#include "GrdeclParser.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -124,11 +124,11 @@ void CheckDeck(const resmr::CornerPointModel& deck)
     if (array.values.size() != n)
     {
       BrokenInvariant("array " + array.name + " has " + std::to_string(array.values.size()) +
-        " values for " + std::to_string(n) + " cells");
+                      " values for " + std::to_string(n) + " cells");
     }
   }
   if (!deck.coord.empty() &&
-    deck.coord.size() != static_cast<std::size_t>(6 * (d[0] + 1) * (d[1] + 1)))
+      deck.coord.size() != static_cast<std::size_t>(6 * (d[0] + 1) * (d[1] + 1)))
   {
     BrokenInvariant("COORD has " + std::to_string(deck.coord.size()) + " values");
   }
@@ -142,8 +142,8 @@ void CheckDeck(const resmr::CornerPointModel& deck)
     if (!vectors[axis]->empty() && vectors[axis]->size() != static_cast<std::size_t>(d[axis]))
     {
       BrokenInvariant(std::string("D") + "XYZ"[axis] + "V has " +
-        std::to_string(vectors[axis]->size()) + " values for " + std::to_string(d[axis]) +
-        " cells along the axis");
+                      std::to_string(vectors[axis]->size()) + " values for " +
+                      std::to_string(d[axis]) + " cells along the axis");
     }
   }
   for (const resmr::Fault& fault : deck.faults)
@@ -156,7 +156,8 @@ void CheckDeck(const resmr::CornerPointModel& deck)
         if (lo < 0 || lo > hi || hi >= d[axis])
         {
           BrokenInvariant("fault " + fault.name + " box " + std::to_string(lo) + "-" +
-            std::to_string(hi) + " is outside the grid along axis " + std::to_string(axis));
+                          std::to_string(hi) + " is outside the grid along axis " +
+                          std::to_string(axis));
         }
       }
       if (face.face < resmr::FaultFace::IMinus || face.face > resmr::FaultFace::KPlus)
@@ -168,7 +169,8 @@ void CheckDeck(const resmr::CornerPointModel& deck)
 }
 
 /// What the reader does with fault faces: the corners of every cell in each box (capped).
-void VisitFaultCells(const resmr::CornerPointModel& deck, const resmr::CornerPointGeometry& geometry)
+void VisitFaultCells(const resmr::CornerPointModel& deck,
+  const resmr::CornerPointGeometry& geometry)
 {
   int64_t budget = 100000;
   double corners[8][3];
@@ -219,11 +221,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
       if (id < 0 || static_cast<std::size_t>(id) >= points)
       {
         BrokenInvariant("BuildSharedCorners: corner point id " + std::to_string(id) +
-          " outside [0, " + std::to_string(points) + ")");
+                        " outside [0, " + std::to_string(points) + ")");
       }
     }
     RESMR_FUZZ_OUTCOME("parsed, " + std::to_string(geometry.CellCount()) + " cells, " +
-      std::to_string(points) + " shared points");
+                       std::to_string(points) + " shared points");
   }
   catch (const resmr::InputError& error)
   {
@@ -255,7 +257,10 @@ void RunOne(const std::string& path, const std::string& contents, long& count)
 int main(int argc, char** argv)
 {
   long count = 0;
-  return resmr_fuzz::ReplayMain("FuzzGrdeclParserReplay", argc, argv, count,
+  return resmr_fuzz::ReplayMain("FuzzGrdeclParserReplay",
+    argc,
+    argv,
+    count,
     [&](const std::string& path, const std::string& contents) { RunOne(path, contents, count); });
 }
 #endif
