@@ -33,18 +33,16 @@ void vtkBuildMultiresolutionHierarchy::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Resume: " << this->Resume << "\n";
 }
 
-int vtkBuildMultiresolutionHierarchy::RequestInformation(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkBuildMultiresolutionHierarchy::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   // Every rank must run RequestData (the build is collective), not only piece 0.
   outputVector->GetInformationObject(0)->Set(CAN_HANDLE_PIECE_REQUEST(), 1);
   return 1;
 }
 
-int vtkBuildMultiresolutionHierarchy::RequestData(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkBuildMultiresolutionHierarchy::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkTable* output = vtkTable::GetData(outputVector, 0);
   this->LastError.clear();
@@ -72,23 +70,16 @@ int vtkBuildMultiresolutionHierarchy::RequestData(vtkInformation*,
     // unique unlinked files in the shared scratch folder, so ranks never collide).
     std::unique_ptr<resmr::LayerSource> source =
       resmr::OpenLayerSource(this->Input, resmr::ScratchFolder(this->FileName, options));
-    const resmr::HierarchyReport report = resmr::BuildHierarchy(*source,
-      this->FileName,
-      options,
-      [this](const char* phase, double fraction)
-      {
+    const resmr::HierarchyReport report =
+      resmr::BuildHierarchy(*source, this->FileName, options, [this](const char* phase, double fraction) {
         this->SetProgressText(phase);
         this->UpdateProgress(fraction);
       });
     const std::pair<const char*, double> values[] = { { "Cells", double(report.cells) },
-      { "ActiveCells", double(report.activeCells) },
-      { "Columns", double(report.columns) },
-      { "Levels", double(report.leafLevel + 1) },
-      { "Regions", double(report.regions) },
-      { "FileBytes", double(report.fileBytes) },
-      { "Seconds", report.totalSeconds },
-      { "ResumedFromLevel", double(report.resumedFromLevel) },
-      { "HashedCells", double(report.hashedCells) },
+      { "ActiveCells", double(report.activeCells) }, { "Columns", double(report.columns) },
+      { "Levels", double(report.leafLevel + 1) }, { "Regions", double(report.regions) },
+      { "FileBytes", double(report.fileBytes) }, { "Seconds", report.totalSeconds },
+      { "ResumedFromLevel", double(report.resumedFromLevel) }, { "HashedCells", double(report.hashedCells) },
       { "Ranks", double(options.ranks) } };
     for (const auto& value : values)
     {

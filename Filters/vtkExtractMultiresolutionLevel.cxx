@@ -40,9 +40,8 @@ void vtkExtractMultiresolutionLevel::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ErrorTolerance: " << this->ErrorTolerance << "\n";
 }
 
-int vtkExtractMultiresolutionLevel::RequestData(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkExtractMultiresolutionLevel::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
   this->LastError.clear();
@@ -53,9 +52,8 @@ int vtkExtractMultiresolutionLevel::RequestData(vtkInformation*,
       throw std::runtime_error("no file name given");
     }
     const resmr::MultiresolutionFile file(this->FileName);
-    const std::vector<std::size_t> regions = this->Level >= 0
-                                               ? resmr::SelectLevel(file, this->Level)
-                                               : resmr::SelectByError(file, this->ErrorTolerance);
+    const std::vector<std::size_t> regions =
+      this->Level >= 0 ? resmr::SelectLevel(file, this->Level) : resmr::SelectByError(file, this->ErrorTolerance);
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
     vtkNew<vtkDoubleArray> topology;

@@ -51,15 +51,13 @@ int vtkSimplifyReservoirGrid::FillInputPortInformation(int, vtkInformation* info
 
 using resmr_filters::AddValue;
 
-int vtkSimplifyReservoirGrid::RequestData(vtkInformation*,
-  vtkInformationVector** inputVector,
-  vtkInformationVector* outputVector)
+int vtkSimplifyReservoirGrid::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   this->LastError.clear();
   vtkExplicitStructuredGrid* input = vtkExplicitStructuredGrid::GetData(inputVector[0], 0);
   vtkUnstructuredGrid* output = vtkUnstructuredGrid::GetData(outputVector, 0);
-  auto fail = [&](const std::string& message)
-  {
+  auto fail = [&](const std::string& message) {
     this->LastError = "SimplifyReservoirGrid: " + message;
     vtkErrorMacro(<< this->LastError);
     return 0;
@@ -104,8 +102,7 @@ int vtkSimplifyReservoirGrid::RequestData(vtkInformation*,
   // Mirrored (left-handed) grids store the layers upside down: VTK points 0-3 are deeper.
   vtkPoints* points = input->GetPoints();
   vtkCellArray* hexahedra = input->GetCells();
-  const auto corners = [&](int64_t i, int64_t j, int64_t k, double out[8][3])
-  {
+  const auto corners = [&](int64_t i, int64_t j, int64_t k, double out[8][3]) {
     const vtkIdType id = cellOf[(k * ny + j) * nx + i];
     vtkIdType count = 0;
     const vtkIdType* ids = nullptr;
@@ -122,13 +119,11 @@ int vtkSimplifyReservoirGrid::RequestData(vtkInformation*,
   };
   try
   {
-    resmr::ColumnMesh mesh =
-      resmr::ColumnMesh::FromCells({ nx, ny, nz }, corners, active, 0, nx, 0, ny);
+    resmr::ColumnMesh mesh = resmr::ColumnMesh::FromCells({ nx, ny, nz }, corners, active, 0, nx, 0, ny);
     const int64_t before = mesh.AliveColumns();
-    const int64_t target =
-      this->TargetColumns > 0
-        ? this->TargetColumns
-        : static_cast<int64_t>(std::llround(this->TargetFraction * static_cast<double>(before)));
+    const int64_t target = this->TargetColumns > 0
+      ? this->TargetColumns
+      : static_cast<int64_t>(std::llround(this->TargetFraction * static_cast<double>(before)));
     resmr::ColumnCollapse collapse(mesh, static_cast<uint64_t>(this->Seed));
     collapse.SetCandidates(this->Candidates);
     const resmr::SimplifyReport report =

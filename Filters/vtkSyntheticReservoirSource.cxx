@@ -48,8 +48,8 @@ vtkSyntheticReservoirSource::~vtkSyntheticReservoirSource() = default;
 void vtkSyntheticReservoirSource::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "Dimensions: " << this->Dimensions[0] << " " << this->Dimensions[1] << " "
-     << this->Dimensions[2] << "\n";
+  os << indent << "Dimensions: " << this->Dimensions[0] << " " << this->Dimensions[1] << " " << this->Dimensions[2]
+     << "\n";
   os << indent << "Seed: " << this->Seed << "\n";
   os << indent << "Faults: " << this->Faults << "\n";
   os << indent << "Throw: " << this->Throw << "\n";
@@ -69,15 +69,8 @@ void vtkSyntheticReservoirSource::ReportError(const std::string& message)
 
 namespace
 {
-resmr::SyntheticParameters ParametersOf(const int dims[3],
-  int seed,
-  int faults,
-  double maxThrow,
-  double dip,
-  double pinched,
-  double water,
-  double outside,
-  int steps)
+resmr::SyntheticParameters ParametersOf(const int dims[3], int seed, int faults, double maxThrow, double dip,
+  double pinched, double water, double outside, int steps)
 {
   resmr::SyntheticParameters p;
   p.nx = dims[0];
@@ -95,31 +88,22 @@ resmr::SyntheticParameters ParametersOf(const int dims[3],
 }
 
 /// A float cell array in VTK order from values in ECLIPSE order, NaN in inactive cells.
-vtkSmartPointer<vtkFloatArray> CellArray(const char* name,
-  const resmr_readers::CellOrder& order,
-  const std::vector<float>& values)
+vtkSmartPointer<vtkFloatArray> CellArray(
+  const char* name, const resmr_readers::CellOrder& order, const std::vector<float>& values)
 {
   return resmr_readers::MakeCellArray<vtkFloatArray>(
     name, order, [&](float* out) { std::copy(values.begin(), values.end(), out); });
 }
 } // namespace
 
-int vtkSyntheticReservoirSource::RequestInformation(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkSyntheticReservoirSource::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkInformation* info = outputVector->GetInformationObject(0);
   info->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
   info->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  const resmr::SyntheticParameters p = ParametersOf(this->Dimensions,
-    this->Seed,
-    this->Faults,
-    this->Throw,
-    this->Dip,
-    this->PinchedFraction,
-    this->WaterFraction,
-    this->OutsideFraction,
-    this->Steps);
+  const resmr::SyntheticParameters p = ParametersOf(this->Dimensions, this->Seed, this->Faults, this->Throw, this->Dip,
+    this->PinchedFraction, this->WaterFraction, this->OutsideFraction, this->Steps);
   try
   {
     p.Validate();
@@ -136,8 +120,7 @@ int vtkSyntheticReservoirSource::RequestInformation(vtkInformation*,
     {
       days.push_back(static_cast<double>((3650LL * s) / p.steps)); // SyntheticReservoir::StepDays
     }
-    info->Set(
-      vtkStreamingDemandDrivenPipeline::TIME_STEPS(), days.data(), static_cast<int>(days.size()));
+    info->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), days.data(), static_cast<int>(days.size()));
     const double range[2] = { days.front(), days.back() };
     info->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
   }
@@ -153,27 +136,18 @@ bool vtkSyntheticReservoirSource::BuildModelIfNeeded()
   }
   internal.Base = nullptr;
   internal.Model.reset();
-  const resmr::SyntheticParameters p = ParametersOf(this->Dimensions,
-    this->Seed,
-    this->Faults,
-    this->Throw,
-    this->Dip,
-    this->PinchedFraction,
-    this->WaterFraction,
-    this->OutsideFraction,
-    this->Steps);
+  const resmr::SyntheticParameters p = ParametersOf(this->Dimensions, this->Seed, this->Faults, this->Throw, this->Dip,
+    this->PinchedFraction, this->WaterFraction, this->OutsideFraction, this->Steps);
   try
   {
     p.Validate();
     const int64_t limit = resmr::MaxFullResolutionCells(int64_t(this->MemoryLimitMB) << 20);
     if (p.CellCount() > limit)
     {
-      throw std::invalid_argument(
-        std::to_string(p.nx) + " x " + std::to_string(p.ny) + " x " + std::to_string(p.nz) +
+      throw std::invalid_argument(std::to_string(p.nx) + " x " + std::to_string(p.ny) + " x " + std::to_string(p.nz) +
         " cells are more than fit in memory at full resolution (limit " + std::to_string(limit) +
-        " cells); write the model with `resmr synth " + std::to_string(p.nx) + " " +
-        std::to_string(p.ny) + " " + std::to_string(p.nz) + " -o MODEL.EGRID` and " +
-        resmr::MultiresolutionAdvice("MODEL.EGRID"));
+        " cells); write the model with `resmr synth " + std::to_string(p.nx) + " " + std::to_string(p.ny) + " " +
+        std::to_string(p.nz) + " -o MODEL.EGRID` and " + resmr::MultiresolutionAdvice("MODEL.EGRID"));
     }
     internal.Model = std::make_unique<resmr::SyntheticReservoir>(p);
     const resmr::SyntheticReservoir& model = *internal.Model;
@@ -189,14 +163,13 @@ bool vtkSyntheticReservoirSource::BuildModelIfNeeded()
     std::vector<int32_t> actnum(static_cast<std::size_t>(cells));
     internal.Active.assign(static_cast<std::size_t>(cells), false);
     const float nan = std::numeric_limits<float>::quiet_NaN();
-    std::vector<float> poro(actnum.size(), nan), permx(actnum.size(), nan),
-      permz(actnum.size(), nan), ntg(actnum.size(), nan), porv(actnum.size(), 0.0f);
+    std::vector<float> poro(actnum.size(), nan), permx(actnum.size(), nan), permz(actnum.size(), nan),
+      ntg(actnum.size(), nan), porv(actnum.size(), 0.0f);
     resmr::SyntheticLayerStream stream(model);
     resmr::SyntheticLayer layer;
     while (stream.Next(layer))
     {
-      std::copy(
-        layer.zcorn.begin(), layer.zcorn.end(), deck.zcornSingle.begin() + 8 * columns * layer.k);
+      std::copy(layer.zcorn.begin(), layer.zcorn.end(), deck.zcornSingle.begin() + 8 * columns * layer.k);
       for (int64_t c = 0; c < columns; ++c)
       {
         const int64_t cell = layer.k * columns + c;
@@ -216,8 +189,7 @@ bool vtkSyntheticReservoirSource::BuildModelIfNeeded()
     }
     const resmr::CornerPointGeometry geometry = resmr::CornerPointGeometry::FromDeck(deck, false);
     auto base = vtkSmartPointer<vtkExplicitStructuredGrid>::New();
-    internal.Order =
-      resmr_readers::BuildExplicitGrid(geometry, actnum, internal.Active, false, base);
+    internal.Order = resmr_readers::BuildExplicitGrid(geometry, actnum, internal.Active, false, base);
     vtkCellData* data = base->GetCellData();
     data->AddArray(CellArray("PORV", internal.Order, porv));
     data->AddArray(CellArray("PORO", internal.Order, poro));
@@ -243,9 +215,8 @@ bool vtkSyntheticReservoirSource::BuildModelIfNeeded()
   return true;
 }
 
-int vtkSyntheticReservoirSource::RequestData(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkSyntheticReservoirSource::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   this->LastError.clear();
   vtkInformation* info = outputVector->GetInformationObject(0);
@@ -272,10 +243,8 @@ int vtkSyntheticReservoirSource::RequestData(vtkInformation*,
     }
     const int64_t columns = p.nx * p.ny;
     const float nan = std::numeric_limits<float>::quiet_NaN();
-    std::vector<float> pressure(static_cast<std::size_t>(p.CellCount()), nan),
-      swat(pressure.size(), nan);
-    std::vector<float> layerPressure(static_cast<std::size_t>(columns)),
-      layerSwat(layerPressure.size());
+    std::vector<float> pressure(static_cast<std::size_t>(p.CellCount()), nan), swat(pressure.size(), nan);
+    std::vector<float> layerPressure(static_cast<std::size_t>(columns)), layerSwat(layerPressure.size());
     resmr::SyntheticLayerStream stream(model);
     resmr::SyntheticLayer layer;
     while (stream.Next(layer))

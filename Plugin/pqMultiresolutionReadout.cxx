@@ -10,8 +10,7 @@
 vtkSMProxy* pqMultiresolutionReadout::Surface(pqRepresentation* representation, bool visibleOnly)
 {
   vtkSMProxy* proxy = representation ? representation->getProxy() : nullptr;
-  if (!proxy || !proxy->GetProperty("Representation") ||
-      (visibleOnly && !representation->isVisible()))
+  if (!proxy || !proxy->GetProperty("Representation") || (visibleOnly && !representation->isVisible()))
   {
     return nullptr;
   }
@@ -19,9 +18,8 @@ vtkSMProxy* pqMultiresolutionReadout::Surface(pqRepresentation* representation, 
   // The exposed readout property belongs to the surface sub-proxy (GetSubProxy is protected).
   vtkSMProperty* readout = proxy->GetProperty("TrianglesDrawn");
   vtkSMProxy* surface = readout ? readout->GetParent() : nullptr;
-  if (!type || std::strcmp(type, "Multiresolution Surface") != 0 || !surface ||
-      !surface->GetXMLName() ||
-      std::strcmp(surface->GetXMLName(), "ResMRSurfaceRepresentation") != 0)
+  if (!type || std::strcmp(type, "Multiresolution Surface") != 0 || !surface || !surface->GetXMLName() ||
+    std::strcmp(surface->GetXMLName(), "ResMRSurfaceRepresentation") != 0)
   {
     return nullptr;
   }

@@ -22,8 +22,7 @@ struct pqMultiresolutionReadout
 
   /// The Multiresolution Surface sub-proxy of a representation shown as one, else nullptr.
   static vtkSMProxy* Surface(pqRepresentation* representation, bool visibleOnly);
-  /// Pulls the readout (from the render server, see
-  /// vtkSMMultiresolutionSurfaceRepresentationProxy).
+  /// Pulls the readout (from the render server, see vtkSMMultiresolutionSurfaceRepresentationProxy).
   static pqMultiresolutionReadout Pull(vtkSMProxy* surface);
 };
 

@@ -26,8 +26,7 @@ pqMultiresolutionReadoutDock::pqMultiresolutionReadoutDock(QWidget* parent)
   this->Values = new QWidget(body);
   auto* form = new QFormLayout(this->Values);
   form->setContentsMargins(0, 0, 0, 0);
-  const auto row = [&](const QString& name, const QString& help)
-  {
+  const auto row = [&](const QString& name, const QString& help) {
     auto* value = new QLabel(this->Values);
     value->setTextInteractionFlags(Qt::TextSelectableByMouse);
     value->setToolTip(help);
@@ -38,8 +37,7 @@ pqMultiresolutionReadoutDock::pqMultiresolutionReadoutDock(QWidget* parent)
   this->Resident = row(tr("Resident"), tr("Memory held by loaded meshes, of the memory budget"));
   this->Triangles = row(tr("Triangles drawn"), tr("Triangles drawn in the last frame"));
   this->Regions = row(tr("Regions drawn"),
-    tr("Region meshes drawn in the last frame; in brackets, those standing in for finer ones still "
-       "loading"));
+    tr("Region meshes drawn in the last frame; in brackets, those standing in for finer ones still loading"));
   this->Frame = row(tr("Last frame"), tr("Time the last frame took"));
   this->Loads = row(tr("Loads"), tr("Whether meshes the view wants are still loading"));
   layout->addWidget(this->Values);
@@ -56,16 +54,12 @@ pqMultiresolutionReadoutDock::pqMultiresolutionReadoutDock(QWidget* parent)
   // done, and once for any number of requests made meanwhile.
   this->Update.setSingleShot(true);
   this->Update.setInterval(0);
-  QObject::connect(
-    &this->Update, &QTimer::timeout, this, &pqMultiresolutionReadoutDock::updateReadout);
+  QObject::connect(&this->Update, &QTimer::timeout, this, &pqMultiresolutionReadoutDock::updateReadout);
   const auto request = [this]() { this->Update.start(); };
   pqActiveObjects& active = pqActiveObjects::instance();
+  QObject::connect(&active, &pqActiveObjects::viewChanged, this, &pqMultiresolutionReadoutDock::setView);
   QObject::connect(
-    &active, &pqActiveObjects::viewChanged, this, &pqMultiresolutionReadoutDock::setView);
-  QObject::connect(&active,
-    QOverload<pqDataRepresentation*>::of(&pqActiveObjects::representationChanged),
-    this,
-    request);
+    &active, QOverload<pqDataRepresentation*>::of(&pqActiveObjects::representationChanged), this, request);
   QObject::connect(this, &QDockWidget::visibilityChanged, this, request);
   this->setView(active.activeView());
 }
@@ -98,7 +92,7 @@ void pqMultiresolutionReadoutDock::updateReadout()
   pqRepresentation* chosen = nullptr;
   pqDataRepresentation* activeRepresentation = pqActiveObjects::instance().activeRepresentation();
   if (this->View && activeRepresentation && activeRepresentation->getView() == this->View &&
-      pqMultiresolutionReadout::Surface(activeRepresentation, false))
+    pqMultiresolutionReadout::Surface(activeRepresentation, false))
   {
     chosen = activeRepresentation;
   }
@@ -127,10 +121,8 @@ void pqMultiresolutionReadoutDock::updateReadout()
   this->Tolerance->setText(
     tr("%1 px (%2)")
       .arg(readout.Tolerance, 0, 'f', 2)
-      .arg(readout.TargetFrameRate > 0 ? tr("holding %1 fps").arg(readout.TargetFrameRate)
-                                       : tr("fixed")));
-  this->Resident->setText(
-    tr("%1 MB of %2 MB").arg(readout.ResidentMB, 0, 'f', 1).arg(readout.BudgetMB));
+      .arg(readout.TargetFrameRate > 0 ? tr("holding %1 fps").arg(readout.TargetFrameRate) : tr("fixed")));
+  this->Resident->setText(tr("%1 MB of %2 MB").arg(readout.ResidentMB, 0, 'f', 1).arg(readout.BudgetMB));
   this->Triangles->setText(locale.toString(static_cast<qlonglong>(readout.Triangles)));
   this->Regions->setText(tr("%1 (%2 standing in)").arg(readout.Regions).arg(readout.Substituted));
   this->Frame->setText(tr("%1 ms").arg(readout.FrameMs, 0, 'f', 1));
@@ -138,12 +130,7 @@ void pqMultiresolutionReadoutDock::updateReadout()
   this->Error->setText(readout.Error);
   this->Values->setVisible(true);
   this->Error->setVisible(!readout.Error.isEmpty());
-  vtkLogF(TRACE,
-    "multiresolution readout: %.2f px, %.1f MB, %.0f triangles, %d regions, %d substituted, %s",
-    readout.Tolerance,
-    readout.ResidentMB,
-    readout.Triangles,
-    readout.Regions,
-    readout.Substituted,
+  vtkLogF(TRACE, "multiresolution readout: %.2f px, %.1f MB, %.0f triangles, %d regions, %d substituted, %s",
+    readout.Tolerance, readout.ResidentMB, readout.Triangles, readout.Regions, readout.Substituted,
     readout.LoadsPending ? "pending" : "idle");
 }

@@ -27,7 +27,7 @@ constexpr double RefiningStep = 0.99;
 struct pqMultiresolutionRefreshManager::ViewState
 {
   QTimer Timer;
-  bool OwnRender = false; ///< the render now ending is one this manager asked for
+  bool OwnRender = false;                               ///< the render now ending is one this manager asked for
   std::map<vtkSMProxy*, pqMultiresolutionReadout> Last; ///< each surface's previous frame
 };
 
@@ -35,14 +35,8 @@ pqMultiresolutionRefreshManager::pqMultiresolutionRefreshManager(QObject* parent
   : Superclass(parent)
 {
   pqServerManagerModel* model = pqApplicationCore::instance()->getServerManagerModel();
-  QObject::connect(model,
-    &pqServerManagerModel::preViewAdded,
-    this,
-    &pqMultiresolutionRefreshManager::onViewAdded);
-  QObject::connect(model,
-    &pqServerManagerModel::preViewRemoved,
-    this,
-    &pqMultiresolutionRefreshManager::onViewRemoved);
+  QObject::connect(model, &pqServerManagerModel::preViewAdded, this, &pqMultiresolutionRefreshManager::onViewAdded);
+  QObject::connect(model, &pqServerManagerModel::preViewRemoved, this, &pqMultiresolutionRefreshManager::onViewRemoved);
   for (pqView* view : model->findItems<pqView*>())
   {
     this->onViewAdded(view);
@@ -61,26 +55,21 @@ void pqMultiresolutionRefreshManager::onViewAdded(pqView* view)
   state->Timer.setSingleShot(true);
   ViewState* raw = state.get();
   QPointer<pqView> guarded(view);
-  QObject::connect(&state->Timer,
-    &QTimer::timeout,
-    this,
-    [raw, guarded]()
+  QObject::connect(&state->Timer, &QTimer::timeout, this, [raw, guarded]() {
+    if (guarded)
     {
-      if (guarded)
-      {
-        vtkLogF(TRACE, "multiresolution refresh: rendering");
-        raw->OwnRender = true;
-        guarded->render();
-      }
-    });
+      vtkLogF(TRACE, "multiresolution refresh: rendering");
+      raw->OwnRender = true;
+      guarded->render();
+    }
+  });
   QObject::connect(view, &pqView::endRender, this, &pqMultiresolutionRefreshManager::onRenderEnded);
   this->Views[view] = std::move(state);
 }
 
 void pqMultiresolutionRefreshManager::onViewRemoved(pqView* view)
 {
-  QObject::disconnect(
-    view, &pqView::endRender, this, &pqMultiresolutionRefreshManager::onRenderEnded);
+  QObject::disconnect(view, &pqView::endRender, this, &pqMultiresolutionRefreshManager::onRenderEnded);
   this->Views.erase(view);
 }
 
@@ -108,14 +97,12 @@ void pqMultiresolutionRefreshManager::onRenderEnded()
     }
     const pqMultiresolutionReadout readout = pqMultiresolutionReadout::Pull(surface);
     const auto before = state.Last.find(surface);
-    const pqMultiresolutionReadout* previous =
-      before != state.Last.end() ? &before->second : nullptr;
+    const pqMultiresolutionReadout* previous = before != state.Last.end() ? &before->second : nullptr;
     // Loads that finish while a frame draws leave nothing pending, but that frame stood in
     // ancestors for them: render again, as long as each such frame changes something (a load
     // that failed or does not fit the budget would give the same frame forever).
     const bool changed = !own || !previous || previous->Regions != readout.Regions ||
-                         previous->Triangles != readout.Triangles ||
-                         previous->Substituted != readout.Substituted;
+      previous->Triangles != readout.Triangles || previous->Substituted != readout.Substituted;
     again = again || readout.LoadsPending || (readout.Substituted > 0 && changed);
     if (readout.TargetFrameRate > 0)
     {

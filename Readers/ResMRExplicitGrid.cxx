@@ -28,11 +28,8 @@ long long FileModificationTime(const char* path)
   return static_cast<long long>(info.st_mtim.tv_sec) * 1000000000LL + info.st_mtim.tv_nsec;
 }
 
-CellOrder BuildExplicitGrid(const resmr::CornerPointGeometry& geometry,
-  const std::vector<int32_t>& actnum,
-  const std::vector<bool>& active,
-  bool showInactive,
-  vtkExplicitStructuredGrid* grid)
+CellOrder BuildExplicitGrid(const resmr::CornerPointGeometry& geometry, const std::vector<int32_t>& actnum,
+  const std::vector<bool>& active, bool showInactive, vtkExplicitStructuredGrid* grid)
 {
   CellOrder order;
   order.nx = geometry.Dims()[0];

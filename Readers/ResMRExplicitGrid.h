@@ -1,6 +1,6 @@
-// Shared by the Eclipse readers and the synthetic reservoir source: turns a Core corner-point grid
-// into the plugin's vtkExplicitStructuredGrid contract (paper Sec. 3): z up, corners shared where
-// ECLIPSE connects cells, I/J/K from 1, ACTNUM, HIDDENCELL for inactive cells, face connectivity
+// Shared by the Eclipse readers and the synthetic reservoir source: turns a Core corner-point grid into the plugin's
+// vtkExplicitStructuredGrid contract (paper Sec. 3): z up, corners shared where ECLIPSE
+// connects cells, I/J/K from 1, ACTNUM, HIDDENCELL for inactive cells, face connectivity
 // flags; and maps per-cell arrays from ECLIPSE cell order to VTK cell order.
 #ifndef ResMRExplicitGrid_h
 #define ResMRExplicitGrid_h
@@ -54,9 +54,7 @@ struct CellOrder
 /// `actnum` holds ACTNUM as given (one per cell, ECLIPSE order), `active` which cells are
 /// shown; inactive cells get HIDDENCELL unless showInactive. Throws std::bad_alloc.
 RESMRREADERS_EXPORT CellOrder BuildExplicitGrid(const resmr::CornerPointGeometry& geometry,
-  const std::vector<int32_t>& actnum,
-  const std::vector<bool>& active,
-  bool showInactive,
+  const std::vector<int32_t>& actnum, const std::vector<bool>& active, bool showInactive,
   vtkExplicitStructuredGrid* grid);
 
 /// A new array of `cells` tuples named `name`, VTKArray (vtkFloatArray, vtkIntArray ...);

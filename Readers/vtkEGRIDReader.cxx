@@ -44,22 +44,8 @@ struct SelectableArray
 
 bool IsCommonArray(const std::string& name)
 {
-  static const std::set<std::string> names = { "PORO",
-    "PERMX",
-    "PERMY",
-    "PERMZ",
-    "NTG",
-    "PORV",
-    "SATNUM",
-    "PVTNUM",
-    "EQLNUM",
-    "FIPNUM",
-    "PRESSURE",
-    "SWAT",
-    "SGAS",
-    "SOIL",
-    "RS",
-    "RV" };
+  static const std::set<std::string> names = { "PORO", "PERMX", "PERMY", "PERMZ", "NTG", "PORV", "SATNUM", "PVTNUM",
+    "EQLNUM", "FIPNUM", "PRESSURE", "SWAT", "SGAS", "SOIL", "RS", "RV" };
   return names.count(name) > 0;
 }
 } // namespace
@@ -125,10 +111,11 @@ void vtkEGRIDReader::PrintSelf(ostream& os, vtkIndent indent)
 int vtkEGRIDReader::CanReadFile(const char* fileName)
 {
   // Any keyword file: old-style GRID files are then refused with a message saying why.
-  return fileName && (resmr::EclipseKeywordFile::LooksLikeUnformatted(fileName) ||
-                       resmr::EclipseKeywordFile::LooksLikeFormatted(fileName))
-           ? 1
-           : 0;
+  return fileName &&
+      (resmr::EclipseKeywordFile::LooksLikeUnformatted(fileName) ||
+        resmr::EclipseKeywordFile::LooksLikeFormatted(fileName))
+    ? 1
+    : 0;
 }
 
 vtkDataArraySelection* vtkEGRIDReader::GetCellArraySelection()
@@ -149,8 +136,7 @@ int vtkEGRIDReader::GetCellArrayStatus(const char* name)
 }
 void vtkEGRIDReader::SetCellArrayStatus(const char* name, int status)
 {
-  if (this->CellArraySelection->ArrayIsEnabled(name) != (status != 0) ||
-      !this->CellArraySelection->ArrayExists(name))
+  if (this->CellArraySelection->ArrayIsEnabled(name) != (status != 0) || !this->CellArraySelection->ArrayExists(name))
   {
     this->CellArraySelection->SetArraySetting(name, status);
     this->Modified();
@@ -191,8 +177,7 @@ bool vtkEGRIDReader::OpenIfNeeded()
   }
   const long long modified = resmr_readers::FileModificationTime(this->FileName);
   Internals& internal = *this->Internal;
-  if (internal.Results && internal.OpenedFile == this->FileName &&
-      internal.OpenedModificationTime == modified)
+  if (internal.Results && internal.OpenedFile == this->FileName && internal.OpenedModificationTime == modified)
   {
     return !internal.RescanCompanions || this->RescanCompanions();
   }
@@ -206,18 +191,16 @@ bool vtkEGRIDReader::OpenIfNeeded()
   this->Warnings.clear();
   try
   {
-    internal.Grid = resmr::ReadEclipseGrid(
-      this->FileName, resmr::MaxFullResolutionCells(int64_t(this->MemoryLimitMB) << 20));
+    internal.Grid =
+      resmr::ReadEclipseGrid(this->FileName, resmr::MaxFullResolutionCells(int64_t(this->MemoryLimitMB) << 20));
     internal.Results = std::make_unique<resmr::EclipseResults>(this->FileName, *internal.Grid);
-    internal.Geometry =
-      resmr::CornerPointGeometry::FromDeck(internal.Grid->deck, this->ApplyMapAxes);
+    internal.Geometry = resmr::CornerPointGeometry::FromDeck(internal.Grid->deck, this->ApplyMapAxes);
   }
   catch (const std::exception& error)
   {
     const bool memory = dynamic_cast<const std::bad_alloc*>(&error) != nullptr;
     const std::string message =
-      memory ? std::string(this->FileName) + ": not enough memory to read this grid"
-             : std::string(error.what());
+      memory ? std::string(this->FileName) + ": not enough memory to read this grid" : std::string(error.what());
     internal.Reset();
     internal.FailedFile = this->FileName;
     internal.FailedModificationTime = modified;
@@ -273,19 +256,16 @@ void vtkEGRIDReader::ListArraysAndTimes()
 {
   Internals& internal = *this->Internal;
   std::vector<std::string> warnings = internal.Grid->deck.warnings;
-  warnings.insert(
-    warnings.end(), internal.Results->Warnings().begin(), internal.Results->Warnings().end());
+  warnings.insert(warnings.end(), internal.Results->Warnings().begin(), internal.Results->Warnings().end());
 
   // Selectable arrays: restart arrays keep their names; an INIT array of the same name is
   // shown as NAME_INIT.
   const auto& dynamicArrays = internal.Results->DynamicArrays();
   for (const resmr::EclipseResultArray& array : internal.Results->StaticArrays())
   {
-    const bool clash = std::any_of(dynamicArrays.begin(),
-      dynamicArrays.end(),
+    const bool clash = std::any_of(dynamicArrays.begin(), dynamicArrays.end(),
       [&](const resmr::EclipseResultArray& other) { return other.name == array.name; });
-    internal.Arrays.push_back(
-      { clash ? array.name + "_INIT" : array.name, array.name, false, array });
+    internal.Arrays.push_back({ clash ? array.name + "_INIT" : array.name, array.name, false, array });
   }
   std::vector<std::string> dynamicNames;
   for (const resmr::EclipseResultArray& array : dynamicArrays)
@@ -295,9 +275,7 @@ void vtkEGRIDReader::ListArraysAndTimes()
   }
   if (resmr::NeedsDerivedOil(dynamicNames))
   {
-    SelectableArray oil{ resmr::DerivedOilName,
-      resmr::DerivedOilName,
-      true,
+    SelectableArray oil{ resmr::DerivedOilName, resmr::DerivedOilName, true,
       { resmr::DerivedOilName, resmr::EclipseDataType::Real } };
     oil.derivedOil = true;
     internal.Arrays.push_back(oil);
@@ -307,8 +285,7 @@ void vtkEGRIDReader::ListArraysAndTimes()
   {
     if (!this->CellArraySelection->ArrayExists(array.shownName.c_str()))
     {
-      this->CellArraySelection->AddArray(
-        array.shownName.c_str(), all || IsCommonArray(array.keyword));
+      this->CellArraySelection->AddArray(array.shownName.c_str(), all || IsCommonArray(array.keyword));
     }
   }
 
@@ -322,8 +299,7 @@ void vtkEGRIDReader::ListArraysAndTimes()
   {
     if (!(internal.Times[s] > internal.Times[s - 1]))
     {
-      warnings.push_back(
-        std::string(this->FileName) +
+      warnings.push_back(std::string(this->FileName) +
         ": report step times are not increasing; time steps are numbered by report index");
       for (std::size_t t = 0; t < internal.Times.size(); ++t)
       {
@@ -348,7 +324,7 @@ bool vtkEGRIDReader::BuildBaseIfNeeded()
 {
   Internals& internal = *this->Internal;
   if (internal.Base && internal.BaseShowInactive == this->ShowInactiveCells &&
-      internal.BaseApplyMapAxes == this->ApplyMapAxes)
+    internal.BaseApplyMapAxes == this->ApplyMapAxes)
   {
     return true;
   }
@@ -381,24 +357,18 @@ namespace
 {
 /// Reads one INIT or restart array into a new VTK array of the matching type; nullptr if the
 /// step lacks it.
-vtkSmartPointer<vtkDataArray> ReadCellArray(const resmr::EclipseResults& results,
-  const SelectableArray& array,
-  std::size_t step,
-  const resmr_readers::CellOrder& order)
+vtkSmartPointer<vtkDataArray> ReadCellArray(const resmr::EclipseResults& results, const SelectableArray& array,
+  std::size_t step, const resmr_readers::CellOrder& order)
 {
   if (array.derivedOil)
   {
     bool found = true;
-    auto oil = resmr_readers::MakeCellArray<vtkFloatArray>(resmr::DerivedOilName,
-      order,
-      [&](float* out) {
-        found = resmr::ReadDerivedOil(results, step, out, int64_t(order.nx) * order.ny * order.nz);
-      });
+    auto oil = resmr_readers::MakeCellArray<vtkFloatArray>(resmr::DerivedOilName, order,
+      [&](float* out) { found = resmr::ReadDerivedOil(results, step, out, int64_t(order.nx) * order.ny * order.nz); });
     return found ? oil : nullptr;
   }
   bool found = true;
-  const auto read = [&](auto* out, auto fill)
-  {
+  const auto read = [&](auto* out, auto fill) {
     found = array.dynamic ? results.ReadDynamic(step, array.keyword, out, fill)
                           : results.ReadStatic(array.keyword, out, fill);
   };
@@ -410,25 +380,20 @@ vtkSmartPointer<vtkDataArray> ReadCellArray(const resmr::EclipseResults& results
   }
   else if (array.info.type == resmr::EclipseDataType::Double)
   {
-    result = resmr_readers::MakeCellArray<vtkDoubleArray>(array.shownName.c_str(),
-      order,
-      [&](double* out) { read(out, std::numeric_limits<double>::quiet_NaN()); });
+    result = resmr_readers::MakeCellArray<vtkDoubleArray>(
+      array.shownName.c_str(), order, [&](double* out) { read(out, std::numeric_limits<double>::quiet_NaN()); });
   }
   else
   {
-    result = resmr_readers::MakeCellArray<vtkFloatArray>(array.shownName.c_str(),
-      order,
-      [&](float* out) { read(out, std::numeric_limits<float>::quiet_NaN()); });
+    result = resmr_readers::MakeCellArray<vtkFloatArray>(
+      array.shownName.c_str(), order, [&](float* out) { read(out, std::numeric_limits<float>::quiet_NaN()); });
   }
   return found ? result : nullptr;
 }
 /// ReadCellArray, with a record whose blocks turn out damaged costing that array only:
 /// nullptr, and `why` says what was left out.
-vtkSmartPointer<vtkDataArray> ReadCellArrayOrExplain(const resmr::EclipseResults& results,
-  const SelectableArray& array,
-  std::size_t step,
-  const resmr_readers::CellOrder& order,
-  std::string& why)
+vtkSmartPointer<vtkDataArray> ReadCellArrayOrExplain(const resmr::EclipseResults& results, const SelectableArray& array,
+  std::size_t step, const resmr_readers::CellOrder& order, std::string& why)
 {
   try
   {
@@ -481,9 +446,7 @@ void vtkEGRIDReader::UpdateStaticArrays()
   }
 }
 
-int vtkEGRIDReader::RequestInformation(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkEGRIDReader::RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   this->LastError.clear();
   vtkInformation* info = outputVector->GetInformationObject(0);
@@ -497,24 +460,19 @@ int vtkEGRIDReader::RequestInformation(vtkInformation*,
     return 1;
   }
   const auto& dims = this->Internal->Grid->deck.dims;
-  int extent[6] = {
-    0, static_cast<int>(dims[0]), 0, static_cast<int>(dims[1]), 0, static_cast<int>(dims[2])
-  };
+  int extent[6] = { 0, static_cast<int>(dims[0]), 0, static_cast<int>(dims[1]), 0, static_cast<int>(dims[2]) };
   info->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
   const std::vector<double>& times = this->Internal->Times;
   if (!times.empty())
   {
-    info->Set(
-      vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
+    info->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), static_cast<int>(times.size()));
     const double range[2] = { times.front(), times.back() };
     info->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
   }
   return 1;
 }
 
-int vtkEGRIDReader::RequestData(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkEGRIDReader::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkInformation* info = outputVector->GetInformationObject(0);
   vtkExplicitStructuredGrid* output = vtkExplicitStructuredGrid::GetData(outputVector, 0);
@@ -580,8 +538,7 @@ int vtkEGRIDReader::RequestData(vtkInformation*,
       vtkNew<vtkStringArray> date;
       date->SetName("Date");
       char text[32];
-      std::snprintf(
-        text, sizeof(text), "%04d-%02d-%02d", report.date[0], report.date[1], report.date[2]);
+      std::snprintf(text, sizeof(text), "%04d-%02d-%02d", report.date[0], report.date[1], report.date[2]);
       date->InsertNextValue(text);
       output->GetFieldData()->AddArray(reportStep);
       output->GetFieldData()->AddArray(days);

@@ -10,11 +10,11 @@
  * Companion files are found by the EGRID's basename. A damaged, empty or foreign INIT, and
  * report steps whose restart is cut short or damaged (a run still being written), are left
  * out with a warning (Warnings) naming the file, the step and the byte offset; the grid and
- * the other steps open. Reload() (File > Reload Files) indexes the companions again. Arrays with
- * one value per active cell are mapped to cells through the EGRID's ACTNUM; inactive cells get NaN
- * (real arrays) or 0. Report steps become time steps in days (TIME_STEPS); only the requested
- * step's selected arrays are read, by seeking to record offsets indexed once when the file is
- * opened. The geometry and static arrays are built once and shared by every step's output.
+ * the other steps open. Reload() (File > Reload Files) indexes the companions again. Arrays with one value per active
+ * cell are mapped to cells through the EGRID's ACTNUM; inactive cells get NaN (real arrays) or 0. Report steps become
+ * time steps in days (TIME_STEPS); only the requested step's selected arrays are read, by seeking to record offsets
+ * indexed once when the file is opened. The geometry and static arrays are built once and shared by every step's
+ * output.
  *
  * LGRs and non-neighbour connections are not shown (a warning names them); dual-porosity
  * grids show the matrix grid. Field data: ReportStep, Days, Date of the step shown;

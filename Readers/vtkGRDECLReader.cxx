@@ -66,8 +66,7 @@ void vtkGRDECLReader::PrintSelf(ostream& os, vtkIndent indent)
 
 int vtkGRDECLReader::FillOutputPortInformation(int port, vtkInformation* info)
 {
-  info->Set(
-    vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkExplicitStructuredGrid" : "vtkPolyData");
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkExplicitStructuredGrid" : "vtkPolyData");
   return 1;
 }
 
@@ -94,8 +93,7 @@ int vtkGRDECLReader::GetCellArrayStatus(const char* name)
 }
 void vtkGRDECLReader::SetCellArrayStatus(const char* name, int status)
 {
-  if (this->CellArraySelection->ArrayIsEnabled(name) != (status != 0) ||
-      !this->CellArraySelection->ArrayExists(name))
+  if (this->CellArraySelection->ArrayIsEnabled(name) != (status != 0) || !this->CellArraySelection->ArrayExists(name))
   {
     this->CellArraySelection->SetArraySetting(name, status);
     this->Modified();
@@ -120,8 +118,7 @@ int vtkGRDECLReader::GetFaultArrayStatus(const char* name)
 }
 void vtkGRDECLReader::SetFaultArrayStatus(const char* name, int status)
 {
-  if (this->FaultSelection->ArrayIsEnabled(name) != (status != 0) ||
-      !this->FaultSelection->ArrayExists(name))
+  if (this->FaultSelection->ArrayIsEnabled(name) != (status != 0) || !this->FaultSelection->ArrayExists(name))
   {
     this->FaultSelection->SetArraySetting(name, status);
     this->Modified();
@@ -159,8 +156,7 @@ bool vtkGRDECLReader::ParseIfNeeded()
   }
   const long long modified = resmr_readers::FileModificationTime(this->FileName);
   Internals& internal = *this->Internal;
-  if (internal.Geometry && internal.ParsedFile == this->FileName &&
-      internal.ParsedModificationTime == modified)
+  if (internal.Geometry && internal.ParsedFile == this->FileName && internal.ParsedModificationTime == modified)
   {
     return true;
   }
@@ -174,8 +170,7 @@ bool vtkGRDECLReader::ParseIfNeeded()
   internal.ParsedFile.clear();
   internal.FailedFile.clear();
   this->Warnings.clear();
-  const auto fail = [&](const std::string& message)
-  {
+  const auto fail = [&](const std::string& message) {
     internal.Deck = resmr::CornerPointModel();
     internal.Geometry.reset();
     internal.FailedFile = this->FileName;
@@ -209,8 +204,7 @@ bool vtkGRDECLReader::ParseIfNeeded()
   }
   for (const resmr::CellArray& array : internal.Deck.arrays)
   {
-    if (!resmr::IsGeometryArrayName(array.name) &&
-        !this->CellArraySelection->ArrayExists(array.name.c_str()))
+    if (!resmr::IsGeometryArrayName(array.name) && !this->CellArraySelection->ArrayExists(array.name.c_str()))
     {
       this->CellArraySelection->AddArray(array.name.c_str(), true);
     }
@@ -225,31 +219,23 @@ bool vtkGRDECLReader::ParseIfNeeded()
   return true;
 }
 
-int vtkGRDECLReader::RequestInformation(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkGRDECLReader::RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   this->LastError.clear();
   if (!this->ParseIfNeeded())
   {
     // Let RequestData run and empty the outputs, so no stale data is shown.
     int empty[6] = { 0, -1, 0, -1, 0, -1 };
-    outputVector->GetInformationObject(0)->Set(
-      vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), empty, 6);
+    outputVector->GetInformationObject(0)->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), empty, 6);
     return 1;
   }
   const auto& dims = this->Internal->Geometry->Dims();
-  int extent[6] = {
-    0, static_cast<int>(dims[0]), 0, static_cast<int>(dims[1]), 0, static_cast<int>(dims[2])
-  };
-  outputVector->GetInformationObject(0)->Set(
-    vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  int extent[6] = { 0, static_cast<int>(dims[0]), 0, static_cast<int>(dims[1]), 0, static_cast<int>(dims[2]) };
+  outputVector->GetInformationObject(0)->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
   return 1;
 }
 
-int vtkGRDECLReader::RequestData(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkGRDECLReader::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkExplicitStructuredGrid* grid = vtkExplicitStructuredGrid::GetData(outputVector, 0);
   vtkPolyData* faults = vtkPolyData::GetData(outputVector, 1);
@@ -285,30 +271,25 @@ int vtkGRDECLReader::RequestData(vtkInformation*,
 
     for (const resmr::CellArray& property : deck.arrays)
     {
-      if (resmr::IsGeometryArrayName(property.name) ||
-          !this->CellArraySelection->ArrayIsEnabled(property.name.c_str()))
+      if (resmr::IsGeometryArrayName(property.name) || !this->CellArraySelection->ArrayIsEnabled(property.name.c_str()))
       {
         continue;
       }
       const std::vector<double>& values = property.values;
       if (property.isInteger)
       {
-        cellData->AddArray(resmr_readers::MakeCellArray<vtkIntArray>(property.name.c_str(),
-          order,
-          [&](int* out)
+        cellData->AddArray(resmr_readers::MakeCellArray<vtkIntArray>(property.name.c_str(), order, [&](int* out) {
+          for (int64_t cell = 0; cell < cellCount; ++cell)
           {
-            for (int64_t cell = 0; cell < cellCount; ++cell)
-            {
-              const double value = values[static_cast<std::size_t>(cell)];
-              out[cell] = std::isfinite(value) ? static_cast<int>(value) : 0;
-            }
-          }));
+            const double value = values[static_cast<std::size_t>(cell)];
+            out[cell] = std::isfinite(value) ? static_cast<int>(value) : 0;
+          }
+        }));
       }
       else
       {
-        cellData->AddArray(resmr_readers::MakeCellArray<vtkDoubleArray>(property.name.c_str(),
-          order,
-          [&](double* out) { std::copy(values.begin(), values.end(), out); }));
+        cellData->AddArray(resmr_readers::MakeCellArray<vtkDoubleArray>(
+          property.name.c_str(), order, [&](double* out) { std::copy(values.begin(), values.end(), out); }));
       }
     }
 
@@ -320,9 +301,8 @@ int vtkGRDECLReader::RequestData(vtkInformation*,
     faultIndex->SetName("FaultIndex");
     vtkNew<vtkStringArray> faultNames;
     faultNames->SetName("FaultNames");
-    static const int faceCorners[6][4] = {
-      { 0, 2, 6, 4 }, { 1, 5, 7, 3 }, { 0, 4, 5, 1 }, { 2, 3, 7, 6 }, { 0, 1, 3, 2 }, { 4, 6, 7, 5 }
-    };
+    static const int faceCorners[6][4] = { { 0, 2, 6, 4 }, { 1, 5, 7, 3 }, { 0, 4, 5, 1 }, { 2, 3, 7, 6 },
+      { 0, 1, 3, 2 }, { 4, 6, 7, 5 } };
     for (std::size_t f = 0; f < deck.faults.size(); ++f)
     {
       const resmr::Fault& fault = deck.faults[f];

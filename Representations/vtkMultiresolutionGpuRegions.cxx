@@ -36,8 +36,7 @@ struct GpuPiece
 
 double ElapsedMs(std::chrono::steady_clock::time_point since)
 {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
-    .count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
 }
 } // namespace
 
@@ -78,13 +77,10 @@ public:
     }
     piece->layout->Bind();
     piece->vertices->Upload(vertices.data() + std::size_t(next.lowVertex) * 6,
-      (std::size_t(next.highVertex) - next.lowVertex + 1) * 6,
-      vtkOpenGLBufferObject::ArrayBuffer);
+      (std::size_t(next.highVertex) - next.lowVertex + 1) * 6, vtkOpenGLBufferObject::ArrayBuffer);
     piece->indices->Upload(scratch, vtkOpenGLBufferObject::ElementArrayBuffer);
-    piece->layout->AddAttributeArray(
-      program, piece->vertices, "vertexPosition", 0, 24, VTK_FLOAT, 3, false);
-    piece->layout->AddAttributeArray(
-      program, piece->vertices, "cellCoordinate", 12, 24, VTK_FLOAT, 3, false);
+    piece->layout->AddAttributeArray(program, piece->vertices, "vertexPosition", 0, 24, VTK_FLOAT, 3, false);
+    piece->layout->AddAttributeArray(program, piece->vertices, "cellCoordinate", 12, 24, VTK_FLOAT, 3, false);
     piece->layout->Release();
     this->Pieces.push_back(std::move(piece));
     this->Bytes += next.bytes;
@@ -146,8 +142,7 @@ void vtkMultiresolutionGpuRegions::ReleaseEvicted(const resmr::RegionCache& cach
 }
 
 vtkMultiresolutionGpuRegions::RegionMap::iterator vtkMultiresolutionGpuRegions::Find(
-  std::size_t region,
-  const resmr::RegionCache& cache)
+  std::size_t region, const resmr::RegionCache& cache)
 {
   auto found = this->Regions.find(region);
   if (found == this->Regions.end())
@@ -161,9 +156,8 @@ vtkMultiresolutionGpuRegions::RegionMap::iterator vtkMultiresolutionGpuRegions::
   return found;
 }
 
-void vtkMultiresolutionGpuRegions::ReleaseUnwanted(const std::vector<std::size_t>& order,
-  RegionMap::iterator entry,
-  std::size_t gpuShare)
+void vtkMultiresolutionGpuRegions::ReleaseUnwanted(
+  const std::vector<std::size_t>& order, RegionMap::iterator entry, std::size_t gpuShare)
 {
   std::vector<std::pair<std::size_t, std::size_t>> mirrored;
   for (const auto& copy : this->Regions)
@@ -171,20 +165,15 @@ void vtkMultiresolutionGpuRegions::ReleaseUnwanted(const std::vector<std::size_t
     mirrored.emplace_back(copy.first, copy.second->Bytes);
   }
   const std::set<std::size_t> wanted(order.begin(), order.end());
-  for (std::size_t region : resmr::CopiesToRelease(
-         mirrored, wanted, this->GpuBytes, entry->second->NextPieceBytes(), gpuShare))
+  for (std::size_t region :
+    resmr::CopiesToRelease(mirrored, wanted, this->GpuBytes, entry->second->NextPieceBytes(), gpuShare))
   {
     this->Erase(this->Regions.find(region));
   }
 }
 
-bool vtkMultiresolutionGpuRegions::Upload(const resmr::RegionCache& cache,
-  const std::vector<std::size_t>& order,
-  std::size_t roots,
-  bool bounded,
-  resmr::UploadPacer& pacer,
-  std::size_t gpuShare,
-  vtkShaderProgram* program)
+bool vtkMultiresolutionGpuRegions::Upload(const resmr::RegionCache& cache, const std::vector<std::size_t>& order,
+  std::size_t roots, bool bounded, resmr::UploadPacer& pacer, std::size_t gpuShare, vtkShaderProgram* program)
 {
   for (std::size_t n = 0; n < order.size(); ++n)
   {
@@ -220,8 +209,7 @@ bool vtkMultiresolutionGpuRegions::Upload(const resmr::RegionCache& cache,
     }
     Region& gpu = *found->second;
     while (
-      !gpu.Ready() && resmr::MayCopyPiece(
-                        bounded, n < roots, pacer, gpu.NextPieceBytes(), this->GpuBytes, gpuShare))
+      !gpu.Ready() && resmr::MayCopyPiece(bounded, n < roots, pacer, gpu.NextPieceBytes(), this->GpuBytes, gpuShare))
     {
       const auto copyStart = std::chrono::steady_clock::now();
       const std::size_t bytes = gpu.UploadNextPiece(program, this->IndexScratch);
@@ -236,9 +224,8 @@ bool vtkMultiresolutionGpuRegions::Upload(const resmr::RegionCache& cache,
   return false;
 }
 
-const resmr::RegionDrawBuffers* vtkMultiresolutionGpuRegions::Prepare(std::size_t region,
-  const resmr::RegionCache& cache,
-  vtkShaderProgram* program)
+const resmr::RegionDrawBuffers* vtkMultiresolutionGpuRegions::Prepare(
+  std::size_t region, const resmr::RegionCache& cache, vtkShaderProgram* program)
 {
   const auto found = this->Find(region, cache);
   if (found == this->Regions.end())
@@ -255,9 +242,8 @@ const resmr::RegionDrawBuffers* vtkMultiresolutionGpuRegions::Prepare(std::size_
   return gpu.Buffers.get();
 }
 
-std::size_t vtkMultiresolutionGpuRegions::Draw(std::size_t region,
-  const std::array<resmr::DrawPart, 3>& parts,
-  vtkShaderProgram* program)
+std::size_t vtkMultiresolutionGpuRegions::Draw(
+  std::size_t region, const std::array<resmr::DrawPart, 3>& parts, vtkShaderProgram* program)
 {
   std::size_t triangles = 0;
   for (const auto& piece : this->Regions.at(region)->Pieces)
@@ -272,9 +258,7 @@ std::size_t vtkMultiresolutionGpuRegions::Draw(std::size_t region,
       if (part.shown && end > begin)
       {
         program->SetUniformi("faceKind", part.kind);
-        glDrawElements(GL_TRIANGLES,
-          static_cast<GLsizei>(end - begin),
-          GL_UNSIGNED_INT,
+        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(end - begin), GL_UNSIGNED_INT,
           reinterpret_cast<const void*>(std::size_t(begin - piece->first) * sizeof(uint32_t)));
         triangles += (end - begin) / 3;
       }

@@ -45,24 +45,16 @@ public:
   /// `gpuShare` bytes: copies the cache evicted meanwhile go first, then copies this frame
   /// does not want. Vertex layouts are bound against `program`. True when copies had to wait
   /// (the allowance or the share ran out) and the next frame will go on.
-  bool Upload(const resmr::RegionCache& cache,
-    const std::vector<std::size_t>& order,
-    std::size_t roots,
-    bool bounded,
-    resmr::UploadPacer& pacer,
-    std::size_t gpuShare,
-    vtkShaderProgram* program);
+  bool Upload(const resmr::RegionCache& cache, const std::vector<std::size_t>& order, std::size_t roots, bool bounded,
+    resmr::UploadPacer& pacer, std::size_t gpuShare, vtkShaderProgram* program);
 
   /// The buffers of a region about to be drawn, its copy completed now if the pacer left it
   /// unfinished; null when the cache no longer has it.
-  const resmr::RegionDrawBuffers* Prepare(std::size_t region,
-    const resmr::RegionCache& cache,
-    vtkShaderProgram* program);
+  const resmr::RegionDrawBuffers* Prepare(
+    std::size_t region, const resmr::RegionCache& cache, vtkShaderProgram* program);
   /// Draws the shown parts of a Prepare'd region piece by piece, setting `faceKind` for each;
   /// the triangles drawn.
-  std::size_t Draw(std::size_t region,
-    const std::array<resmr::DrawPart, 3>& parts,
-    vtkShaderProgram* program);
+  std::size_t Draw(std::size_t region, const std::array<resmr::DrawPart, 3>& parts, vtkShaderProgram* program);
 
   /// Frees every GL buffer.
   void ReleaseGraphicsResources();
@@ -74,9 +66,7 @@ private:
   RegionMap::iterator Find(std::size_t region, const resmr::RegionCache& cache);
   void Erase(RegionMap::iterator entry);
   /// Frees copies not in `order` until the next piece of `entry` fits `gpuShare`.
-  void ReleaseUnwanted(const std::vector<std::size_t>& order,
-    RegionMap::iterator entry,
-    std::size_t gpuShare);
+  void ReleaseUnwanted(const std::vector<std::size_t>& order, RegionMap::iterator entry, std::size_t gpuShare);
 
   RegionMap Regions;
   std::size_t GpuBytes = 0;

@@ -40,7 +40,7 @@ std::string FileStamp(const std::string& path)
     return {};
   }
   return std::to_string(status.st_ino) + ":" + std::to_string(status.st_size) + ":" +
-         std::to_string(status.st_mtim.tv_sec) + "." + std::to_string(status.st_mtim.tv_nsec);
+    std::to_string(status.st_mtim.tv_sec) + "." + std::to_string(status.st_mtim.tv_nsec);
 }
 } // namespace
 
@@ -59,16 +59,14 @@ std::string vtkMultiresolutionReader::PropertyPathFor() const
   }
   const std::string& name = this->FileName;
   const std::size_t dot = name.find_last_of('.');
-  const std::string stem = dot != std::string::npos && name.find('/', dot) == std::string::npos
-                             ? name.substr(0, dot)
-                             : name;
+  const std::string stem =
+    dot != std::string::npos && name.find('/', dot) == std::string::npos ? name.substr(0, dot) : name;
   const std::string beside = stem + ".resmrp";
   return IsFile(beside) ? beside : std::string();
 }
 
-int vtkMultiresolutionReader::RequestInformation(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkMultiresolutionReader::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
@@ -108,9 +106,8 @@ int vtkMultiresolutionReader::RequestInformation(vtkInformation*,
     }
     if (!this->StepDays.empty())
     {
-      outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(),
-        this->StepDays.data(),
-        static_cast<int>(this->StepDays.size()));
+      outInfo->Set(
+        vtkStreamingDemandDrivenPipeline::TIME_STEPS(), this->StepDays.data(), static_cast<int>(this->StepDays.size()));
       const double range[2] = { this->StepDays.front(), this->StepDays.back() };
       outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
     }
@@ -123,9 +120,7 @@ int vtkMultiresolutionReader::RequestInformation(vtkInformation*,
   return 1;
 }
 
-int vtkMultiresolutionReader::RequestData(vtkInformation*,
-  vtkInformationVector**,
-  vtkInformationVector* outputVector)
+int vtkMultiresolutionReader::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   vtkPolyData* output = vtkPolyData::GetData(outInfo);
@@ -136,7 +131,7 @@ int vtkMultiresolutionReader::RequestData(vtkInformation*,
   this->LastError.clear();
   // One piece: the descriptor is tiny, and the view reads the file wherever it renders.
   if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()) &&
-      outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()) > 0)
+    outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()) > 0)
   {
     return 1;
   }
@@ -144,11 +139,9 @@ int vtkMultiresolutionReader::RequestData(vtkInformation*,
   {
     const resmr::MultiresolutionFile geometry(this->FileName);
     // The model's box: the union of the roots' bounding volumes (x, y, depth), z = -depth.
-    double low[3] = { std::numeric_limits<double>::max(),
-      std::numeric_limits<double>::max(),
+    double low[3] = { std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
       std::numeric_limits<double>::max() };
-    double high[3] = { std::numeric_limits<double>::lowest(),
-      std::numeric_limits<double>::lowest(),
+    double high[3] = { std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest(),
       std::numeric_limits<double>::lowest() };
     for (const resmr::RegionRecord& region : geometry.Regions())
     {
@@ -168,8 +161,8 @@ int vtkMultiresolutionReader::RequestData(vtkInformation*,
     }
     // The box's corners in map coordinates (MAPAXES), as the grid readers place the grid.
     std::array<double, 6> transform;
-    const bool mapAxes = this->ApplyMapAxes && resmr::CornerPointGeometry::PlacementTransform(
-                                                 geometry.Header().map, transform);
+    const bool mapAxes =
+      this->ApplyMapAxes && resmr::CornerPointGeometry::PlacementTransform(geometry.Header().map, transform);
     vtkNew<vtkPoints> points;
     points->SetDataTypeToDouble();
     for (int corner = 0; corner < 8; ++corner)
@@ -203,13 +196,11 @@ int vtkMultiresolutionReader::RequestData(vtkInformation*,
       const resmr::PropertyFile properties(this->ResolvedPropertyFile);
       properties.CheckGeometry(geometry);
       // The step shown: the last whose time is not after the requested one.
-      if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()) &&
-          !this->StepDays.empty())
+      if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()) && !this->StepDays.empty())
       {
         const double time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
         step = this->GetStepNumber(time);
-        output->GetInformation()->Set(
-          vtkDataObject::DATA_TIME_STEP(), this->StepDays[this->StepIndex(time)]);
+        output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), this->StepDays[this->StepIndex(time)]);
       }
       // Each property's range at that step (static ones at every step): what Color By lists
       // and Rescale reads. Names without a table at this step get NaN.
@@ -247,8 +238,7 @@ int vtkMultiresolutionReader::RequestData(vtkInformation*,
 std::size_t vtkMultiresolutionReader::StepIndex(double time) const
 {
   const auto after = std::upper_bound(this->StepDays.begin(), this->StepDays.end(), time);
-  return static_cast<std::size_t>(
-    std::max<std::ptrdiff_t>(0, (after - this->StepDays.begin()) - 1));
+  return static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (after - this->StepDays.begin()) - 1));
 }
 
 int vtkMultiresolutionReader::GetStepNumber(double time) const

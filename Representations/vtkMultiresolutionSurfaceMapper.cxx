@@ -50,8 +50,7 @@ namespace
 {
 double ElapsedMs(std::chrono::steady_clock::time_point since)
 {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
-    .count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
 }
 
 /// GPU time of a frame, from a timer query read back a frame or more later (never waits).
@@ -300,17 +299,13 @@ void vtkMultiresolutionSurfaceMapper::ReleaseGraphicsResources(vtkWindow* window
 namespace
 {
 /// (.resmr path, .resmrp path, step, map axes) from the descriptor; false if it has none.
-bool ReadSource(vtkDataObject* input,
-  std::string& file,
-  std::string& properties,
-  int32_t& step,
-  bool& mapAxes,
+bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties, int32_t& step, bool& mapAxes,
   std::string& propertiesStamp)
 {
   vtkFieldData* fields = input ? input->GetFieldData() : nullptr;
-  vtkStringArray* source = fields ? vtkStringArray::SafeDownCast(fields->GetAbstractArray(
-                                      vtkMultiresolutionSurfaceMapper::SourceArrayName()))
-                                  : nullptr;
+  vtkStringArray* source = fields
+    ? vtkStringArray::SafeDownCast(fields->GetAbstractArray(vtkMultiresolutionSurfaceMapper::SourceArrayName()))
+    : nullptr;
   if (!source || source->GetNumberOfValues() < 3)
   {
     return false;
@@ -332,11 +327,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   {
     return; // hardware picking: the descriptor has no cells to name
   }
-  if (!ReadSource(this->GetInputDataObject(0, 0),
-        frame.filePath,
-        frame.propertyPath,
-        frame.step,
-        frame.applyMapAxes,
+  if (!ReadSource(this->GetInputDataObject(0, 0), frame.filePath, frame.propertyPath, frame.step, frame.applyMapAxes,
         frame.propertyStamp))
   {
     return; // an empty piece (another rank) or no file yet
@@ -390,9 +381,7 @@ void vtkMultiresolutionSurfaceMapper::BeginFrame(Frame& frame)
   // while frames come back to back the interval between them (resmr::MeasuredFrameMs).
   frame.rendererMs = frame.renderer->GetLastRenderTimeInSeconds() * 1000;
   frame.intervalMs =
-    in.HaveFrameStart
-      ? std::chrono::duration<double, std::milli>(frame.start - in.FrameStart).count()
-      : 0;
+    in.HaveFrameStart ? std::chrono::duration<double, std::milli>(frame.start - in.FrameStart).count() : 0;
   in.FrameStart = frame.start;
   in.HaveFrameStart = true;
   // The renderer's time and the interval both still hold the last frame.
@@ -427,7 +416,7 @@ bool vtkMultiresolutionSurfaceMapper::OpenFiles(Frame& frame)
   // (Re)open the files when the descriptor names others, or the property file was rewritten
   // (steps added to a run still being written).
   if (frame.filePath != in.FilePath || frame.propertyPath != in.PropertyPath ||
-      frame.propertyStamp != in.PropertyStamp || !in.Cache)
+    frame.propertyStamp != in.PropertyStamp || !in.Cache)
   {
     in.Close();
     in.ReleaseGpu();
@@ -442,8 +431,7 @@ bool vtkMultiresolutionSurfaceMapper::OpenFiles(Frame& frame)
         in.Properties = properties;
       }
       in.Selector.reset(new resmr::ViewSelector(*in.File));
-      in.Cache.reset(new resmr::RegionCache(
-        in.File, in.Properties, resmr::MainMemoryShare(this->MemoryBudgetMB)));
+      in.Cache.reset(new resmr::RegionCache(in.File, in.Properties, resmr::MainMemoryShare(this->MemoryBudgetMB)));
       in.FilePath = frame.filePath;
       in.PropertyPath = frame.propertyPath;
       in.PropertyStamp = frame.propertyStamp;
@@ -471,10 +459,8 @@ bool vtkMultiresolutionSurfaceMapper::SelectLayer(Frame& frame)
   // not ask for.
   if (this->Layer < 0 || this->Layer > header.dims[2])
   {
-    const std::string message = "Layer " + std::to_string(this->Layer) +
-                                " is out of range: " + in.FilePath + " has " +
-                                std::to_string(header.dims[2]) + " layers (1 to " +
-                                std::to_string(header.dims[2]) + "; 0 draws the whole model)";
+    const std::string message = "Layer " + std::to_string(this->Layer) + " is out of range: " + in.FilePath + " has " +
+      std::to_string(header.dims[2]) + " layers (1 to " + std::to_string(header.dims[2]) + "; 0 draws the whole model)";
     if (message != in.LayerError)
     {
       vtkWarningMacro(<< message);
@@ -492,10 +478,8 @@ bool vtkMultiresolutionSurfaceMapper::SelectLayer(Frame& frame)
 void vtkMultiresolutionSurfaceMapper::RequestProperty(Frame& frame)
 {
   Internals& in = *this->Internal;
-  const resmr::PropertyFile* properties =
-    this->ColorMode == PropertyColors ? in.Properties.get() : nullptr;
-  frame.property =
-    resmr::RequestFor(properties, this->ArrayName ? this->ArrayName : "", frame.step, frame.layer);
+  const resmr::PropertyFile* properties = this->ColorMode == PropertyColors ? in.Properties.get() : nullptr;
+  frame.property = resmr::RequestFor(properties, this->ArrayName ? this->ArrayName : "", frame.step, frame.layer);
   if (frame.property.wanted)
   {
     in.Cache->RequestProperty(frame.property.name, frame.property.step, frame.layer);
@@ -509,8 +493,7 @@ void vtkMultiresolutionSurfaceMapper::ComputeView(Frame& frame)
   // projection, in double (map coordinates are large).
   resmr::Matrix4 mapAxes = resmr::IdentityMatrix();
   std::array<double, 6> map;
-  if (frame.applyMapAxes &&
-      resmr::CornerPointGeometry::PlacementTransform(in.File->Header().map, map))
+  if (frame.applyMapAxes && resmr::CornerPointGeometry::PlacementTransform(in.File->Header().map, map))
   {
     mapAxes = resmr::PlacementMatrix(map);
   }
@@ -578,8 +561,7 @@ void vtkMultiresolutionSurfaceMapper::SelectRegions(Frame& frame)
   if (in.HavePreviousView)
   {
     const auto all = [](std::size_t) { return true; };
-    predicted =
-      in.Selector->Select(resmr::PredictNextView(in.PreviousView, frame.view), all).wanted;
+    predicted = in.Selector->Select(resmr::PredictNextView(in.PreviousView, frame.view), all).wanted;
   }
   cache.Request(frame.selection.wanted, predicted);
   // The roots stand in for everything, so a frame missing them (the first of a file or a
@@ -593,12 +575,11 @@ void vtkMultiresolutionSurfaceMapper::SelectRegions(Frame& frame)
   // Still renders (scripts, screenshots) wait for the wanted set, as long as they asked.
   if (this->WaitForDetailMs > 0)
   {
-    const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::milliseconds(this->WaitForDetailMs);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(this->WaitForDetailMs);
     while (cache.Pending() && std::chrono::steady_clock::now() < deadline)
     {
-      cache.WaitIdle(std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now()));
+      cache.WaitIdle(
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()));
       frame.selection = in.Selector->Select(frame.view, resident);
       cache.Request(frame.selection.wanted, predicted);
     }
@@ -635,8 +616,7 @@ void vtkMultiresolutionSurfaceMapper::StreamTables(Frame& frame)
   std::size_t budget = resmr::TableBytesPerFrame;
   frame.tablesStart = std::chrono::steady_clock::now();
   in.Tables.StreamHash(frame.window, *in.Cache, budget, !frame.bounded);
-  std::shared_ptr<const resmr::PropertyTableData> loaded =
-    frame.property.wanted ? in.Cache->Property() : nullptr;
+  std::shared_ptr<const resmr::PropertyTableData> loaded = frame.property.wanted ? in.Cache->Property() : nullptr;
   if (!resmr::IsRequested(loaded.get(), frame.property))
   {
     loaded.reset(); // still the previous property
@@ -663,14 +643,9 @@ void vtkMultiresolutionSurfaceMapper::UploadMeshes(Frame& frame)
   in.Pacer.Spend(frame.tableBytes, ElapsedMs(frame.tablesStart));
   std::vector<std::size_t> order = in.Selector->Roots();
   order.insert(order.end(), frame.selection.wanted.begin(), frame.selection.wanted.end());
-  in.UploadsDeferred = in.Regions.Upload(*in.Cache,
-                         order,
-                         in.Selector->Roots().size(),
-                         frame.bounded,
-                         in.Pacer,
-                         resmr::GpuShare(this->MemoryBudgetMB),
-                         frame.program) ||
-                       in.Tables.Busy();
+  in.UploadsDeferred = in.Regions.Upload(*in.Cache, order, in.Selector->Roots().size(), frame.bounded, in.Pacer,
+                         resmr::GpuShare(this->MemoryBudgetMB), frame.program) ||
+    in.Tables.Busy();
   // Drawn: what is on the GPU, ancestors standing in for the rest.
   const auto onGpu = [&in](std::size_t region) { return in.Regions.Ready(region); };
   frame.selection = in.Selector->Select(frame.view, onGpu);
@@ -689,10 +664,8 @@ void vtkMultiresolutionSurfaceMapper::SetUniforms(Frame& frame)
   program->SetUniformMatrix4x4("modelToView", packed.data());
   std::array<float, 9> normal = resmr::NormalMatrix(frame.modelToView);
   program->SetUniformMatrix3x3("normalToView", normal.data());
-  glUniform3i(glGetUniformLocation(static_cast<GLuint>(program->GetHandle()), "gridDims"),
-    int(header.dims[0]),
-    int(header.dims[1]),
-    int(header.dims[2]));
+  glUniform3i(glGetUniformLocation(static_cast<GLuint>(program->GetHandle()), "gridDims"), int(header.dims[0]),
+    int(header.dims[1]), int(header.dims[2]));
   in.Tables.Bind(program, header);
   program->SetUniformi("layer", frame.layer);
   vtkProperty* look = frame.actor->GetProperty();
@@ -714,13 +687,10 @@ void vtkMultiresolutionSurfaceMapper::SetUniforms(Frame& frame)
   program->SetUniform3f("solidColor", look->GetDiffuseColor());
   program->SetUniformf("gridLineWidth", static_cast<float>(this->GridLineWidth));
   program->SetUniform3f("gridLineColor", this->GridLineColor);
-  program->SetUniformf(
-    "ambient", static_cast<float>(look->GetAmbient() + (look->GetLighting() ? 0 : 1)));
+  program->SetUniformf("ambient", static_cast<float>(look->GetAmbient() + (look->GetLighting() ? 0 : 1)));
   program->SetUniformf("diffuse", static_cast<float>(look->GetLighting() ? look->GetDiffuse() : 0));
-  program->SetUniformf(
-    "specular", static_cast<float>(look->GetLighting() ? look->GetSpecular() : 0));
-  program->SetUniformf(
-    "specularPower", static_cast<float>(std::max(1.0, look->GetSpecularPower())));
+  program->SetUniformf("specular", static_cast<float>(look->GetLighting() ? look->GetSpecular() : 0));
+  program->SetUniformf("specularPower", static_cast<float>(std::max(1.0, look->GetSpecularPower())));
 }
 
 void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
@@ -748,14 +718,13 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
 
   for (const resmr::DrawnRegion& drawn : frame.selection.drawn)
   {
-    const resmr::RegionDrawBuffers* buffers =
-      in.Regions.Prepare(drawn.region, *in.Cache, frame.program);
+    const resmr::RegionDrawBuffers* buffers = in.Regions.Prepare(drawn.region, *in.Cache, frame.program);
     if (!buffers || buffers->indices.empty())
     {
       continue;
     }
-    const std::array<resmr::DrawPart, 3> parts = resmr::PartsToDraw(
-      *buffers, drawn, frame.layer >= 0, in.File->Regions()[drawn.region], frame.view);
+    const std::array<resmr::DrawPart, 3> parts =
+      resmr::PartsToDraw(*buffers, drawn, frame.layer >= 0, in.File->Regions()[drawn.region], frame.view);
     in.Triangles += static_cast<vtkIdType>(in.Regions.Draw(drawn.region, parts, frame.program));
     ++in.Drawn;
   }
@@ -776,20 +745,17 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
   // (tables, the property, wanted meshes), and the next frame will copy. Without it a render
   // could report nothing pending and leave the GUI (and scripts waiting on LoadsPending) with
   // the picture before the property arrived.
-  const auto arrivedLate = [&]()
-  {
+  const auto arrivedLate = [&]() {
     if (!in.Tables.HashReady() && cache.Tables())
     {
       return true;
     }
-    const std::shared_ptr<const resmr::PropertyTableData> now =
-      frame.property.wanted ? cache.Property() : nullptr;
+    const std::shared_ptr<const resmr::PropertyTableData> now = frame.property.wanted ? cache.Property() : nullptr;
     if (now && now != in.Tables.UploadedProperty() && resmr::IsRequested(now.get(), frame.property))
     {
       return true;
     }
-    return std::any_of(frame.selection.wanted.begin(),
-      frame.selection.wanted.end(),
+    return std::any_of(frame.selection.wanted.begin(), frame.selection.wanted.end(),
       [&](std::size_t region) { return !in.Regions.Ready(region) && cache.IsResident(region); });
   };
   in.Pending = cache.Pending() || in.UploadsDeferred || arrivedLate();
@@ -801,11 +767,8 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
     in.Reported = loadError;
     vtkErrorMacro(<< loadError);
   }
-  vtkLogF(TRACE,
-    "multiresolution surface: %d regions, %lld triangles at %.2f px",
-    in.Drawn,
-    static_cast<long long>(in.Triangles),
-    in.Tolerance);
+  vtkLogF(TRACE, "multiresolution surface: %d regions, %lld triangles at %.2f px", in.Drawn,
+    static_cast<long long>(in.Triangles), in.Tolerance);
   in.FrameMs = ElapsedMs(frame.start) + in.Timer.Ms();
   if (this->TargetFrameRate > 0)
   {

@@ -42,9 +42,8 @@ int vtkMultiresolutionSurfaceRepresentation::FillInputPortInformation(int, vtkIn
   return 1;
 }
 
-int vtkMultiresolutionSurfaceRepresentation::RequestData(vtkInformation* request,
-  vtkInformationVector** inputVector,
-  vtkInformationVector* outputVector)
+int vtkMultiresolutionSurfaceRepresentation::RequestData(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   this->Delivered = vtkSmartPointer<vtkPolyData>::New();
   this->Error.clear();
@@ -54,20 +53,17 @@ int vtkMultiresolutionSurfaceRepresentation::RequestData(vtkInformation* request
     // The reader upstream (past ParaView's post filter) names the files; the step is the one
     // the descriptor was made for, so the animation cache keeps the right step with it.
     vtkMultiresolutionReader* reader = nullptr;
-    vtkAlgorithm* upstream =
-      this->GetNumberOfInputConnections(0) ? this->GetInputAlgorithm(0, 0) : nullptr;
+    vtkAlgorithm* upstream = this->GetNumberOfInputConnections(0) ? this->GetInputAlgorithm(0, 0) : nullptr;
     for (int depth = 0; upstream && !reader && depth < 8; ++depth)
     {
       reader = vtkMultiresolutionReader::SafeDownCast(upstream);
-      upstream =
-        upstream->GetNumberOfInputPorts() > 0 && upstream->GetNumberOfInputConnections(0) > 0
-          ? upstream->GetInputAlgorithm(0, 0)
-          : nullptr;
+      upstream = upstream->GetNumberOfInputPorts() > 0 && upstream->GetNumberOfInputConnections(0) > 0
+        ? upstream->GetInputAlgorithm(0, 0)
+        : nullptr;
     }
     if (!reader)
     {
-      this->Error =
-        "Multiresolution Surface needs a .resmr file (a Multiresolution Reservoir source) as input";
+      this->Error = "Multiresolution Surface needs a .resmr file (a Multiresolution Reservoir source) as input";
       vtkErrorMacro(<< this->Error);
     }
     else if (input && input->GetNumberOfPoints() > 0)
@@ -108,9 +104,8 @@ int vtkMultiresolutionSurfaceRepresentation::RequestData(vtkInformation* request
   return this->Superclass::RequestData(request, inputVector, outputVector);
 }
 
-int vtkMultiresolutionSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKey* request,
-  vtkInformation* inInfo,
-  vtkInformation* outInfo)
+int vtkMultiresolutionSurfaceRepresentation::ProcessViewRequest(
+  vtkInformationRequestKey* request, vtkInformation* inInfo, vtkInformation* outInfo)
 {
   if (!this->Superclass::ProcessViewRequest(request, inInfo, outInfo))
   {
@@ -170,11 +165,8 @@ void vtkMultiresolutionSurfaceRepresentation::SetVisibility(bool visible)
   this->Actor->SetVisibility(visible ? 1 : 0);
 }
 
-void vtkMultiresolutionSurfaceRepresentation::SetInputArrayToProcess(int index,
-  int port,
-  int connection,
-  int fieldAssociation,
-  const char* name)
+void vtkMultiresolutionSurfaceRepresentation::SetInputArrayToProcess(
+  int index, int port, int connection, int fieldAssociation, const char* name)
 {
   this->Superclass::SetInputArrayToProcess(index, port, connection, fieldAssociation, name);
   // Any association: the descriptor's arrays stand for the file's properties.

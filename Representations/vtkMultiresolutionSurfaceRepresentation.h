@@ -22,47 +22,32 @@ class vtkMultiresolutionSurfaceMapper;
 class vtkPolyData;
 class vtkScalarsToColors;
 
-class RESMRREPRESENTATIONS_EXPORT vtkMultiresolutionSurfaceRepresentation
-  : public vtkPVDataRepresentation
+class RESMRREPRESENTATIONS_EXPORT vtkMultiresolutionSurfaceRepresentation : public vtkPVDataRepresentation
 {
 public:
   static vtkMultiresolutionSurfaceRepresentation* New();
   vtkTypeMacro(vtkMultiresolutionSurfaceRepresentation, vtkPVDataRepresentation);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
-  int ProcessViewRequest(vtkInformationRequestKey* request,
-    vtkInformation* inInfo,
-    vtkInformation* outInfo) override;
+  int ProcessViewRequest(vtkInformationRequestKey* request, vtkInformation* inInfo, vtkInformation* outInfo) override;
   void SetVisibility(bool visible) override;
 
   ///@{
   /// Colouring (ColorArrayName, LookupTable): a point or cell array name picks the property.
-  void SetInputArrayToProcess(int index,
-    int port,
-    int connection,
-    int fieldAssociation,
-    const char* name) override;
-  void SetInputArrayToProcess(int index,
-    int port,
-    int connection,
-    int fieldAssociation,
-    int fieldAttributeType) override
+  void SetInputArrayToProcess(int index, int port, int connection, int fieldAssociation, const char* name) override;
+  void SetInputArrayToProcess(
+    int index, int port, int connection, int fieldAssociation, int fieldAttributeType) override
   {
-    this->Superclass::SetInputArrayToProcess(
-      index, port, connection, fieldAssociation, fieldAttributeType);
+    this->Superclass::SetInputArrayToProcess(index, port, connection, fieldAssociation, fieldAttributeType);
   }
   void SetInputArrayToProcess(int index, vtkInformation* info) override
   {
     this->Superclass::SetInputArrayToProcess(index, info);
   }
-  void SetInputArrayToProcess(int index,
-    int port,
-    int connection,
-    const char* fieldAssociation,
-    const char* attributeTypeOrName) override
+  void SetInputArrayToProcess(
+    int index, int port, int connection, const char* fieldAssociation, const char* attributeTypeOrName) override
   {
-    this->Superclass::SetInputArrayToProcess(
-      index, port, connection, fieldAssociation, attributeTypeOrName);
+    this->Superclass::SetInputArrayToProcess(index, port, connection, fieldAssociation, attributeTypeOrName);
   }
   void SetLookupTable(vtkScalarsToColors* table);
   ///@}
@@ -115,9 +100,8 @@ protected:
   ~vtkMultiresolutionSurfaceRepresentation() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
-  int RequestData(vtkInformation* request,
-    vtkInformationVector** inputVector,
-    vtkInformationVector* outputVector) override;
+  int RequestData(
+    vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector) override;
   bool AddToView(vtkView* view) override;
   bool RemoveFromView(vtkView* view) override;
 

@@ -26,17 +26,9 @@ public:
   /// alive until the copy ends. Allocating is most of the cost on drivers that zero new
   /// storage (llvmpipe), so a property's tables are copied turn about into two textures. True
   /// if it allocated.
-  bool Start(vtkOpenGLRenderWindow* window,
-    const std::array<uint32_t, 3>& sides,
-    int components,
-    int vtkType,
-    unsigned int internalFormat,
-    unsigned int format,
-    unsigned int type,
-    std::size_t texelBytes,
-    const void* data,
-    std::shared_ptr<const void> owner,
-    vtkSmartPointer<vtkTextureObject> spare = nullptr)
+  bool Start(vtkOpenGLRenderWindow* window, const std::array<uint32_t, 3>& sides, int components, int vtkType,
+    unsigned int internalFormat, unsigned int format, unsigned int type, std::size_t texelBytes, const void* data,
+    std::shared_ptr<const void> owner, vtkSmartPointer<vtkTextureObject> spare = nullptr)
   {
     this->Sides = sides;
     this->Format = format;
@@ -61,8 +53,7 @@ public:
     this->Texture->SetDataType(type);
     this->Texture->SetMinificationFilter(vtkTextureObject::Nearest);
     this->Texture->SetMagnificationFilter(vtkTextureObject::Nearest);
-    this->Texture->Create3DFromRaw(
-      sides[0], sides[1], sides[2], components, vtkType, nullptr); // storage only
+    this->Texture->Create3DFromRaw(sides[0], sides[1], sides[2], components, vtkType, nullptr); // storage only
     return true;
   }
 
@@ -70,7 +61,7 @@ public:
   static bool Fits(vtkTextureObject* texture, const std::array<uint32_t, 3>& sides)
   {
     return texture && texture->GetWidth() == sides[0] && texture->GetHeight() == sides[1] &&
-           texture->GetDepth() == sides[2];
+      texture->GetDepth() == sides[2];
   }
 
   bool Busy() const { return this->Texture != nullptr; }
@@ -87,16 +78,8 @@ public:
     {
       state->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
       this->Texture->Activate();
-      glTexSubImage3D(GL_TEXTURE_3D,
-        0,
-        0,
-        0,
-        static_cast<GLint>(this->NextSlice),
-        static_cast<GLsizei>(this->Sides[0]),
-        static_cast<GLsizei>(this->Sides[1]),
-        static_cast<GLsizei>(slices),
-        this->Format,
-        this->Type,
+      glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, static_cast<GLint>(this->NextSlice), static_cast<GLsizei>(this->Sides[0]),
+        static_cast<GLsizei>(this->Sides[1]), static_cast<GLsizei>(slices), this->Format, this->Type,
         this->Data + this->NextSlice * this->SliceBytes);
       this->Texture->Deactivate();
       this->NextSlice += slices;
@@ -136,13 +119,8 @@ private:
 
 namespace
 {
-void UploadInteger3D(vtkTextureObject* texture,
-  vtkOpenGLRenderWindow* window,
-  const std::array<uint32_t, 3>& sides,
-  int components,
-  unsigned int internalFormat,
-  unsigned int format,
-  const void* data)
+void UploadInteger3D(vtkTextureObject* texture, vtkOpenGLRenderWindow* window, const std::array<uint32_t, 3>& sides,
+  int components, unsigned int internalFormat, unsigned int format, const void* data)
 {
   texture->SetContext(window);
   texture->ResetFormatAndType();
@@ -151,8 +129,7 @@ void UploadInteger3D(vtkTextureObject* texture,
   texture->SetDataType(GL_UNSIGNED_SHORT);
   texture->SetMinificationFilter(vtkTextureObject::Nearest);
   texture->SetMagnificationFilter(vtkTextureObject::Nearest);
-  texture->Create3DFromRaw(
-    sides[0], sides[1], sides[2], components, VTK_UNSIGNED_SHORT, const_cast<void*>(data));
+  texture->Create3DFromRaw(sides[0], sides[1], sides[2], components, VTK_UNSIGNED_SHORT, const_cast<void*>(data));
 }
 } // namespace
 
@@ -170,10 +147,8 @@ bool vtkMultiresolutionTableTextures::Busy() const
   return this->OffsetUpload->Busy() || this->PropertyUpload->Busy();
 }
 
-void vtkMultiresolutionTableTextures::StreamHash(vtkOpenGLRenderWindow* window,
-  const resmr::RegionCache& cache,
-  std::size_t& budget,
-  bool unbounded)
+void vtkMultiresolutionTableTextures::StreamHash(
+  vtkOpenGLRenderWindow* window, const resmr::RegionCache& cache, std::size_t& budget, bool unbounded)
 {
   // Until the hash is in, the whole model is drawn in the solid colour, lit by facet normals,
   // with 1-texel stand-ins for the samplers.
@@ -195,46 +170,22 @@ void vtkMultiresolutionTableTextures::StreamHash(vtkOpenGLRenderWindow* window,
   {
     const resmr::PerfectSpatialHash& hash = tables->hash;
     this->AllocatedThisFrame = true;
-    this->OffsetUpload->Start(window,
-      hash.offsetSides,
-      3,
-      VTK_UNSIGNED_SHORT,
-      GL_RGB16UI,
-      GL_RGB_INTEGER,
-      GL_UNSIGNED_SHORT,
-      6,
-      hash.offsets.data(),
-      tables);
+    this->OffsetUpload->Start(window, hash.offsetSides, 3, VTK_UNSIGNED_SHORT, GL_RGB16UI, GL_RGB_INTEGER,
+      GL_UNSIGNED_SHORT, 6, hash.offsets.data(), tables);
     if (tables->normals.size() == hash.TableSize() * 4)
     {
-      this->NormalUpload->Start(window,
-        hash.tableSides,
-        2,
-        VTK_UNSIGNED_SHORT,
-        GL_RG16UI,
-        GL_RG_INTEGER,
-        GL_UNSIGNED_SHORT,
-        4,
-        tables->normals.data(),
-        tables);
+      this->NormalUpload->Start(window, hash.tableSides, 2, VTK_UNSIGNED_SHORT, GL_RG16UI, GL_RG_INTEGER,
+        GL_UNSIGNED_SHORT, 4, tables->normals.data(), tables);
     }
     else
     {
       auto up = std::make_shared<std::vector<uint16_t>>(hash.TableSize() * 2, 0); // code 0 is +z
-      this->NormalUpload->Start(window,
-        hash.tableSides,
-        2,
-        VTK_UNSIGNED_SHORT,
-        GL_RG16UI,
-        GL_RG_INTEGER,
-        GL_UNSIGNED_SHORT,
-        4,
-        up->data(),
-        up);
+      this->NormalUpload->Start(
+        window, hash.tableSides, 2, VTK_UNSIGNED_SHORT, GL_RG16UI, GL_RG_INTEGER, GL_UNSIGNED_SHORT, 4, up->data(), up);
     }
   }
   if (this->OffsetUpload->Busy() && this->OffsetUpload->Continue(state, budget, unbounded) &&
-      this->NormalUpload->Continue(state, budget, unbounded))
+    this->NormalUpload->Continue(state, budget, unbounded))
   {
     this->OffsetTexture->ReleaseGraphicsResources(window);
     this->NormalTexture->ReleaseGraphicsResources(window);
@@ -245,10 +196,8 @@ void vtkMultiresolutionTableTextures::StreamHash(vtkOpenGLRenderWindow* window,
 }
 
 void vtkMultiresolutionTableTextures::StreamProperty(vtkOpenGLRenderWindow* window,
-  const std::shared_ptr<const resmr::PropertyTableData>& loaded,
-  const resmr::MultiresolutionHeader& header,
-  std::size_t& budget,
-  bool unbounded)
+  const std::shared_ptr<const resmr::PropertyTableData>& loaded, const resmr::MultiresolutionHeader& header,
+  std::size_t& budget, bool unbounded)
 {
   vtkOpenGLState* state = window->GetState();
   if (this->PropertyTexture->GetHandle() == 0)
@@ -290,26 +239,14 @@ void vtkMultiresolutionTableTextures::StreamProperty(vtkOpenGLRenderWindow* wind
     this->LayerPropertyTexture->SetMinificationFilter(vtkTextureObject::Nearest);
     this->LayerPropertyTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
     this->LayerPropertyTexture->Create2DFromRaw(static_cast<unsigned int>(header.dims[0]),
-      static_cast<unsigned int>(header.dims[1]),
-      1,
-      VTK_FLOAT,
-      const_cast<float*>(loaded->values.data()));
+      static_cast<unsigned int>(header.dims[1]), 1, VTK_FLOAT, const_cast<float*>(loaded->values.data()));
     this->Uploaded = loaded;
     return;
   }
   if (!this->PropertyUpload->Busy())
   {
-    this->AllocatedThisFrame = this->PropertyUpload->Start(window,
-      header.hashTableSides,
-      1,
-      VTK_FLOAT,
-      0,
-      GL_RED,
-      GL_FLOAT,
-      sizeof(float),
-      loaded->values.data(),
-      loaded,
-      this->SparePropertyTexture);
+    this->AllocatedThisFrame = this->PropertyUpload->Start(window, header.hashTableSides, 1, VTK_FLOAT, 0, GL_RED,
+      GL_FLOAT, sizeof(float), loaded->values.data(), loaded, this->SparePropertyTexture);
     this->SparePropertyTexture = nullptr; // taken (a spare always has the table's sides)
   }
   if (this->PropertyUpload->Continue(state, budget, unbounded))
@@ -328,8 +265,7 @@ void vtkMultiresolutionTableTextures::StreamProperty(vtkOpenGLRenderWindow* wind
   }
 }
 
-void vtkMultiresolutionTableTextures::UpdateColorMap(vtkOpenGLRenderWindow* window,
-  vtkScalarsToColors* table)
+void vtkMultiresolutionTableTextures::UpdateColorMap(vtkOpenGLRenderWindow* window, vtkScalarsToColors* table)
 {
   if (table == this->ColorTable && table->GetMTime() == this->ColorTableTime)
   {
@@ -344,10 +280,8 @@ void vtkMultiresolutionTableTextures::UpdateColorMap(vtkOpenGLRenderWindow* wind
   for (int i = 0; i < size; ++i)
   {
     const double t = (i + 0.5) / size;
-    values[i] =
-      logScale
-        ? std::pow(10.0, std::log10(range[0]) + t * (std::log10(range[1]) - std::log10(range[0])))
-        : range[0] + t * (range[1] - range[0]);
+    values[i] = logScale ? std::pow(10.0, std::log10(range[0]) + t * (std::log10(range[1]) - std::log10(range[0])))
+                         : range[0] + t * (range[1] - range[0]);
   }
   std::vector<unsigned char> rgba(size * 4);
   for (int i = 0; i < size; ++i)
@@ -365,12 +299,12 @@ void vtkMultiresolutionTableTextures::UpdateColorMap(vtkOpenGLRenderWindow* wind
   this->ColorTableTime = table->GetMTime();
 }
 
-void vtkMultiresolutionTableTextures::Bind(vtkShaderProgram* program,
-  const resmr::MultiresolutionHeader& header)
+void vtkMultiresolutionTableTextures::Bind(vtkShaderProgram* program, const resmr::MultiresolutionHeader& header)
 {
   const GLuint handle = static_cast<GLuint>(program->GetHandle());
-  const auto uniform3i = [handle](const char* name, const std::array<uint32_t, 3>& sides)
-  { glUniform3i(glGetUniformLocation(handle, name), int(sides[0]), int(sides[1]), int(sides[2])); };
+  const auto uniform3i = [handle](const char* name, const std::array<uint32_t, 3>& sides) {
+    glUniform3i(glGetUniformLocation(handle, name), int(sides[0]), int(sides[1]), int(sides[2]));
+  };
   const std::array<uint32_t, 3> one{ 1, 1, 1 };
   uniform3i("tableSides", this->HashUploaded ? header.hashTableSides : one);
   uniform3i("offsetSides", this->HashUploaded ? header.hashOffsetSides : one);

@@ -42,27 +42,18 @@ public:
   /// Streams the hash's offsets and normals once the loader has read them (`cache.Tables()`),
   /// spending `budget` bytes (all of it when `unbounded`); a frame that allocates their
   /// textures says so in Allocated().
-  void StreamHash(vtkOpenGLRenderWindow* window,
-    const resmr::RegionCache& cache,
-    std::size_t& budget,
-    bool unbounded);
+  void StreamHash(vtkOpenGLRenderWindow* window, const resmr::RegionCache& cache, std::size_t& budget, bool unbounded);
   /// Streams `loaded` (the requested property table, or null) the same way: a layer's 2D
   /// table at once, a packed table a slab at a time over the texture no longer drawn.
-  void StreamProperty(vtkOpenGLRenderWindow* window,
-    const std::shared_ptr<const resmr::PropertyTableData>& loaded,
-    const resmr::MultiresolutionHeader& header,
-    std::size_t& budget,
-    bool unbounded);
+  void StreamProperty(vtkOpenGLRenderWindow* window, const std::shared_ptr<const resmr::PropertyTableData>& loaded,
+    const resmr::MultiresolutionHeader& header, std::size_t& budget, bool unbounded);
   /// Refills the colour map when the lookup table changed.
   void UpdateColorMap(vtkOpenGLRenderWindow* window, vtkScalarsToColors* table);
 
   /// The hash tables are complete on the GPU (cell lookups can be drawn).
   bool HashReady() const { return this->HashUploaded; }
   /// The property table on the GPU (null: none yet).
-  const std::shared_ptr<const resmr::PropertyTableData>& UploadedProperty() const
-  {
-    return this->Uploaded;
-  }
+  const std::shared_ptr<const resmr::PropertyTableData>& UploadedProperty() const { return this->Uploaded; }
   /// A table is still being streamed.
   bool Busy() const;
   /// The colour map's range (the lookup table's when last filled).

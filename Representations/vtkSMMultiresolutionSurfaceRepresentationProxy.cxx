@@ -10,13 +10,10 @@
 
 vtkStandardNewMacro(vtkSMMultiresolutionSurfaceRepresentationProxy);
 
-vtkSMMultiresolutionSurfaceRepresentationProxy::vtkSMMultiresolutionSurfaceRepresentationProxy() =
-  default;
-vtkSMMultiresolutionSurfaceRepresentationProxy::~vtkSMMultiresolutionSurfaceRepresentationProxy() =
-  default;
+vtkSMMultiresolutionSurfaceRepresentationProxy::vtkSMMultiresolutionSurfaceRepresentationProxy() = default;
+vtkSMMultiresolutionSurfaceRepresentationProxy::~vtkSMMultiresolutionSurfaceRepresentationProxy() = default;
 
-void vtkSMMultiresolutionSurfaceRepresentationProxy::UpdatePropertyInformationInternal(
-  vtkSMProperty* property)
+void vtkSMMultiresolutionSurfaceRepresentationProxy::UpdatePropertyInformationInternal(vtkSMProperty* property)
 {
   this->CreateVTKObjects();
   vtkSMSession* session = this->GetSession();

@@ -14,8 +14,7 @@
 #include "ResMRRepresentationsModule.h"
 #include "vtkSMRepresentationProxy.h"
 
-class RESMRREPRESENTATIONS_EXPORT vtkSMMultiresolutionSurfaceRepresentationProxy
-  : public vtkSMRepresentationProxy
+class RESMRREPRESENTATIONS_EXPORT vtkSMMultiresolutionSurfaceRepresentationProxy : public vtkSMRepresentationProxy
 {
 public:
   static vtkSMMultiresolutionSurfaceRepresentationProxy* New();
@@ -29,8 +28,7 @@ protected:
   void UpdatePropertyInformationInternal(vtkSMProperty* property = nullptr) override;
 
 private:
-  vtkSMMultiresolutionSurfaceRepresentationProxy(
-    const vtkSMMultiresolutionSurfaceRepresentationProxy&) = delete;
+  vtkSMMultiresolutionSurfaceRepresentationProxy(const vtkSMMultiresolutionSurfaceRepresentationProxy&) = delete;
   void operator=(const vtkSMMultiresolutionSurfaceRepresentationProxy&) = delete;
 };
 

@@ -26,8 +26,7 @@ struct Gap
   int thread = 0;
 };
 
-double Seconds(std::chrono::steady_clock::time_point t,
-  std::chrono::steady_clock::time_point origin)
+double Seconds(std::chrono::steady_clock::time_point t, std::chrono::steady_clock::time_point origin)
 {
   return std::chrono::duration<double>(t - origin).count();
 }
@@ -41,8 +40,7 @@ int main(int argc, char** argv)
     return 2;
   }
   const double seconds = std::atof(argv[1]);
-  const int threads =
-    argc > 2 ? std::atoi(argv[2]) : static_cast<int>(std::thread::hardware_concurrency());
+  const int threads = argc > 2 ? std::atoi(argv[2]) : static_cast<int>(std::thread::hardware_concurrency());
   const double thresholdMs = argc > 3 ? std::atof(argv[3]) : 2.0;
   if (!(seconds > 0) || threads < 1 || !(thresholdMs > 0))
   {
@@ -54,25 +52,23 @@ int main(int argc, char** argv)
   std::vector<std::thread> workers;
   for (int t = 0; t < threads; ++t)
   {
-    workers.emplace_back(
-      [&, t]
+    workers.emplace_back([&, t] {
+      auto last = std::chrono::steady_clock::now();
+      for (;;)
       {
-        auto last = std::chrono::steady_clock::now();
-        for (;;)
+        const auto now = std::chrono::steady_clock::now();
+        const double ms = std::chrono::duration<double, std::milli>(now - last).count();
+        if (ms > thresholdMs && Seconds(last, origin) > 0.5)
         {
-          const auto now = std::chrono::steady_clock::now();
-          const double ms = std::chrono::duration<double, std::milli>(now - last).count();
-          if (ms > thresholdMs && Seconds(last, origin) > 0.5)
-          {
-            found[static_cast<std::size_t>(t)].push_back({ Seconds(last, origin), ms, t });
-          }
-          last = now;
-          if (Seconds(now, origin) > seconds)
-          {
-            break;
-          }
+          found[static_cast<std::size_t>(t)].push_back({ Seconds(last, origin), ms, t });
         }
-      });
+        last = now;
+        if (Seconds(now, origin) > seconds)
+        {
+          break;
+        }
+      }
+    });
   }
   for (auto& w : workers)
   {
@@ -104,23 +100,14 @@ int main(int argc, char** argv)
     ++b.gaps;
   }
 
-  std::printf("{\"seconds\": %.1f, \"threads\": %d, \"threshold_ms\": %.1f, \"gaps\": %zu,\n",
-    seconds,
-    threads,
-    thresholdMs,
-    gaps.size());
+  std::printf("{\"seconds\": %.1f, \"threads\": %d, \"threshold_ms\": %.1f, \"gaps\": %zu,\n", seconds, threads,
+    thresholdMs, gaps.size());
   std::printf(" \"bursts\": [");
   for (std::size_t n = 0; n < bursts.size(); ++n)
   {
     const Burst& b = bursts[n];
-    std::printf("%s\n  {\"start_s\": %.3f, \"span_ms\": %.1f, \"gaps\": %d, \"lost_ms\": %.1f, "
-                "\"longest_ms\": %.1f}",
-      n ? "," : "",
-      b.start,
-      1000 * (b.end - b.start),
-      b.gaps,
-      b.lostMs,
-      b.longestMs);
+    std::printf("%s\n  {\"start_s\": %.3f, \"span_ms\": %.1f, \"gaps\": %d, \"lost_ms\": %.1f, \"longest_ms\": %.1f}",
+      n ? "," : "", b.start, 1000 * (b.end - b.start), b.gaps, b.lostMs, b.longestMs);
   }
   std::printf("],\n \"large_burst_intervals_s\": [");
   double previous = -1;

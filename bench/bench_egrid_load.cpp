@@ -139,9 +139,7 @@ double ReadFilesFresh(const std::vector<std::string>& paths, bool huge)
     char* data = static_cast<char*>(memory);
     std::size_t done = 0;
     ssize_t got = 0;
-    while (
-      done < size &&
-      (got = read(fd, data + done, std::min<std::size_t>(size - done, std::size_t(16) << 20))) > 0)
+    while (done < size && (got = read(fd, data + done, std::min<std::size_t>(size - done, std::size_t(16) << 20))) > 0)
     {
       done += static_cast<std::size_t>(got);
     }
@@ -189,11 +187,8 @@ struct Loaded
 };
 
 /// Bytes in the file of the step's whole record range and of the `names` records in it.
-void StepBytes(const resmr::EclipseResults& results,
-  std::size_t step,
-  const std::vector<std::string>& names,
-  long long& stepBytes,
-  long long& arrayBytes)
+void StepBytes(const resmr::EclipseResults& results, std::size_t step, const std::vector<std::string>& names,
+  long long& stepBytes, long long& arrayBytes)
 {
   const resmr::EclipseReportStep& info = results.Steps()[step];
   const resmr::EclipseKeywordFile file(results.RestartPaths()[info.file]);
@@ -250,10 +245,7 @@ void MeasureSequentialReads(const std::vector<std::string>& files, double loadBy
     }
     std::printf("{\"kind\": \"seqread\", \"chunk_bytes\": %zu, \"bytes\": %.0f, "
                 "\"seconds\": %.6f, \"mb_per_s\": %.1f}\n",
-      chunk,
-      loadBytes,
-      best,
-      loadBytes / best / 1e6);
+      chunk, loadBytes, best, loadBytes / best / 1e6);
   }
   for (const bool huge : { false, true })
   {
@@ -264,20 +256,13 @@ void MeasureSequentialReads(const std::vector<std::string>& files, double loadBy
     }
     std::printf("{\"kind\": \"seqread_fresh\", \"huge_pages\": %s, \"bytes\": %.0f, "
                 "\"seconds\": %.6f, \"mb_per_s\": %.1f}\n",
-      huge ? "true" : "false",
-      loadBytes,
-      best,
-      loadBytes / best / 1e6);
+      huge ? "true" : "false", loadBytes, best, loadBytes / best / 1e6);
   }
   std::fflush(stdout);
 }
 
 /// (a) EGRID + INIT open, `runs` times; returns the last load, kept for the step switches.
-Loaded MeasureLoads(const std::string& path,
-  double loadBytes,
-  long long egridBytes,
-  long long initBytes,
-  int runs)
+Loaded MeasureLoads(const std::string& path, double loadBytes, long long egridBytes, long long initBytes, int runs)
 {
   Loaded kept;
   for (int run = 1; run <= runs; ++run)
@@ -327,25 +312,10 @@ Loaded MeasureLoads(const std::string& path,
                 "\"minor_faults\": %lld, \"peak_rss_bytes\": %lld, \"dims\": [%lld, %lld, %lld], "
                 "\"cells\": %zu, \"active\": %lld, \"steps\": %zu, \"unified\": %s, "
                 "\"init_arrays\": [%s]}\n",
-      run,
-      loadBytes,
-      egridBytes,
-      initBytes,
-      seconds,
-      gridSeconds,
-      indexSeconds,
-      initSeconds,
-      loadBytes / seconds / 1e6,
-      faults,
-      PeakRssBytes(),
-      static_cast<long long>(d[0]),
-      static_cast<long long>(d[1]),
-      static_cast<long long>(d[2]),
-      cells,
-      static_cast<long long>(loaded.grid.activeCells),
-      loaded.results->Steps().size(),
-      loaded.results->UnifiedRestart() ? "true" : "false",
-      names.c_str());
+      run, loadBytes, egridBytes, initBytes, seconds, gridSeconds, indexSeconds, initSeconds, loadBytes / seconds / 1e6,
+      faults, PeakRssBytes(), static_cast<long long>(d[0]), static_cast<long long>(d[1]), static_cast<long long>(d[2]),
+      cells, static_cast<long long>(loaded.grid.activeCells), loaded.results->Steps().size(),
+      loaded.results->UnifiedRestart() ? "true" : "false", names.c_str());
     std::fflush(stdout);
     kept = std::move(loaded);
   }
@@ -370,8 +340,7 @@ void MeasureStepSwitches(const Loaded& kept, int switches)
     names.emplace_back(name);
   }
   std::vector<std::vector<float>> shown(names.size(), std::vector<float>(cells, 0.0f));
-  const auto readStep = [&](std::size_t step)
-  {
+  const auto readStep = [&](std::size_t step) {
     int found = 0;
     for (std::size_t a = 0; a < names.size(); ++a)
     {
@@ -395,17 +364,9 @@ void MeasureStepSwitches(const Loaded& kept, int switches)
                 "\"arrays\": %d, \"seconds\": %.6f, \"array_bytes\": %lld, \"step_bytes\": %lld, "
                 "\"restart_file_bytes\": %lld, \"mb_per_s\": %.1f, \"minor_faults\": %lld, "
                 "\"peak_rss_bytes\": %lld}\n",
-      s,
-      results.Steps()[current].reportNumber,
-      results.Steps()[next].reportNumber,
-      found,
-      seconds,
-      arrayBytes,
-      stepBytes,
-      FileBytes(results.RestartPaths()[results.Steps()[next].file]),
-      static_cast<double>(arrayBytes) / seconds / 1e6,
-      faults,
-      PeakRssBytes());
+      s, results.Steps()[current].reportNumber, results.Steps()[next].reportNumber, found, seconds, arrayBytes,
+      stepBytes, FileBytes(results.RestartPaths()[results.Steps()[next].file]),
+      static_cast<double>(arrayBytes) / seconds / 1e6, faults, PeakRssBytes());
     std::fflush(stdout);
     current = next;
   }

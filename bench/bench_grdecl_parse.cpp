@@ -39,8 +39,7 @@ long long PeakRssBytes()
 
 long long OutputBytes(const resmr::CornerPointModel& deck)
 {
-  std::size_t values =
-    deck.coord.size() + deck.zcorn.size() + deck.dxv.size() + deck.dyv.size() + deck.dzv.size();
+  std::size_t values = deck.coord.size() + deck.zcorn.size() + deck.dxv.size() + deck.dyv.size() + deck.dzv.size();
   for (const auto& array : deck.arrays)
   {
     values += array.values.size();
@@ -106,8 +105,7 @@ int main(int argc, char** argv)
     {
       const auto start = std::chrono::steady_clock::now();
       resmr::CornerPointModel deck = resmr::ParseGrdeclFile(path);
-      const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       std::size_t faces = 0;
       for (const auto& fault : deck.faults)
       {
@@ -117,23 +115,13 @@ int main(int argc, char** argv)
                   "\"mb_per_s\": %.1f, \"output_bytes\": %lld, \"geometry_bytes\": %lld, "
                   "\"peak_rss_bytes\": %lld, "
                   "\"cells\": %lld, \"arrays\": %zu, \"fault_faces\": %zu}\n",
-        run,
-        fileBytes,
-        seconds,
-        fileBytes / seconds / 1e6,
-        OutputBytes(deck),
-        GeometryBytes(deck),
-        PeakRssBytes(),
-        static_cast<long long>(deck.CellCount()),
-        deck.arrays.size(),
-        faces);
+        run, fileBytes, seconds, fileBytes / seconds / 1e6, OutputBytes(deck), GeometryBytes(deck), PeakRssBytes(),
+        static_cast<long long>(deck.CellCount()), deck.arrays.size(), faces);
       std::fflush(stdout);
     }
     catch (const std::exception& error)
     {
-      std::printf("{\"tool\": \"resmr\", \"run\": %d, \"error\": \"%s\"}\n",
-        run,
-        JsonEscape(error.what()).c_str());
+      std::printf("{\"tool\": \"resmr\", \"run\": %d, \"error\": \"%s\"}\n", run, JsonEscape(error.what()).c_str());
       return 1;
     }
   }

@@ -28,8 +28,7 @@ int main(int argc, char** argv)
   {
     const auto start = std::chrono::steady_clock::now();
     const resmr::SyntheticReservoir model(parameters);
-    const double setup =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     resmr::SyntheticLayerStream stream(model);
     resmr::SyntheticLayer layer;
     uint64_t checksum = 0;
@@ -46,24 +45,15 @@ int main(int argc, char** argv)
         checksum += static_cast<uint64_t>(state);
       }
     }
-    const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     struct rusage usage;
     getrusage(RUSAGE_SELF, &usage);
     const resmr::SyntheticStatistics& s = stream.Statistics();
-    std::printf(
-      "{\"dims\": [%lld, %lld, %lld], \"cells\": %lld, \"active\": %lld, \"setup_seconds\": %.3f, "
-      "\"seconds\": %.3f, \"cells_per_second\": %.0f, \"peak_rss_mb\": %.1f, \"checksum\": "
-      "\"%016llx\"}\n",
-      static_cast<long long>(parameters.nx),
-      static_cast<long long>(parameters.ny),
-      static_cast<long long>(parameters.nz),
-      static_cast<long long>(s.cells),
-      static_cast<long long>(s.active),
-      setup,
-      seconds,
-      static_cast<double>(s.cells) / seconds,
-      usage.ru_maxrss / 1024.0,
+    std::printf("{\"dims\": [%lld, %lld, %lld], \"cells\": %lld, \"active\": %lld, \"setup_seconds\": %.3f, "
+                "\"seconds\": %.3f, \"cells_per_second\": %.0f, \"peak_rss_mb\": %.1f, \"checksum\": \"%016llx\"}\n",
+      static_cast<long long>(parameters.nx), static_cast<long long>(parameters.ny),
+      static_cast<long long>(parameters.nz), static_cast<long long>(s.cells), static_cast<long long>(s.active), setup,
+      seconds, static_cast<double>(s.cells) / seconds, usage.ru_maxrss / 1024.0,
       static_cast<unsigned long long>(checksum));
   }
   catch (const std::exception& error)

@@ -155,14 +155,12 @@ int BuildCommand(int argc, char** argv)
     const bool terminal = isatty(2);
     double lastShown = -1;
     std::string lastPhase;
-    const auto progress = [&](const char* phase, double fraction)
-    {
+    const auto progress = [&](const char* phase, double fraction) {
       if (quiet)
       {
         return;
       }
-      const double elapsed =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (!terminal && fraction - lastShown < 0.05 && fraction < 1.0 && lastPhase == phase)
       {
         return;
@@ -172,17 +170,9 @@ int BuildCommand(int argc, char** argv)
       const int width = 30;
       const int filled = static_cast<int>(fraction * width + 0.5);
       const std::string bar = std::string(filled, '#') + std::string(width - filled, '.');
-      const std::string eta =
-        fraction > 0.02 ? Duration(elapsed * (1 - fraction) / fraction) : std::string("?");
-      std::fprintf(stderr,
-        "%s[%s] %5.1f%% %-9s elapsed %s ETA %s%s",
-        terminal ? "\r" : "",
-        bar.c_str(),
-        100 * fraction,
-        phase,
-        Duration(elapsed).c_str(),
-        eta.c_str(),
-        terminal ? "" : "\n");
+      const std::string eta = fraction > 0.02 ? Duration(elapsed * (1 - fraction) / fraction) : std::string("?");
+      std::fprintf(stderr, "%s[%s] %5.1f%% %-9s elapsed %s ETA %s%s", terminal ? "\r" : "", bar.c_str(), 100 * fraction,
+        phase, Duration(elapsed).c_str(), eta.c_str(), terminal ? "" : "\n");
       std::fflush(stderr);
     };
     const resmr::HierarchyReport report = resmr::BuildHierarchy(*source, output, options, progress);
@@ -193,34 +183,18 @@ int BuildCommand(int argc, char** argv)
     struct rusage usage;
     getrusage(RUSAGE_SELF, &usage);
     std::printf(
-      "{\"input\": \"%s\", \"output\": \"%s\", \"cells\": %lld, \"active_cells\": %lld, "
-      "\"columns\": %lld, "
-      "\"leaf_level\": %d, \"regions\": %lld, \"threads\": %d, \"file_bytes\": %llu, "
-      "\"bytes_per_cell\": %.3f, "
+      "{\"input\": \"%s\", \"output\": \"%s\", \"cells\": %lld, \"active_cells\": %lld, \"columns\": %lld, "
+      "\"leaf_level\": %d, \"regions\": %lld, \"threads\": %d, \"file_bytes\": %llu, \"bytes_per_cell\": %.3f, "
       "\"partition_s\": %.2f, \"leaves_s\": %.2f, \"simplify_s\": %.2f, \"total_s\": %.2f, "
-      "\"cells_per_s\": %.0f, \"peak_rss_mb\": %.1f, \"resumed_from_level\": %d, \"hashed_cells\": "
-      "%llu, "
+      "\"cells_per_s\": %.0f, \"peak_rss_mb\": %.1f, \"resumed_from_level\": %d, \"hashed_cells\": %llu, "
       "\"hash_slots\": %llu, \"hash_offsets\": %llu}\n",
-      input.c_str(),
-      output.c_str(),
-      static_cast<long long>(report.cells),
-      static_cast<long long>(report.activeCells),
-      static_cast<long long>(report.columns),
-      report.leafLevel,
-      static_cast<long long>(report.regions),
-      report.threadsUsed,
-      static_cast<unsigned long long>(report.fileBytes),
-      double(report.fileBytes) / double(report.cells),
-      report.partitionSeconds,
-      report.leafSeconds,
-      report.simplifySeconds,
-      report.totalSeconds,
-      double(report.cells) / std::max(report.totalSeconds, 1e-9),
-      usage.ru_maxrss / 1024.0,
-      report.resumedFromLevel,
-      static_cast<unsigned long long>(report.hashedCells),
-      static_cast<unsigned long long>(report.hashSlots),
-      static_cast<unsigned long long>(report.hashOffsets));
+      input.c_str(), output.c_str(), static_cast<long long>(report.cells), static_cast<long long>(report.activeCells),
+      static_cast<long long>(report.columns), report.leafLevel, static_cast<long long>(report.regions),
+      report.threadsUsed, static_cast<unsigned long long>(report.fileBytes),
+      double(report.fileBytes) / double(report.cells), report.partitionSeconds, report.leafSeconds,
+      report.simplifySeconds, report.totalSeconds, double(report.cells) / std::max(report.totalSeconds, 1e-9),
+      usage.ru_maxrss / 1024.0, report.resumedFromLevel, static_cast<unsigned long long>(report.hashedCells),
+      static_cast<unsigned long long>(report.hashSlots), static_cast<unsigned long long>(report.hashOffsets));
     return 0;
   }
   catch (const std::exception& error)
@@ -257,41 +231,24 @@ int MultiresolutionInfo(const char* path, bool listRegions)
     level.error = std::max<double>(level.error, r.error);
   }
   const double cells = double(h.dims[0]) * double(h.dims[1]) * double(h.dims[2]);
-  std::printf("{\"file\": \"%s\", \"kind\": \"resmr\", \"version\": %u, \"bytes\": %llu, \"dims\": "
-              "[%lld, %lld, %lld], "
-              "\"cells\": %.0f, \"bytes_per_cell\": %.3f, \"leaf_level\": %d, \"cmax\": %d, "
-              "\"regions\": %llu, \"levels\": [",
-    path,
-    h.version,
-    static_cast<unsigned long long>(file.FileSize()),
-    static_cast<long long>(h.dims[0]),
-    static_cast<long long>(h.dims[1]),
-    static_cast<long long>(h.dims[2]),
-    cells,
-    double(file.FileSize()) / cells,
-    h.leafLevel,
-    h.cmax,
-    static_cast<unsigned long long>(h.regionCount));
+  std::printf(
+    "{\"file\": \"%s\", \"kind\": \"resmr\", \"version\": %u, \"bytes\": %llu, \"dims\": [%lld, %lld, %lld], "
+    "\"cells\": %.0f, \"bytes_per_cell\": %.3f, \"leaf_level\": %d, \"cmax\": %d, \"regions\": %llu, \"levels\": [",
+    path, h.version, static_cast<unsigned long long>(file.FileSize()), static_cast<long long>(h.dims[0]),
+    static_cast<long long>(h.dims[1]), static_cast<long long>(h.dims[2]), cells, double(file.FileSize()) / cells,
+    h.leafLevel, h.cmax, static_cast<unsigned long long>(h.regionCount));
   bool first = true;
   for (const auto& entry : levels)
   {
     const Level& l = entry.second;
-    std::printf("%s\n  {\"level\": %d, \"regions\": %lld, \"columns\": %lld, \"active_cells\": "
-                "%lld, \"vertices\": %lld, "
-                "\"bytes\": %llu, \"mesh_bytes\": %llu, \"surface_bytes\": %llu, "
-                "\"uncompressed_bytes\": %llu, "
-                "\"max_error\": %.6g}",
-      first ? "" : ",",
-      entry.first,
-      static_cast<long long>(l.regions),
-      static_cast<long long>(l.columns),
-      static_cast<long long>(l.cells),
-      static_cast<long long>(l.vertices),
-      static_cast<unsigned long long>(l.bytes),
-      static_cast<unsigned long long>(l.meshBytes),
-      static_cast<unsigned long long>(l.bytes - l.meshBytes),
-      static_cast<unsigned long long>(l.rawBytes),
-      l.error);
+    std::printf(
+      "%s\n  {\"level\": %d, \"regions\": %lld, \"columns\": %lld, \"active_cells\": %lld, \"vertices\": %lld, "
+      "\"bytes\": %llu, \"mesh_bytes\": %llu, \"surface_bytes\": %llu, \"uncompressed_bytes\": %llu, "
+      "\"max_error\": %.6g}",
+      first ? "" : ",", entry.first, static_cast<long long>(l.regions), static_cast<long long>(l.columns),
+      static_cast<long long>(l.cells), static_cast<long long>(l.vertices), static_cast<unsigned long long>(l.bytes),
+      static_cast<unsigned long long>(l.meshBytes), static_cast<unsigned long long>(l.bytes - l.meshBytes),
+      static_cast<unsigned long long>(l.rawBytes), l.error);
     first = false;
   }
   // Sec. 5.4: the packed 3D textures, against the cells they hold and the full grid.
@@ -304,25 +261,14 @@ int MultiresolutionInfo(const char* path, bool listRegions)
   {
     modelBytes += m.chunk.stored;
   }
-  std::printf(
-    "],\n \"model_chunk_bytes\": %llu, \"geometry_id\": \"%016llx\", \"hash\": {\"cells\": %llu, "
-    "\"table_sides\": [%u, %u, %u], \"offset_sides\": [%u, %u, %u], \"slots\": %.0f, \"offsets\": "
-    "%.0f, \"fill\": %.4f, "
-    "\"packed_over_cells_float\": %.4f, \"packed_over_cells_float_with_offsets\": %.4f, "
-    "\"packed_over_full_grid\": %.6f}",
-    static_cast<unsigned long long>(modelBytes),
-    static_cast<unsigned long long>(h.geometryId),
-    static_cast<unsigned long long>(h.hashedCells),
-    m[0],
-    m[1],
-    m[2],
-    r[0],
-    r[1],
-    r[2],
-    slots,
-    offsets,
-    slots > 0 ? double(h.hashedCells) / slots : 0.0,
-    h.hashedCells ? slots / double(h.hashedCells) : 0.0,
+  std::printf("],\n \"model_chunk_bytes\": %llu, \"geometry_id\": \"%016llx\", \"hash\": {\"cells\": %llu, "
+              "\"table_sides\": [%u, %u, %u], \"offset_sides\": [%u, %u, %u], \"slots\": %.0f, \"offsets\": %.0f, "
+              "\"fill\": %.4f, "
+              "\"packed_over_cells_float\": %.4f, \"packed_over_cells_float_with_offsets\": %.4f, "
+              "\"packed_over_full_grid\": %.6f}",
+    static_cast<unsigned long long>(modelBytes), static_cast<unsigned long long>(h.geometryId),
+    static_cast<unsigned long long>(h.hashedCells), m[0], m[1], m[2], r[0], r[1], r[2], slots, offsets,
+    slots > 0 ? double(h.hashedCells) / slots : 0.0, h.hashedCells ? slots / double(h.hashedCells) : 0.0,
     h.hashedCells ? (slots * 4 + offsets * 6) / (double(h.hashedCells) * 4) : 0.0,
     (slots * 4 + offsets * 6) / (cells * 4));
   // MAPAXES as the input gave it; viewers apply it when "applies" (as the grid readers do).
@@ -331,22 +277,13 @@ int MultiresolutionInfo(const char* path, bool listRegions)
   if (map.hasMapAxes || !map.mapUnits.empty() || !map.gridUnit.empty())
   {
     const auto& a = map.mapAxes;
-    std::printf(
-      ",\n \"map_axes\": {\"given\": %s, \"applies\": %s, \"y_axis_point\": [%.17g, %.17g], "
-      "\"origin\": [%.17g, %.17g], \"x_axis_point\": [%.17g, %.17g], \"map_units\": %s, "
-      "\"grid_unit\": %s, "
-      "\"grid_in_map_units\": %s}",
+    std::printf(",\n \"map_axes\": {\"given\": %s, \"applies\": %s, \"y_axis_point\": [%.17g, %.17g], "
+                "\"origin\": [%.17g, %.17g], \"x_axis_point\": [%.17g, %.17g], \"map_units\": %s, \"grid_unit\": %s, "
+                "\"grid_in_map_units\": %s}",
       map.hasMapAxes ? "true" : "false",
-      resmr::CornerPointGeometry::PlacementTransform(map, transform) ? "true" : "false",
-      a.yAxisPoint[0],
-      a.yAxisPoint[1],
-      a.origin[0],
-      a.origin[1],
-      a.xAxisPoint[0],
-      a.xAxisPoint[1],
-      JsonString(map.mapUnits).c_str(),
-      JsonString(map.gridUnit).c_str(),
-      map.gridUnitIsMap ? "true" : "false");
+      resmr::CornerPointGeometry::PlacementTransform(map, transform) ? "true" : "false", a.yAxisPoint[0],
+      a.yAxisPoint[1], a.origin[0], a.origin[1], a.xAxisPoint[0], a.xAxisPoint[1], JsonString(map.mapUnits).c_str(),
+      JsonString(map.gridUnit).c_str(), map.gridUnitIsMap ? "true" : "false");
   }
   else
   {
@@ -358,26 +295,12 @@ int MultiresolutionInfo(const char* path, bool listRegions)
     bool firstRegion = true;
     for (const auto& r : file.Regions())
     {
-      std::printf("%s\n  [%d, %lld, %lld, %lld, %lld, %.9g, %.9g, [%.9g, %.9g, %.9g, %.9g, %.9g, "
-                  "%.9g], [%u, %u, %u, %u]]",
-        firstRegion ? "" : ",",
-        r.level,
-        static_cast<long long>(r.index),
-        static_cast<long long>(r.columns),
-        static_cast<long long>(r.activeCells),
-        static_cast<long long>(r.vertices),
-        r.error,
-        r.ownError,
-        r.bounds[0],
-        r.bounds[1],
-        r.bounds[2],
-        r.bounds[3],
-        r.bounds[4],
-        r.bounds[5],
-        r.chunks[0].crc,
-        r.chunks[1].crc,
-        r.chunks[2].crc,
-        r.chunks[3].crc);
+      std::printf(
+        "%s\n  [%d, %lld, %lld, %lld, %lld, %.9g, %.9g, [%.9g, %.9g, %.9g, %.9g, %.9g, %.9g], [%u, %u, %u, %u]]",
+        firstRegion ? "" : ",", r.level, static_cast<long long>(r.index), static_cast<long long>(r.columns),
+        static_cast<long long>(r.activeCells), static_cast<long long>(r.vertices), r.error, r.ownError, r.bounds[0],
+        r.bounds[1], r.bounds[2], r.bounds[3], r.bounds[4], r.bounds[5], r.chunks[0].crc, r.chunks[1].crc,
+        r.chunks[2].crc, r.chunks[3].crc);
       firstRegion = false;
     }
     std::printf("]");

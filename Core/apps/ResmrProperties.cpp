@@ -63,9 +63,7 @@ std::string Extension(const std::string& path)
 {
   const std::size_t dot = path.find_last_of('.');
   const std::size_t slash = path.find_last_of('/');
-  return dot == std::string::npos || (slash != std::string::npos && dot < slash)
-           ? ""
-           : Upper(path.substr(dot + 1));
+  return dot == std::string::npos || (slash != std::string::npos && dot < slash) ? "" : Upper(path.substr(dot + 1));
 }
 
 /// The EGRID beside a results file (same basename, either case, formatted or not).
@@ -80,8 +78,8 @@ std::string GridBeside(const std::string& path)
       return stem + ext;
     }
   }
-  throw std::invalid_argument(path + ": no EGRID beside it (" + stem +
-                              ".EGRID): its active cells are needed to place the values");
+  throw std::invalid_argument(
+    path + ": no EGRID beside it (" + stem + ".EGRID): its active cells are needed to place the values");
 }
 
 /// The properties of the generated model `spec` names, as the INIT (and UNRST) resmr synth
@@ -91,18 +89,15 @@ std::string GridBeside(const std::string& path)
 /// in one whole array (4 bytes a cell; at least one): memory never exceeds what a file input
 /// needs, and no whole array is held. Every layer's active cells must be the geometry's.
 /// Returns the generator passes made.
-int AddSyntheticProperties(const std::string& spec,
-  const resmr::MultiresolutionFile& geometry,
-  resmr::PropertyFileWriter& writer,
-  const std::function<void(const resmr::PropertyTable&)>& added)
+int AddSyntheticProperties(const std::string& spec, const resmr::MultiresolutionFile& geometry,
+  resmr::PropertyFileWriter& writer, const std::function<void(const resmr::PropertyTable&)>& added)
 {
   const resmr::SyntheticParameters parameters = resmr::ParseSyntheticSpec(spec);
   const auto& h = geometry.Header();
   if (parameters.nx != h.dims[0] || parameters.ny != h.dims[1] || parameters.nz != h.dims[2])
   {
-    throw std::invalid_argument(
-      spec + ": grid " + std::to_string(parameters.nx) + "x" + std::to_string(parameters.ny) + "x" +
-      std::to_string(parameters.nz) + " is not the grid of " + geometry.Path());
+    throw std::invalid_argument(spec + ": grid " + std::to_string(parameters.nx) + "x" + std::to_string(parameters.ny) +
+      "x" + std::to_string(parameters.nz) + " is not the grid of " + geometry.Path());
   }
   const resmr::SyntheticReservoir model(parameters);
   const auto& arrays = resmr::SyntheticInitArrays();
@@ -135,8 +130,7 @@ int AddSyntheticProperties(const std::string& spec,
   }
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
   const uint64_t cells = static_cast<uint64_t>(parameters.CellCount());
-  const std::size_t group =
-    static_cast<std::size_t>(std::max<uint64_t>(1, slots > 0 ? cells / slots : jobs.size()));
+  const std::size_t group = static_cast<std::size_t>(std::max<uint64_t>(1, slots > 0 ? cells / slots : jobs.size()));
 
   std::vector<float> values, pressure, swat;
   int passes = 0;
@@ -156,7 +150,7 @@ int AddSyntheticProperties(const std::string& spec,
       {
         const Quantity quantity = jobs[j].quantity;
         table.name = quantity == Quantity::Pressure ? "PRESSURE"
-                     : quantity == Quantity::Water  ? "SWAT"
+          : quantity == Quantity::Water             ? "SWAT"
                                                     : resmr::DerivedOilName;
         table.step = jobs[j].step - 1;
         table.reportNumber = jobs[j].step;
@@ -174,12 +168,10 @@ int AddSyntheticProperties(const std::string& spec,
         const std::vector<uint8_t> active = geometry.ReadActiveLayer(layer.k);
         for (std::size_t c = 0; c < layer.state.size(); ++c)
         {
-          if ((layer.state[c] == resmr::SyntheticCellState::Active) !=
-              (c < active.size() && active[c] != 0))
+          if ((layer.state[c] == resmr::SyntheticCellState::Active) != (c < active.size() && active[c] != 0))
           {
-            throw std::invalid_argument(spec + ": the active cells of layer " +
-                                        std::to_string(layer.k + 1) + " differ from those of " +
-                                        geometry.Path() + ": another model (seed?)");
+            throw std::invalid_argument(spec + ": the active cells of layer " + std::to_string(layer.k + 1) +
+              " differ from those of " + geometry.Path() + ": another model (seed?)");
           }
         }
       }
@@ -192,8 +184,7 @@ int AddSyntheticProperties(const std::string& spec,
         const Job& job = jobs[j];
         if (job.array >= 0)
         {
-          resmr::FillSyntheticInitArray(
-            model, static_cast<std::size_t>(job.array), layer, values.data());
+          resmr::FillSyntheticInitArray(model, static_cast<std::size_t>(job.array), layer, values.data());
           writer.AddLayer(handles[j - first], values.data());
           continue;
         }
@@ -211,9 +202,9 @@ int AddSyntheticProperties(const std::string& spec,
           }
         }
         writer.AddLayer(handles[j - first],
-          job.quantity == Quantity::Pressure ? pressure.data()
-          : job.quantity == Quantity::Water  ? swat.data()
-                                             : values.data());
+          job.quantity == Quantity::Pressure  ? pressure.data()
+            : job.quantity == Quantity::Water ? swat.data()
+                                              : values.data());
       }
     }
     ++passes;
@@ -241,34 +232,23 @@ bool HoldsStep(const resmr::PropertyFile& older, const resmr::PropertyTable& tab
 /// The tables of an EGRID's INIT and restarts (or of an INIT or restart beside its EGRID), by
 /// `add`: steps `older` holds already are counted in `kept`, not read again; steps and arrays
 /// of files cut short or damaged are counted in `leftOut`, with a warning.
-void AddEclipseResults(const std::string& input,
-  bool isInit,
-  bool isRestart,
-  const std::string& geometryPath,
-  const std::array<int64_t, 3>& dims,
-  int64_t active,
-  const resmr::PropertyFile* older,
-  std::vector<float>& values,
-  const std::function<void(resmr::PropertyTable)>& add,
-  int64_t& kept,
-  int64_t& leftOut)
+void AddEclipseResults(const std::string& input, bool isInit, bool isRestart, const std::string& geometryPath,
+  const std::array<int64_t, 3>& dims, int64_t active, const resmr::PropertyFile* older, std::vector<float>& values,
+  const std::function<void(resmr::PropertyTable)>& add, int64_t& kept, int64_t& leftOut)
 {
   const float none = std::numeric_limits<float>::quiet_NaN();
   const std::string gridPath = (isInit || isRestart) ? GridBeside(input) : input;
-  const resmr::EclipseGrid grid =
-    resmr::ReadEclipseGrid(gridPath, 0, resmr::EclipseGridParts::ActiveCellsOnly);
+  const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath, 0, resmr::EclipseGridParts::ActiveCellsOnly);
   if (grid.deck.dims != dims)
   {
     throw std::invalid_argument(gridPath + ": grid " + std::to_string(grid.deck.dims[0]) + "x" +
-                                std::to_string(grid.deck.dims[1]) + "x" +
-                                std::to_string(grid.deck.dims[2]) + " is not the grid of " +
-                                geometryPath);
+      std::to_string(grid.deck.dims[1]) + "x" + std::to_string(grid.deck.dims[2]) + " is not the grid of " +
+      geometryPath);
   }
   if (grid.activeCells != active)
   {
-    throw std::invalid_argument(gridPath + ": " + std::to_string(grid.activeCells) +
-                                " active cells, " + geometryPath + " has " +
-                                std::to_string(active) + ": results of another grid");
+    throw std::invalid_argument(gridPath + ": " + std::to_string(grid.activeCells) + " active cells, " + geometryPath +
+      " has " + std::to_string(active) + ": results of another grid");
   }
   const resmr::EclipseResults results(gridPath, grid);
   for (const std::string& warning : results.Warnings())
@@ -277,8 +257,7 @@ void AddEclipseResults(const std::string& input,
   }
   leftOut += static_cast<int64_t>(results.SkippedSteps().size());
   // A record whose blocks turn out damaged costs that table only.
-  const auto readable = [&](const std::function<bool()>& read)
-  {
+  const auto readable = [&](const std::function<bool()>& read) {
     try
     {
       return read();
@@ -326,13 +305,10 @@ void AddEclipseResults(const std::string& input,
           continue;
         }
         const bool derived = deriveOil && name == resmr::DerivedOilName;
-        if (readable(
-              [&]
-              {
-                return derived
-                         ? resmr::ReadDerivedOil(results, s, values.data(), int64_t(values.size()))
-                         : results.ReadDynamic<float>(s, name, values.data(), none);
-              }))
+        if (readable([&] {
+              return derived ? resmr::ReadDerivedOil(results, s, values.data(), int64_t(values.size()))
+                             : results.ReadDynamic<float>(s, name, values.data(), none);
+            }))
         {
           add(table);
         }
@@ -394,9 +370,8 @@ int AddPropertiesCommand(int argc, char** argv)
     }
     if (output.empty())
     {
-      output = (Extension(geometryPath) == "RESMR" ? geometryPath.substr(0, geometryPath.size() - 6)
-                                                   : geometryPath) +
-               ".resmrp";
+      output = (Extension(geometryPath) == "RESMR" ? geometryPath.substr(0, geometryPath.size() - 6) : geometryPath) +
+        ".resmrp";
     }
     const resmr::MultiresolutionFile geometry(geometryPath);
     const auto& dims = geometry.Header().dims;
@@ -412,19 +387,14 @@ int AddPropertiesCommand(int argc, char** argv)
     std::vector<float> values; // one whole array, for file inputs only
     int64_t added = 0, kept = 0, leftOut = 0;
     int generatorPasses = 0;
-    const auto report = [&](const resmr::PropertyTable& table)
-    {
+    const auto report = [&](const resmr::PropertyTable& table) {
       ++added;
-      std::fprintf(stderr,
-        "resmr add-properties: %s%s\n",
-        table.name.c_str(),
-        table.step < 0 ? ""
-                       : (" step " + std::to_string(table.step) + " (report " +
-                           std::to_string(table.reportNumber) + ")")
-                           .c_str());
+      std::fprintf(stderr, "resmr add-properties: %s%s\n", table.name.c_str(),
+        table.step < 0
+          ? ""
+          : (" step " + std::to_string(table.step) + " (report " + std::to_string(table.reportNumber) + ")").c_str());
     };
-    const auto add = [&](resmr::PropertyTable table)
-    {
+    const auto add = [&](resmr::PropertyTable table) {
       writer.Add(table, values);
       report(table);
     };
@@ -439,42 +409,30 @@ int AddPropertiesCommand(int argc, char** argv)
       const std::string ext = Extension(input);
       const bool isInit = ext == "INIT" || ext == "FINIT";
       const bool isRestart = ext == "UNRST" || ext == "FUNRST" ||
-                             (ext.size() == 5 && (ext[0] == 'X' || ext[0] == 'F') &&
-                               std::isdigit(static_cast<unsigned char>(ext[1])));
+        (ext.size() == 5 && (ext[0] == 'X' || ext[0] == 'F') && std::isdigit(static_cast<unsigned char>(ext[1])));
       if (ext == "EGRID" || ext == "FEGRID" || isInit || isRestart)
       {
-        AddEclipseResults(input,
-          isInit,
-          isRestart,
-          geometryPath,
-          dims,
-          active,
-          older.get(),
-          values,
-          add,
-          kept,
-          leftOut);
+        AddEclipseResults(
+          input, isInit, isRestart, geometryPath, dims, active, older.get(), values, add, kept, leftOut);
       }
       else
       {
         const resmr::CornerPointModel deck = resmr::ParseGrdeclFile(input);
         if (deck.dims != dims)
         {
-          throw std::invalid_argument(
-            input + ": grid " + std::to_string(deck.dims[0]) + "x" + std::to_string(deck.dims[1]) +
-            "x" + std::to_string(deck.dims[2]) + " is not the grid of " + geometryPath);
+          throw std::invalid_argument(input + ": grid " + std::to_string(deck.dims[0]) + "x" +
+            std::to_string(deck.dims[1]) + "x" + std::to_string(deck.dims[2]) + " is not the grid of " + geometryPath);
         }
         for (const auto& array : deck.arrays)
         {
           if (resmr::IsGeometryArrayName(array.name) || array.name == "ACTNUM" ||
-              static_cast<int64_t>(array.values.size()) != cells)
+            static_cast<int64_t>(array.values.size()) != cells)
           {
             continue;
           }
           for (int64_t c = 0; c < cells; ++c)
           {
-            values[static_cast<std::size_t>(c)] =
-              static_cast<float>(array.values[static_cast<std::size_t>(c)]);
+            values[static_cast<std::size_t>(c)] = static_cast<float>(array.values[static_cast<std::size_t>(c)]);
           }
           resmr::PropertyTable table;
           table.name = array.name;
@@ -498,26 +456,17 @@ int AddPropertiesCommand(int argc, char** argv)
     }
     else
     {
-      std::fprintf(stderr,
-        "resmr add-properties: %s already holds every step found; not rewritten\n",
-        output.c_str());
+      std::fprintf(stderr, "resmr add-properties: %s already holds every step found; not rewritten\n", output.c_str());
     }
     if (leftOut > 0)
     {
-      std::fprintf(stderr,
-        "resmr add-properties: warning: %lld report steps or tables left out (see above)\n",
+      std::fprintf(stderr, "resmr add-properties: warning: %lld report steps or tables left out (see above)\n",
         static_cast<long long>(leftOut));
     }
-    std::printf("{\"geometry\": \"%s\", \"properties\": \"%s\", \"tables_added\": %lld, "
-                "\"tables_kept\": %lld, "
+    std::printf("{\"geometry\": \"%s\", \"properties\": \"%s\", \"tables_added\": %lld, \"tables_kept\": %lld, "
                 "\"tables\": %zu, \"left_out\": %lld, \"generator_passes\": %d}\n",
-      geometryPath.c_str(),
-      output.c_str(),
-      static_cast<long long>(added),
-      static_cast<long long>(kept),
-      tables,
-      static_cast<long long>(leftOut),
-      generatorPasses);
+      geometryPath.c_str(), output.c_str(), static_cast<long long>(added), static_cast<long long>(kept), tables,
+      static_cast<long long>(leftOut), generatorPasses);
     return 0;
   }
   catch (const std::exception& error)

@@ -70,8 +70,7 @@ bool EndsWithNoCase(const std::string& text, const std::string& suffix)
   }
   for (std::size_t i = 0; i < suffix.size(); ++i)
   {
-    if (std::toupper(static_cast<unsigned char>(text[text.size() - suffix.size() + i])) !=
-        suffix[i])
+    if (std::toupper(static_cast<unsigned char>(text[text.size() - suffix.size() + i])) != suffix[i])
     {
       return false;
     }
@@ -99,21 +98,19 @@ int SynthCommand(int argc, char** argv)
         const char* text = value();
         if (text[0] == '-')
         {
-          throw std::invalid_argument(
-            std::string("--seed must be a whole number from 0 (got '") + text + "')");
+          throw std::invalid_argument(std::string("--seed must be a whole number from 0 (got '") + text + "')");
         }
         errno = 0;
         char* end = nullptr;
         parameters.seed = std::strtoull(text, &end, 10);
         if (errno != 0 || end == text || *end != '\0')
         {
-          throw std::invalid_argument(
-            std::string("--seed must be a whole number from 0 (got '") + text + "')");
+          throw std::invalid_argument(std::string("--seed must be a whole number from 0 (got '") + text + "')");
         }
       }
       else if (option == "--faults")
-        parameters.faults = static_cast<int>(
-          std::max<int64_t>(-1, std::min<int64_t>(1000, ParseInteger(value(), "--faults"))));
+        parameters.faults =
+          static_cast<int>(std::max<int64_t>(-1, std::min<int64_t>(1000, ParseInteger(value(), "--faults"))));
       else if (option == "--throw")
         parameters.maxThrow = ParseNumber(value(), "--throw");
       else if (option == "--dip")
@@ -125,8 +122,8 @@ int SynthCommand(int argc, char** argv)
       else if (option == "--outside")
         parameters.outsideFraction = ParseNumber(value(), "--outside");
       else if (option == "--steps")
-        parameters.steps = static_cast<int>(
-          std::max<int64_t>(-1, std::min<int64_t>(100000, ParseInteger(value(), "--steps"))));
+        parameters.steps =
+          static_cast<int>(std::max<int64_t>(-1, std::min<int64_t>(100000, ParseInteger(value(), "--steps"))));
       else if (option == "--cell-size")
         parameters.cellSize = ParseNumber(value(), "--cell-size");
       else if (option == "--thickness")
@@ -138,8 +135,7 @@ int SynthCommand(int argc, char** argv)
         std::fputs(SynthUsage, stdout);
         return 0;
       }
-      else if (!option.empty() && option[0] == '-' &&
-               !std::isdigit(static_cast<unsigned char>(option[1])))
+      else if (!option.empty() && option[0] == '-' && !std::isdigit(static_cast<unsigned char>(option[1])))
         throw std::invalid_argument("unknown option " + option);
       else
       {
@@ -161,58 +157,48 @@ int SynthCommand(int argc, char** argv)
     const bool grdecl = EndsWithNoCase(output, ".GRDECL");
     if (!grdecl && !EndsWithNoCase(output, ".EGRID"))
     {
-      throw std::invalid_argument(output + ": the extension chooses the format: .EGRID (with .INIT "
-                                           "and .UNRST beside it) or .GRDECL");
+      throw std::invalid_argument(output +
+        ": the extension chooses the format: .EGRID (with .INIT "
+        "and .UNRST beside it) or .GRDECL");
     }
     parameters.Validate();
     if (!grdecl && parameters.CellCount() > resmr::MaxEgridCells)
     {
-      throw std::invalid_argument(
-        output +
+      throw std::invalid_argument(output +
         ": an EGRID holds at most 268,435,455 cells (ZCORN's 8 "
         "values a cell must fit the 32-bit count of an ECLIPSE keyword header); " +
         std::to_string(parameters.CellCount()) +
         " cells were asked for. Models this large are "
         "streamed straight into the multiresolution builder (input synth:" +
-        std::to_string(parameters.nx) + "x" + std::to_string(parameters.ny) + "x" +
-        std::to_string(parameters.nz) + ":" + std::to_string(parameters.seed) +
-        ") instead of a file");
+        std::to_string(parameters.nx) + "x" + std::to_string(parameters.ny) + "x" + std::to_string(parameters.nz) +
+        ":" + std::to_string(parameters.seed) + ") instead of a file");
     }
 
     const auto start = std::chrono::steady_clock::now();
     const resmr::SyntheticReservoir model(parameters);
     const bool showProgress = !quiet && isatty(STDERR_FILENO);
     int shown = -1;
-    const resmr::SyntheticProgress progress = [&](double fraction)
-    {
+    const resmr::SyntheticProgress progress = [&](double fraction) {
       const int percent = static_cast<int>(fraction * 100);
       if (showProgress && percent != shown)
       {
         shown = percent;
-        const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        std::fprintf(stderr,
-          "\rresmr synth: %3d%%  %.0f s, about %.0f s left ",
-          percent,
-          elapsed,
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        std::fprintf(stderr, "\rresmr synth: %3d%%  %.0f s, about %.0f s left ", percent, elapsed,
           fraction > 0.01 ? elapsed * (1 - fraction) / fraction : 0.0);
       }
     };
-    const resmr::SyntheticOutput written =
-      grdecl ? resmr::WriteSyntheticGrdecl(model, output, progress)
-             : resmr::WriteSyntheticEclipse(model, output, progress);
+    const resmr::SyntheticOutput written = grdecl ? resmr::WriteSyntheticGrdecl(model, output, progress)
+                                                  : resmr::WriteSyntheticEclipse(model, output, progress);
     if (showProgress)
     {
       std::fputs("\n", stderr);
     }
     for (const std::string& removed : written.removed)
     {
-      std::fprintf(stderr,
-        "resmr: note: removed %s, left from an older model (no steps asked)\n",
-        removed.c_str());
+      std::fprintf(stderr, "resmr: note: removed %s, left from an older model (no steps asked)\n", removed.c_str());
     }
-    const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     struct rusage usage;
     getrusage(RUSAGE_SELF, &usage);
     const resmr::SyntheticStatistics& s = written.statistics;
@@ -222,34 +208,23 @@ int SynthCommand(int argc, char** argv)
     {
       files += (files.empty() ? "\"" : ", \"") + file + "\"";
     }
-    std::printf(
-      "{\"files\": [%s], \"dims\": [%lld, %lld, %lld], \"seed\": %llu, \"cells\": %lld, "
-      "\"active\": %lld, \"outside_cells\": %lld, \"pinched_cells\": %lld, \"water_cells\": %lld, "
-      "\"inactive_fraction\": %.6f, \"outside_fraction\": %.6f, \"pinched_fraction\": %.6f, "
-      "\"water_fraction\": %.6f, \"fault_face_fraction\": %.6f, \"oil_water_contact\": %.3f, "
-      "\"steps\": %d, \"bytes\": %lld, \"seconds\": %.3f, \"cells_per_minute\": %.0f, "
-      "\"peak_rss_mb\": %.1f}\n",
-      files.c_str(),
-      static_cast<long long>(parameters.nx),
-      static_cast<long long>(parameters.ny),
-      static_cast<long long>(parameters.nz),
-      static_cast<unsigned long long>(parameters.seed),
-      static_cast<long long>(s.cells),
-      static_cast<long long>(s.active),
-      static_cast<long long>(s.outside),
-      static_cast<long long>(s.pinched),
-      static_cast<long long>(s.water),
+    std::printf("{\"files\": [%s], \"dims\": [%lld, %lld, %lld], \"seed\": %llu, \"cells\": %lld, "
+                "\"active\": %lld, \"outside_cells\": %lld, \"pinched_cells\": %lld, \"water_cells\": %lld, "
+                "\"inactive_fraction\": %.6f, \"outside_fraction\": %.6f, \"pinched_fraction\": %.6f, "
+                "\"water_fraction\": %.6f, \"fault_face_fraction\": %.6f, \"oil_water_contact\": %.3f, "
+                "\"steps\": %d, \"bytes\": %lld, \"seconds\": %.3f, \"cells_per_minute\": %.0f, "
+                "\"peak_rss_mb\": %.1f}\n",
+      files.c_str(), static_cast<long long>(parameters.nx), static_cast<long long>(parameters.ny),
+      static_cast<long long>(parameters.nz), static_cast<unsigned long long>(parameters.seed),
+      static_cast<long long>(s.cells), static_cast<long long>(s.active), static_cast<long long>(s.outside),
+      static_cast<long long>(s.pinched), static_cast<long long>(s.water),
       1.0 - static_cast<double>(s.active) / static_cast<double>(s.cells),
       static_cast<double>(s.outside) / static_cast<double>(s.cells),
       inside > 0 ? static_cast<double>(s.pinched) / inside : 0.0,
       inside > 0 ? static_cast<double>(s.water) / inside : 0.0,
-      s.lateralFaces > 0 ? static_cast<double>(s.faultFaces) / static_cast<double>(s.lateralFaces)
-                         : 0.0,
-      std::isfinite(model.OilWaterContact()) ? model.OilWaterContact() : -1.0,
-      parameters.steps,
-      static_cast<long long>(written.bytes),
-      seconds,
-      seconds > 0 ? static_cast<double>(s.cells) / seconds * 60 : 0.0,
+      s.lateralFaces > 0 ? static_cast<double>(s.faultFaces) / static_cast<double>(s.lateralFaces) : 0.0,
+      std::isfinite(model.OilWaterContact()) ? model.OilWaterContact() : -1.0, parameters.steps,
+      static_cast<long long>(written.bytes), seconds, seconds > 0 ? static_cast<double>(s.cells) / seconds * 60 : 0.0,
       usage.ru_maxrss / 1024.0);
     return 0;
   }

@@ -57,39 +57,23 @@ int GridInfo(const char* path)
     std::fprintf(stderr, "resmr: warning: %s\n", warning.c_str());
   }
   const auto& d = grid.deck.dims;
-  std::printf("{\"file\": %s, \"kind\": \"egrid\", \"dims\": [%lld, %lld, %lld], \"cells\": %lld, "
-              "\"active\": %lld, \"nonzero_actnum\": %lld, \"dual_porosity\": %s, "
-              "\"fracture_cells\": %lld, \"lgrs\": %zu, "
-              "\"nnc\": %lld, \"units\": %s, \"init\": %s, \"init_arrays\": %s, \"restarts\": %zu, "
-              "\"unified\": %s, \"restart_arrays\": %s, \"steps\": [",
-    JsonString(path).c_str(),
-    static_cast<long long>(d[0]),
-    static_cast<long long>(d[1]),
-    static_cast<long long>(d[2]),
-    static_cast<long long>(grid.deck.CellCount()),
-    static_cast<long long>(grid.activeCells),
-    static_cast<long long>(
-      std::count_if(grid.actnum.begin(), grid.actnum.end(), [](int32_t v) { return v > 0; })),
-    grid.dualPorosity ? "true" : "false",
-    static_cast<long long>(grid.fractureCells),
-    grid.localGridNames.size(),
-    static_cast<long long>(grid.nonNeighbourConnections),
-    JsonString(grid.units).c_str(),
-    JsonString(results.InitPath()).c_str(),
-    JsonNames(results.StaticArrays()).c_str(),
-    results.RestartPaths().size(),
-    results.UnifiedRestart() ? "true" : "false",
-    JsonNames(results.DynamicArrays()).c_str());
+  std::printf(
+    "{\"file\": %s, \"kind\": \"egrid\", \"dims\": [%lld, %lld, %lld], \"cells\": %lld, "
+    "\"active\": %lld, \"nonzero_actnum\": %lld, \"dual_porosity\": %s, \"fracture_cells\": %lld, \"lgrs\": %zu, "
+    "\"nnc\": %lld, \"units\": %s, \"init\": %s, \"init_arrays\": %s, \"restarts\": %zu, "
+    "\"unified\": %s, \"restart_arrays\": %s, \"steps\": [",
+    JsonString(path).c_str(), static_cast<long long>(d[0]), static_cast<long long>(d[1]), static_cast<long long>(d[2]),
+    static_cast<long long>(grid.deck.CellCount()), static_cast<long long>(grid.activeCells),
+    static_cast<long long>(std::count_if(grid.actnum.begin(), grid.actnum.end(), [](int32_t v) { return v > 0; })),
+    grid.dualPorosity ? "true" : "false", static_cast<long long>(grid.fractureCells), grid.localGridNames.size(),
+    static_cast<long long>(grid.nonNeighbourConnections), JsonString(grid.units).c_str(),
+    JsonString(results.InitPath()).c_str(), JsonNames(results.StaticArrays()).c_str(), results.RestartPaths().size(),
+    results.UnifiedRestart() ? "true" : "false", JsonNames(results.DynamicArrays()).c_str());
   for (std::size_t s = 0; s < results.Steps().size(); ++s)
   {
     const resmr::EclipseReportStep& step = results.Steps()[s];
-    std::printf("%s{\"report\": %d, \"days\": %.17g, \"date\": \"%04d-%02d-%02d\", \"arrays\": [",
-      s ? ", " : "",
-      step.reportNumber,
-      step.days,
-      step.date[0],
-      step.date[1],
-      step.date[2]);
+    std::printf("%s{\"report\": %d, \"days\": %.17g, \"date\": \"%04d-%02d-%02d\", \"arrays\": [", s ? ", " : "",
+      step.reportNumber, step.days, step.date[0], step.date[1], step.date[2]);
     for (std::size_t a = 0; a < step.names.size(); ++a)
     {
       std::printf("%s%s", a ? ", " : "", JsonString(step.names[a]).c_str());
@@ -97,16 +81,12 @@ int GridInfo(const char* path)
     std::printf("]}");
   }
   // Steps of a run cut short (or still being written) that are not offered, and why.
-  std::printf(
-    "], \"init_used\": %s, \"steps_left_out\": [", results.InitUsable() ? "true" : "false");
+  std::printf("], \"init_used\": %s, \"steps_left_out\": [", results.InitUsable() ? "true" : "false");
   for (std::size_t s = 0; s < results.SkippedSteps().size(); ++s)
   {
     const resmr::EclipseSkippedStep& skipped = results.SkippedSteps()[s];
-    std::printf("%s{\"file\": %s, \"report\": %d, \"offset\": %lld, \"reason\": %s}",
-      s ? ", " : "",
-      JsonString(skipped.file).c_str(),
-      skipped.reportNumber,
-      static_cast<long long>(skipped.offset),
+    std::printf("%s{\"file\": %s, \"report\": %d, \"offset\": %lld, \"reason\": %s}", s ? ", " : "",
+      JsonString(skipped.file).c_str(), skipped.reportNumber, static_cast<long long>(skipped.offset),
       JsonString(skipped.reason).c_str());
   }
   std::printf("]}\n");
@@ -120,11 +100,10 @@ int Info(const char* path, bool skipMissingIncludes)
   {
     c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   }
-  const bool keywordFile = resmr::EclipseKeywordFile::LooksLikeUnformatted(path) ||
-                           resmr::EclipseKeywordFile::LooksLikeFormatted(path);
+  const bool keywordFile =
+    resmr::EclipseKeywordFile::LooksLikeUnformatted(path) || resmr::EclipseKeywordFile::LooksLikeFormatted(path);
   if (resmr::LooksLikeEclipseGridFile(path) ||
-      (keywordFile && (extension == ".EGRID" || extension == ".FEGRID" || extension == ".GRID" ||
-                        extension == ".FGRID")))
+    (keywordFile && (extension == ".EGRID" || extension == ".FEGRID" || extension == ".GRID" || extension == ".FGRID")))
   {
     return GridInfo(path);
   }
@@ -161,15 +140,9 @@ int Info(const char* path, bool skipMissingIncludes)
   }
   std::printf("{\"file\": %s, \"dims\": [%lld, %lld, %lld], \"cells\": %lld, \"active\": %lld, "
               "\"geometry\": \"%s\", \"left_handed\": %s, \"fault_records\": %lld, \"faults\": [",
-    JsonString(path).c_str(),
-    static_cast<long long>(deck.dims[0]),
-    static_cast<long long>(deck.dims[1]),
-    static_cast<long long>(deck.dims[2]),
-    static_cast<long long>(cells),
-    static_cast<long long>(active),
-    geometry.c_str(),
-    leftHanded ? "true" : "false",
-    static_cast<long long>(faultRecords));
+    JsonString(path).c_str(), static_cast<long long>(deck.dims[0]), static_cast<long long>(deck.dims[1]),
+    static_cast<long long>(deck.dims[2]), static_cast<long long>(cells), static_cast<long long>(active),
+    geometry.c_str(), leftHanded ? "true" : "false", static_cast<long long>(faultRecords));
   for (std::size_t f = 0; f < deck.faults.size(); ++f)
   {
     std::printf("%s%s", f ? ", " : "", JsonString(deck.faults[f].name).c_str());
@@ -224,8 +197,7 @@ int main(int argc, char** argv)
     return AddPropertiesCommand(argc, argv);
   }
   const bool listRegions = argc == 4 && std::strcmp(argv[2], "--regions") == 0;
-  if ((argc == 3 || listRegions) && std::strcmp(argv[1], "info") == 0 &&
-      LooksLikeMultiresolutionFile(argv[argc - 1]))
+  if ((argc == 3 || listRegions) && std::strcmp(argv[1], "info") == 0 && LooksLikeMultiresolutionFile(argv[argc - 1]))
   {
     try
     {

@@ -19,8 +19,7 @@ AtomicOutputFile::AtomicOutputFile(const std::string& path)
   const int descriptor = mkstemp(&pattern[0]);
   if (descriptor < 0)
   {
-    throw InputError(
-      path, 0, "", std::string("cannot create the output file beside it: ") + std::strerror(errno));
+    throw InputError(path, 0, "", std::string("cannot create the output file beside it: ") + std::strerror(errno));
   }
   this->Temporary = pattern;
   this->File = fdopen(descriptor, "wb");
@@ -29,8 +28,7 @@ AtomicOutputFile::AtomicOutputFile(const std::string& path)
     const int error = errno;
     close(descriptor);
     unlink(this->Temporary.c_str());
-    throw InputError(
-      path, 0, "", std::string("cannot open the output file: ") + std::strerror(error));
+    throw InputError(path, 0, "", std::string("cannot open the output file: ") + std::strerror(error));
   }
   fchmod(descriptor, 0644); // mkstemp creates 0600; outputs are ordinary files
   std::setvbuf(this->File, nullptr, _IOFBF, 1 << 20);
@@ -63,8 +61,8 @@ bool AtomicOutputFile::WriteAt(const void* data, std::size_t size, long offset)
     return false;
   }
   const long end = std::ftell(this->File);
-  const bool ok = end >= 0 && std::fseek(this->File, offset, SEEK_SET) == 0 &&
-                  std::fwrite(data, 1, size, this->File) == size;
+  const bool ok =
+    end >= 0 && std::fseek(this->File, offset, SEEK_SET) == 0 && std::fwrite(data, 1, size, this->File) == size;
   return std::fseek(this->File, end, SEEK_SET) == 0 && ok;
 }
 
@@ -81,19 +79,15 @@ void AtomicOutputFile::Commit()
   if (!flushed || !closed)
   {
     unlink(this->Temporary.c_str());
-    throw InputError(this->FinalPath,
-      0,
-      "",
-      std::string("write failed (disk full?): ") + std::strerror(flushed ? errno : error));
+    throw InputError(
+      this->FinalPath, 0, "", std::string("write failed (disk full?): ") + std::strerror(flushed ? errno : error));
   }
   if (std::rename(this->Temporary.c_str(), this->FinalPath.c_str()) != 0)
   {
     const int renameError = errno;
     unlink(this->Temporary.c_str());
-    throw InputError(this->FinalPath,
-      0,
-      "",
-      std::string("cannot move the finished file into place: ") + std::strerror(renameError));
+    throw InputError(
+      this->FinalPath, 0, "", std::string("cannot move the finished file into place: ") + std::strerror(renameError));
   }
 }
 

@@ -23,8 +23,7 @@ public:
   template<typename T>
   void Put(const T& value)
   {
-    static_assert(
-      std::is_trivially_copyable<T>::value, "raw bytes of a trivially copyable value only");
+    static_assert(std::is_trivially_copyable<T>::value, "raw bytes of a trivially copyable value only");
     this->PutBytes(&value, sizeof(T));
   }
   void PutBytes(const void* data, std::size_t size)
@@ -44,10 +43,7 @@ class ByteReader
 {
 public:
   ByteReader() = default;
-  ByteReader(const uint8_t* data, std::size_t size, std::string place)
-  {
-    this->Reset(data, size, std::move(place));
-  }
+  ByteReader(const uint8_t* data, std::size_t size, std::string place) { this->Reset(data, size, std::move(place)); }
   void Reset(const uint8_t* data, std::size_t size, std::string place)
   {
     this->Data = data;
@@ -58,8 +54,7 @@ public:
   template<typename T>
   T Get()
   {
-    static_assert(
-      std::is_trivially_copyable<T>::value, "raw bytes of a trivially copyable value only");
+    static_assert(std::is_trivially_copyable<T>::value, "raw bytes of a trivially copyable value only");
     T value{};
     this->GetBytes(&value, sizeof(T));
     return value;
@@ -81,8 +76,7 @@ public:
   std::string GetString()
   {
     const uint64_t size = this->Get<uint64_t>();
-    const uint8_t* from =
-      this->Skip(static_cast<std::size_t>(std::min<uint64_t>(size, this->Left() + 1)));
+    const uint8_t* from = this->Skip(static_cast<std::size_t>(std::min<uint64_t>(size, this->Left() + 1)));
     return std::string(reinterpret_cast<const char*>(from), static_cast<std::size_t>(size));
   }
   /// The next `size` bytes, in place; throws if fewer are left.
@@ -90,9 +84,8 @@ public:
   {
     if (size > this->Size - this->At)
     {
-      throw FileFormatError(this->Place + ": ends early (needs " + std::to_string(size) +
-                            " more bytes at byte " + std::to_string(this->At) + " of " +
-                            std::to_string(this->Size) + ")");
+      throw FileFormatError(this->Place + ": ends early (needs " + std::to_string(size) + " more bytes at byte " +
+        std::to_string(this->At) + " of " + std::to_string(this->Size) + ")");
     }
     const uint8_t* from = this->Data + this->At;
     this->At += size;

@@ -15,18 +15,12 @@ namespace resmr
 class InputError : public std::runtime_error
 {
 public:
-  InputError(const std::string& file,
-    int64_t line,
-    const std::string& keyword,
-    const std::string& what)
+  InputError(const std::string& file, int64_t line, const std::string& keyword, const std::string& what)
     : std::runtime_error(Format(file, line, keyword, what))
   {
   }
 
-  static std::string Format(const std::string& file,
-    int64_t line,
-    const std::string& keyword,
-    const std::string& what)
+  static std::string Format(const std::string& file, int64_t line, const std::string& keyword, const std::string& what)
   {
     std::string message = file;
     if (line > 0)

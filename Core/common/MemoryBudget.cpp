@@ -57,7 +57,7 @@ std::string MultiresolutionAdvice(const std::string& path)
 {
   return "open it through the multiresolution path instead, which loads only what the view "
          "needs: resmr build " +
-         path + " -o MODEL.resmr, then open MODEL.resmr";
+    path + " -o MODEL.resmr, then open MODEL.resmr";
 }
 
 } // namespace resmr

@@ -23,10 +23,8 @@ SpoolFile::SpoolFile(const std::string& folder, const std::string& name)
   this->Descriptor = mkstemp(path.data());
   if (this->Descriptor < 0)
   {
-    throw InputError(this->Folder,
-      0,
-      name,
-      std::string("cannot create a temporary file for the array: ") + std::strerror(errno));
+    throw InputError(
+      this->Folder, 0, name, std::string("cannot create a temporary file for the array: ") + std::strerror(errno));
   }
   // Unlinked at once: nothing is left behind, whatever happens to this process.
   unlink(path.data());
@@ -53,9 +51,7 @@ void SpoolFile::WriteBytes(int64_t offset, const void* data, int64_t size)
     }
     if (put <= 0)
     {
-      throw InputError(this->Folder,
-        0,
-        this->ArrayName,
+      throw InputError(this->Folder, 0, this->ArrayName,
         "temporary file write at byte " + std::to_string(offset) +
           " failed: " + (put < 0 ? std::strerror(errno) : "no space left?"));
     }
@@ -77,9 +73,7 @@ void SpoolFile::ReadBytes(int64_t offset, void* data, int64_t size) const
     }
     if (got <= 0)
     {
-      throw InputError(this->Folder,
-        0,
-        this->ArrayName,
+      throw InputError(this->Folder, 0, this->ArrayName,
         "temporary file read at byte " + std::to_string(offset) + " failed" +
           (got < 0 ? std::string(": ") + std::strerror(errno) : std::string(": short file")));
     }

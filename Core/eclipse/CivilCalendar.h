@@ -25,15 +25,12 @@ inline std::array<int, 3> CivilFromDays(int64_t days)
   days += 719468;
   const int64_t era = (days >= 0 ? days : days - 146096) / 146097;
   const int64_t dayOfEra = days - era * 146097;
-  const int64_t yearOfEra =
-    (dayOfEra - dayOfEra / 1460 + dayOfEra / 36524 - dayOfEra / 146096) / 365;
+  const int64_t yearOfEra = (dayOfEra - dayOfEra / 1460 + dayOfEra / 36524 - dayOfEra / 146096) / 365;
   const int64_t dayOfYear = dayOfEra - (365 * yearOfEra + yearOfEra / 4 - yearOfEra / 100);
   const int64_t shifted = (5 * dayOfYear + 2) / 153;
   const int64_t day = dayOfYear - (153 * shifted + 2) / 5 + 1;
   const int64_t month = shifted + (shifted < 10 ? 3 : -9);
-  return { static_cast<int>(yearOfEra + era * 400 + (month <= 2)),
-    static_cast<int>(month),
-    static_cast<int>(day) };
+  return { static_cast<int>(yearOfEra + era * 400 + (month <= 2)), static_cast<int>(month), static_cast<int>(day) };
 }
 
 } // namespace resmr

@@ -17,18 +17,12 @@ void BuildCartesian(CornerPointModel& deck, std::vector<double>& coord, std::vec
 {
   const int64_t nx = deck.dims[0], ny = deck.dims[1], nz = deck.dims[2];
   const std::string& file = deck.files.front();
-  const auto cellArray = [&](const char* name) -> const std::vector<double>*
-  {
+  const auto cellArray = [&](const char* name) -> const std::vector<double>* {
     const CellArray* array = deck.FindArray(name);
     return array ? &array->values : nullptr;
   };
-  const auto size = [&](const char* name,
-                      const std::vector<double>& vectorForm,
-                      int64_t i,
-                      int64_t j,
-                      int64_t k,
-                      int axis)
-  {
+  const auto size = [&](const char* name, const std::vector<double>& vectorForm, int64_t i, int64_t j, int64_t k,
+                      int axis) {
     const int64_t along = axis == 0 ? i : (axis == 1 ? j : k);
     double value = std::nan("");
     if (!vectorForm.empty())
@@ -41,11 +35,9 @@ void BuildCartesian(CornerPointModel& deck, std::vector<double>& coord, std::vec
     }
     if (!std::isfinite(value) || value < 0)
     {
-      throw InputError(file,
-        0,
-        name,
-        "cell (" + std::to_string(i + 1) + "," + std::to_string(j + 1) + "," +
-          std::to_string(k + 1) + ") has no valid size");
+      throw InputError(file, 0, name,
+        "cell (" + std::to_string(i + 1) + "," + std::to_string(j + 1) + "," + std::to_string(k + 1) +
+          ") has no valid size");
     }
     return value;
   };
@@ -87,18 +79,15 @@ void BuildCartesian(CornerPointModel& deck, std::vector<double>& coord, std::vec
         }
         else if (k == 0)
         {
-          throw InputError(file,
-            0,
-            "TOPS",
-            "column (" + std::to_string(i + 1) + "," + std::to_string(j + 1) +
-              ") has no top depth in layer 1");
+          throw InputError(file, 0, "TOPS",
+            "column (" + std::to_string(i + 1) + "," + std::to_string(j + 1) + ") has no top depth in layer 1");
         }
         const double bottom = top + size("DZ", deck.dzv, i, j, k, 2);
         for (int corner = 0; corner < 8; ++corner)
         {
           const int64_t di = corner & 1, dj = (corner >> 1) & 1, dk = corner >> 2;
-          zcorn[static_cast<std::size_t>(
-            ((2 * k + dk) * 2 * ny + 2 * j + dj) * 2 * nx + 2 * i + di)] = dk ? bottom : top;
+          zcorn[static_cast<std::size_t>(((2 * k + dk) * 2 * ny + 2 * j + dj) * 2 * nx + 2 * i + di)] =
+            dk ? bottom : top;
         }
         top = bottom;
       }
@@ -118,23 +107,18 @@ CornerPointGeometry CornerPointGeometry::FromDeck(CornerPointModel& deck, bool a
     const bool hasDz = deck.FindArray("DZ") || !deck.dzv.empty();
     if (!hasDx || !hasDy || !hasDz || !deck.FindArray("TOPS"))
     {
-      throw InputError(deck.files.empty() ? std::string("deck") : deck.files.front(),
-        0,
-        "COORD",
+      throw InputError(deck.files.empty() ? std::string("deck") : deck.files.front(), 0, "COORD",
         "no grid geometry: need COORD and ZCORN, or DX/DXV, DY/DYV, DZ/DZV and TOPS");
     }
   }
   if (deck.HasCornerPointGeometry())
   {
     const int64_t nx = deck.dims[0], ny = deck.dims[1];
-    const std::size_t depths =
-      deck.zcornSingle.empty() ? deck.zcorn.size() : deck.zcornSingle.size();
+    const std::size_t depths = deck.zcornSingle.empty() ? deck.zcorn.size() : deck.zcornSingle.size();
     if (static_cast<int64_t>(deck.coord.size()) != 6 * (nx + 1) * (ny + 1) ||
-        static_cast<int64_t>(depths) != 8 * deck.CellCount())
+      static_cast<int64_t>(depths) != 8 * deck.CellCount())
     {
-      throw InputError(deck.files.empty() ? std::string("deck") : deck.files.front(),
-        0,
-        "ZCORN",
+      throw InputError(deck.files.empty() ? std::string("deck") : deck.files.front(), 0, "ZCORN",
         "COORD/ZCORN sizes do not match the grid dimensions");
     }
     geometry.CoordValues = std::move(deck.coord);
@@ -159,9 +143,7 @@ void CornerPointGeometry::CheckMapAxes(const CornerPointModel& deck)
   std::array<double, 6> transform;
   if (deck.hasMapAxes && !deck.gridUnitIsMap && !MapTransformOf(deck.mapAxes, transform))
   {
-    throw InputError(deck.files.empty() ? std::string("deck") : deck.files.front(),
-      0,
-      "MAPAXES",
+    throw InputError(deck.files.empty() ? std::string("deck") : deck.files.front(), 0, "MAPAXES",
       "axis points coincide with the origin");
   }
 }
@@ -180,11 +162,9 @@ bool CornerPointGeometry::MapTransformOf(const MapAxes& axes, std::array<double,
   return true;
 }
 
-bool CornerPointGeometry::PlacementTransform(const MapPlacement& placement,
-  std::array<double, 6>& transform)
+bool CornerPointGeometry::PlacementTransform(const MapPlacement& placement, std::array<double, 6>& transform)
 {
-  return placement.hasMapAxes && !placement.gridUnitIsMap &&
-         MapTransformOf(placement.mapAxes, transform);
+  return placement.hasMapAxes && !placement.gridUnitIsMap && MapTransformOf(placement.mapAxes, transform);
 }
 
 void CornerPointGeometry::SetMapAxesApplied(bool apply)
@@ -216,8 +196,7 @@ void CornerPointGeometry::DetectHandedness()
 {
   // Sum of the (i, j) cross products of the top pillar ends: its sign is the grid's turn.
   const int64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
-  const auto point = [&](int64_t i, int64_t j, double out[2])
-  {
+  const auto point = [&](int64_t i, int64_t j, double out[2]) {
     const double* p = &this->CoordValues[static_cast<std::size_t>(6 * (j * (nx + 1) + i))];
     out[0] = p[0];
     out[1] = p[1];
@@ -280,9 +259,7 @@ CornerPointGeometry::SharedCorners CornerPointGeometry::BuildSharedCorners() con
           }
         }
       }
-      std::sort(entries.begin(),
-        entries.end(),
-        [](const Entry& a, const Entry& b) { return a.depth < b.depth; });
+      std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.depth < b.depth; });
       const int64_t pillar = pj * (nx + 1) + pi;
       for (std::size_t e = 0; e < entries.size(); ++e)
       {

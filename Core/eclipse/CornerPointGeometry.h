@@ -47,10 +47,7 @@ public:
   void SetMapAxesApplied(bool apply);
 
   const std::array<int64_t, 3>& Dims() const { return this->Dimensions; }
-  int64_t CellCount() const
-  {
-    return this->Dimensions[0] * this->Dimensions[1] * this->Dimensions[2];
-  }
+  int64_t CellCount() const { return this->Dimensions[0] * this->Dimensions[1] * this->Dimensions[2]; }
 
   /// The 8 corners (x, y, depth) of cell (i, j, k), 0-based, ECLIPSE corner order.
   void CellCorners(int64_t i, int64_t j, int64_t k, double corners[8][3]) const;
@@ -93,8 +90,7 @@ private:
   {
     const int64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
     const int64_t di = corner & 1, dj = (corner >> 1) & 1, dk = corner >> 2;
-    const auto index =
-      static_cast<std::size_t>(((2 * k + dk) * 2 * ny + 2 * j + dj) * 2 * nx + 2 * i + di);
+    const auto index = static_cast<std::size_t>(((2 * k + dk) * 2 * ny + 2 * j + dj) * 2 * nx + 2 * i + di);
     return this->ZcornSingle.empty() ? this->ZcornValues[index] : this->ZcornSingle[index];
   }
   void DetectHandedness();

@@ -74,8 +74,8 @@ struct CornerPointModel
   MapAxes mapAxes;
   std::string mapUnits;
   std::string gridUnit;
-  bool gridUnitIsMap = false;        ///< GRIDUNIT 'METRES' 'MAP': COORD already in map coordinates
-  std::vector<std::string> gdorient; ///< GDORIENT record, as written
+  bool gridUnitIsMap = false;                         ///< GRIDUNIT 'METRES' 'MAP': COORD already in map coordinates
+  std::vector<std::string> gdorient;                  ///< GDORIENT record, as written
   std::vector<std::array<int32_t, 2>> coordsysLayers; ///< COORDSYS k1 k2 (1-based)
 
   /// Cell arrays in first-definition order. ACTNUM, DX, DY, DZ and TOPS live here too so

@@ -10,15 +10,11 @@ namespace resmr
 
 bool NeedsDerivedOil(const std::vector<std::string>& names)
 {
-  const auto holds = [&](const char* name)
-  { return std::find(names.begin(), names.end(), name) != names.end(); };
+  const auto holds = [&](const char* name) { return std::find(names.begin(), names.end(), name) != names.end(); };
   return holds("SWAT") && !holds(DerivedOilName);
 }
 
-bool ReadDerivedOil(const EclipseResults& results,
-  std::size_t step,
-  float* cellValues,
-  int64_t cellCount)
+bool ReadDerivedOil(const EclipseResults& results, std::size_t step, float* cellValues, int64_t cellCount)
 {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   if (!results.ReadDynamic(step, "SWAT", cellValues, nan))

@@ -23,9 +23,6 @@ bool NeedsDerivedOil(const std::vector<std::string>& names);
 /// Fills cellValues[0, cellCount) with 1 - SWAT - SGAS of report step `step` (index into
 /// results.Steps()); SGAS counts as 0 in a run without gas, a cell without SWAT gets NaN.
 /// False if the step has no SWAT.
-bool ReadDerivedOil(const EclipseResults& results,
-  std::size_t step,
-  float* cellValues,
-  int64_t cellCount);
+bool ReadDerivedOil(const EclipseResults& results, std::size_t step, float* cellValues, int64_t cellCount);
 
 } // namespace resmr

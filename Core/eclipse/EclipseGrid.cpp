@@ -30,7 +30,7 @@ bool LooksLikeEclipseGridFile(const std::string& path)
     name = std::strchr(head, '\'') + 1;
   }
   return name && name + 8 <= head + got &&
-         (std::strncmp(name, "FILEHEAD", 8) == 0 || std::strncmp(name, "GRIDHEAD", 8) == 0);
+    (std::strncmp(name, "FILEHEAD", 8) == 0 || std::strncmp(name, "GRIDHEAD", 8) == 0);
 }
 
 namespace
@@ -56,8 +56,9 @@ bool AllFinite(const Real* values, std::size_t count)
 EclipseGridLayout LocateEclipseGrid(const EclipseKeywordFile& file, int64_t maxCells)
 {
   const std::string& path = file.Path();
-  const auto fail = [&](const EclipseRecord* record, const std::string& what) -> void
-  { file.Fail(record, record ? record->headerOffset : 0, what); };
+  const auto fail = [&](const EclipseRecord* record, const std::string& what) -> void {
+    file.Fail(record, record ? record->headerOffset : 0, what);
+  };
   const auto& records = file.Records();
 
   // Old-style GRID files carry DIMENS + COORDS/CORNERS per cell instead of GRIDHEAD.
@@ -133,8 +134,7 @@ EclipseGridLayout LocateEclipseGrid(const EclipseKeywordFile& file, int64_t maxC
       if (integers[0] != 1)
       {
         fail(&record,
-          "grid type " + std::to_string(integers[0]) +
-            " is not a corner-point grid (only type 1 is supported)");
+          "grid type " + std::to_string(integers[0]) + " is not a corner-point grid (only type 1 is supported)");
       }
       const std::array<int64_t, 3> dims{ integers[1], integers[2], integers[3] };
       CheckedCellCount(dims, maxCells, path, 0, "GRIDHEAD");
@@ -172,15 +172,15 @@ EclipseGridLayout LocateEclipseGrid(const EclipseKeywordFile& file, int64_t maxC
         fail(&record, "appears before GRIDHEAD");
       }
       const int64_t nx = deck.dims[0], ny = deck.dims[1], nz = deck.dims[2];
-      const int64_t expected = name == "COORD"   ? 6 * (nx + 1) * (ny + 1)
-                               : name == "ZCORN" ? 8 * nx * ny * nz
-                                                 : nx * ny * nz;
+      const int64_t expected = name == "COORD" ? 6 * (nx + 1) * (ny + 1)
+        : name == "ZCORN"                      ? 8 * nx * ny * nz
+                                               : nx * ny * nz;
       if (!record.IsNumeric() || record.count != expected)
       {
         fail(&record,
-          "expected " + std::to_string(expected) + " numbers for a " + std::to_string(nx) + " x " +
-            std::to_string(ny) + " x " + std::to_string(nz) + " grid, file has " +
-            std::to_string(record.count) + " of type " + record.typeName);
+          "expected " + std::to_string(expected) + " numbers for a " + std::to_string(nx) + " x " + std::to_string(ny) +
+            " x " + std::to_string(nz) + " grid, file has " + std::to_string(record.count) + " of type " +
+            record.typeName);
       }
       (name == "COORD" ? layout.coord : name == "ZCORN" ? layout.zcorn : layout.actnum) = &record;
     }
@@ -188,9 +188,10 @@ EclipseGridLayout LocateEclipseGrid(const EclipseKeywordFile& file, int64_t maxC
   if (!sawGridHead || !layout.coord || !layout.zcorn)
   {
     fail(nullptr,
-      std::string("the global grid lacks ") + (!sawGridHead     ? "GRIDHEAD"
-                                                : !layout.coord ? "COORD"
-                                                                : "ZCORN"));
+      std::string("the global grid lacks ") +
+        (!sawGridHead       ? "GRIDHEAD"
+            : !layout.coord ? "COORD"
+                            : "ZCORN"));
   }
   return layout;
 }
@@ -199,9 +200,7 @@ namespace
 {
 /// Reads a COORD or ZCORN record whole into `target`; every value must be finite.
 template<typename Real>
-void ReadFiniteRecord(const EclipseKeywordFile& file,
-  const EclipseRecord& record,
-  std::vector<Real>& target)
+void ReadFiniteRecord(const EclipseKeywordFile& file, const EclipseRecord& record, std::vector<Real>& target)
 {
   target.clear();
   ResizeLarge(target, static_cast<std::size_t>(record.count));
@@ -212,8 +211,7 @@ void ReadFiniteRecord(const EclipseKeywordFile& file,
     {
       if (!std::isfinite(target[v]))
       {
-        file.Fail(
-          &record, record.headerOffset, "value " + std::to_string(v + 1) + " is not finite");
+        file.Fail(&record, record.headerOffset, "value " + std::to_string(v + 1) + " is not finite");
       }
     }
   }
@@ -240,8 +238,7 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells, EclipseGr
     ReadFiniteRecord(file, *layout.coord, deck.coord);
     if (layout.zcorn->type == EclipseDataType::Real)
     {
-      ReadFiniteRecord(
-        file, *layout.zcorn, deck.zcornSingle); // EGRID's float32 depths, kept as they are
+      ReadFiniteRecord(file, *layout.zcorn, deck.zcornSingle); // EGRID's float32 depths, kept as they are
     }
     else
     {
@@ -271,8 +268,8 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells, EclipseGr
   if (grid.dualPorosity)
   {
     deck.warnings.push_back(path + ": dual-porosity grid: showing the matrix grid (" +
-                            std::to_string(grid.activeCells) + " matrix cells; " +
-                            std::to_string(grid.fractureCells) + " fracture cells not shown)");
+      std::to_string(grid.activeCells) + " matrix cells; " + std::to_string(grid.fractureCells) +
+      " fracture cells not shown)");
   }
   if (!grid.localGridNames.empty())
   {
@@ -282,7 +279,7 @@ EclipseGrid ReadEclipseGrid(const std::string& path, int64_t maxCells, EclipseGr
       names += (names.empty() ? "" : ", ") + lgr;
     }
     deck.warnings.push_back(path + ": " + std::to_string(grid.localGridNames.size()) +
-                            " local grid refinement(s) not shown, only the global grid: " + names);
+      " local grid refinement(s) not shown, only the global grid: " + names);
   }
   return grid;
 }

@@ -88,8 +88,7 @@ enum class EclipseGridParts
 };
 
 /// Reads an EGRID or FEGRID file; maxCells 0 means "what this machine can hold".
-EclipseGrid ReadEclipseGrid(const std::string& path,
-  int64_t maxCells = 0,
-  EclipseGridParts parts = EclipseGridParts::Everything);
+EclipseGrid ReadEclipseGrid(
+  const std::string& path, int64_t maxCells = 0, EclipseGridParts parts = EclipseGridParts::Everything);
 
 } // namespace resmr

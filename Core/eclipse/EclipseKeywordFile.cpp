@@ -56,10 +56,10 @@ bool ParseType(EclipseRecord& record)
   const std::string& t = record.typeName;
   if (t == "INTE" || t == "REAL" || t == "LOGI" || t == "DOUB")
   {
-    record.type = t == "INTE"   ? EclipseDataType::Integer
-                  : t == "REAL" ? EclipseDataType::Real
-                  : t == "LOGI" ? EclipseDataType::Logical
-                                : EclipseDataType::Double;
+    record.type = t == "INTE" ? EclipseDataType::Integer
+      : t == "REAL"           ? EclipseDataType::Real
+      : t == "LOGI"           ? EclipseDataType::Logical
+                              : EclipseDataType::Double;
     record.elementSize = t == "DOUB" ? 8 : 4;
     return true;
   }
@@ -76,8 +76,7 @@ bool ParseType(EclipseRecord& record)
     return true;
   }
   if (t.size() == 4 && t[0] == 'C' && std::isdigit(static_cast<unsigned char>(t[1])) &&
-      std::isdigit(static_cast<unsigned char>(t[2])) &&
-      std::isdigit(static_cast<unsigned char>(t[3])))
+    std::isdigit(static_cast<unsigned char>(t[2])) && std::isdigit(static_cast<unsigned char>(t[3])))
   {
     record.type = EclipseDataType::Character;
     record.elementSize = std::stoi(t.substr(1));
@@ -105,8 +104,7 @@ void SwapWords32(const unsigned char* in, int64_t n, void* out)
   {
     const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + 4 * i));
     const __m128i swapped = _mm_or_si128(_mm_or_si128(_mm_srli_epi32(v, 24), _mm_slli_epi32(v, 24)),
-      _mm_or_si128(
-        _mm_and_si128(_mm_srli_epi32(v, 8), low), _mm_and_si128(_mm_slli_epi32(v, 8), high)));
+      _mm_or_si128(_mm_and_si128(_mm_srli_epi32(v, 8), low), _mm_and_si128(_mm_slli_epi32(v, 8), high)));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(bytes + 4 * i), swapped);
   }
 #endif
@@ -159,7 +157,7 @@ template<typename T>
 void ConvertBigEndian(EclipseDataType type, const unsigned char* in, int64_t n, T* out)
 {
   if ((type == EclipseDataType::Real && std::is_same_v<T, float>) ||
-      (type == EclipseDataType::Integer && std::is_same_v<T, int32_t>))
+    (type == EclipseDataType::Integer && std::is_same_v<T, int32_t>))
   {
     SwapWords32(in, n, out);
     return;
@@ -205,8 +203,7 @@ void ConvertBigEndian(EclipseDataType type, const unsigned char* in, int64_t n, 
         std::memcpy(values, words, static_cast<std::size_t>(4 * count));
         for (int64_t i = 0; i < count; ++i)
         {
-          target[i] = type == EclipseDataType::Logical ? (values[i] != 0 ? T(1) : T(0))
-                                                       : static_cast<T>(values[i]);
+          target[i] = type == EclipseDataType::Logical ? (values[i] != 0 ? T(1) : T(0)) : static_cast<T>(values[i]);
         }
         break;
       }
@@ -281,16 +278,14 @@ private:
   int Peek()
   {
     if (this->Offset < this->BufferStart ||
-        this->Offset >= this->BufferStart + static_cast<int64_t>(this->Buffer.size()))
+      this->Offset >= this->BufferStart + static_cast<int64_t>(this->Buffer.size()))
     {
       if (this->Offset >= this->FileSize)
       {
         return -1;
       }
-      this->Buffer.resize(
-        static_cast<std::size_t>(std::min<int64_t>(1 << 20, this->FileSize - this->Offset)));
-      const ssize_t got =
-        pread(this->Descriptor, this->Buffer.data(), this->Buffer.size(), this->Offset);
+      this->Buffer.resize(static_cast<std::size_t>(std::min<int64_t>(1 << 20, this->FileSize - this->Offset)));
+      const ssize_t got = pread(this->Descriptor, this->Buffer.data(), this->Buffer.size(), this->Offset);
       if (got <= 0)
       {
         this->Buffer.clear();
@@ -299,8 +294,7 @@ private:
       this->Buffer.resize(static_cast<std::size_t>(got));
       this->BufferStart = this->Offset;
     }
-    return static_cast<unsigned char>(
-      this->Buffer[static_cast<std::size_t>(this->Offset - this->BufferStart)]);
+    return static_cast<unsigned char>(this->Buffer[static_cast<std::size_t>(this->Offset - this->BufferStart)]);
   }
 
   int Descriptor;
@@ -368,9 +362,7 @@ EclipseKeywordFile::EclipseKeywordFile(const std::string& path, KeywordFileIndex
     }
     else
     {
-      throw InputError(path,
-        0,
-        "",
+      throw InputError(path, 0, "",
         "not an ECLIPSE keyword file (neither a binary record header nor a formatted "
         "'KEYWORD' count 'TYPE' line at the start)");
     }
@@ -428,14 +420,10 @@ bool EclipseKeywordFile::LooksLikeFormatted(const std::string& path)
   return second && second + 5 < head + got && second[5] == '\'';
 }
 
-void EclipseKeywordFile::Fail(const EclipseRecord* record,
-  int64_t offset,
-  const std::string& what) const
+void EclipseKeywordFile::Fail(const EclipseRecord* record, int64_t offset, const std::string& what) const
 {
-  throw InputError(this->FilePath,
-    0,
-    record ? record->name : std::string(),
-    what + " (at byte " + std::to_string(offset) + ")");
+  throw InputError(
+    this->FilePath, 0, record ? record->name : std::string(), what + " (at byte " + std::to_string(offset) + ")");
 }
 
 const EclipseRecord* EclipseKeywordFile::Find(const std::string& name, std::size_t from) const
@@ -450,10 +438,7 @@ const EclipseRecord* EclipseKeywordFile::Find(const std::string& name, std::size
   return nullptr;
 }
 
-void EclipseKeywordFile::ReadRaw(int64_t offset,
-  void* data,
-  int64_t size,
-  const EclipseRecord* record) const
+void EclipseKeywordFile::ReadRaw(int64_t offset, void* data, int64_t size, const EclipseRecord* record) const
 {
   if (offset < 0 || size < 0 || offset + size > this->FileSize)
   {
@@ -469,10 +454,8 @@ void EclipseKeywordFile::ReadRaw(int64_t offset,
     }
     if (got <= 0)
     {
-      this->Fail(record,
-        offset,
-        got < 0 ? std::string("read error: ") + std::strerror(errno)
-                : std::string("file truncated"));
+      this->Fail(
+        record, offset, got < 0 ? std::string("read error: ") + std::strerror(errno) : std::string("file truncated"));
     }
     bytes += got;
     offset += got;
@@ -504,12 +487,10 @@ void EclipseKeywordFile::IndexUnformatted()
   // (restart headers, well data) are indexed with a few reads, not three per record.
   std::vector<unsigned char> window;
   int64_t windowStart = 0;
-  const auto peek = [&](int64_t offset, void* data, int64_t size, const EclipseRecord* record)
-  {
+  const auto peek = [&](int64_t offset, void* data, int64_t size, const EclipseRecord* record) {
     if (offset < windowStart || offset + size > windowStart + static_cast<int64_t>(window.size()))
     {
-      const int64_t want =
-        std::min<int64_t>(std::max<int64_t>(size, IndexWindowBytes), this->FileSize - offset);
+      const int64_t want = std::min<int64_t>(std::max<int64_t>(size, IndexWindowBytes), this->FileSize - offset);
       window.resize(static_cast<std::size_t>(std::max<int64_t>(want, 0)));
       windowStart = offset;
       this->ReadRaw(offset, window.data(), static_cast<int64_t>(window.size()), record);
@@ -534,9 +515,8 @@ void EclipseKeywordFile::IndexUnformatted()
     peek(position, raw, HeaderBytes, nullptr);
     if (BigEndian32(raw) != 16 || BigEndian32(raw + 20) != 16)
     {
-      this->Fail(nullptr,
-        position,
-        "expected a 16-byte keyword header record; record markers disagree or the file is corrupt");
+      this->Fail(
+        nullptr, position, "expected a 16-byte keyword header record; record markers disagree or the file is corrupt");
     }
     for (int c = 4; c < 20; ++c)
     {
@@ -564,8 +544,7 @@ void EclipseKeywordFile::IndexUnformatted()
     const int64_t payload = record.count * record.elementSize;
     if (payload > this->FileSize - record.dataOffset)
     {
-      this->Fail(&record,
-        position,
+      this->Fail(&record, position,
         "declares " + std::to_string(record.count) + " elements of type " + record.typeName +
           " but the file is too short to hold them (truncated?)");
     }
@@ -580,12 +559,10 @@ void EclipseKeywordFile::IndexUnformatted()
       unsigned char marker[4];
       peek(record.dataOffset, marker, 4, &record);
       bool standard =
-        BigEndian32(marker) == std::min(record.count, perBlock) * record.elementSize &&
-        end <= this->FileSize;
+        BigEndian32(marker) == std::min(record.count, perBlock) * record.elementSize && end <= this->FileSize;
       if (standard && end < this->FileSize)
       {
-        standard =
-          this->FileSize - end >= 4 && (peek(end, marker, 4, &record), BigEndian32(marker) == 16);
+        standard = this->FileSize - end >= 4 && (peek(end, marker, 4, &record), BigEndian32(marker) == 16);
       }
       record.endOffset = standard ? end : this->WalkBlocks(record);
       record.standardBlocks = standard;
@@ -606,11 +583,9 @@ int64_t EclipseKeywordFile::WalkBlocks(const EclipseRecord& record) const
     const int64_t length = BigEndian32(marker);
     if (length == 0 || length % record.elementSize != 0 || length > remaining * record.elementSize)
     {
-      this->Fail(&record,
-        position,
-        "data record of " + std::to_string(length) + " bytes does not fit the " +
-          std::to_string(remaining) + " remaining elements of " +
-          std::to_string(record.elementSize) + " bytes");
+      this->Fail(&record, position,
+        "data record of " + std::to_string(length) + " bytes does not fit the " + std::to_string(remaining) +
+          " remaining elements of " + std::to_string(record.elementSize) + " bytes");
     }
     if (length + 8 > this->FileSize - position)
     {
@@ -619,8 +594,7 @@ int64_t EclipseKeywordFile::WalkBlocks(const EclipseRecord& record) const
     this->ReadRaw(position + 4 + length, marker, 4, &record);
     if (BigEndian32(marker) != length)
     {
-      this->Fail(
-        &record, position + 4 + length, "data record end marker differs from its start marker");
+      this->Fail(&record, position + 4 + length, "data record end marker differs from its start marker");
     }
     position += length + 8;
     remaining -= length / record.elementSize;
@@ -629,10 +603,8 @@ int64_t EclipseKeywordFile::WalkBlocks(const EclipseRecord& record) const
 }
 
 template<typename Consumer>
-void EclipseKeywordFile::ForEachBlock(const EclipseRecord& record,
-  Consumer&& consume,
-  int64_t firstBlock,
-  int64_t endBlock) const
+void EclipseKeywordFile::ForEachBlock(
+  const EclipseRecord& record, Consumer&& consume, int64_t firstBlock, int64_t endBlock) const
 {
   if (record.count == 0 || record.elementSize == 0)
   {
@@ -654,8 +626,7 @@ void EclipseKeywordFile::ForEachBlock(const EclipseRecord& record,
   std::vector<unsigned char> buffer;
   int64_t bufferStart = 0;
   int64_t bufferEnd = 0; // absolute offsets of the bytes held in buffer
-  const auto ensure = [&](int64_t offset, int64_t size) -> const unsigned char*
-  {
+  const auto ensure = [&](int64_t offset, int64_t size) -> const unsigned char* {
     if (offset < bufferStart || offset + size > bufferEnd)
     {
       const int64_t want = std::min(std::max(size, ChunkBytes), record.endOffset - offset);
@@ -675,17 +646,14 @@ void EclipseKeywordFile::ForEachBlock(const EclipseRecord& record,
     const int64_t length = BigEndian32(ensure(position, 4));
     if (length == 0 || length % record.elementSize != 0 || length > remaining * record.elementSize)
     {
-      this->Fail(&record,
-        position,
-        "data record of " + std::to_string(length) + " bytes does not fit the " +
-          std::to_string(remaining) + " remaining elements of " +
-          std::to_string(record.elementSize) + " bytes");
+      this->Fail(&record, position,
+        "data record of " + std::to_string(length) + " bytes does not fit the " + std::to_string(remaining) +
+          " remaining elements of " + std::to_string(record.elementSize) + " bytes");
     }
     const unsigned char* block = ensure(position, length + 8);
     if (BigEndian32(block + 4 + length) != static_cast<uint32_t>(length))
     {
-      this->Fail(
-        &record, position + 4 + length, "data record end marker differs from its start marker");
+      this->Fail(&record, position + 4 + length, "data record end marker differs from its start marker");
     }
     const int64_t elements = length / record.elementSize;
     consume(block + 4, done, elements);
@@ -725,8 +693,7 @@ void EclipseKeywordFile::SetParallelMinimumValues(int64_t values)
 }
 
 template<typename Consumer>
-void EclipseKeywordFile::ForEachBlockInParallel(const EclipseRecord& record,
-  Consumer&& consume) const
+void EclipseKeywordFile::ForEachBlockInParallel(const EclipseRecord& record, Consumer&& consume) const
 {
   if (!record.standardBlocks || record.count < ParallelMinimumValues())
   {
@@ -744,8 +711,7 @@ void EclipseKeywordFile::ForEachBlockInParallel(const EclipseRecord& record,
     return;
   }
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(workers));
-  const auto work = [&](int64_t w)
-  {
+  const auto work = [&](int64_t w) {
     try
     {
       this->ForEachBlock(record, consume, blocks * w / workers, blocks * (w + 1) / workers);
@@ -779,8 +745,7 @@ void EclipseKeywordFile::Read(const EclipseRecord& record, T* out) const
 {
   if (!record.IsNumeric())
   {
-    this->Fail(
-      &record, record.headerOffset, "expected numeric data, found type " + record.typeName);
+    this->Fail(&record, record.headerOffset, "expected numeric data, found type " + record.typeName);
   }
   if (this->Formatted)
   {
@@ -788,18 +753,16 @@ void EclipseKeywordFile::Read(const EclipseRecord& record, T* out) const
     return;
   }
   this->ForEachBlockInParallel(record,
-    [&](const unsigned char* data, int64_t first, int64_t n)
-    { ConvertBigEndian(record.type, data, n, out + first); });
+    [&](const unsigned char* data, int64_t first, int64_t n) { ConvertBigEndian(record.type, data, n, out + first); });
 }
 
 template<typename T>
-void EclipseKeywordFile::ReadInPieces(const EclipseRecord& record,
-  const std::function<void(const T*, int64_t, int64_t)>& sink) const
+void EclipseKeywordFile::ReadInPieces(
+  const EclipseRecord& record, const std::function<void(const T*, int64_t, int64_t)>& sink) const
 {
   if (!record.IsNumeric())
   {
-    this->Fail(
-      &record, record.headerOffset, "expected numeric data, found type " + record.typeName);
+    this->Fail(&record, record.headerOffset, "expected numeric data, found type " + record.typeName);
   }
   constexpr int64_t Piece = 4096;
   if (this->Formatted)
@@ -813,25 +776,23 @@ void EclipseKeywordFile::ReadInPieces(const EclipseRecord& record,
     }
     return;
   }
-  this->ForEachBlockInParallel(record,
-    [&](const unsigned char* data, int64_t first, int64_t n)
+  this->ForEachBlockInParallel(record, [&](const unsigned char* data, int64_t first, int64_t n) {
+    T values[Piece]; // per call, so each thread converts into its own
+    for (int64_t done = 0; done < n; done += Piece)
     {
-      T values[Piece]; // per call, so each thread converts into its own
-      for (int64_t done = 0; done < n; done += Piece)
-      {
-        const int64_t count = std::min(Piece, n - done);
-        ConvertBigEndian(record.type, data + done * record.elementSize, count, values);
-        sink(values, first + done, count);
-      }
-    });
+      const int64_t count = std::min(Piece, n - done);
+      ConvertBigEndian(record.type, data + done * record.elementSize, count, values);
+      sink(values, first + done, count);
+    }
+  });
 }
 
-template void EclipseKeywordFile::ReadInPieces<int32_t>(const EclipseRecord&,
-  const std::function<void(const int32_t*, int64_t, int64_t)>&) const;
-template void EclipseKeywordFile::ReadInPieces<float>(const EclipseRecord&,
-  const std::function<void(const float*, int64_t, int64_t)>&) const;
-template void EclipseKeywordFile::ReadInPieces<double>(const EclipseRecord&,
-  const std::function<void(const double*, int64_t, int64_t)>&) const;
+template void EclipseKeywordFile::ReadInPieces<int32_t>(
+  const EclipseRecord&, const std::function<void(const int32_t*, int64_t, int64_t)>&) const;
+template void EclipseKeywordFile::ReadInPieces<float>(
+  const EclipseRecord&, const std::function<void(const float*, int64_t, int64_t)>&) const;
+template void EclipseKeywordFile::ReadInPieces<double>(
+  const EclipseRecord&, const std::function<void(const double*, int64_t, int64_t)>&) const;
 
 template void EclipseKeywordFile::Read<int32_t>(const EclipseRecord&, int32_t*) const;
 template void EclipseKeywordFile::Read<float>(const EclipseRecord&, float*) const;
@@ -841,8 +802,7 @@ void EclipseKeywordFile::ReadNumbers(const EclipseRecord& record, std::vector<do
 {
   if (!record.IsNumeric())
   {
-    this->Fail(
-      &record, record.headerOffset, "expected numeric data, found type " + record.typeName);
+    this->Fail(&record, record.headerOffset, "expected numeric data, found type " + record.typeName);
   }
   values.resize(static_cast<std::size_t>(record.count));
   this->Read(record, values.data());
@@ -852,8 +812,7 @@ std::vector<std::string> EclipseKeywordFile::ReadStrings(const EclipseRecord& re
 {
   if (record.type != EclipseDataType::Character)
   {
-    this->Fail(
-      &record, record.headerOffset, "expected character data, found type " + record.typeName);
+    this->Fail(&record, record.headerOffset, "expected character data, found type " + record.typeName);
   }
   if (this->Formatted)
   {
@@ -861,15 +820,13 @@ std::vector<std::string> EclipseKeywordFile::ReadStrings(const EclipseRecord& re
   }
   std::vector<std::string> values;
   values.reserve(static_cast<std::size_t>(record.count));
-  this->ForEachBlock(record,
-    [&](const unsigned char* data, int64_t, int64_t n)
+  this->ForEachBlock(record, [&](const unsigned char* data, int64_t, int64_t n) {
+    for (int64_t i = 0; i < n; ++i)
     {
-      for (int64_t i = 0; i < n; ++i)
-      {
-        values.push_back(Trimmed(reinterpret_cast<const char*>(data + i * record.elementSize),
-          static_cast<std::size_t>(record.elementSize)));
-      }
-    });
+      values.push_back(Trimmed(
+        reinterpret_cast<const char*>(data + i * record.elementSize), static_cast<std::size_t>(record.elementSize)));
+    }
+  });
   return values;
 }
 
@@ -887,13 +844,11 @@ void EclipseKeywordFile::IndexFormatted()
     record.headerOffset = start;
     if (!quoted || token.size() > 8)
     {
-      this->Fail(
-        nullptr, start, "expected a quoted keyword name, found '" + token.substr(0, 20) + "'");
+      this->Fail(nullptr, start, "expected a quoted keyword name, found '" + token.substr(0, 20) + "'");
     }
     record.name = Trimmed(token.data(), token.size());
     int64_t count = 0;
-    if (!cursor.Next(token, quoted, start) || quoted || !ParseInteger(token, count) || count < 0 ||
-        count > INT32_MAX)
+    if (!cursor.Next(token, quoted, start) || quoted || !ParseInteger(token, count) || count < 0 || count > INT32_MAX)
     {
       this->Fail(&record, start, "expected an element count after the keyword name");
     }
@@ -914,27 +869,22 @@ void EclipseKeywordFile::IndexFormatted()
     {
       if (!cursor.Next(token, quoted, start))
       {
-        this->Fail(&record,
-          cursor.Offset,
-          "file ends after " + std::to_string(i) + " of " + std::to_string(record.count) +
-            " values");
+        this->Fail(&record, cursor.Offset,
+          "file ends after " + std::to_string(i) + " of " + std::to_string(record.count) + " values");
       }
       if (quoted != strings)
       {
-        this->Fail(&record,
-          start,
+        this->Fail(&record, start,
           "value " + std::to_string(i + 1) + " of " + std::to_string(record.count) +
             (strings ? " is not a quoted string" : " is a string, expected a number") +
             " (declared count larger than the data?)");
       }
     }
     record.endOffset = cursor.Offset;
-    if (this->Indexing == KeywordFileIndexing::UpToLastWholeRecord && tokens > 0 &&
-        record.endOffset == this->FileSize)
+    if (this->Indexing == KeywordFileIndexing::UpToLastWholeRecord && tokens > 0 && record.endOffset == this->FileSize)
     {
       // Writers end every line; a last value touching the end may have been cut inside.
-      this->Fail(
-        &record, start, "the last value ends the file without a line end (cut inside it?)");
+      this->Fail(&record, start, "the last value ends the file without a line end (cut inside it?)");
     }
     this->Index.push_back(std::move(record));
   }
@@ -950,11 +900,8 @@ namespace
 {
 /// Converts the next token of a formatted record, value `i` (0-based), to T.
 template<typename T>
-void ReadFormattedValue(const EclipseKeywordFile& file,
-  const EclipseRecord& record,
-  TextCursor& cursor,
-  int64_t i,
-  T& out)
+void ReadFormattedValue(
+  const EclipseKeywordFile& file, const EclipseRecord& record, TextCursor& cursor, int64_t i, T& out)
 {
   std::string token;
   bool quoted = false;
@@ -988,11 +935,10 @@ void ReadFormattedValue(const EclipseKeywordFile& file,
   ok = ok && token.size() <= MaxNumberCharacters; // longer ones were cut by the cursor
   if (!ok)
   {
-    file.Fail(&record,
-      start,
+    file.Fail(&record, start,
       "value " + std::to_string(i + 1) + " '" + token.substr(0, 30) +
-        (token.size() > 30 ? "...' (" + std::to_string(token.size()) + "+ characters)" : "'") +
-        " is not a valid " + record.typeName);
+        (token.size() > 30 ? "...' (" + std::to_string(token.size()) + "+ characters)" : "'") + " is not a valid " +
+        record.typeName);
   }
 }
 } // namespace
@@ -1032,8 +978,7 @@ struct EclipseRecordCursor::Text
   TextCursor Tokens;
 };
 
-EclipseRecordCursor::EclipseRecordCursor(const EclipseKeywordFile& file,
-  const EclipseRecord& record)
+EclipseRecordCursor::EclipseRecordCursor(const EclipseKeywordFile& file, const EclipseRecord& record)
   : File(file)
   , Header(record)
 {
@@ -1044,8 +989,7 @@ EclipseRecordCursor::EclipseRecordCursor(const EclipseKeywordFile& file,
   this->NextBlock = record.dataOffset;
   if (file.Formatted)
   {
-    this->Formatted.reset(
-      new Text{ TextCursor(file.Descriptor, file.FileSize, record.dataOffset) });
+    this->Formatted.reset(new Text{ TextCursor(file.Descriptor, file.FileSize, record.dataOffset) });
   }
 }
 
@@ -1074,10 +1018,9 @@ void EclipseRecordCursor::Read(int64_t count, T* out)
   const EclipseRecord& record = this->Header;
   if (count < 0 || count > record.count - this->Done)
   {
-    this->File.Fail(&record,
-      record.headerOffset,
-      "asked for values " + std::to_string(this->Done + 1) + " to " +
-        std::to_string(this->Done + count) + " of a record of " + std::to_string(record.count));
+    this->File.Fail(&record, record.headerOffset,
+      "asked for values " + std::to_string(this->Done + 1) + " to " + std::to_string(this->Done + count) +
+        " of a record of " + std::to_string(record.count));
   }
   if (this->Formatted)
   {
@@ -1096,20 +1039,16 @@ void EclipseRecordCursor::Read(int64_t count, T* out)
       const int64_t remaining = record.count - this->Done;
       const int64_t position = this->NextBlock;
       const int64_t length = BigEndian32(this->Ensure(position, 4));
-      if (length == 0 || length % record.elementSize != 0 ||
-          length > remaining * record.elementSize)
+      if (length == 0 || length % record.elementSize != 0 || length > remaining * record.elementSize)
       {
-        this->File.Fail(&record,
-          position,
-          "data record of " + std::to_string(length) + " bytes does not fit the " +
-            std::to_string(remaining) + " remaining elements of " +
-            std::to_string(record.elementSize) + " bytes");
+        this->File.Fail(&record, position,
+          "data record of " + std::to_string(length) + " bytes does not fit the " + std::to_string(remaining) +
+            " remaining elements of " + std::to_string(record.elementSize) + " bytes");
       }
       const unsigned char* block = this->Ensure(position, length + 8);
       if (BigEndian32(block + 4 + length) != static_cast<uint32_t>(length))
       {
-        this->File.Fail(
-          &record, position + 4 + length, "data record end marker differs from its start marker");
+        this->File.Fail(&record, position + 4 + length, "data record end marker differs from its start marker");
       }
       this->BlockData = position + 4;
       this->BlockLeft = length / record.elementSize;

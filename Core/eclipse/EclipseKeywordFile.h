@@ -54,10 +54,7 @@ struct EclipseRecord
   /// parallel pieces.
   bool standardBlocks = false;
 
-  bool IsNumeric() const
-  {
-    return this->type != EclipseDataType::Character && this->type != EclipseDataType::Message;
-  }
+  bool IsNumeric() const { return this->type != EclipseDataType::Character && this->type != EclipseDataType::Message; }
 };
 
 enum class KeywordFileIndexing
@@ -71,8 +68,7 @@ class EclipseKeywordFile
 public:
   /// Opens and indexes the file; throws InputError if it is not a valid keyword file (with
   /// UpToLastWholeRecord: only if it does not start like one).
-  explicit EclipseKeywordFile(const std::string& path,
-    KeywordFileIndexing indexing = KeywordFileIndexing::WholeFile);
+  explicit EclipseKeywordFile(const std::string& path, KeywordFileIndexing indexing = KeywordFileIndexing::WholeFile);
   ~EclipseKeywordFile();
   EclipseKeywordFile(const EclipseKeywordFile&) = delete;
   EclipseKeywordFile& operator=(const EclipseKeywordFile&) = delete;
@@ -108,8 +104,7 @@ public:
   /// increasing order; the sink must only write where `first` says. Defined for int32_t,
   /// float and double.
   template<typename T>
-  void ReadInPieces(const EclipseRecord& record,
-    const std::function<void(const T*, int64_t, int64_t)>& sink) const;
+  void ReadInPieces(const EclipseRecord& record, const std::function<void(const T*, int64_t, int64_t)>& sink) const;
 
   /// Records of at least this many values are read by several threads (one per core, at
   /// most 8), each converting its own range of blocks: on a workstation the conversion and
@@ -124,9 +119,7 @@ public:
   std::vector<std::string> ReadStrings(const EclipseRecord& record) const;
 
   /// Throws InputError for `record` at byte `offset`.
-  [[noreturn]] void Fail(const EclipseRecord* record,
-    int64_t offset,
-    const std::string& what) const;
+  [[noreturn]] void Fail(const EclipseRecord* record, int64_t offset, const std::string& what) const;
 
 private:
   friend class EclipseRecordCursor;
@@ -141,10 +134,8 @@ private:
   void ReadFormatted(const EclipseRecord& record, T* out) const;
   std::vector<std::string> ReadFormattedStrings(const EclipseRecord& record) const;
   template<typename Consumer>
-  void ForEachBlock(const EclipseRecord& record,
-    Consumer&& consume,
-    int64_t firstBlock = 0,
-    int64_t endBlock = -1) const;
+  void ForEachBlock(
+    const EclipseRecord& record, Consumer&& consume, int64_t firstBlock = 0, int64_t endBlock = -1) const;
   template<typename Consumer>
   void ForEachBlockInParallel(const EclipseRecord& record, Consumer&& consume) const;
 

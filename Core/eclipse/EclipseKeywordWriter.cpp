@@ -59,36 +59,34 @@ void EclipseKeywordWriter::Begin(const std::string& name, const std::string& typ
 {
   if (this->Remaining > 0)
   {
-    this->Fail("started keyword " + name + " with " + std::to_string(this->Remaining) +
-               " values of this one still missing");
+    this->Fail(
+      "started keyword " + name + " with " + std::to_string(this->Remaining) + " values of this one still missing");
   }
   this->Keyword = name;
   if (name.empty() || name.size() > 8 || type.size() != 4 ||
-      std::any_of(name.begin(), name.end(), [](char c) { return c < 32 || c > 126; }))
+    std::any_of(name.begin(), name.end(), [](char c) { return c < 32 || c > 126; }))
   {
     this->Fail("keyword names have 1 to 8 printable characters and types 4");
   }
-  if (type != "INTE" && type != "REAL" && type != "DOUB" && type != "LOGI" && type != "CHAR" &&
-      type != "MESS")
+  if (type != "INTE" && type != "REAL" && type != "DOUB" && type != "LOGI" && type != "CHAR" && type != "MESS")
   {
     this->Fail("cannot write type '" + type + "'");
   }
   if (count < 0 || count > std::numeric_limits<int32_t>::max())
   {
     this->Fail(
-      std::to_string(count) +
-      " values do not fit the 32-bit count of an ECLIPSE keyword header (at most 2147483647)");
+      std::to_string(count) + " values do not fit the 32-bit count of an ECLIPSE keyword header (at most 2147483647)");
   }
   if (type == "MESS" && count != 0)
   {
     this->Fail("MESS keywords carry no data");
   }
-  this->Type = type == "INTE"   ? EclipseDataType::Integer
-               : type == "REAL" ? EclipseDataType::Real
-               : type == "DOUB" ? EclipseDataType::Double
-               : type == "LOGI" ? EclipseDataType::Logical
-               : type == "CHAR" ? EclipseDataType::Character
-                                : EclipseDataType::Message;
+  this->Type = type == "INTE" ? EclipseDataType::Integer
+    : type == "REAL"          ? EclipseDataType::Real
+    : type == "DOUB"          ? EclipseDataType::Double
+    : type == "LOGI"          ? EclipseDataType::Logical
+    : type == "CHAR"          ? EclipseDataType::Character
+                              : EclipseDataType::Message;
   this->ElementSize = type == "DOUB" || type == "CHAR" ? 8 : (type == "MESS" ? 0 : 4);
   unsigned char header[24];
   PutBigEndian32(header, 16);
@@ -112,7 +110,7 @@ void EclipseKeywordWriter::AppendNumbers(const T* values, int64_t count)
   if (count > this->Remaining)
   {
     this->Fail(std::to_string(count) + " values given, only " + std::to_string(this->Remaining) +
-               " left of the count in the header");
+      " left of the count in the header");
   }
   const int64_t size = this->ElementSize;
   while (count > 0)
@@ -189,7 +187,7 @@ void EclipseKeywordWriter::Append(const std::vector<std::string>& values)
   if (count > this->Remaining)
   {
     this->Fail(std::to_string(count) + " strings given, only " + std::to_string(this->Remaining) +
-               " left of the count in the header");
+      " left of the count in the header");
   }
   for (const std::string& value : values)
   {
@@ -211,8 +209,7 @@ void EclipseKeywordWriter::Append(const std::vector<std::string>& values)
   }
 }
 
-void EclipseKeywordWriter::WriteStrings(const std::string& name,
-  const std::vector<std::string>& values)
+void EclipseKeywordWriter::WriteStrings(const std::string& name, const std::vector<std::string>& values)
 {
   this->Begin(name, "CHAR", static_cast<int64_t>(values.size()));
   this->Append(values);

@@ -21,65 +21,17 @@ namespace fs = std::filesystem;
 /// Header and table records that are never per-cell arrays, whatever their length.
 bool IsHeaderRecord(const std::string& name)
 {
-  static const std::set<std::string> names = { "INTEHEAD",
-    "LOGIHEAD",
-    "DOUBHEAD",
-    "SEQNUM",
-    "TABDIMS",
-    "TAB",
-    "CON",
-    "TRANNNC",
-    "TRANGL",
-    "TRANGG",
-    "IGRP",
-    "SGRP",
-    "XGRP",
-    "ZGRP",
-    "IWEL",
-    "SWEL",
-    "XWEL",
-    "ZWEL",
-    "ICON",
-    "SCON",
-    "XCON",
-    "IWLS",
-    "ZWLS",
-    "DLYTIM",
-    "HIDDEN",
-    "REGDIMS",
-    "REGRPT",
-    "FIPFAMNA",
-    "LGRNAMES",
-    "ZNODE",
-    "INODE",
-    "RNODE",
-    "IBRAN",
-    "ISEG",
-    "RSEG",
-    "ILBS",
-    "ILBR",
-    "IUAD",
-    "IUAP",
-    "IGPH",
-    "IUDQ",
-    "DUDW",
-    "DUDG",
-    "DUDF",
-    "ZUDN",
-    "ZUDL",
-    "IACT",
-    "SACT",
-    "ZACT",
-    "ZLACT",
-    "XHEAD",
-    "ZFMFWE" };
+  static const std::set<std::string> names = { "INTEHEAD", "LOGIHEAD", "DOUBHEAD", "SEQNUM", "TABDIMS", "TAB", "CON",
+    "TRANNNC", "TRANGL", "TRANGG", "IGRP", "SGRP", "XGRP", "ZGRP", "IWEL", "SWEL", "XWEL", "ZWEL", "ICON", "SCON",
+    "XCON", "IWLS", "ZWLS", "DLYTIM", "HIDDEN", "REGDIMS", "REGRPT", "FIPFAMNA", "LGRNAMES", "ZNODE", "INODE", "RNODE",
+    "IBRAN", "ISEG", "RSEG", "ILBS", "ILBR", "IUAD", "IUAP", "IGPH", "IUDQ", "DUDW", "DUDG", "DUDF", "ZUDN", "ZUDL",
+    "IACT", "SACT", "ZACT", "ZLACT", "XHEAD", "ZFMFWE" };
   return names.count(name) > 0;
 }
 
 bool ValidDate(const std::array<int, 3>& date)
 {
-  return date[0] > 1000 && date[0] < 10000 && date[1] >= 1 && date[1] <= 12 && date[2] >= 1 &&
-         date[2] <= 31;
+  return date[0] > 1000 && date[0] < 10000 && date[1] >= 1 && date[1] <= 12 && date[2] >= 1 && date[2] <= 31;
 }
 
 std::string Upper(std::string text)
@@ -96,9 +48,8 @@ std::string StemOf(const std::string& path)
   return fs::path(path).stem().string();
 }
 
-std::string FirstExisting(const fs::path& directory,
-  const std::string& stem,
-  std::initializer_list<const char*> extensions)
+std::string FirstExisting(
+  const fs::path& directory, const std::string& stem, std::initializer_list<const char*> extensions)
 {
   std::error_code error;
   for (const char* extension : extensions)
@@ -118,8 +69,7 @@ std::string FirstExisting(const fs::path& directory,
 /// An error message without the file name it starts with (the caller names the file).
 std::string WithoutPath(const std::string& message, const std::string& path)
 {
-  return message.compare(0, path.size() + 2, path + ": ") == 0 ? message.substr(path.size() + 2)
-                                                               : message;
+  return message.compare(0, path.size() + 2, path + ": ") == 0 ? message.substr(path.size() + 2) : message;
 }
 
 /// Why a results file cannot be used at all, or empty if it opened: `file` is then set.
@@ -155,9 +105,8 @@ std::vector<std::string> EclipseResults::FindRestarts(const std::string& gridPat
   const fs::path directory = fs::path(gridPath).parent_path();
   const std::string stem = StemOf(gridPath);
   const bool formattedGrid = Upper(fs::path(gridPath).extension().string()) == ".FEGRID";
-  const std::string unifiedPath = formattedGrid
-                                    ? FirstExisting(directory, stem, { ".funrst", ".unrst" })
-                                    : FirstExisting(directory, stem, { ".unrst", ".funrst" });
+  const std::string unifiedPath = formattedGrid ? FirstExisting(directory, stem, { ".funrst", ".unrst" })
+                                                : FirstExisting(directory, stem, { ".unrst", ".funrst" });
   unified = !unifiedPath.empty();
   if (unified)
   {
@@ -166,30 +115,24 @@ std::vector<std::string> EclipseResults::FindRestarts(const std::string& gridPat
   // Per-step files: STEM.Xnnnn (unformatted) or STEM.Fnnnn (formatted), either case.
   std::vector<std::pair<int, std::string>> found;
   std::error_code error;
-  for (fs::directory_iterator entry(directory.empty() ? fs::path(".") : directory, error), end;
-       !error && entry != end;
+  for (fs::directory_iterator entry(directory.empty() ? fs::path(".") : directory, error), end; !error && entry != end;
        entry.increment(error))
   {
     const std::string name = entry->path().filename().string();
-    if (name.size() != stem.size() + 6 || name.compare(0, stem.size(), stem) != 0 ||
-        name[stem.size()] != '.')
+    if (name.size() != stem.size() + 6 || name.compare(0, stem.size(), stem) != 0 || name[stem.size()] != '.')
     {
       continue;
     }
-    const char kind =
-      static_cast<char>(std::toupper(static_cast<unsigned char>(name[stem.size() + 1])));
+    const char kind = static_cast<char>(std::toupper(static_cast<unsigned char>(name[stem.size() + 1])));
     const std::string digits = name.substr(stem.size() + 2);
     if ((kind != 'X' && kind != 'F') ||
-        !std::all_of(digits.begin(),
-          digits.end(),
-          [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+      !std::all_of(digits.begin(), digits.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
     {
       continue;
     }
     const int number = std::stoi(digits);
     const bool preferred = (kind == 'F') == formattedGrid;
-    auto same = std::find_if(
-      found.begin(), found.end(), [&](const auto& item) { return item.first == number; });
+    auto same = std::find_if(found.begin(), found.end(), [&](const auto& item) { return item.first == number; });
     if (same == found.end())
     {
       found.emplace_back(number, entry->path().string());
@@ -220,8 +163,7 @@ EclipseResults::EclipseResults(const std::string& gridPath, const EclipseGrid& g
     {
       continue;
     }
-    if (!this->ActiveRuns.empty() &&
-        this->ActiveRuns.back().first + this->ActiveRuns.back().second == cell)
+    if (!this->ActiveRuns.empty() && this->ActiveRuns.back().first + this->ActiveRuns.back().second == cell)
     {
       ++this->ActiveRuns.back().second;
     }
@@ -240,8 +182,7 @@ EclipseResults::EclipseResults(const std::string& gridPath, const EclipseGrid& g
   this->Init = FindInit(gridPath);
   if (this->Init.empty())
   {
-    this->Notes.push_back(
-      gridPath + ": no INIT file beside it (" + StemOf(gridPath) + ".INIT): no static properties");
+    this->Notes.push_back(gridPath + ": no INIT file beside it (" + StemOf(gridPath) + ".INIT): no static properties");
   }
   else
   {
@@ -255,12 +196,11 @@ EclipseResults::EclipseResults(const std::string& gridPath, const EclipseGrid& g
   {
     if (!std::isfinite(step.days) || step.days < 0)
     {
-      const std::array<int, 3>& start =
-        ValidDate(this->StartDate) ? this->StartDate : this->ReportSteps.front().date;
+      const std::array<int, 3>& start = ValidDate(this->StartDate) ? this->StartDate : this->ReportSteps.front().date;
       step.days = ValidDate(step.date) && ValidDate(start)
-                    ? static_cast<double>(DaysFromCivil(step.date[0], step.date[1], step.date[2]) -
-                                          DaysFromCivil(start[0], start[1], start[2]))
-                    : static_cast<double>(step.reportNumber);
+        ? static_cast<double>(
+            DaysFromCivil(step.date[0], step.date[1], step.date[2]) - DaysFromCivil(start[0], start[1], start[2]))
+        : static_cast<double>(step.reportNumber);
     }
   }
 }
@@ -269,8 +209,8 @@ EclipseResults::~EclipseResults() = default;
 
 bool EclipseResults::FitsGrid(int64_t count) const
 {
-  return count > 0 && (count == this->Expected || count == this->CellCount ||
-                        (this->DualPorosity && count == 2 * this->CellCount));
+  return count > 0 &&
+    (count == this->Expected || count == this->CellCount || (this->DualPorosity && count == 2 * this->CellCount));
 }
 
 void EclipseResults::OpenInit()
@@ -279,7 +219,7 @@ void EclipseResults::OpenInit()
   if (problem.empty() && this->InitFile->StoppedAt() >= 0)
   {
     problem = "damaged or cut short at byte " + std::to_string(this->InitFile->StoppedAt()) + " (" +
-              WithoutPath(this->InitFile->StopReason(), this->Init) + ")";
+      WithoutPath(this->InitFile->StopReason(), this->Init) + ")";
   }
   else if (problem.empty() && this->InitFile->Records().empty())
   {
@@ -305,8 +245,7 @@ void EclipseResults::OpenInit()
   this->StaticRecords.clear();
   if (!problem.empty())
   {
-    this->Notes.push_back(
-      this->Init + ": " + problem + ": the INIT file is not used (no static properties)");
+    this->Notes.push_back(this->Init + ": " + problem + ": the INIT file is not used (no static properties)");
   }
 }
 
@@ -315,8 +254,8 @@ void EclipseResults::OpenRestarts(const std::string& gridPath)
   this->Restarts = FindRestarts(gridPath, this->Unified);
   if (this->Restarts.empty())
   {
-    this->Notes.push_back(gridPath + ": no restart files beside it (" + StemOf(gridPath) +
-                          ".UNRST or .Xnnnn): no time steps");
+    this->Notes.push_back(
+      gridPath + ": no restart files beside it (" + StemOf(gridPath) + ".UNRST or .Xnnnn): no time steps");
     return;
   }
   for (std::size_t f = 0; f < this->Restarts.size(); ++f)
@@ -338,19 +277,15 @@ void EclipseResults::OpenRestarts(const std::string& gridPath)
   }
 }
 
-void EclipseResults::LeaveOut(const std::string& path,
-  int reportNumber,
-  int64_t offset,
-  const std::string& reason)
+void EclipseResults::LeaveOut(const std::string& path, int reportNumber, int64_t offset, const std::string& reason)
 {
   this->Skipped.push_back({ path, reportNumber, offset, reason });
-  const std::string step =
-    reportNumber >= 0 ? "report step " + std::to_string(reportNumber)
+  const std::string step = reportNumber >= 0 ? "report step " + std::to_string(reportNumber)
     : this->Unified && !this->ReportSteps.empty()
-      ? "the report step after report " + std::to_string(this->ReportSteps.back().reportNumber)
-      : std::string("its report steps");
-  this->Notes.push_back(path + ": " + step + " left out: incomplete at byte " +
-                        std::to_string(offset) + " (" + reason + "); the other steps are kept");
+    ? "the report step after report " + std::to_string(this->ReportSteps.back().reportNumber)
+    : std::string("its report steps");
+  this->Notes.push_back(path + ": " + step + " left out: incomplete at byte " + std::to_string(offset) + " (" + reason +
+    "); the other steps are kept");
 }
 
 void EclipseResults::ListDynamicArrays()
@@ -359,10 +294,10 @@ void EclipseResults::ListDynamicArrays()
   this->Dynamic.clear();
   for (const EclipseResultArray& array : this->SeenDynamic)
   {
-    const bool used = std::any_of(this->ReportSteps.begin(),
-      this->ReportSteps.end(),
-      [&](const EclipseReportStep& step)
-      { return std::find(step.names.begin(), step.names.end(), array.name) != step.names.end(); });
+    const bool used =
+      std::any_of(this->ReportSteps.begin(), this->ReportSteps.end(), [&](const EclipseReportStep& step) {
+        return std::find(step.names.begin(), step.names.end(), array.name) != step.names.end();
+      });
     if (used)
     {
       this->Dynamic.push_back(array);
@@ -400,8 +335,7 @@ bool EclipseResults::IndexInit()
       this->StartDate = { header[66], header[65], header[64] };
       if (header[11] != this->Expected)
       {
-        this->Notes.push_back(
-          this->Init + ": keyword INTEHEAD: " + std::to_string(header[11]) +
+        this->Notes.push_back(this->Init + ": keyword INTEHEAD: " + std::to_string(header[11]) +
           " active cells, but the grid has " + std::to_string(this->Expected) +
           ": the INIT file does not belong to this grid; its arrays are not shown");
         this->Static.clear();
@@ -414,8 +348,7 @@ bool EclipseResults::IndexInit()
     {
       continue;
     }
-    const bool seen = std::any_of(this->Static.begin(),
-      this->Static.end(),
+    const bool seen = std::any_of(this->Static.begin(), this->Static.end(),
       [&](const EclipseResultArray& array) { return array.name == record.name; });
     if (!seen)
     {
@@ -434,9 +367,7 @@ struct EclipseResults::RestartScan
   bool lastClosed = false;      ///< the last step's ENDSOL met
 };
 
-void EclipseResults::IndexRestart(std::size_t fileIndex,
-  const EclipseKeywordFile& file,
-  int fileReportNumber)
+void EclipseResults::IndexRestart(std::size_t fileIndex, const EclipseKeywordFile& file, int fileReportNumber)
 {
   const std::size_t firstStep = this->ReportSteps.size();
   RestartScan scan;
@@ -452,12 +383,10 @@ void EclipseResults::IndexRestart(std::size_t fileIndex,
   // written: one holding no array yet, or fewer than the step before it, is still being
   // written.
   const std::size_t count = this->ReportSteps.size();
-  const bool unclosed =
-    scan.closesSolutions
-      ? !scan.lastClosed
-      : started && (this->ReportSteps.back().names.empty() ||
-                     (count > firstStep + 1 && this->ReportSteps.back().names.size() <
-                                                 this->ReportSteps[count - 2].names.size()));
+  const bool unclosed = scan.closesSolutions ? !scan.lastClosed
+                                             : started &&
+      (this->ReportSteps.back().names.empty() ||
+        (count > firstStep + 1 && this->ReportSteps.back().names.size() < this->ReportSteps[count - 2].names.size()));
   // In a unified restart, damage after the last step's ENDSOL belongs to the step after it;
   // a per-step file is one step, left out for any damage.
   const bool lastWhole = !unclosed && (!damaged || (this->Unified && scan.closesSolutions));
@@ -467,11 +396,8 @@ void EclipseResults::IndexRestart(std::size_t fileIndex,
     // A writer still appending, or a cut.
     const int number = this->ReportSteps.back().reportNumber;
     this->ReportSteps.pop_back();
-    this->LeaveOut(file.Path(),
-      number,
-      damaged ? scan.damagedAt : file.Size(),
-      damaged ? rest
-              : "its solution has no ENDSOL: the file ends there (still being written, or cut)");
+    this->LeaveOut(file.Path(), number, damaged ? scan.damagedAt : file.Size(),
+      damaged ? rest : "its solution has no ENDSOL: the file ends there (still being written, or cut)");
   }
   else if (damaged)
   {
@@ -479,20 +405,17 @@ void EclipseResults::IndexRestart(std::size_t fileIndex,
   }
 }
 
-void EclipseResults::ScanRestart(std::size_t fileIndex,
-  const EclipseKeywordFile& file,
-  int fileReportNumber,
-  RestartScan& scan)
+void EclipseResults::ScanRestart(
+  std::size_t fileIndex, const EclipseKeywordFile& file, int fileReportNumber, RestartScan& scan)
 {
   const auto& records = file.Records();
   const std::string& path = file.Path();
   EclipseReportStep* step = nullptr;
-  bool inLocalGrid = false, inSolution = false, sawSolution = false, headerRead = false,
-       timeRead = false, mismatch = false;
+  bool inLocalGrid = false, inSolution = false, sawSolution = false, headerRead = false, timeRead = false,
+       mismatch = false;
   std::vector<int32_t> integers;
   std::vector<double> numbers;
-  const auto startStep = [&](int reportNumber)
-  {
+  const auto startStep = [&](int reportNumber) {
     this->ReportSteps.emplace_back();
     step = &this->ReportSteps.back();
     step->reportNumber = reportNumber;
@@ -526,8 +449,7 @@ void EclipseResults::ScanRestart(std::size_t fileIndex,
         {
           continue; // nothing before the first step's header belongs to a step
         }
-        startStep(
-          fileReportNumber >= 0 ? fileReportNumber : static_cast<int>(this->ReportSteps.size()));
+        startStep(fileReportNumber >= 0 ? fileReportNumber : static_cast<int>(this->ReportSteps.size()));
       }
       if (name == "LGR")
       {
@@ -552,11 +474,9 @@ void EclipseResults::ScanRestart(std::size_t fileIndex,
         if (integers[11] != this->Expected)
         {
           mismatch = true;
-          this->Notes.push_back(
-            path + ": keyword INTEHEAD: report step " + std::to_string(step->reportNumber) +
+          this->Notes.push_back(path + ": keyword INTEHEAD: report step " + std::to_string(step->reportNumber) +
             " has " + std::to_string(integers[11]) + " active cells, but the grid has " +
-            std::to_string(this->Expected) +
-            ": this restart does not belong to the grid; its arrays are not shown");
+            std::to_string(this->Expected) + ": this restart does not belong to the grid; its arrays are not shown");
         }
         continue;
       }
@@ -584,15 +504,12 @@ void EclipseResults::ScanRestart(std::size_t fileIndex,
       }
       if (!this->FitsGrid(record.count))
       {
-        static const std::set<std::string> perCell = {
-          "PRESSURE", "SWAT", "SGAS", "SOIL", "RS", "RV"
-        };
+        static const std::set<std::string> perCell = { "PRESSURE", "SWAT", "SGAS", "SOIL", "RS", "RV" };
         if (perCell.count(name) > 0)
         {
-          this->Notes.push_back(path + ": keyword " + name + ": report step " +
-                                std::to_string(step->reportNumber) + " has " +
-                                std::to_string(record.count) + " values, the grid has " +
-                                std::to_string(this->Expected) + " active cells; not shown");
+          this->Notes.push_back(path + ": keyword " + name + ": report step " + std::to_string(step->reportNumber) +
+            " has " + std::to_string(record.count) + " values, the grid has " + std::to_string(this->Expected) +
+            " active cells; not shown");
         }
         continue;
       }
@@ -602,8 +519,7 @@ void EclipseResults::ScanRestart(std::size_t fileIndex,
       }
       step->names.push_back(name);
       step->records.push_back(r);
-      const bool known = std::any_of(this->SeenDynamic.begin(),
-        this->SeenDynamic.end(),
+      const bool known = std::any_of(this->SeenDynamic.begin(), this->SeenDynamic.end(),
         [&](const EclipseResultArray& array) { return array.name == name; });
       if (!known)
       {
@@ -620,14 +536,11 @@ void EclipseResults::ScanRestart(std::size_t fileIndex,
 }
 
 template<typename T>
-void EclipseResults::Scatter(const EclipseKeywordFile& file,
-  const EclipseRecord& record,
-  T* cellValues,
-  T fill) const
+void EclipseResults::Scatter(const EclipseKeywordFile& file, const EclipseRecord& record, T* cellValues, T fill) const
 {
   const bool perActiveCell = record.count == this->Expected;
   if ((perActiveCell && this->ActiveCount == this->CellCount && !this->DualPorosity) ||
-      (!perActiveCell && record.count == this->CellCount))
+    (!perActiveCell && record.count == this->CellCount))
   {
     file.Read(record, cellValues); // one value per cell, in cell order: no copy
     return;
@@ -635,14 +548,12 @@ void EclipseResults::Scatter(const EclipseKeywordFile& file,
   if (!perActiveCell)
   {
     // Dual porosity, one value per cell and porosity: the matrix half comes first.
-    file.ReadInPieces<T>(record,
-      [&](const T* values, int64_t first, int64_t count)
+    file.ReadInPieces<T>(record, [&](const T* values, int64_t first, int64_t count) {
+      if (first < this->CellCount)
       {
-        if (first < this->CellCount)
-        {
-          std::copy(values, values + std::min(count, this->CellCount - first), cellValues + first);
-        }
-      });
+        std::copy(values, values + std::min(count, this->CellCount - first), cellValues + first);
+      }
+    });
     return;
   }
   // Active cells in order, matrix values first (fracture values, after them, are dropped).
@@ -650,33 +561,31 @@ void EclipseResults::Scatter(const EclipseKeywordFile& file,
   // gap before a run gets `fill` from whoever writes that run's first value.
   const auto& runs = this->ActiveRuns;
   const auto& before = this->ValuesBeforeRun;
-  file.ReadInPieces<T>(record,
-    [&](const T* values, int64_t first, int64_t count)
+  file.ReadInPieces<T>(record, [&](const T* values, int64_t first, int64_t count) {
+    if (runs.empty() || first >= this->ActiveCount)
     {
-      if (runs.empty() || first >= this->ActiveCount)
+      return;
+    }
+    count = std::min(count, this->ActiveCount - first);
+    std::size_t run =
+      static_cast<std::size_t>(std::upper_bound(before.begin(), before.end(), first) - before.begin() - 1);
+    int64_t intoRun = first - before[run];
+    while (count > 0)
+    {
+      const auto& [start, length] = runs[run];
+      if (intoRun == 0)
       {
-        return;
+        const int64_t gapStart = run > 0 ? runs[run - 1].first + runs[run - 1].second : 0;
+        std::fill(cellValues + gapStart, cellValues + start, fill);
       }
-      count = std::min(count, this->ActiveCount - first);
-      std::size_t run = static_cast<std::size_t>(
-        std::upper_bound(before.begin(), before.end(), first) - before.begin() - 1);
-      int64_t intoRun = first - before[run];
-      while (count > 0)
-      {
-        const auto& [start, length] = runs[run];
-        if (intoRun == 0)
-        {
-          const int64_t gapStart = run > 0 ? runs[run - 1].first + runs[run - 1].second : 0;
-          std::fill(cellValues + gapStart, cellValues + start, fill);
-        }
-        const int64_t take = std::min(count, length - intoRun);
-        std::copy(values, values + take, cellValues + start + intoRun);
-        values += take;
-        count -= take;
-        intoRun = 0;
-        ++run;
-      }
-    });
+      const int64_t take = std::min(count, length - intoRun);
+      std::copy(values, values + take, cellValues + start + intoRun);
+      values += take;
+      count -= take;
+      intoRun = 0;
+      ++run;
+    }
+  });
   const int64_t tail = runs.empty() ? 0 : runs.back().first + runs.back().second;
   std::fill(cellValues + tail, cellValues + this->CellCount, fill);
 }
@@ -697,10 +606,7 @@ bool EclipseResults::ReadStatic(const std::string& name, T* cellValues, T fill) 
 }
 
 template<typename T>
-bool EclipseResults::ReadDynamic(std::size_t stepIndex,
-  const std::string& name,
-  T* cellValues,
-  T fill) const
+bool EclipseResults::ReadDynamic(std::size_t stepIndex, const std::string& name, T* cellValues, T fill) const
 {
   if (stepIndex >= this->ReportSteps.size())
   {
@@ -712,8 +618,7 @@ bool EclipseResults::ReadDynamic(std::size_t stepIndex,
   {
     return false;
   }
-  const std::size_t recordIndex =
-    step.records[static_cast<std::size_t>(found - step.names.begin())];
+  const std::size_t recordIndex = step.records[static_cast<std::size_t>(found - step.names.begin())];
   if (this->Unified)
   {
     this->Scatter(*this->UnifiedFile, this->UnifiedFile->Records()[recordIndex], cellValues, fill);
@@ -724,8 +629,8 @@ bool EclipseResults::ReadDynamic(std::size_t stepIndex,
   if (!this->StepFile || this->StepFileIndex != step.file)
   {
     this->StepFile.reset();
-    this->StepFile = std::make_unique<EclipseKeywordFile>(
-      this->Restarts[step.file], KeywordFileIndexing::UpToLastWholeRecord);
+    this->StepFile =
+      std::make_unique<EclipseKeywordFile>(this->Restarts[step.file], KeywordFileIndexing::UpToLastWholeRecord);
     this->StepFileIndex = step.file;
   }
   const EclipseKeywordFile& file = *this->StepFile;
@@ -740,17 +645,8 @@ bool EclipseResults::ReadDynamic(std::size_t stepIndex,
 template bool EclipseResults::ReadStatic<float>(const std::string&, float*, float) const;
 template bool EclipseResults::ReadStatic<double>(const std::string&, double*, double) const;
 template bool EclipseResults::ReadStatic<int32_t>(const std::string&, int32_t*, int32_t) const;
-template bool EclipseResults::ReadDynamic<float>(std::size_t,
-  const std::string&,
-  float*,
-  float) const;
-template bool EclipseResults::ReadDynamic<double>(std::size_t,
-  const std::string&,
-  double*,
-  double) const;
-template bool EclipseResults::ReadDynamic<int32_t>(std::size_t,
-  const std::string&,
-  int32_t*,
-  int32_t) const;
+template bool EclipseResults::ReadDynamic<float>(std::size_t, const std::string&, float*, float) const;
+template bool EclipseResults::ReadDynamic<double>(std::size_t, const std::string&, double*, double) const;
+template bool EclipseResults::ReadDynamic<int32_t>(std::size_t, const std::string&, int32_t*, int32_t) const;
 
 } // namespace resmr

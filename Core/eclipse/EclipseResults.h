@@ -40,10 +40,7 @@ struct EclipseResultArray
 {
   std::string name;
   EclipseDataType type = EclipseDataType::Real;
-  bool IsInteger() const
-  {
-    return this->type == EclipseDataType::Integer || this->type == EclipseDataType::Logical;
-  }
+  bool IsInteger() const { return this->type == EclipseDataType::Integer || this->type == EclipseDataType::Logical; }
 };
 
 struct EclipseReportStep
@@ -106,21 +103,12 @@ private:
   /// Indexes one restart file's steps and leaves out its last one if it is not whole.
   void IndexRestart(std::size_t fileIndex, const EclipseKeywordFile& file, int fileReportNumber);
   struct RestartScan;
-  void ScanRestart(std::size_t fileIndex,
-    const EclipseKeywordFile& file,
-    int fileReportNumber,
-    RestartScan& scan);
-  void LeaveOut(const std::string& path,
-    int reportNumber,
-    int64_t offset,
-    const std::string& reason);
+  void ScanRestart(std::size_t fileIndex, const EclipseKeywordFile& file, int fileReportNumber, RestartScan& scan);
+  void LeaveOut(const std::string& path, int reportNumber, int64_t offset, const std::string& reason);
   void ListDynamicArrays();
   bool FitsGrid(int64_t count) const;
   template<typename T>
-  void Scatter(const EclipseKeywordFile& file,
-    const EclipseRecord& record,
-    T* cellValues,
-    T fill) const;
+  void Scatter(const EclipseKeywordFile& file, const EclipseRecord& record, T* cellValues, T fill) const;
 
   /// Runs of consecutive active (matrix) cells: first cell, length. Values of active-cell
   /// arrays go to these cells in order.

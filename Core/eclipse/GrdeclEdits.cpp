@@ -13,8 +13,7 @@ namespace
 bool EndsWith(const std::string& text, const char* suffix)
 {
   const std::string tail(suffix);
-  return text.size() > tail.size() &&
-         text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
+  return text.size() > tail.size() && text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
 }
 
 bool StartsWith(const std::string& text, const char* prefix)
@@ -49,8 +48,7 @@ std::string SimulatorArrayKind(const std::string& name)
   {
     return "diffusivity multiplier";
   }
-  if (name == "SIGMAV" || name == "DZMTRXV" || name == "DZMATRIX" || name == "LX" || name == "LY" ||
-      name == "LZ")
+  if (name == "SIGMAV" || name == "DZMTRXV" || name == "DZMATRIX" || name == "LX" || name == "LY" || name == "LZ")
   {
     return "dual-porosity coupling factor";
   }
@@ -59,63 +57,15 @@ std::string SimulatorArrayKind(const std::string& name)
 
 bool IsViewerArray(const std::string& name)
 {
-  static const std::unordered_set<std::string> names = { "ACTNUM",
-    "DX",
-    "DY",
-    "DZ",
-    "TOPS",
-    "PORO",
-    "PERMX",
-    "PERMY",
-    "PERMZ",
-    "PERMXY",
-    "PERMYZ",
-    "PERMZX",
-    "PERMR",
-    "PERMTHT",
-    "NTG",
-    "SWATINIT",
-    "SWL",
-    "SWLPC",
-    "SWCR",
-    "SWU",
-    "SGL",
-    "SGLPC",
-    "SGCR",
-    "SGU",
-    "SOWCR",
-    "SOGCR",
-    "KRW",
-    "KRWR",
-    "KRO",
-    "KRORW",
-    "KRORG",
-    "KRG",
-    "KRGR",
-    "PCW",
-    "PCG",
-    "PRESSURE",
-    "SWAT",
-    "SGAS",
-    "SOIL",
-    "RS",
-    "RV",
-    "PBUB",
-    "PDEW",
-    "TEMPI",
-    "SALT",
-    "FACIES",
-    "THCONR",
-    "THCONSF",
-    "SPOLY",
-    "SFOAM",
-    "SSOL" };
+  static const std::unordered_set<std::string> names = { "ACTNUM", "DX", "DY", "DZ", "TOPS", "PORO", "PERMX", "PERMY",
+    "PERMZ", "PERMXY", "PERMYZ", "PERMZX", "PERMR", "PERMTHT", "NTG", "SWATINIT", "SWL", "SWLPC", "SWCR", "SWU", "SGL",
+    "SGLPC", "SGCR", "SGU", "SOWCR", "SOGCR", "KRW", "KRWR", "KRO", "KRORW", "KRORG", "KRG", "KRGR", "PCW", "PCG",
+    "PRESSURE", "SWAT", "SGAS", "SOIL", "RS", "RV", "PBUB", "PDEW", "TEMPI", "SALT", "FACIES", "THCONR", "THCONSF",
+    "SPOLY", "SFOAM", "SSOL" };
   return names.count(name) > 0 || EndsWith(name, "NUM");
 }
 
-std::function<double(double, double)> ArrayOperation(const std::string& operation,
-  double alpha,
-  double beta)
+std::function<double(double, double)> ArrayOperation(const std::string& operation, double alpha, double beta)
 {
   using Op = std::function<double(double, double)>;
   // ECLIPSE's OPERATE table: R is the target's value, X the source's.
@@ -206,8 +156,7 @@ SkippedShape SkippedKeyword(const std::string& keyword, std::string& why)
         "the minimum pore volume under which the simulator makes cells inactive "
         "(it shows the cells ACTNUM makes active)" } },
     { "MINPVFIL", { SkippedShape::OneRecord, "the minimum pore volume for filling pinch-outs" } },
-    { "PINCH",
-      { SkippedShape::OneRecord, "connections the simulator makes across pinched-out layers" } },
+    { "PINCH", { SkippedShape::OneRecord, "connections the simulator makes across pinched-out layers" } },
     { "CARFIN", { SkippedShape::LocalGrid, "a local grid refinement" } },
     { "RADFIN", { SkippedShape::LocalGrid, "a radial local grid refinement" } },
     { "RADFIN4", { SkippedShape::LocalGrid, "a radial local grid refinement" } },

@@ -29,9 +29,8 @@ std::string SimulatorArrayKind(const std::string& name);
 
 /// The OPERATE / OPERATER operations (ECLIPSE's names): result = f(target, source), where
 /// alpha and beta are the record's parameters. Empty function for an unknown name.
-std::function<double(double target, double source)> ArrayOperation(const std::string& operation,
-  double alpha,
-  double beta);
+std::function<double(double target, double source)> ArrayOperation(
+  const std::string& operation, double alpha, double beta);
 
 /// True for operations whose result depends on the target's old value (POLY, MULTIPLY).
 bool OperationReadsTarget(const std::string& operation);

@@ -43,32 +43,24 @@ bool IsGeometryArrayName(const std::string& name)
   return name == "DX" || name == "DY" || name == "DZ" || name == "TOPS" || name == "ACTNUM";
 }
 
-int64_t CheckedCellCount(const std::array<int64_t, 3>& dims,
-  int64_t maxCells,
-  const std::string& file,
-  int64_t line,
+int64_t CheckedCellCount(const std::array<int64_t, 3>& dims, int64_t maxCells, const std::string& file, int64_t line,
   const std::string& keyword)
 {
   for (int64_t d : dims)
   {
     if (d <= 0 || d > std::numeric_limits<int32_t>::max())
     {
-      throw InputError(file,
-        line,
-        keyword,
+      throw InputError(file, line, keyword,
         "grid dimensions " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
           std::to_string(dims[2]) + " must each be between 1 and 2147483647");
     }
   }
   int64_t count = 0;
-  if (__builtin_mul_overflow(dims[0], dims[1], &count) ||
-      __builtin_mul_overflow(count, dims[2], &count) || count > maxCells)
+  if (__builtin_mul_overflow(dims[0], dims[1], &count) || __builtin_mul_overflow(count, dims[2], &count) ||
+    count > maxCells)
   {
-    throw InputError(file,
-      line,
-      keyword,
-      "grid of " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
-        std::to_string(dims[2]) +
+    throw InputError(file, line, keyword,
+      "grid of " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " + std::to_string(dims[2]) +
         " cells is larger than this machine can hold in memory at full "
         "resolution (limit " +
         std::to_string(maxCells) + " cells); " + MultiresolutionAdvice(file));
@@ -101,8 +93,7 @@ bool LooksLikeKeyword(std::string_view word)
   }
   for (char c : word)
   {
-    const bool ok =
-      (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '+' || c == '-';
+    const bool ok = (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '+' || c == '-';
     if (!ok)
     {
       return false;
@@ -125,95 +116,27 @@ double NotGiven(const std::string& name)
 
 bool IsIntegerArrayName(const std::string& name)
 {
-  return name == "ACTNUM" || name == "FACIES" ||
-         (name.size() > 3 && name.compare(name.size() - 3, 3, "NUM") == 0);
+  return name == "ACTNUM" || name == "FACIES" || (name.size() > 3 && name.compare(name.size() - 3, 3, "NUM") == 0);
 }
 
 /// Cell property keywords whose value count is checked strictly (a wrong count is an error,
 /// not an unknown keyword to skip).
 bool IsKnownCellArray(const std::string& name)
 {
-  static const std::unordered_set<std::string> names = { "ACTNUM",
-    "PORO",
-    "PERMX",
-    "PERMY",
-    "PERMZ",
-    "PERMXY",
-    "PERMYZ",
-    "PERMZX",
-    "NTG",
-    "DX",
-    "DY",
-    "DZ",
-    "TOPS",
-    "MULTX",
-    "MULTY",
-    "MULTZ",
-    "MULTX-",
-    "MULTY-",
-    "MULTZ-",
-    "MULTPV",
-    "PORV",
-    "SATNUM",
-    "FIPNUM",
-    "EQLNUM",
-    "PVTNUM",
-    "IMBNUM",
-    "ROCKNUM",
-    "MULTNUM",
-    "FLUXNUM",
-    "OPERNUM",
-    "ENDNUM",
-    "MISCNUM",
-    "SWATINIT",
-    "SWL",
-    "SWCR",
-    "SWU",
-    "SGL",
-    "SGCR",
-    "SGU",
-    "SOWCR",
-    "SOGCR",
-    "KRW",
-    "KRO",
-    "KRG",
-    "PCW",
-    "PCG",
-    "PRESSURE",
-    "SWAT",
-    "SGAS",
-    "SOIL",
-    "RS",
-    "RV",
-    "FACIES",
-    "THCONR",
-    "DEPTH",
-    "TRANX",
-    "TRANY",
-    "TRANZ",
-    "PORE",
-    "DIFFMX",
-    "DIFFMY",
-    "DIFFMZ" };
+  static const std::unordered_set<std::string> names = { "ACTNUM", "PORO", "PERMX", "PERMY", "PERMZ", "PERMXY",
+    "PERMYZ", "PERMZX", "NTG", "DX", "DY", "DZ", "TOPS", "MULTX", "MULTY", "MULTZ", "MULTX-", "MULTY-", "MULTZ-",
+    "MULTPV", "PORV", "SATNUM", "FIPNUM", "EQLNUM", "PVTNUM", "IMBNUM", "ROCKNUM", "MULTNUM", "FLUXNUM", "OPERNUM",
+    "ENDNUM", "MISCNUM", "SWATINIT", "SWL", "SWCR", "SWU", "SGL", "SGCR", "SGU", "SOWCR", "SOGCR", "KRW", "KRO", "KRG",
+    "PCW", "PCG", "PRESSURE", "SWAT", "SGAS", "SOIL", "RS", "RV", "FACIES", "THCONR", "DEPTH", "TRANX", "TRANY",
+    "TRANZ", "PORE", "DIFFMX", "DIFFMY", "DIFFMZ" };
   return names.count(name) > 0;
 }
 
 /// Keywords whose records edit cell arrays (see ReadArrayOperations).
 bool IsEditKeyword(const std::string& name)
 {
-  static const std::unordered_set<std::string> names = { "EQUALS",
-    "MULTIPLY",
-    "ADD",
-    "COPY",
-    "MINVALUE",
-    "MAXVALUE",
-    "COPYBOX",
-    "OPERATE",
-    "OPERATER",
-    "EQUALREG",
-    "MULTIREG",
-    "ADDREG",
-    "COPYREG" };
+  static const std::unordered_set<std::string> names = { "EQUALS", "MULTIPLY", "ADD", "COPY", "MINVALUE", "MAXVALUE",
+    "COPYBOX", "OPERATE", "OPERATER", "EQUALREG", "MULTIREG", "ADDREG", "COPYREG" };
   return names.count(name) > 0;
 }
 
@@ -237,42 +160,16 @@ std::size_t MinimumEditItems(const std::string& keyword)
 /// Keywords that change the deck when read (geometry, arrays, edits, sections, INCLUDE).
 bool IsActedOnKeyword(const std::string& name)
 {
-  static const std::unordered_set<std::string> names = { "SPECGRID",
-    "DIMENS",
-    "COORD",
-    "ZCORN",
-    "DXV",
-    "DYV",
-    "DZV",
-    "MAPAXES",
-    "MAPUNITS",
-    "GRIDUNIT",
-    "GDORIENT",
-    "COORDSYS",
-    "INCLUDE",
-    "IMPORT",
-    "FAULTS",
-    "BOX",
-    "ENDBOX",
-    "RUNSPEC",
-    "GRID",
-    "EDIT",
-    "PROPS",
-    "REGIONS",
-    "SOLUTION",
-    "SUMMARY",
-    "SCHEDULE",
-    "END" };
+  static const std::unordered_set<std::string> names = { "SPECGRID", "DIMENS", "COORD", "ZCORN", "DXV", "DYV", "DZV",
+    "MAPAXES", "MAPUNITS", "GRIDUNIT", "GDORIENT", "COORDSYS", "INCLUDE", "IMPORT", "FAULTS", "BOX", "ENDBOX",
+    "RUNSPEC", "GRID", "EDIT", "PROPS", "REGIONS", "SOLUTION", "SUMMARY", "SCHEDULE", "END" };
   return names.count(name) > 0 || IsEditKeyword(name) || IsKnownCellArray(name);
 }
 
 struct Box
 {
   std::array<int64_t, 6> range{}; ///< i1 i2 j1 j2 k1 k2, 0-based inclusive
-  int64_t Size() const
-  {
-    return (range[1] - range[0] + 1) * (range[3] - range[2] + 1) * (range[5] - range[4] + 1);
-  }
+  int64_t Size() const { return (range[1] - range[0] + 1) * (range[3] - range[2] + 1) * (range[5] - range[4] + 1); }
 };
 
 enum class Section
@@ -444,8 +341,8 @@ private:
   {
     if (this->Deck.dims[0] == 0)
     {
-      this->FailHere(keyword,
-        "appears before SPECGRID or DIMENS gave the grid dimensions" + this->MissingIncludeNote());
+      this->FailHere(
+        keyword, "appears before SPECGRID or DIMENS gave the grid dimensions" + this->MissingIncludeNote());
     }
     return this->Deck.CellCount();
   }
@@ -482,11 +379,9 @@ private:
       // A keyword this parser acts on, opening a new line after some items: this record
       // lost its '/'. (Other words may start lines inside records: GDORIENT's INC, ...)
       if (token.kind == TokenKind::Word && token.atLineStart && !items.empty() &&
-          IsActedOnKeyword(std::string(token.text)))
+        IsActedOnKeyword(std::string(token.text)))
       {
-        this->Fail(token,
-          keyword,
-          "record not terminated by '/' before " + Describe(token) + " on a new line");
+        this->Fail(token, keyword, "record not terminated by '/' before " + Describe(token) + " on a new line");
       }
       if (items.size() > 4096)
       {
@@ -494,7 +389,7 @@ private:
       }
       NumberToken number;
       if (token.kind == TokenKind::Word && token.text.find('*') != std::string_view::npos &&
-          ParseNumberToken(token.text, number) && number.isDefault)
+        ParseNumberToken(token.text, number) && number.isDefault)
       {
         if (number.repeat > 4096)
         {
@@ -507,12 +402,8 @@ private:
     }
   }
 
-  int64_t RecordInteger(const std::vector<std::string>& items,
-    std::size_t index,
-    const std::string& keyword,
-    const std::string& what,
-    int64_t fallback,
-    bool required)
+  int64_t RecordInteger(const std::vector<std::string>& items, std::size_t index, const std::string& keyword,
+    const std::string& what, int64_t fallback, bool required)
   {
     if (index >= items.size() || items[index].empty())
     {
@@ -530,25 +421,20 @@ private:
     return static_cast<int64_t>(value);
   }
 
-  double RecordNumber(const std::vector<std::string>& items,
-    std::size_t index,
-    const std::string& keyword,
-    const std::string& what)
+  double RecordNumber(
+    const std::vector<std::string>& items, std::size_t index, const std::string& keyword, const std::string& what)
   {
     double value = 0;
     if (index >= items.size() || !ParseDouble(items[index], value))
     {
-      this->FailHere(keyword,
-        what + " must be a number, got '" + (index < items.size() ? items[index] : "") + "'");
+      this->FailHere(keyword, what + " must be a number, got '" + (index < items.size() ? items[index] : "") + "'");
     }
     return value;
   }
 
   /// Reads an optional box (i1 i2 j1 j2 k1 k2, 1-based) starting at items[first].
-  Box RecordBox(const std::vector<std::string>& items,
-    std::size_t first,
-    const Box& fallback,
-    const std::string& keyword)
+  Box RecordBox(
+    const std::vector<std::string>& items, std::size_t first, const Box& fallback, const std::string& keyword)
   {
     Box box = fallback;
     const auto& d = this->Deck.dims;
@@ -564,12 +450,11 @@ private:
         }
       }
       if (box.range[2 * axis] < 0 || box.range[2 * axis] > box.range[2 * axis + 1] ||
-          box.range[2 * axis + 1] >= d[axis])
+        box.range[2 * axis + 1] >= d[axis])
       {
         this->FailHere(keyword,
-          "box " + std::to_string(box.range[2 * axis] + 1) + "-" +
-            std::to_string(box.range[2 * axis + 1] + 1) + " is outside the grid's " + "IJK"[axis] +
-            " range 1-" + std::to_string(d[axis]));
+          "box " + std::to_string(box.range[2 * axis] + 1) + "-" + std::to_string(box.range[2 * axis + 1] + 1) +
+            " is outside the grid's " + "IJK"[axis] + " range 1-" + std::to_string(d[axis]));
       }
     }
     return box;
@@ -625,18 +510,15 @@ private:
   bool Spooling() const { return this->Spool != nullptr; }
 
   /// Spooling: the cell arrays kept (in temporary files); any other one is dropped.
-  bool Spooled(const std::string& name) const
-  {
-    return this->Spooling() && IsGeometryArrayName(name);
-  }
+  bool Spooled(const std::string& name) const { return this->Spooling() && IsGeometryArrayName(name); }
 
   std::unique_ptr<SpoolFile>& SpoolSlot(const std::string& name)
   {
     GrdeclGridSpool& spool = *this->Spool;
     return name == "ACTNUM" ? spool.actnum
-           : name == "DX"   ? spool.dx
-           : name == "DY"   ? spool.dy
-           : name == "DZ"   ? spool.dz
+      : name == "DX"        ? spool.dx
+      : name == "DY"        ? spool.dy
+      : name == "DZ"        ? spool.dz
                             : spool.tops;
   }
 
@@ -660,8 +542,7 @@ private:
     {
       return this->Deck.FindArray(name) != nullptr;
     }
-    return this->Spooled(name) ? this->SpoolSlot(name) != nullptr
-                               : this->DroppedArrays.count(name) > 0;
+    return this->Spooled(name) ? this->SpoolSlot(name) != nullptr : this->DroppedArrays.count(name) > 0;
   }
 
   /// Applies edit(value&) to the cells of `box` in a spooled array, a row at a time.
@@ -669,17 +550,15 @@ private:
   void EditSpool(SpoolFile& file, const Box& box, Edit&& edit)
   {
     std::vector<double> row;
-    this->ForEachRow(box,
-      [&](int64_t first, int64_t count)
+    this->ForEachRow(box, [&](int64_t first, int64_t count) {
+      row.resize(static_cast<std::size_t>(count));
+      file.Read(first, row.data(), count);
+      for (double& value : row)
       {
-        row.resize(static_cast<std::size_t>(count));
-        file.Read(first, row.data(), count);
-        for (double& value : row)
-        {
-          edit(value);
-        }
-        file.Write(first, row.data(), count);
-      });
+        edit(value);
+      }
+      file.Write(first, row.data(), count);
+    });
   }
 
   // ---------------------------------------------------------------- number arrays
@@ -687,11 +566,7 @@ private:
   /// Returns false (without consuming the unexpected token) if `lenient` and the data turn
   /// out not to be a plain numeric array.
   template<typename Store>
-  bool ReadNumbers(const std::string& keyword,
-    int64_t expected,
-    bool lenient,
-    bool allowDefaults,
-    Store&& store,
+  bool ReadNumbers(const std::string& keyword, int64_t expected, bool lenient, bool allowDefaults, Store&& store,
     int64_t alsoAccepted = -1)
   {
     int64_t count = 0;
@@ -709,10 +584,9 @@ private:
         {
           return false;
         }
-        this->Fail(token,
-          keyword,
-          "unterminated keyword: reached end of file after " + std::to_string(count) +
-            " values, expected " + std::to_string(expected) + " and a '/'");
+        this->Fail(token, keyword,
+          "unterminated keyword: reached end of file after " + std::to_string(count) + " values, expected " +
+            std::to_string(expected) + " and a '/'");
       }
       NumberToken number;
       if (token.kind != TokenKind::Word || !ParseNumberToken(token.text, number))
@@ -724,15 +598,13 @@ private:
         }
         if (token.atLineStart && token.kind == TokenKind::Word && LooksLikeKeyword(token.text))
         {
-          this->Fail(token,
-            keyword,
-            "missing '/' terminator: reached keyword " + Describe(token) + " after " +
-              std::to_string(count) + " of " + std::to_string(expected) + " values");
+          this->Fail(token, keyword,
+            "missing '/' terminator: reached keyword " + Describe(token) + " after " + std::to_string(count) + " of " +
+              std::to_string(expected) + " values");
         }
-        this->Fail(token,
-          keyword,
-          "expected a number, got " + Describe(token) + " (value " + std::to_string(count + 1) +
-            " of " + std::to_string(expected) + ")");
+        this->Fail(token, keyword,
+          "expected a number, got " + Describe(token) + " (value " + std::to_string(count + 1) + " of " +
+            std::to_string(expected) + ")");
       }
       if (!std::isfinite(number.value))
       {
@@ -749,10 +621,8 @@ private:
           this->Tokens->PushBack();
           return false;
         }
-        this->Fail(token,
-          keyword,
-          "too many values: more than the " + std::to_string(expected) + " expected (at " +
-            Describe(token) + ")");
+        this->Fail(token, keyword,
+          "too many values: more than the " + std::to_string(expected) + " expected (at " + Describe(token) + ")");
       }
       const double value = number.isDefault ? undefined : number.value;
       for (int64_t r = 0; r < number.repeat; ++r)
@@ -778,8 +648,7 @@ private:
   {
     target.clear();
     target.reserve(static_cast<std::size_t>(expected));
-    this->ReadNumbers(
-      keyword, expected, false, false, [&](int64_t, double value) { target.push_back(value); });
+    this->ReadNumbers(keyword, expected, false, false, [&](int64_t, double value) { target.push_back(value); });
   }
 
   /// Reads a cell array (PORO, ACTNUM, ...) into the current BOX; `lenient` for keywords we
@@ -823,19 +692,15 @@ private:
     {
       SpoolWriter<double> writer(this->SpoolFor(keyword));
       BoxWalk cells(box, this->Deck.dims);
-      this->ReadNumbers(keyword,
-        expected,
-        false,
-        true,
-        [&](int64_t, double value) { writer.Put(cells.Next(), value); });
+      this->ReadNumbers(
+        keyword, expected, false, true, [&](int64_t, double value) { writer.Put(cells.Next(), value); });
       writer.Flush();
       return;
     }
     if (lenient)
     {
       std::vector<double> values;
-      if (!this->ReadNumbers(
-            keyword, expected, true, true, [&](int64_t, double value) { values.push_back(value); }))
+      if (!this->ReadNumbers(keyword, expected, true, true, [&](int64_t, double value) { values.push_back(value); }))
       {
         this->SkipRestOfKeyword();
         return;
@@ -849,18 +714,13 @@ private:
     double* data = array.values.data();
     if (wholeGrid)
     {
-      this->ReadNumbers(
-        keyword, expected, false, true, [&](int64_t index, double value) { data[index] = value; });
+      this->ReadNumbers(keyword, expected, false, true, [&](int64_t index, double value) { data[index] = value; });
       return;
     }
     std::vector<int64_t> cells;
     cells.reserve(static_cast<std::size_t>(expected));
     this->ForEachCell(box, [&](int64_t cell) { cells.push_back(cell); });
-    this->ReadNumbers(keyword,
-      expected,
-      false,
-      true,
-      [&](int64_t index, double value) { data[cells[index]] = value; });
+    this->ReadNumbers(keyword, expected, false, true, [&](int64_t index, double value) { data[cells[index]] = value; });
   }
 
   void ReadTops()
@@ -871,12 +731,7 @@ private:
     {
       SpoolWriter<double> writer(this->SpoolFor("TOPS"));
       this->ReadNumbers(
-        "TOPS",
-        n,
-        false,
-        true,
-        [&](int64_t index, double value) { writer.Put(index, value); },
-        layer);
+        "TOPS", n, false, true, [&](int64_t index, double value) { writer.Put(index, value); }, layer);
       writer.Flush();
       return;
     }
@@ -929,8 +784,8 @@ private:
     {
       this->FailHere(keyword,
         "grid dimensions " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
-          std::to_string(dims[2]) + " differ from the " + std::to_string(old[0]) + " x " +
-          std::to_string(old[1]) + " x " + std::to_string(old[2]) + " given before");
+          std::to_string(dims[2]) + " differ from the " + std::to_string(old[0]) + " x " + std::to_string(old[1]) +
+          " x " + std::to_string(old[2]) + " given before");
     }
     this->Deck.dims = dims;
   }
@@ -941,8 +796,7 @@ private:
     std::array<int64_t, 3> dims{};
     for (int axis = 0; axis < 3; ++axis)
     {
-      dims[axis] =
-        this->RecordInteger(items, axis, keyword, std::string("N") + "XYZ"[axis], 0, true);
+      dims[axis] = this->RecordInteger(items, axis, keyword, std::string("N") + "XYZ"[axis], 0, true);
     }
     double numres = 1;
     if (keyword == "SPECGRID" && items.size() > 3 && ParseDouble(items[3], numres) && numres != 1)
@@ -970,8 +824,7 @@ private:
       }
       if (items.size() < 8)
       {
-        this->FailHere(
-          keyword, "record for fault '" + items[0] + "' needs NAME I1 I2 J1 J2 K1 K2 FACE");
+        this->FailHere(keyword, "record for fault '" + items[0] + "' needs NAME I1 I2 J1 J2 K1 K2 FACE");
       }
       FaultFace face;
       const Box box = this->RecordBox(items, 1, this->WholeGrid(), keyword);
@@ -980,26 +833,12 @@ private:
         face.box[b] = static_cast<int32_t>(box.range[b]);
       }
       const std::string direction = Upper(items[7]);
-      static const std::pair<const char*, FaultFace::Direction> directions[] = {
-        { "I", FaultFace::IPlus },
-        { "I+", FaultFace::IPlus },
-        { "X", FaultFace::IPlus },
-        { "X+", FaultFace::IPlus },
-        { "I-", FaultFace::IMinus },
-        { "X-", FaultFace::IMinus },
-        { "J", FaultFace::JPlus },
-        { "J+", FaultFace::JPlus },
-        { "Y", FaultFace::JPlus },
-        { "Y+", FaultFace::JPlus },
-        { "J-", FaultFace::JMinus },
-        { "Y-", FaultFace::JMinus },
-        { "K", FaultFace::KPlus },
-        { "K+", FaultFace::KPlus },
-        { "Z", FaultFace::KPlus },
-        { "Z+", FaultFace::KPlus },
-        { "K-", FaultFace::KMinus },
-        { "Z-", FaultFace::KMinus }
-      };
+      static const std::pair<const char*, FaultFace::Direction> directions[] = { { "I", FaultFace::IPlus },
+        { "I+", FaultFace::IPlus }, { "X", FaultFace::IPlus }, { "X+", FaultFace::IPlus }, { "I-", FaultFace::IMinus },
+        { "X-", FaultFace::IMinus }, { "J", FaultFace::JPlus }, { "J+", FaultFace::JPlus }, { "Y", FaultFace::JPlus },
+        { "Y+", FaultFace::JPlus }, { "J-", FaultFace::JMinus }, { "Y-", FaultFace::JMinus }, { "K", FaultFace::KPlus },
+        { "K+", FaultFace::KPlus }, { "Z", FaultFace::KPlus }, { "Z+", FaultFace::KPlus }, { "K-", FaultFace::KMinus },
+        { "Z-", FaultFace::KMinus } };
       bool known = false;
       for (const auto& entry : directions)
       {
@@ -1035,13 +874,13 @@ private:
   /// One record of an edit keyword, read and checked before it touches any array.
   struct ArrayEdit
   {
-    std::string target;       ///< array written
-    std::string source;       ///< array read (COPY, COPYBOX, OPERATE ...), or ""
-    bool readsTarget = false; ///< the target's old values matter (MULTIPLY, ADD ...)
-    Box box;                  ///< cells written
-    Box sourceBox;            ///< cells read, cell for cell (COPYBOX; else `box`)
-    std::string regionArray;  ///< *REG, OPERATER: only cells of this region ...
-    int64_t region = 0;       ///< ... with this number
+    std::string target;                          ///< array written
+    std::string source;                          ///< array read (COPY, COPYBOX, OPERATE ...), or ""
+    bool readsTarget = false;                    ///< the target's old values matter (MULTIPLY, ADD ...)
+    Box box;                                     ///< cells written
+    Box sourceBox;                               ///< cells read, cell for cell (COPYBOX; else `box`)
+    std::string regionArray;                     ///< *REG, OPERATER: only cells of this region ...
+    int64_t region = 0;                          ///< ... with this number
     std::function<double(double, double)> apply; ///< (old target, source) -> new target
   };
 
@@ -1066,10 +905,8 @@ private:
     }
   }
 
-  double EditValue(const std::vector<std::string>& items,
-    std::size_t index,
-    const std::string& keyword,
-    const std::string& target)
+  double EditValue(
+    const std::vector<std::string>& items, std::size_t index, const std::string& keyword, const std::string& target)
   {
     const double value = this->RecordNumber(items, index, keyword, "value for " + target);
     if (!std::isfinite(value))
@@ -1081,16 +918,14 @@ private:
 
   /// The record's arrays, cells and operation; `lastBox` is the box a record without one
   /// uses (the previous record's, as ECLIPSE does).
-  ArrayEdit ReadEditRecord(const std::string& keyword,
-    const std::vector<std::string>& items,
-    Box& lastBox)
+  ArrayEdit ReadEditRecord(const std::string& keyword, const std::vector<std::string>& items, Box& lastBox)
   {
     const std::size_t needed = MinimumEditItems(keyword);
     if (items.size() < needed || items[0].empty())
     {
       this->FailHere(keyword,
-        "record needs at least " + std::to_string(needed) +
-          " items (array name, values ...), got " + std::to_string(items.size()));
+        "record needs at least " + std::to_string(needed) + " items (array name, values ...), got " +
+          std::to_string(items.size()));
     }
     ArrayEdit edit;
     edit.target = Upper(items[0]);
@@ -1132,8 +967,7 @@ private:
         const auto& d = edit.box.range;
         if (s[2 * axis + 1] - s[2 * axis] != d[2 * axis + 1] - d[2 * axis])
         {
-          this->FailHere(keyword,
-            "the boxes copied from and to differ in size along " + std::string(1, "IJK"[axis]));
+          this->FailHere(keyword, "the boxes copied from and to differ in size along " + std::string(1, "IJK"[axis]));
         }
       }
       edit.apply = [](double, double x) { return x; };
@@ -1166,15 +1000,12 @@ private:
 
   /// OPERATE: target, box, operation, source, alpha, beta. OPERATER: target, region number,
   /// operation, source, alpha, beta, region array (OPERNUM if not given).
-  ArrayEdit ReadOperateRecord(const std::string& keyword,
-    const std::vector<std::string>& items,
-    ArrayEdit& edit)
+  ArrayEdit ReadOperateRecord(const std::string& keyword, const std::vector<std::string>& items, ArrayEdit& edit)
   {
     std::size_t next = 1;
     if (keyword == "OPERATE")
     {
-      edit.box = this->RecordBox(
-        items, 1, this->CurrentBox ? *this->CurrentBox : this->WholeGrid(), keyword);
+      edit.box = this->RecordBox(items, 1, this->CurrentBox ? *this->CurrentBox : this->WholeGrid(), keyword);
       next = 7;
     }
     else
@@ -1191,11 +1022,11 @@ private:
       this->FailHere(keyword, "record for " + edit.target + " names no source array");
     }
     const double alpha = next + 2 < items.size() && !items[next + 2].empty()
-                           ? this->EditValue(items, next + 2, keyword, edit.target)
-                           : 0.0;
+      ? this->EditValue(items, next + 2, keyword, edit.target)
+      : 0.0;
     const double beta = next + 3 < items.size() && !items[next + 3].empty()
-                          ? this->EditValue(items, next + 3, keyword, edit.target)
-                          : 0.0;
+      ? this->EditValue(items, next + 3, keyword, edit.target)
+      : 0.0;
     edit.apply = ArrayOperation(operation, alpha, beta);
     if (!edit.apply)
     {
@@ -1212,13 +1043,10 @@ private:
     return edit;
   }
 
-  std::string RegionArrayFor(const std::string& keyword,
-    const std::vector<std::string>& items,
-    std::size_t index,
-    const std::string& fallback)
+  std::string RegionArrayFor(
+    const std::string& keyword, const std::vector<std::string>& items, std::size_t index, const std::string& fallback)
   {
-    const std::string given =
-      index < items.size() && !items[index].empty() ? Upper(items[index]) : fallback;
+    const std::string given = index < items.size() && !items[index].empty() ? Upper(items[index]) : fallback;
     const std::string name = RegionArrayName(given);
     if (name.empty())
     {
@@ -1232,14 +1060,12 @@ private:
   bool CanApply(const std::string& keyword, const ArrayEdit& edit)
   {
     const bool viewerEdit =
-      IsViewerArray(edit.target) ||
-      (!edit.source.empty() && IsViewerArray(edit.source) && this->Defined(edit.source));
+      IsViewerArray(edit.target) || (!edit.source.empty() && IsViewerArray(edit.source) && this->Defined(edit.source));
     if (!edit.source.empty() && !this->Defined(edit.source) && !IsRegionArrayName(edit.source))
     {
       if (IsViewerArray(edit.source) || IsViewerArray(edit.target))
       {
-        this->FailHere(keyword,
-          "source array " + edit.source + " has not been defined" + this->MissingIncludeNote());
+        this->FailHere(keyword, "source array " + edit.source + " has not been defined" + this->MissingIncludeNote());
       }
       this->WarnSkippedEdit(keyword, edit.source);
       return false;
@@ -1250,8 +1076,7 @@ private:
     }
     if (edit.readsTarget && IsViewerArray(edit.target))
     {
-      this->FailHere(
-        keyword, "array " + edit.target + " has not been defined" + this->MissingIncludeNote());
+      this->FailHere(keyword, "array " + edit.target + " has not been defined" + this->MissingIncludeNote());
     }
     if (edit.readsTarget || !viewerEdit || !IsViewerArray(edit.target))
     {
@@ -1265,16 +1090,14 @@ private:
   void WarnSkippedEdit(const std::string& keyword, const std::string& array)
   {
     const std::string kind = SimulatorArrayKind(array);
-    const std::string why = kind.empty()
-                              ? "is not defined by this deck and is not an array the viewer knows"
-                              : "is a " + kind + ", which the viewer does not build";
+    const std::string why = kind.empty() ? "is not defined by this deck and is not an array the viewer knows"
+                                         : "is a " + kind + ", which the viewer does not build";
     this->Warn(keyword, "array " + array + " " + why + "; edit skipped");
   }
 
   void Warn(const std::string& keyword, const std::string& what)
   {
-    const std::string message =
-      InputError::Format(this->CurrentFile, this->RecordLine, keyword, what);
+    const std::string message = InputError::Format(this->CurrentFile, this->RecordLine, keyword, what);
     if (this->WarningsGiven.insert(message).second)
     {
       this->Deck.warnings.push_back(message);
@@ -1334,8 +1157,7 @@ private:
       {
         this->FailHere(keyword,
           "cannot edit " + edit.target + " by region " + edit.regionArray +
-            ": when the grid is read with bounded memory (resmr build) " +
-            "region arrays are not kept");
+            ": when the grid is read with bounded memory (resmr build) " + "region arrays are not kept");
       }
       out.spooled = &this->SpoolFor(edit.target);
       in.spooled = edit.source.empty() ? nullptr : &this->SpoolFor(edit.source);
@@ -1354,8 +1176,7 @@ private:
     const bool hasRegions = regions.held != nullptr;
     const auto& s = edit.sourceBox.range;
     const auto& d = edit.box.range;
-    const bool backwards =
-      edit.source == edit.target && std::make_pair(d[4], d[2]) > std::make_pair(s[4], s[2]);
+    const bool backwards = edit.source == edit.target && std::make_pair(d[4], d[2]) > std::make_pair(s[4], s[2]);
     const int64_t rows = (d[5] - d[4] + 1) * (d[3] - d[2] + 1);
     const int64_t count = d[1] - d[0] + 1;
     std::vector<double> target(count), source(count), region(count);
@@ -1477,8 +1298,7 @@ private:
         if (depth + 1 > MaxIncludeDepth)
         {
           this->FailHere(keyword,
-            "includes nested deeper than " + std::to_string(MaxIncludeDepth) +
-              " levels (does a file include itself?)");
+            "includes nested deeper than " + std::to_string(MaxIncludeDepth) + " levels (does a file include itself?)");
         }
         const std::string savedFile = this->CurrentFile;
         const int64_t savedLine = this->CurrentLine;
@@ -1491,16 +1311,15 @@ private:
       }
     }
     const std::string message = "included file '" + name + "' not found (looked in " + here +
-                                (here == this->RootDirectory ? "" : " and " + this->RootDirectory) +
-                                ")";
+      (here == this->RootDirectory ? "" : " and " + this->RootDirectory) + ")";
     if (!this->Options.skipMissingIncludes)
     {
       this->FailHere(keyword, message);
     }
     this->Deck.warnings.push_back(
       InputError::Format(this->CurrentFile, this->CurrentLine, keyword, message + "; skipped"));
-    this->MissingIncludes.push_back(keyword + " of '" + name + "' at " + this->CurrentFile + ":" +
-                                    std::to_string(this->CurrentLine));
+    this->MissingIncludes.push_back(
+      keyword + " of '" + name + "' at " + this->CurrentFile + ":" + std::to_string(this->CurrentLine));
   }
 
   void ParseTextFile(const std::string& path, int depth)
@@ -1534,22 +1353,16 @@ private:
   bool InPropertySection() const
   {
     return this->CurrentSection != Section::Runspec && this->CurrentSection != Section::Summary &&
-           this->CurrentSection != Section::Schedule;
+      this->CurrentSection != Section::Schedule;
   }
 
   /// Section keywords (RUNSPEC ... SCHEDULE, END): true if `keyword` is one.
   bool EnterSection(const std::string& keyword)
   {
-    static const std::unordered_map<std::string, Section> sections = { { "RUNSPEC",
-                                                                         Section::Runspec },
-      { "GRID", Section::Grid },
-      { "EDIT", Section::Edit },
-      { "PROPS", Section::Props },
-      { "REGIONS", Section::Regions },
-      { "SOLUTION", Section::Solution },
-      { "SUMMARY", Section::Summary },
-      { "SCHEDULE", Section::Schedule },
-      { "END", Section::Schedule } };
+    static const std::unordered_map<std::string, Section> sections = { { "RUNSPEC", Section::Runspec },
+      { "GRID", Section::Grid }, { "EDIT", Section::Edit }, { "PROPS", Section::Props },
+      { "REGIONS", Section::Regions }, { "SOLUTION", Section::Solution }, { "SUMMARY", Section::Summary },
+      { "SCHEDULE", Section::Schedule }, { "END", Section::Schedule } };
     const auto found = sections.find(keyword);
     if (found == sections.end())
     {
@@ -1569,9 +1382,8 @@ private:
     std::string why;
     if (this->CurrentSection == Section::Summary)
     {
-      static const std::unordered_set<std::string> leaving = {
-        "SCHEDULE", "END", "RUNSPEC", "GRID", "EDIT", "PROPS", "REGIONS", "SOLUTION"
-      };
+      static const std::unordered_set<std::string> leaving = { "SCHEDULE", "END", "RUNSPEC", "GRID", "EDIT", "PROPS",
+        "REGIONS", "SOLUTION" };
       if (!leaving.count(keyword))
       {
         return; // summary vectors: nothing for the grid
@@ -1592,10 +1404,7 @@ private:
       const int64_t expected = 8 * this->CellCount(keyword);
       std::unique_ptr<SpoolFile> file(new SpoolFile(this->SpoolFolder, keyword));
       SpoolWriter<float> writer(*file);
-      this->ReadNumbers(keyword,
-        expected,
-        false,
-        false,
+      this->ReadNumbers(keyword, expected, false, false,
         [&](int64_t index, double value) { writer.Put(index, static_cast<float>(value)); });
       writer.Flush();
       this->Spool->zcorn = std::move(file); // a second ZCORN replaces the first
@@ -1608,8 +1417,7 @@ private:
     {
       this->CellCount(keyword);
       const int axis = keyword[1] - 'X';
-      std::vector<double>& target =
-        axis == 0 ? this->Deck.dxv : (axis == 1 ? this->Deck.dyv : this->Deck.dzv);
+      std::vector<double>& target = axis == 0 ? this->Deck.dxv : (axis == 1 ? this->Deck.dyv : this->Deck.dzv);
       this->ReadDenseArray(keyword, target, this->Deck.dims[axis]);
     }
     else if (keyword == "MAPAXES")
@@ -1633,8 +1441,7 @@ private:
       const int64_t k2 = this->RecordInteger(items, 1, keyword, "K2", 1, true);
       if (k1 < 1 || k2 < k1 || (this->Deck.dims[2] > 0 && k2 > this->Deck.dims[2]))
       {
-        this->FailHere(keyword,
-          "layer range " + std::to_string(k1) + "-" + std::to_string(k2) + " is not valid");
+        this->FailHere(keyword, "layer range " + std::to_string(k1) + "-" + std::to_string(k2) + " is not valid");
       }
       this->Deck.coordsysLayers.push_back({ static_cast<int32_t>(k1), static_cast<int32_t>(k2) });
     }
@@ -1711,12 +1518,9 @@ private:
     for (const EclipseRecord& header : reader.Records())
     {
       const std::string& keyword = header.name;
-      const auto fail = [&](const std::string& what)
-      {
-        throw InputError(path,
-          0,
-          keyword,
-          what + " (keyword header at byte " + std::to_string(header.headerOffset) + ")");
+      const auto fail = [&](const std::string& what) {
+        throw InputError(
+          path, 0, keyword, what + " (keyword header at byte " + std::to_string(header.headerOffset) + ")");
       };
       if (!header.IsNumeric())
       {
@@ -1780,26 +1584,21 @@ private:
       {
         if (header.count != expected)
         {
-          fail("expected " + std::to_string(expected) + " values, file has " +
-               std::to_string(header.count));
+          fail("expected " + std::to_string(expected) + " values, file has " + std::to_string(header.count));
         }
         if (keyword == "ZCORN" && this->Spooling())
         {
           std::unique_ptr<SpoolFile> file(new SpoolFile(this->SpoolFolder, keyword));
-          this->SpoolRecord<float>(reader,
-            header,
-            *file,
-            [&](const double* v, int64_t count, float* out)
+          this->SpoolRecord<float>(reader, header, *file, [&](const double* v, int64_t count, float* out) {
+            for (int64_t i = 0; i < count; ++i)
             {
-              for (int64_t i = 0; i < count; ++i)
+              if (!std::isfinite(v[i]))
               {
-                if (!std::isfinite(v[i]))
-                {
-                  fail("holds a value that is not finite");
-                }
-                out[i] = static_cast<float>(v[i]);
+                fail("holds a value that is not finite");
               }
-            });
+              out[i] = static_cast<float>(v[i]);
+            }
+          });
           this->Spool->zcorn = std::move(file);
           continue;
         }
@@ -1817,8 +1616,7 @@ private:
       {
         if (IsKnownCellArray(keyword))
         {
-          fail("expected " + std::to_string(n) + " values (one per cell), file has " +
-               std::to_string(header.count));
+          fail("expected " + std::to_string(n) + " values (one per cell), file has " + std::to_string(header.count));
         }
         continue;
       }
@@ -1830,10 +1628,8 @@ private:
           continue;
         }
         std::unique_ptr<SpoolFile> file(new SpoolFile(this->SpoolFolder, keyword));
-        this->SpoolRecord<double>(reader,
-          header,
-          *file,
-          [](const double* v, int64_t count, double* out) { std::copy(v, v + count, out); });
+        this->SpoolRecord<double>(
+          reader, header, *file, [](const double* v, int64_t count, double* out) { std::copy(v, v + count, out); });
         this->SpoolSlot(keyword) = std::move(file); // replaces any earlier values, as below
         continue;
       }
@@ -1848,10 +1644,7 @@ private:
   /// Copies a binary record into a spool file piece by piece: convert(values as doubles,
   /// count, out) fills the spool's values (checking them).
   template<typename T, typename Convert>
-  void SpoolRecord(const EclipseKeywordFile& reader,
-    const EclipseRecord& header,
-    SpoolFile& file,
-    Convert&& convert)
+  void SpoolRecord(const EclipseKeywordFile& reader, const EclipseRecord& header, SpoolFile& file, Convert&& convert)
   {
     constexpr int64_t Piece = 1 << 16;
     std::vector<double> values(static_cast<std::size_t>(std::min<int64_t>(Piece, header.count)));
@@ -1873,30 +1666,23 @@ private:
     const std::string& file = deck.files.front();
     if (deck.dims[0] == 0)
     {
-      throw InputError(file,
-        0,
-        "SPECGRID",
-        "no SPECGRID or DIMENS: grid dimensions unknown" + this->MissingIncludeNote());
+      throw InputError(
+        file, 0, "SPECGRID", "no SPECGRID or DIMENS: grid dimensions unknown" + this->MissingIncludeNote());
     }
     const bool hasZcorn = this->Spooling() ? this->Spool->zcorn != nullptr : !deck.zcorn.empty();
     if (deck.coord.empty() == hasZcorn)
     {
-      throw InputError(file,
-        0,
-        deck.coord.empty() ? "COORD" : "ZCORN",
+      throw InputError(file, 0, deck.coord.empty() ? "COORD" : "ZCORN",
         "missing; corner-point grids need both COORD and ZCORN" + this->MissingIncludeNote());
     }
-    const auto given = [&](const std::string& name, const std::vector<double>& vector)
-    { return !vector.empty() || this->Defined(name); };
-    const bool cartesian =
-      given("DX", deck.dxv) && given("DY", deck.dyv) && given("DZ", deck.dzv) && given("TOPS", {});
+    const auto given = [&](const std::string& name, const std::vector<double>& vector) {
+      return !vector.empty() || this->Defined(name);
+    };
+    const bool cartesian = given("DX", deck.dxv) && given("DY", deck.dyv) && given("DZ", deck.dzv) && given("TOPS", {});
     if (!hasZcorn && !cartesian && !this->MissingIncludes.empty())
     {
-      throw InputError(file,
-        0,
-        "COORD",
-        "no grid geometry: need COORD and ZCORN, or DX/DXV, DY/DYV, DZ/DZV and TOPS" +
-          this->MissingIncludeNote());
+      throw InputError(file, 0, "COORD",
+        "no grid geometry: need COORD and ZCORN, or DX/DXV, DY/DYV, DZ/DZV and TOPS" + this->MissingIncludeNote());
     }
     if (this->Spooling() && this->Spool->actnum)
     {
@@ -1952,8 +1738,8 @@ private:
   GrdeclGridSpool* Spool = nullptr; ///< bounded-memory mode when set
   std::string SpoolFolder;
   std::unordered_set<std::string> DroppedArrays; ///< bounded-memory mode: given, not kept
-  int64_t LastRecordLine = 0; ///< line of the first token of the last record read
-  int64_t RecordLine = 0;     ///< line a warning names
+  int64_t LastRecordLine = 0;                    ///< line of the first token of the last record read
+  int64_t RecordLine = 0;                        ///< line a warning names
   std::unordered_set<std::string> WarningsGiven;
   std::vector<std::string> MissingIncludes; ///< "'name' (file:line)" of each INCLUDE not found
 };
@@ -2002,17 +1788,15 @@ CornerPointModel ParseGrdeclFile(const std::string& path, const GrdeclParseOptio
 SpoolFile* GrdeclGridSpool::Find(const std::string& name) const
 {
   return name == "ACTNUM" ? this->actnum.get()
-         : name == "DX"   ? this->dx.get()
-         : name == "DY"   ? this->dy.get()
-         : name == "DZ"   ? this->dz.get()
-         : name == "TOPS" ? this->tops.get()
+    : name == "DX"        ? this->dx.get()
+    : name == "DY"        ? this->dy.get()
+    : name == "DZ"        ? this->dz.get()
+    : name == "TOPS"      ? this->tops.get()
                           : nullptr;
 }
 
-CornerPointModel ParseGrdeclGrid(const std::string& path,
-  const std::string& spoolFolder,
-  GrdeclGridSpool& spool,
-  GrdeclParseOptions options)
+CornerPointModel ParseGrdeclGrid(
+  const std::string& path, const std::string& spoolFolder, GrdeclGridSpool& spool, GrdeclParseOptions options)
 {
   if (options.maxCells <= 0)
   {

@@ -64,10 +64,8 @@ struct GrdeclGridSpool
 /// naming the file, line and keyword. The deck returned holds dims, COORD, DXV/DYV/DZV, map
 /// axes, units, faults, files and warnings: no zcorn and no cell arrays. Memory: COORD and
 /// buffers of a few hundred KiB, whatever the grid's size; maxCells 0 means no limit here.
-CornerPointModel ParseGrdeclGrid(const std::string& path,
-  const std::string& spoolFolder,
-  GrdeclGridSpool& spool,
-  GrdeclParseOptions options = {});
+CornerPointModel ParseGrdeclGrid(
+  const std::string& path, const std::string& spoolFolder, GrdeclGridSpool& spool, GrdeclParseOptions options = {});
 
 /// Cheap check for file dialogs: binary GRDECL, or text with an ECLIPSE keyword in column 1
 /// within its first 64 KiB.
@@ -75,10 +73,7 @@ bool LooksLikeGrdeclFile(const std::string& path);
 
 /// Checks dims and returns nx*ny*nz; throws InputError (file, line, keyword) when a dim is
 /// not positive, the product overflows, or exceeds maxCells.
-int64_t CheckedCellCount(const std::array<int64_t, 3>& dims,
-  int64_t maxCells,
-  const std::string& file,
-  int64_t line,
+int64_t CheckedCellCount(const std::array<int64_t, 3>& dims, int64_t maxCells, const std::string& file, int64_t line,
   const std::string& keyword);
 
 } // namespace resmr

@@ -36,29 +36,8 @@ inline bool IsDigit(char c)
   return static_cast<unsigned char>(c - '0') < 10;
 }
 
-constexpr double ExactPowersOfTen[] = { 1e0,
-  1e1,
-  1e2,
-  1e3,
-  1e4,
-  1e5,
-  1e6,
-  1e7,
-  1e8,
-  1e9,
-  1e10,
-  1e11,
-  1e12,
-  1e13,
-  1e14,
-  1e15,
-  1e16,
-  1e17,
-  1e18,
-  1e19,
-  1e20,
-  1e21,
-  1e22 };
+constexpr double ExactPowersOfTen[] = { 1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14,
+  1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22 };
 } // namespace
 
 bool ParseDouble(std::string_view word, double& out)
@@ -142,8 +121,7 @@ bool ParseDouble(std::string_view word, double& out)
   if (!truncated && mantissa < (uint64_t(1) << 53) && exponent10 >= -22 && exponent10 <= 22)
   {
     double value = static_cast<double>(mantissa);
-    value =
-      exponent10 < 0 ? value / ExactPowersOfTen[-exponent10] : value * ExactPowersOfTen[exponent10];
+    value = exponent10 < 0 ? value / ExactPowersOfTen[-exponent10] : value * ExactPowersOfTen[exponent10];
     out = negative ? -value : value;
     return true;
   }
@@ -256,8 +234,7 @@ bool GrdeclTokenizer::Refill(std::size_t keepFrom)
     }
     this->Buffer.resize(this->Buffer.size() * 2);
   }
-  const std::size_t got =
-    std::fread(this->Buffer.data() + kept, 1, this->Buffer.size() - kept, this->File);
+  const std::size_t got = std::fread(this->Buffer.data() + kept, 1, this->Buffer.size() - kept, this->File);
   if (got == 0)
   {
     if (std::ferror(this->File))
@@ -363,10 +340,8 @@ const Token& GrdeclTokenizer::Next()
       }
       const std::size_t textStart = this->Begin + 1;
       const std::size_t textEnd = this->Begin + length;
-      this->Current = Token{ TokenKind::String,
-        std::string_view(this->Buffer.data() + textStart, textEnd - textStart),
-        this->Line,
-        atLineStart };
+      this->Current = Token{ TokenKind::String, std::string_view(this->Buffer.data() + textStart, textEnd - textStart),
+        this->Line, atLineStart };
       const bool closed = textEnd < this->EndOfData && this->Buffer[textEnd] == c;
       this->Begin = closed ? textEnd + 1 : textEnd;
       return this->Current;
@@ -392,10 +367,8 @@ const Token& GrdeclTokenizer::Next()
     {
       throw InputError(this->Path, this->Line, "", "token longer than 1 MiB (binary file?)");
     }
-    this->Current = Token{ TokenKind::Word,
-      std::string_view(this->Buffer.data() + this->Begin, length),
-      this->Line,
-      atLineStart };
+    this->Current =
+      Token{ TokenKind::Word, std::string_view(this->Buffer.data() + this->Begin, length), this->Line, atLineStart };
     this->Begin += length;
     return this->Current;
   }

@@ -53,10 +53,8 @@ bool SyntheticLayerSource::Next(std::vector<float>& zcorn, std::vector<uint8_t>&
   return true;
 }
 
-CornerPointLayerSource::CornerPointLayerSource(const CornerPointGeometry& geometry,
-  const std::vector<bool>& active,
-  std::string name,
-  MapPlacement placement)
+CornerPointLayerSource::CornerPointLayerSource(
+  const CornerPointGeometry& geometry, const std::vector<bool>& active, std::string name, MapPlacement placement)
   : Geometry(geometry)
   , Active(active)
   , Label(std::move(name))
@@ -104,9 +102,7 @@ bool CornerPointLayerSource::Next(std::vector<float>& zcorn, std::vector<uint8_t
   return true;
 }
 
-void ReadCornerPointModel(const std::string& path,
-  CornerPointModel& deck,
-  std::vector<bool>& active)
+void ReadCornerPointModel(const std::string& path, CornerPointModel& deck, std::vector<bool>& active)
 {
   if (LooksLikeEclipseGridFile(path))
   {
@@ -124,8 +120,7 @@ void ReadCornerPointModel(const std::string& path,
   active.resize(static_cast<std::size_t>(deck.CellCount()));
   for (int64_t c = 0; c < deck.CellCount(); ++c)
   {
-    active[static_cast<std::size_t>(c)] =
-      !actnum || actnum->values[static_cast<std::size_t>(c)] != 0;
+    active[static_cast<std::size_t>(c)] = !actnum || actnum->values[static_cast<std::size_t>(c)] != 0;
   }
 }
 
@@ -147,8 +142,7 @@ public:
     {
       if (!std::isfinite(this->CoordValues[v]))
       {
-        this->File.Fail(
-          &coord, coord.headerOffset, "value " + std::to_string(v + 1) + " is not finite");
+        this->File.Fail(&coord, coord.headerOffset, "value " + std::to_string(v + 1) + " is not finite");
       }
     }
     CornerPointGeometry::CheckMapAxes(this->Layout.deck);
@@ -193,15 +187,12 @@ public:
     const EclipseRecord& record = *this->Layout.zcorn;
     const int64_t first = 8 * layer * this->K;
     zcorn.resize(static_cast<std::size_t>(8 * layer));
-    const auto finite = [&](const auto* values)
-    {
+    const auto finite = [&](const auto* values) {
       for (int64_t v = 0; v < 8 * layer; ++v)
       {
         if (!std::isfinite(values[v]))
         {
-          this->File.Fail(&record,
-            record.headerOffset,
-            "value " + std::to_string(first + v + 1) + " is not finite");
+          this->File.Fail(&record, record.headerOffset, "value " + std::to_string(first + v + 1) + " is not finite");
         }
       }
     };
@@ -218,8 +209,7 @@ public:
       finite(this->Depths.data());
       for (int64_t v = 0; v < 8 * layer; ++v)
       {
-        zcorn[static_cast<std::size_t>(v)] =
-          static_cast<float>(this->Depths[static_cast<std::size_t>(v)]);
+        zcorn[static_cast<std::size_t>(v)] = static_cast<float>(this->Depths[static_cast<std::size_t>(v)]);
       }
     }
     active.assign(static_cast<std::size_t>(layer), 1);
@@ -270,10 +260,8 @@ public:
       const bool hasDz = this->Spool.dz || !deck.dzv.empty();
       if (!hasDx || !hasDy || !hasDz || !this->Spool.tops)
       {
-        throw InputError(file,
-          0,
-          "COORD",
-          "no grid geometry: need COORD and ZCORN, or DX/DXV, DY/DYV, DZ/DZV and TOPS");
+        throw InputError(
+          file, 0, "COORD", "no grid geometry: need COORD and ZCORN, or DX/DXV, DY/DYV, DZ/DZV and TOPS");
       }
     }
     if (cornerPoint)
@@ -321,8 +309,7 @@ public:
       this->Spool.actnum->Read(layer * this->K, this->Values.data(), layer);
       for (int64_t c = 0; c < layer; ++c)
       {
-        active[static_cast<std::size_t>(c)] =
-          this->Values[static_cast<std::size_t>(c)] != 0 ? 1 : 0;
+        active[static_cast<std::size_t>(c)] = this->Values[static_cast<std::size_t>(c)] != 0 ? 1 : 0;
       }
     }
     ++this->K;
@@ -334,14 +321,8 @@ public:
 private:
   /// A cell size as BuildCartesian takes it: the vector form (DXV ...) if given, else the
   /// cell's value (`layerValues` holds layer k of the array when given, else read here).
-  double CellSize(const char* name,
-    const std::vector<double>& vectorForm,
-    SpoolFile* full,
-    const double* layerValues,
-    int64_t i,
-    int64_t j,
-    int64_t k,
-    int axis)
+  double CellSize(const char* name, const std::vector<double>& vectorForm, SpoolFile* full, const double* layerValues,
+    int64_t i, int64_t j, int64_t k, int axis)
   {
     const int64_t nx = this->Deck.dims[0], ny = this->Deck.dims[1];
     const int64_t along = axis == 0 ? i : (axis == 1 ? j : k);
@@ -360,11 +341,9 @@ private:
     }
     if (!std::isfinite(value) || value < 0)
     {
-      throw InputError(this->Deck.files.front(),
-        0,
-        name,
-        "cell (" + std::to_string(i + 1) + "," + std::to_string(j + 1) + "," +
-          std::to_string(k + 1) + ") has no valid size");
+      throw InputError(this->Deck.files.front(), 0, name,
+        "cell (" + std::to_string(i + 1) + "," + std::to_string(j + 1) + "," + std::to_string(k + 1) +
+          ") has no valid size");
     }
     return value;
   }
@@ -376,13 +355,11 @@ private:
     std::vector<double> yEdges(static_cast<std::size_t>(ny + 1), 0.0);
     for (int64_t i = 0; i < nx; ++i)
     {
-      xEdges[i + 1] =
-        xEdges[i] + this->CellSize("DX", this->Deck.dxv, this->Spool.dx.get(), nullptr, i, 0, 0, 0);
+      xEdges[i + 1] = xEdges[i] + this->CellSize("DX", this->Deck.dxv, this->Spool.dx.get(), nullptr, i, 0, 0, 0);
     }
     for (int64_t j = 0; j < ny; ++j)
     {
-      yEdges[j + 1] =
-        yEdges[j] + this->CellSize("DY", this->Deck.dyv, this->Spool.dy.get(), nullptr, 0, j, 0, 1);
+      yEdges[j + 1] = yEdges[j] + this->CellSize("DY", this->Deck.dyv, this->Spool.dy.get(), nullptr, 0, j, 0, 1);
     }
     this->CoordValues.resize(static_cast<std::size_t>(6 * (nx + 1) * (ny + 1)));
     for (int64_t j = 0; j <= ny; ++j)
@@ -425,20 +402,12 @@ private:
         }
         else if (k == 0)
         {
-          throw InputError(this->Deck.files.front(),
-            0,
-            "TOPS",
-            "column (" + std::to_string(i + 1) + "," + std::to_string(j + 1) +
-              ") has no top depth in layer 1");
+          throw InputError(this->Deck.files.front(), 0, "TOPS",
+            "column (" + std::to_string(i + 1) + "," + std::to_string(j + 1) + ") has no top depth in layer 1");
         }
-        const double bottom = top + this->CellSize("DZ",
-                                      this->Deck.dzv,
-                                      this->Spool.dz.get(),
-                                      thickness.empty() ? nullptr : thickness.data(),
-                                      i,
-                                      j,
-                                      k,
-                                      2);
+        const double bottom = top +
+          this->CellSize(
+            "DZ", this->Deck.dzv, this->Spool.dz.get(), thickness.empty() ? nullptr : thickness.data(), i, j, k, 2);
         for (int corner = 0; corner < 8; ++corner)
         {
           const int64_t di = corner & 1, dj = (corner >> 1) & 1, dk = corner >> 2;
@@ -460,8 +429,7 @@ private:
 };
 } // namespace
 
-std::unique_ptr<LayerSource> OpenLayerSource(const std::string& input,
-  const std::string& spoolFolder)
+std::unique_ptr<LayerSource> OpenLayerSource(const std::string& input, const std::string& spoolFolder)
 {
   if (IsSyntheticSpec(input))
   {
@@ -482,10 +450,8 @@ std::unique_ptr<LayerSource> OpenLayerSource(const std::string& input,
   const bool made = mkdir(folder.c_str(), 0755) == 0;
   if (!made && errno != EEXIST)
   {
-    throw InputError(folder,
-      0,
-      "",
-      std::string("cannot create the folder for temporary files: ") + std::strerror(errno));
+    throw InputError(
+      folder, 0, "", std::string("cannot create the folder for temporary files: ") + std::strerror(errno));
   }
   try
   {

@@ -65,9 +65,7 @@ class CornerPointLayerSource : public LayerSource
 public:
   /// `geometry` and `active` (one flag a cell, ECLIPSE order) must outlive the source;
   /// `placement`: the deck's (CornerPointModel::Placement()).
-  CornerPointLayerSource(const CornerPointGeometry& geometry,
-    const std::vector<bool>& active,
-    std::string name,
+  CornerPointLayerSource(const CornerPointGeometry& geometry, const std::vector<bool>& active, std::string name,
     MapPlacement placement = {});
   std::array<int64_t, 3> Dims() const override;
   const std::vector<double>& Coord() const override;
@@ -85,9 +83,7 @@ private:
 
 /// An EGRID or a GRDECL/DATA deck: its deck and one active flag a cell (ACTNUM; all active
 /// if none). Throws InputError naming the file and place.
-void ReadCornerPointModel(const std::string& path,
-  CornerPointModel& deck,
-  std::vector<bool>& active);
+void ReadCornerPointModel(const std::string& path, CornerPointModel& deck, std::vector<bool>& active);
 
 /// The layers of `input`, streamed whatever the model's size:
 /// - "synth:NIxNJxNK[:SEED[:STEPS]]": from the generator (ParseSyntheticSpec);
@@ -97,11 +93,10 @@ void ReadCornerPointModel(const std::string& path,
 /// - a GRDECL/DATA deck: parsed once with ParseGrdeclGrid, ZCORN and ACTNUM (DX, DY, DZ, TOPS
 ///   for Cartesian decks) spooled to unlinked temporary files in `spoolFolder` (created if
 ///   missing; the system temporary folder when empty), freed with the source.
-/// Memory: COORD and O(nx ny) a layer. Layers, Coord(), Dims() and Placement() are exactly those of
-/// a CornerPointLayerSource over ReadCornerPointModel and CornerPointGeometry::FromDeck(deck,
+/// Memory: COORD and O(nx ny) a layer. Layers, Coord(), Dims() and Placement() are exactly those of a
+/// CornerPointLayerSource over ReadCornerPointModel and CornerPointGeometry::FromDeck(deck,
 /// false). Throws InputError naming the file and place, std::invalid_argument for a
 /// malformed synth: spec.
-std::unique_ptr<LayerSource> OpenLayerSource(const std::string& input,
-  const std::string& spoolFolder = "");
+std::unique_ptr<LayerSource> OpenLayerSource(const std::string& input, const std::string& spoolFolder = "");
 
 } // namespace resmr

@@ -23,20 +23,15 @@ namespace
 void InitialiseLzo()
 {
   static std::once_flag once;
-  std::call_once(once,
-    []
+  std::call_once(once, [] {
+    if (lzo_init() != LZO_E_OK)
     {
-      if (lzo_init() != LZO_E_OK)
-      {
-        throw std::runtime_error("LZO library failed to initialise");
-      }
-    });
+      throw std::runtime_error("LZO library failed to initialise");
+    }
+  });
 }
 
-std::vector<uint8_t> Decompress(const uint8_t* data,
-  uint64_t size,
-  const ChunkRef& ref,
-  const std::string& place)
+std::vector<uint8_t> Decompress(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
 {
   if (ref.offset > size || ref.stored > size - ref.offset)
   {
@@ -48,17 +43,15 @@ std::vector<uint8_t> Decompress(const uint8_t* data,
   }
   if (ref.raw > MaxDecompressedBytes(ref.stored))
   {
-    throw FileFormatError(place + ": " + std::to_string(ref.stored) +
-                          " bytes cannot decompress to " + std::to_string(ref.raw) + " (corrupt)");
+    throw FileFormatError(place + ": " + std::to_string(ref.stored) + " bytes cannot decompress to " +
+      std::to_string(ref.raw) + " (corrupt)");
   }
   std::vector<uint8_t> raw(ref.raw);
   lzo_uint length = ref.raw;
-  const int status =
-    lzo1x_decompress_safe(data + ref.offset, ref.stored, raw.data(), &length, nullptr);
+  const int status = lzo1x_decompress_safe(data + ref.offset, ref.stored, raw.data(), &length, nullptr);
   if (status != LZO_E_OK || length != ref.raw)
   {
-    throw FileFormatError(
-      place + ": does not decompress to its " + std::to_string(ref.raw) + " bytes");
+    throw FileFormatError(place + ": does not decompress to its " + std::to_string(ref.raw) + " bytes");
   }
   return raw;
 }
@@ -83,10 +76,7 @@ std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw)
   return stored;
 }
 
-std::vector<uint8_t> DecompressChunk(const uint8_t* data,
-  uint64_t size,
-  const ChunkRef& ref,
-  const std::string& place)
+std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
 {
   InitialiseLzo();
   return Decompress(data, size, ref, place);
@@ -135,12 +125,10 @@ const uint8_t* MapReadOnlyFile(const std::string& path, uint64_t& size, int* kee
 void CheckMappedSize(int descriptor, uint64_t size, const std::string& path)
 {
   struct stat info;
-  if (descriptor >= 0 && fstat(descriptor, &info) == 0 &&
-      static_cast<uint64_t>(info.st_size) < size)
+  if (descriptor >= 0 && fstat(descriptor, &info) == 0 && static_cast<uint64_t>(info.st_size) < size)
   {
     throw FileFormatError(path + ": the file is now " + std::to_string(info.st_size) + " bytes, " +
-                          std::to_string(size) +
-                          " when it was opened (cut or rewritten in place while open)");
+      std::to_string(size) + " when it was opened (cut or rewritten in place while open)");
   }
 }
 
@@ -163,8 +151,7 @@ void UnmapFile(const uint8_t* data, uint64_t size)
 
 uint32_t Crc32(const void* data, std::size_t size, uint32_t crc)
 {
-  static const auto table = []
-  {
+  static const auto table = [] {
     std::array<uint32_t, 256> t{};
     for (uint32_t i = 0; i < 256; ++i)
     {
@@ -186,9 +173,7 @@ uint32_t Crc32(const void* data, std::size_t size, uint32_t crc)
   return ~crc;
 }
 
-std::vector<uint8_t> IndexTrailer(uint64_t indexOffset,
-  const std::vector<uint8_t>& index,
-  const char (&magic)[8])
+std::vector<uint8_t> IndexTrailer(uint64_t indexOffset, const std::vector<uint8_t>& index, const char (&magic)[8])
 {
   ByteWriter trailer;
   trailer.Put(indexOffset);
@@ -199,11 +184,8 @@ std::vector<uint8_t> IndexTrailer(uint64_t indexOffset,
   return std::move(trailer.Bytes);
 }
 
-std::pair<uint64_t, uint64_t> ReadIndexTrailer(const uint8_t* data,
-  uint64_t size,
-  uint64_t headerBytes,
-  const char (&magic)[8],
-  const std::string& path)
+std::pair<uint64_t, uint64_t> ReadIndexTrailer(
+  const uint8_t* data, uint64_t size, uint64_t headerBytes, const char (&magic)[8], const std::string& path)
 {
   ByteReader tail(data + size - IndexTrailerBytes, IndexTrailerBytes, path + ": trailer");
   const uint64_t indexOffset = tail.Get<uint64_t>(), indexSize = tail.Get<uint64_t>();
@@ -213,25 +195,23 @@ std::pair<uint64_t, uint64_t> ReadIndexTrailer(const uint8_t* data,
   tail.GetBytes(stored, 8);
   if (std::memcmp(stored, magic, 8) != 0)
   {
-    throw FileFormatError(
-      path + ": no index trailer at the end of the file (truncated or unfinished)");
+    throw FileFormatError(path + ": no index trailer at the end of the file (truncated or unfinished)");
   }
   if (reserved != 0)
   {
-    throw FileFormatError(path + ": trailer bytes " + std::to_string(size - 12) + "-" +
-                          std::to_string(size - 9) + " (reserved) are not zero (corrupt)");
+    throw FileFormatError(path + ": trailer bytes " + std::to_string(size - 12) + "-" + std::to_string(size - 9) +
+      " (reserved) are not zero (corrupt)");
   }
   const uint64_t indexEnd = size - IndexTrailerBytes;
   if (indexOffset < headerBytes || indexOffset > indexEnd || indexSize != indexEnd - indexOffset)
   {
-    throw FileFormatError(path + ": index at byte " + std::to_string(indexOffset) + " of " +
-                          std::to_string(indexSize) + " bytes does not fit a file of " +
-                          std::to_string(size) + " bytes (truncated or corrupt)");
+    throw FileFormatError(path + ": index at byte " + std::to_string(indexOffset) + " of " + std::to_string(indexSize) +
+      " bytes does not fit a file of " + std::to_string(size) + " bytes (truncated or corrupt)");
   }
   if (Crc32(data + indexOffset, indexSize) != indexCrc)
   {
-    throw FileFormatError(path + ": index checksum mismatch (bytes " + std::to_string(indexOffset) +
-                          "-" + std::to_string(indexEnd) + " are corrupt)");
+    throw FileFormatError(path + ": index checksum mismatch (bytes " + std::to_string(indexOffset) + "-" +
+      std::to_string(indexEnd) + " are corrupt)");
   }
   return { indexOffset, indexSize };
 }

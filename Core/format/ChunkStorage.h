@@ -33,10 +33,7 @@ uint64_t MaxDecompressedBytes(uint64_t stored);
 std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw);
 /// Checks a chunk of a mapped file (in the file, CRC, exact size) and decompresses it;
 /// throws FileFormatError naming `place`.
-std::vector<uint8_t> DecompressChunk(const uint8_t* data,
-  uint64_t size,
-  const ChunkRef& ref,
-  const std::string& place);
+std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place);
 
 /// Maps a whole regular file read-only (nullptr for an empty one); throws
 /// FileFormatError naming the file. Release with UnmapFile. With `keep`, the file
@@ -56,16 +53,11 @@ uint32_t Crc32(const void* data, std::size_t size, uint32_t crc = 0);
 /// The 32 bytes that end .resmr and .resmrp files (Sec. 6.1: written last, so a file whose
 /// writing stopped has none): the index's offset, size and CRC, then an 8-byte magic.
 constexpr std::size_t IndexTrailerBytes = 32;
-std::vector<uint8_t> IndexTrailer(uint64_t indexOffset,
-  const std::vector<uint8_t>& index,
-  const char (&magic)[8]);
+std::vector<uint8_t> IndexTrailer(uint64_t indexOffset, const std::vector<uint8_t>& index, const char (&magic)[8]);
 /// Checks the trailer of a mapped file of `size` bytes (magic, the index between the header
 /// and the trailer, its CRC) and gives the index's offset and size; throws
 /// FileFormatError naming `path` and the bytes at fault.
-std::pair<uint64_t, uint64_t> ReadIndexTrailer(const uint8_t* data,
-  uint64_t size,
-  uint64_t headerBytes,
-  const char (&magic)[8],
-  const std::string& path);
+std::pair<uint64_t, uint64_t> ReadIndexTrailer(
+  const uint8_t* data, uint64_t size, uint64_t headerBytes, const char (&magic)[8], const std::string& path);
 
 } // namespace resmr

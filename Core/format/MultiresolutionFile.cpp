@@ -65,8 +65,7 @@ void RoundToLattice(std::vector<double>& positions, const MultiresolutionHeader&
     const int axis = static_cast<int>(i % 3);
     // As the decoder computes it, so the builder sees the bits every reader sees.
     positions[i] = header.latticeOrigin[axis] +
-                   Quantise(positions[i], header.latticeOrigin[axis], header.latticeStep[axis]) *
-                     header.latticeStep[axis];
+      Quantise(positions[i], header.latticeOrigin[axis], header.latticeStep[axis]) * header.latticeStep[axis];
   }
 }
 
@@ -78,15 +77,11 @@ namespace
 /// difference is 0 or +-1), depth repeats the one above (the difference is the layer's
 /// thickness); the first vertex of a node is predicted by the first of the node before.
 /// Differences are zig-zagged and split into byte planes, which LZO packs well.
-int32_t Predict(int axis,
-  std::size_t k,
-  const std::array<int32_t, 3>& above,
-  const std::array<int32_t, 3>& twoAbove)
+int32_t Predict(int axis, std::size_t k, const std::array<int32_t, 3>& above, const std::array<int32_t, 3>& twoAbove)
 {
   if (axis < 2 && k >= 2)
   {
-    return static_cast<int32_t>(
-      2 * static_cast<uint32_t>(above[axis]) - static_cast<uint32_t>(twoAbove[axis]));
+    return static_cast<int32_t>(2 * static_cast<uint32_t>(above[axis]) - static_cast<uint32_t>(twoAbove[axis]));
   }
   return above[axis];
 }
@@ -106,11 +101,10 @@ void PutPositions(ByteWriter& out, const RegionMesh& mesh, const Multiresolution
       std::array<int32_t, 3> q;
       for (int axis = 0; axis < 3; ++axis)
       {
-        q[axis] =
-          Quantise(mesh.positions[at + axis], header.latticeOrigin[axis], header.latticeStep[axis]);
+        q[axis] = Quantise(mesh.positions[at + axis], header.latticeOrigin[axis], header.latticeStep[axis]);
         const int32_t predicted = Predict(axis, k, above, twoAbove);
-        coded[at + axis] = ZigZag(
-          static_cast<int32_t>(static_cast<uint32_t>(q[axis]) - static_cast<uint32_t>(predicted)));
+        coded[at + axis] =
+          ZigZag(static_cast<int32_t>(static_cast<uint32_t>(q[axis]) - static_cast<uint32_t>(predicted)));
       }
       if (k == 0)
       {
@@ -138,8 +132,7 @@ void GetPositions(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader&
   const std::size_t count = static_cast<std::size_t>(mesh.NodeCount()) * interfaces * 3;
   if (count * 4 > in.Left())
   {
-    throw FileFormatError(
-      in.Where() + ": " + std::to_string(mesh.NodeCount()) + " nodes do not fit in the chunk");
+    throw FileFormatError(in.Where() + ": " + std::to_string(mesh.NodeCount()) + " nodes do not fit in the chunk");
   }
   std::vector<uint8_t> planes(count * 4);
   in.GetBytes(planes.data(), planes.size());
@@ -156,10 +149,9 @@ void GetPositions(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader&
       {
         const std::size_t i = at + axis;
         const uint32_t coded = uint32_t(planes[i]) | uint32_t(planes[count + i]) << 8 |
-                               uint32_t(planes[2 * count + i]) << 16 |
-                               uint32_t(planes[3 * count + i]) << 24;
-        q[axis] = static_cast<int32_t>(static_cast<uint32_t>(Predict(axis, k, above, twoAbove)) +
-                                       static_cast<uint32_t>(UnZigZag(coded)));
+          uint32_t(planes[2 * count + i]) << 16 | uint32_t(planes[3 * count + i]) << 24;
+        q[axis] = static_cast<int32_t>(
+          static_cast<uint32_t>(Predict(axis, k, above, twoAbove)) + static_cast<uint32_t>(UnZigZag(coded)));
         mesh.positions[i] = header.latticeOrigin[axis] + q[axis] * header.latticeStep[axis];
       }
       if (k == 0)
@@ -195,10 +187,7 @@ std::vector<uint8_t> EncodeMesh(const RegionMesh& mesh, const MultiresolutionHea
 
 /// Every index of `polygons` is below `limit`; else the chunk is corrupt ("<what> 12 of 10").
 template<typename Polygon>
-void CheckIndices(const ByteReader& in,
-  const std::vector<Polygon>& polygons,
-  uint64_t limit,
-  const char* what)
+void CheckIndices(const ByteReader& in, const std::vector<Polygon>& polygons, uint64_t limit, const char* what)
 {
   for (const Polygon& polygon : polygons)
   {
@@ -206,48 +195,39 @@ void CheckIndices(const ByteReader& in,
     {
       if (index >= limit)
       {
-        throw FileFormatError(
-          in.Where() + ": " + what + " " + std::to_string(index) + " of " + std::to_string(limit));
+        throw FileFormatError(in.Where() + ": " + what + " " + std::to_string(index) + " of " + std::to_string(limit));
       }
     }
   }
 }
 
-void DecodeMesh(ByteReader& in,
-  RegionMesh& mesh,
-  const MultiresolutionHeader& header,
-  const RegionRecord& record)
+void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header, const RegionRecord& record)
 {
   const uint32_t magic = in.Get<uint32_t>();
-  const uint32_t layers = in.Get<uint32_t>(), nodes = in.Get<uint32_t>(),
-                 columns = in.Get<uint32_t>();
+  const uint32_t layers = in.Get<uint32_t>(), nodes = in.Get<uint32_t>(), columns = in.Get<uint32_t>();
   if (magic != MeshMagic)
   {
     throw FileFormatError(in.Where() + ": not a mesh chunk");
   }
-  if (static_cast<int64_t>(layers) != header.dims[2] ||
-      columns != static_cast<uint64_t>(record.columns) ||
-      static_cast<uint64_t>(nodes) * (layers + 1) != static_cast<uint64_t>(record.vertices))
+  if (static_cast<int64_t>(layers) != header.dims[2] || columns != static_cast<uint64_t>(record.columns) ||
+    static_cast<uint64_t>(nodes) * (layers + 1) != static_cast<uint64_t>(record.vertices))
   {
-    throw FileFormatError(in.Where() + ": " + std::to_string(layers) + " layers, " +
-                          std::to_string(nodes) + " nodes, " + std::to_string(columns) +
-                          " columns disagree with the index");
+    throw FileFormatError(in.Where() + ": " + std::to_string(layers) + " layers, " + std::to_string(nodes) +
+      " nodes, " + std::to_string(columns) + " columns disagree with the index");
   }
   mesh.layers = static_cast<int32_t>(layers);
   // The stored surfaces were extracted with this rule; readers extract them again.
-  mesh.sealedPinchThickness =
-    header.version >= 5 && record.level != header.leafLevel ? record.ownError : 0;
+  mesh.sealedPinchThickness = header.version >= 5 && record.level != header.leafLevel ? record.ownError : 0;
   if (static_cast<uint64_t>(nodes) * 8 > in.Left())
   {
-    throw FileFormatError(
-      in.Where() + ": " + std::to_string(nodes) + " nodes do not fit in the chunk");
+    throw FileFormatError(in.Where() + ": " + std::to_string(nodes) + " nodes do not fit in the chunk");
   }
   mesh.topology.resize(nodes);
   in.GetBytes(mesh.topology.data(), mesh.topology.size() * sizeof(mesh.topology[0]));
   for (const auto& t : mesh.topology)
   {
-    if (!std::isfinite(t[0]) || !std::isfinite(t[1]) || t[0] < 0 || t[1] < 0 ||
-        t[0] > header.dims[0] || t[1] > header.dims[1])
+    if (!std::isfinite(t[0]) || !std::isfinite(t[1]) || t[0] < 0 || t[1] < 0 || t[0] > header.dims[0] ||
+      t[1] > header.dims[1])
     {
       throw FileFormatError(in.Where() + ": a topological coordinate lies outside the grid");
     }
@@ -255,8 +235,8 @@ void DecodeMesh(ByteReader& in,
   GetPositions(in, mesh, header);
   if (static_cast<uint64_t>(columns) * (16 + layers + 1) != in.Left())
   {
-    throw FileFormatError(in.Where() + ": column data of " + std::to_string(in.Left()) +
-                          " bytes for " + std::to_string(columns) + " columns");
+    throw FileFormatError(in.Where() + ": column data of " + std::to_string(in.Left()) + " bytes for " +
+      std::to_string(columns) + " columns");
   }
   mesh.corners.resize(columns);
   in.GetBytes(mesh.corners.data(), mesh.corners.size() * sizeof(mesh.corners[0]));
@@ -269,8 +249,8 @@ void DecodeMesh(ByteReader& in,
   {
     if (mesh.active[i] >> 5)
     {
-      throw FileFormatError(in.Where() + ": cell flags " + std::to_string(mesh.active[i]) +
-                            " of cell " + std::to_string(i) + " are not valid");
+      throw FileFormatError(in.Where() + ": cell flags " + std::to_string(mesh.active[i]) + " of cell " +
+        std::to_string(i) + " are not valid");
     }
     mesh.openSides[i] = mesh.active[i] >> 1;
     mesh.active[i] &= 1;
@@ -278,8 +258,8 @@ void DecodeMesh(ByteReader& in,
   }
   if (activeCells != record.activeCells)
   {
-    throw FileFormatError(in.Where() + ": " + std::to_string(activeCells) +
-                          " active cells, the index says " + std::to_string(record.activeCells));
+    throw FileFormatError(in.Where() + ": " + std::to_string(activeCells) + " active cells, the index says " +
+      std::to_string(record.activeCells));
   }
   mesh.cutEdges.resize(columns);
   in.GetBytes(mesh.cutEdges.data(), mesh.cutEdges.size());
@@ -287,9 +267,8 @@ void DecodeMesh(ByteReader& in,
   {
     if (mesh.cutEdges[c] >> 4)
     {
-      throw FileFormatError(in.Where() + ": cut edges " + std::to_string(mesh.cutEdges[c]) +
-                            " of column " + std::to_string(c) +
-                            " name an edge beyond the column's four");
+      throw FileFormatError(in.Where() + ": cut edges " + std::to_string(mesh.cutEdges[c]) + " of column " +
+        std::to_string(c) + " name an edge beyond the column's four");
     }
   }
 }
@@ -315,8 +294,8 @@ void DecodeSurface(ByteReader& in, RegionSurface& surface, uint64_t vertices)
   in.GetBytes(surface.cone.data(), sizeof(surface.cone));
   if (static_cast<uint64_t>(count) * 16 != in.Left())
   {
-    throw FileFormatError(in.Where() + ": " + std::to_string(count) + " quads in " +
-                          std::to_string(in.Left()) + " bytes");
+    throw FileFormatError(
+      in.Where() + ": " + std::to_string(count) + " quads in " + std::to_string(in.Left()) + " bytes");
   }
   surface.quads.resize(count);
   in.GetBytes(surface.quads.data(), surface.quads.size() * sizeof(surface.quads[0]));
@@ -332,9 +311,7 @@ std::vector<uint8_t> EncodeTriangles(const std::vector<std::array<uint32_t, 3>>&
   return std::move(out.Bytes);
 }
 
-void DecodeTriangles(ByteReader& in,
-  std::vector<std::array<uint32_t, 3>>& triangles,
-  uint64_t vertices)
+void DecodeTriangles(ByteReader& in, std::vector<std::array<uint32_t, 3>>& triangles, uint64_t vertices)
 {
   const uint32_t magic = in.Get<uint32_t>();
   const uint32_t count = in.Get<uint32_t>();
@@ -344,8 +321,8 @@ void DecodeTriangles(ByteReader& in,
   }
   if (static_cast<uint64_t>(count) * 12 != in.Left())
   {
-    throw FileFormatError(in.Where() + ": " + std::to_string(count) + " triangles in " +
-                          std::to_string(in.Left()) + " bytes");
+    throw FileFormatError(
+      in.Where() + ": " + std::to_string(count) + " triangles in " + std::to_string(in.Left()) + " bytes");
   }
   triangles.resize(count);
   in.GetBytes(triangles.data(), triangles.size() * sizeof(triangles[0]));
@@ -369,8 +346,7 @@ void PutHeader(ByteWriter& out, const MultiresolutionHeader& h)
   out.Put(h.hashOffsetSides);
   out.Put(h.hashedCells);
   out.Put(h.geometryId);
-  out.Put(static_cast<uint32_t>(
-    (h.map.hasMapAxes ? MapAxesFlag : 0) | (h.map.gridUnitIsMap ? GridInMapFlag : 0)));
+  out.Put(static_cast<uint32_t>((h.map.hasMapAxes ? MapAxesFlag : 0) | (h.map.gridUnitIsMap ? GridInMapFlag : 0)));
   out.Put(h.map.mapAxes.yAxisPoint);
   out.Put(h.map.mapAxes.origin);
   out.Put(h.map.mapAxes.xAxisPoint);
@@ -436,8 +412,7 @@ RegionRecord GetRecord(ByteReader& in, bool& reservedZero)
   }
   uint8_t padding[RecordBytes - 4 - 4 - 8 * 4 - 24 - 8 - 32 - 4 * 20];
   in.GetBytes(padding, sizeof(padding));
-  reservedZero = reserved == 0 &&
-                 std::all_of(padding, padding + sizeof(padding), [](uint8_t b) { return b == 0; });
+  reservedZero = reserved == 0 && std::all_of(padding, padding + sizeof(padding), [](uint8_t b) { return b == 0; });
   return r;
 }
 } // namespace
@@ -445,21 +420,15 @@ RegionRecord GetRecord(ByteReader& in, bool& reservedZero)
 namespace
 {
 
-RegionMesh DecodeRegion(const uint8_t* data,
-  uint64_t size,
-  const std::string& path,
-  const RegionRecord& record,
+RegionMesh DecodeRegion(const uint8_t* data, uint64_t size, const std::string& path, const RegionRecord& record,
   const MultiresolutionHeader& header)
 {
   RegionMesh mesh;
-  const std::string region = path + ": region (level " + std::to_string(record.level) + ", index " +
-                             std::to_string(record.index) + ") ";
-  const auto chunk = [&](int c)
-  {
-    return DecompressChunk(data,
-      size,
-      record.chunks[c],
-      region + ChunkNames[c] + " at byte " + std::to_string(record.chunks[c].offset));
+  const std::string region =
+    path + ": region (level " + std::to_string(record.level) + ", index " + std::to_string(record.index) + ") ";
+  const auto chunk = [&](int c) {
+    return DecompressChunk(
+      data, size, record.chunks[c], region + ChunkNames[c] + " at byte " + std::to_string(record.chunks[c].offset));
   };
   {
     const auto raw = chunk(RegionRecord::Mesh);
@@ -486,13 +455,10 @@ uint64_t ModelPieces(uint64_t bytes)
 }
 
 /// Throws naming the header field and what it must be.
-[[noreturn]] void BadField(const std::string& path,
-  const std::string& field,
-  const std::string& value,
-  const std::string& must)
+[[noreturn]] void BadField(
+  const std::string& path, const std::string& field, const std::string& value, const std::string& must)
 {
-  throw FileFormatError(
-    path + ": header field '" + field + "' is " + value + ", must be " + must + " (corrupt)");
+  throw FileFormatError(path + ": header field '" + field + "' is " + value + ", must be " + must + " (corrupt)");
 }
 
 std::string Number(double value)
@@ -511,27 +477,21 @@ void CheckHeader(const MultiresolutionHeader& h, const std::string& path)
   {
     if (h.dims[a] <= 0 || h.dims[a] > maxDim)
     {
-      BadField(path,
-        std::string("dimensions (n") + "xyz"[a] + ")",
-        std::to_string(h.dims[a]),
+      BadField(path, std::string("dimensions (n") + "xyz"[a] + ")", std::to_string(h.dims[a]),
         "1 to " + std::to_string(maxDim));
     }
   }
   if (h.dims[0] * h.dims[1] > (int64_t(1) << 40) / h.dims[2])
   {
-    BadField(path,
-      "dimensions",
-      std::to_string(h.dims[0]) + " x " + std::to_string(h.dims[1]) + " x " +
-        std::to_string(h.dims[2]),
+    BadField(path, "dimensions",
+      std::to_string(h.dims[0]) + " x " + std::to_string(h.dims[1]) + " x " + std::to_string(h.dims[2]),
       "at most 2^40 cells");
   }
   for (int a = 0; a < 2; ++a)
   {
     if (!std::isfinite(h.box[a]) || !std::isfinite(h.box[a + 2]) || !(h.box[a] < h.box[a + 2]))
     {
-      BadField(path,
-        std::string("hierarchy box (") + axes[a] + ")",
-        Number(h.box[a]) + " to " + Number(h.box[a + 2]),
+      BadField(path, std::string("hierarchy box (") + axes[a] + ")", Number(h.box[a]) + " to " + Number(h.box[a + 2]),
         "finite with a positive extent");
     }
   }
@@ -539,17 +499,11 @@ void CheckHeader(const MultiresolutionHeader& h, const std::string& path)
   {
     if (!std::isfinite(h.latticeOrigin[a]))
     {
-      BadField(path,
-        std::string("lattice origin (") + axes[a] + ")",
-        Number(h.latticeOrigin[a]),
-        "finite");
+      BadField(path, std::string("lattice origin (") + axes[a] + ")", Number(h.latticeOrigin[a]), "finite");
     }
     if (!std::isfinite(h.latticeStep[a]) || !(h.latticeStep[a] > 0))
     {
-      BadField(path,
-        std::string("lattice step (") + axes[a] + ")",
-        Number(h.latticeStep[a]),
-        "positive and finite");
+      BadField(path, std::string("lattice step (") + axes[a] + ")", Number(h.latticeStep[a]), "positive and finite");
     }
   }
   // The lattice's integers (int32) reach the whole box, and it resolves the box (the builder
@@ -559,41 +513,30 @@ void CheckHeader(const MultiresolutionHeader& h, const std::string& path)
   for (int a = 0; a < 2; ++a)
   {
     const double reach = std::ldexp(h.latticeStep[a], 31);
-    if (std::fabs(h.box[a] - h.latticeOrigin[a]) >= reach ||
-        std::fabs(h.box[a + 2] - h.latticeOrigin[a]) >= reach)
+    if (std::fabs(h.box[a] - h.latticeOrigin[a]) >= reach || std::fabs(h.box[a + 2] - h.latticeOrigin[a]) >= reach)
     {
-      BadField(path,
-        std::string("lattice step (") + axes[a] + ")",
-        Number(h.latticeStep[a]),
+      BadField(path, std::string("lattice step (") + axes[a] + ")", Number(h.latticeStep[a]),
         "large enough for the lattice to reach the hierarchy box");
     }
     if (h.latticeStep[a] > lateral)
     {
-      BadField(path,
-        std::string("lattice step (") + axes[a] + ")",
-        Number(h.latticeStep[a]),
+      BadField(path, std::string("lattice step (") + axes[a] + ")", Number(h.latticeStep[a]),
         "at most the hierarchy box's extent " + Number(lateral));
     }
   }
   if (h.leafLevel < 0 || h.leafLevel > DiamondHierarchy::MaxDepth)
   {
-    BadField(path,
-      "leaf level",
-      std::to_string(h.leafLevel),
-      "0 to " + std::to_string(DiamondHierarchy::MaxDepth));
+    BadField(path, "leaf level", std::to_string(h.leafLevel), "0 to " + std::to_string(DiamondHierarchy::MaxDepth));
   }
   if (h.cmax < 1)
   {
     BadField(path, "Cmax", std::to_string(h.cmax), "at least 1");
   }
   // Each level holds at most 2^(level + 1) regions.
-  const uint64_t maxRegions =
-    h.leafLevel >= 38 ? uint64_t(1) << 40 : (uint64_t(4) << h.leafLevel) - 2;
+  const uint64_t maxRegions = h.leafLevel >= 38 ? uint64_t(1) << 40 : (uint64_t(4) << h.leafLevel) - 2;
   if (h.regionCount < static_cast<uint64_t>(h.leafLevel) + 1 || h.regionCount > maxRegions)
   {
-    BadField(path,
-      "region count",
-      std::to_string(h.regionCount),
+    BadField(path, "region count", std::to_string(h.regionCount),
       std::to_string(h.leafLevel + 1) + " to " + std::to_string(maxRegions) + " for leaf level " +
         std::to_string(h.leafLevel));
   }
@@ -601,121 +544,94 @@ void CheckHeader(const MultiresolutionHeader& h, const std::string& path)
   {
     if (h.hashTableSides[a] < 1 || h.hashTableSides[a] > PerfectSpatialHash::MaxSide)
     {
-      BadField(path,
-        "hash table sides",
-        std::to_string(h.hashTableSides[a]),
+      BadField(path, "hash table sides", std::to_string(h.hashTableSides[a]),
         "1 to " + std::to_string(PerfectSpatialHash::MaxSide));
     }
     if (h.hashOffsetSides[a] < 1 || h.hashOffsetSides[a] > PerfectSpatialHash::MaxSide)
     {
-      BadField(path,
-        "hash offset sides",
-        std::to_string(h.hashOffsetSides[a]),
+      BadField(path, "hash offset sides", std::to_string(h.hashOffsetSides[a]),
         "1 to " + std::to_string(PerfectSpatialHash::MaxSide));
     }
   }
   // Active flags of every layer, then the offset, cell and normal tables in pieces of at most
   // ModelPieceBytes.
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
-  const uint64_t offsets =
-    uint64_t(h.hashOffsetSides[0]) * h.hashOffsetSides[1] * h.hashOffsetSides[2];
-  const uint64_t chunks = static_cast<uint64_t>(h.dims[2]) + ModelPieces(offsets * 6) +
-                          ModelPieces(slots * 8) + ModelPieces(slots * 4);
+  const uint64_t offsets = uint64_t(h.hashOffsetSides[0]) * h.hashOffsetSides[1] * h.hashOffsetSides[2];
+  const uint64_t chunks =
+    static_cast<uint64_t>(h.dims[2]) + ModelPieces(offsets * 6) + ModelPieces(slots * 8) + ModelPieces(slots * 4);
   if (h.modelChunkCount != chunks)
   {
-    BadField(path,
-      "model chunk count",
-      std::to_string(h.modelChunkCount),
-      std::to_string(chunks) + " for " + std::to_string(h.dims[2]) +
-        " layers and the hash's sides");
+    BadField(path, "model chunk count", std::to_string(h.modelChunkCount),
+      std::to_string(chunks) + " for " + std::to_string(h.dims[2]) + " layers and the hash's sides");
   }
   const uint64_t cells = static_cast<uint64_t>(h.dims[0] * h.dims[1] * h.dims[2]);
   if (h.hashedCells < 1 || h.hashedCells > slots || h.hashedCells > cells)
   {
-    BadField(path,
-      "hashed cells",
-      std::to_string(h.hashedCells),
-      "1 to the table's " + std::to_string(slots) + " slots and the grid's " +
-        std::to_string(cells) + " cells");
+    BadField(path, "hashed cells", std::to_string(h.hashedCells),
+      "1 to the table's " + std::to_string(slots) + " slots and the grid's " + std::to_string(cells) + " cells");
   }
 }
 
 /// One region record's fields against the header (chunks are checked by the caller).
 void CheckRecord(const RegionRecord& r, const MultiresolutionHeader& h, const std::string& place)
 {
-  const auto fail = [&](const std::string& what)
-  { throw FileFormatError(place + ": " + what + " (corrupt)"); };
+  const auto fail = [&](const std::string& what) { throw FileFormatError(place + ": " + what + " (corrupt)"); };
   if (r.level < 0 || r.level > h.leafLevel || r.index < 0 || r.index >= (int64_t(2) << r.level))
   {
-    fail(
-      "level or region index outside the hierarchy of leaf level " + std::to_string(h.leafLevel));
+    fail("level or region index outside the hierarchy of leaf level " + std::to_string(h.leafLevel));
   }
   const int64_t layers = h.dims[2];
   if (r.columns < 1 || r.columns > h.dims[0] * h.dims[1])
   {
-    fail(
-      std::to_string(r.columns) + " columns in a grid of " + std::to_string(h.dims[0] * h.dims[1]));
+    fail(std::to_string(r.columns) + " columns in a grid of " + std::to_string(h.dims[0] * h.dims[1]));
   }
   if (r.activeCells < 0 || r.activeCells > r.columns * layers)
   {
-    fail(
-      std::to_string(r.activeCells) + " active cells in " + std::to_string(r.columns) + " columns");
+    fail(std::to_string(r.activeCells) + " active cells in " + std::to_string(r.columns) + " columns");
   }
   // Each column has four corner nodes, each node a vertex at every layer interface.
-  if (r.vertices < layers + 1 || r.vertices % (layers + 1) != 0 ||
-      r.vertices / (layers + 1) > 4 * r.columns)
+  if (r.vertices < layers + 1 || r.vertices % (layers + 1) != 0 || r.vertices / (layers + 1) > 4 * r.columns)
   {
-    fail(std::to_string(r.vertices) + " vertices for " + std::to_string(r.columns) +
-         " columns of " + std::to_string(layers) + " layers");
+    fail(std::to_string(r.vertices) + " vertices for " + std::to_string(r.columns) + " columns of " +
+      std::to_string(layers) + " layers");
   }
   for (int a = 0; a < 3; ++a)
   {
-    if (!std::isfinite(r.bounds[a]) || !std::isfinite(r.bounds[a + 3]) ||
-        r.bounds[a] > r.bounds[a + 3])
+    if (!std::isfinite(r.bounds[a]) || !std::isfinite(r.bounds[a + 3]) || r.bounds[a] > r.bounds[a + 3])
     {
       fail("bounding volume is not finite or empty");
     }
   }
   if (!std::isfinite(r.error) || !std::isfinite(r.ownError) || r.error < 0 || r.ownError < 0)
   {
-    fail("error " + Number(r.error) + " or own error " + Number(r.ownError) +
-         " is not finite and non-negative");
+    fail("error " + Number(r.error) + " or own error " + Number(r.ownError) + " is not finite and non-negative");
   }
   for (const auto* cone : { &r.topCone, &r.bottomCone })
   {
     const auto& c = *cone;
-    const bool finite =
-      std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]) && std::isfinite(c[3]);
-    const double length =
-      std::sqrt(double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2]);
+    const bool finite = std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]) && std::isfinite(c[3]);
+    const double length = std::sqrt(double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2]);
     if (!finite || !(c[3] == -2 || (c[3] >= -1 && c[3] <= 1 && std::fabs(length - 1) < 1e-3)))
     {
-      fail("normal cone is not finite, its axis not of unit length or its cosine not in [-1, 1] "
-           "(nor -2, empty)");
+      fail("normal cone is not finite, its axis not of unit length or its cosine not in [-1, 1] (nor -2, empty)");
     }
   }
 }
 
 /// Model chunks against the header: every layer's active flags once, of nx ny bits; the hash
 /// arrays in whole pieces, of the sizes the hash's sides call for.
-void CheckModelChunks(const std::vector<ModelChunk>& model,
-  const MultiresolutionHeader& h,
-  const std::string& path)
+void CheckModelChunks(const std::vector<ModelChunk>& model, const MultiresolutionHeader& h, const std::string& path)
 {
   const uint64_t layer = static_cast<uint64_t>(h.dims[0] * h.dims[1]);
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
-  const uint64_t offsets =
-    uint64_t(h.hashOffsetSides[0]) * h.hashOffsetSides[1] * h.hashOffsetSides[2];
+  const uint64_t offsets = uint64_t(h.hashOffsetSides[0]) * h.hashOffsetSides[1] * h.hashOffsetSides[2];
   const uint64_t expected[5] = { 0, (layer + 7) / 8, offsets * 6, slots * 8, slots * 4 };
-  const char* const names[5] = {
-    "", "active flags", "hash offset table", "hash cell table", "cell normal table"
-  };
+  const char* const names[5] = { "", "active flags", "hash offset table", "hash cell table", "cell normal table" };
   std::vector<uint8_t> layerSeen(static_cast<std::size_t>(h.dims[2]), 0);
   uint64_t total[5] = {}, pieces[5] = {};
   for (const ModelChunk& m : model)
   {
-    const std::string place =
-      path + ": model chunk " + names[m.kind] + " part " + std::to_string(m.part);
+    const std::string place = path + ": model chunk " + names[m.kind] + " part " + std::to_string(m.part);
     if (m.kind == ModelChunk::ActiveLayer)
     {
       if (m.part >= layerSeen.size() || layerSeen[m.part]++ != 0)
@@ -724,8 +640,8 @@ void CheckModelChunks(const std::vector<ModelChunk>& model,
       }
       if (m.chunk.raw != expected[m.kind])
       {
-        throw FileFormatError(place + ": " + std::to_string(m.chunk.raw) + " bytes for " +
-                              std::to_string(layer) + " cells (corrupt)");
+        throw FileFormatError(
+          place + ": " + std::to_string(m.chunk.raw) + " bytes for " + std::to_string(layer) + " cells (corrupt)");
       }
       continue;
     }
@@ -736,18 +652,16 @@ void CheckModelChunks(const std::vector<ModelChunk>& model,
   {
     if (!layerSeen[k])
     {
-      throw FileFormatError(
-        path + ": no active flags for layer " + std::to_string(k + 1) + " (corrupt)");
+      throw FileFormatError(path + ": no active flags for layer " + std::to_string(k + 1) + " (corrupt)");
     }
   }
   for (uint32_t kind = ModelChunk::HashOffsets; kind <= ModelChunk::CellNormals; ++kind)
   {
     if (total[kind] != expected[kind] || pieces[kind] != ModelPieces(expected[kind]))
     {
-      throw FileFormatError(path + ": " + names[kind] + " of " + std::to_string(total[kind]) +
-                            " bytes in " + std::to_string(pieces[kind]) + " chunks, " +
-                            std::to_string(expected[kind]) +
-                            " expected from the header's hash sides (corrupt)");
+      throw FileFormatError(path + ": " + names[kind] + " of " + std::to_string(total[kind]) + " bytes in " +
+        std::to_string(pieces[kind]) + " chunks, " + std::to_string(expected[kind]) +
+        " expected from the header's hash sides (corrupt)");
     }
   }
 }
@@ -776,19 +690,15 @@ void ChooseLattice(const std::array<double, 6>& extent, MultiresolutionHeader& h
   // Centred, with 2^9 times the extent spare on each side for inactive corners outside it.
   // 2^-22 of the lateral extent (2.4 mm over 10 km) and 2^-20 of the depth range (0.3 mm
   // over 300 m): finer than any cell, coarse enough that differences pack into few bytes.
-  header.latticeOrigin = {
-    0.5 * (extent[0] + extent[3]), 0.5 * (extent[1] + extent[4]), 0.5 * (extent[2] + extent[5])
-  };
-  header.latticeStep = {
-    std::ldexp(lateral, -22), std::ldexp(lateral, -22), std::ldexp(vertical, -20)
-  };
+  header.latticeOrigin = { 0.5 * (extent[0] + extent[3]), 0.5 * (extent[1] + extent[4]),
+    0.5 * (extent[2] + extent[5]) };
+  header.latticeStep = { std::ldexp(lateral, -22), std::ldexp(lateral, -22), std::ldexp(vertical, -20) };
 }
 
 ChunkFile::ChunkFile(const std::string& path, int64_t keepBytes)
   : FilePath(path)
 {
-  this->Descriptor = keepBytes < 0 ? open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644)
-                                   : open(path.c_str(), O_RDWR);
+  this->Descriptor = keepBytes < 0 ? open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644) : open(path.c_str(), O_RDWR);
   if (this->Descriptor < 0)
   {
     throw FileFormatError(path + ": cannot open the chunk file: " + std::strerror(errno));
@@ -796,12 +706,11 @@ ChunkFile::ChunkFile(const std::string& path, int64_t keepBytes)
   if (keepBytes >= 0)
   {
     struct stat info;
-    if (fstat(this->Descriptor, &info) != 0 || info.st_size < keepBytes ||
-        ftruncate(this->Descriptor, keepBytes) != 0)
+    if (fstat(this->Descriptor, &info) != 0 || info.st_size < keepBytes || ftruncate(this->Descriptor, keepBytes) != 0)
     {
       close(this->Descriptor);
-      throw FileFormatError(path + ": shorter than the " + std::to_string(keepBytes) +
-                            " bytes its manifest records (cannot resume)");
+      throw FileFormatError(
+        path + ": shorter than the " + std::to_string(keepBytes) + " bytes its manifest records (cannot resume)");
     }
     this->Offset = static_cast<uint64_t>(keepBytes);
   }
@@ -819,8 +728,8 @@ ChunkRef ChunkFile::Put(const std::vector<uint8_t>& raw, const std::string& what
 {
   if (raw.size() >= MaxChunkBytes)
   {
-    throw FileFormatError(this->FilePath + ": " + what + " of " + std::to_string(raw.size()) +
-                          " bytes is too big for a chunk");
+    throw FileFormatError(
+      this->FilePath + ": " + what + " of " + std::to_string(raw.size()) + " bytes is too big for a chunk");
   }
   const std::vector<uint8_t> stored = CompressChunk(raw);
   const std::size_t length = stored.size();
@@ -833,15 +742,12 @@ ChunkRef ChunkFile::Put(const std::vector<uint8_t>& raw, const std::string& what
   std::size_t done = 0;
   while (done < length)
   {
-    const ssize_t written = pwrite(this->Descriptor,
-      stored.data() + done,
-      length - done,
-      static_cast<off_t>(this->Offset + done));
+    const ssize_t written =
+      pwrite(this->Descriptor, stored.data() + done, length - done, static_cast<off_t>(this->Offset + done));
     if (written <= 0)
     {
       throw FileFormatError(this->FilePath + ": writing the " + what + " at byte " +
-                            std::to_string(this->Offset + done) +
-                            " failed: " + std::strerror(errno));
+        std::to_string(this->Offset + done) + " failed: " + std::strerror(errno));
     }
     done += static_cast<std::size_t>(written);
   }
@@ -849,16 +755,12 @@ ChunkRef ChunkFile::Put(const std::vector<uint8_t>& raw, const std::string& what
   return ref;
 }
 
-void ChunkFile::AddRegion(const RegionMesh& mesh,
-  const MultiresolutionHeader& header,
-  RegionRecord& record)
+void ChunkFile::AddRegion(const RegionMesh& mesh, const MultiresolutionHeader& header, RegionRecord& record)
 {
-  const std::vector<uint8_t> raw[RegionRecord::ChunkCount] = { EncodeMesh(mesh, header),
-    EncodeSurface(mesh.top),
-    EncodeSurface(mesh.bottom),
-    EncodeTriangles(mesh.sideTriangles) };
-  const std::string region = "region (level " + std::to_string(record.level) + ", index " +
-                             std::to_string(record.index) + ") ";
+  const std::vector<uint8_t> raw[RegionRecord::ChunkCount] = { EncodeMesh(mesh, header), EncodeSurface(mesh.top),
+    EncodeSurface(mesh.bottom), EncodeTriangles(mesh.sideTriangles) };
+  const std::string region =
+    "region (level " + std::to_string(record.level) + ", index " + std::to_string(record.index) + ") ";
   for (int c = 0; c < RegionRecord::ChunkCount; ++c)
   {
     record.chunks[c] = this->Put(raw[c], region + ChunkNames[c]);
@@ -870,10 +772,7 @@ void ChunkFile::AddRegion(const RegionMesh& mesh,
   record.bottomCone = mesh.bottom.cone;
 }
 
-void ChunkFile::AddModelArray(uint32_t kind,
-  const void* data,
-  std::size_t bytes,
-  std::vector<ModelChunk>& out)
+void ChunkFile::AddModelArray(uint32_t kind, const void* data, std::size_t bytes, std::vector<ModelChunk>& out)
 {
   const auto* begin = static_cast<const uint8_t*>(data);
   uint32_t part = 0;
@@ -903,20 +802,17 @@ uint64_t ChunkFile::Sync()
   return this->Offset;
 }
 
-void AssembleMultiresolutionFile(const std::string& path,
-  MultiresolutionHeader header,
-  const std::vector<std::string>& parts,
-  const std::vector<PartRecord<RegionRecord>>& regions,
+void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader header,
+  const std::vector<std::string>& parts, const std::vector<PartRecord<RegionRecord>>& regions,
   const std::vector<PartRecord<ModelChunk>>& model)
 {
   AtomicOutputFile output(path);
   uint64_t offset = 0;
-  const auto write = [&](const void* data, std::size_t size, const std::string& what)
-  {
+  const auto write = [&](const void* data, std::size_t size, const std::string& what) {
     if (!output.Write(data, size))
     {
-      throw FileFormatError(path + ": writing the " + what + " at byte " + std::to_string(offset) +
-                            " failed: " + std::strerror(errno));
+      throw FileFormatError(
+        path + ": writing the " + what + " at byte " + std::to_string(offset) + " failed: " + std::strerror(errno));
     }
     offset += size;
   };
@@ -941,8 +837,8 @@ void AssembleMultiresolutionFile(const std::string& path,
   for (const std::string& part : parts)
   {
     struct stat status;
-    blockSize = std::max<std::size_t>(
-      blockSize, stat(part.c_str(), &status) == 0 ? static_cast<std::size_t>(status.st_size) : 0);
+    blockSize =
+      std::max<std::size_t>(blockSize, stat(part.c_str(), &status) == 0 ? static_cast<std::size_t>(status.st_size) : 0);
   }
   blockSize = std::min<std::size_t>(blockSize, std::size_t(1) << 22);
   std::unique_ptr<uint8_t[]> block(new uint8_t[blockSize]);
@@ -966,8 +862,7 @@ void AssembleMultiresolutionFile(const std::string& path,
       throw FileFormatError(parts[p] + ": read failed: " + std::strerror(errno));
     }
   }
-  const auto moved = [&](int part, ChunkRef ref)
-  {
+  const auto moved = [&](int part, ChunkRef ref) {
     if (part < 0 || static_cast<std::size_t>(part) >= parts.size())
     {
       throw std::invalid_argument("AssembleMultiresolutionFile: no part " + std::to_string(part));
@@ -1011,8 +906,8 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
   {
     UnmapFile(this->Data, this->Size);
     CloseDescriptor(this->Descriptor);
-    throw FileFormatError(path + ": " + std::to_string(this->Size) +
-                          " bytes, too short for a multiresolution file (truncated?)");
+    throw FileFormatError(
+      path + ": " + std::to_string(this->Size) + " bytes, too short for a multiresolution file (truncated?)");
   }
   try
   {
@@ -1026,10 +921,8 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
     const uint32_t version = head.Get<uint32_t>();
     if (version < MultiresolutionHeader::OldestVersion || version > MultiresolutionHeader::Version)
     {
-      throw FileFormatError(
-        path + ": format version " + std::to_string(version) +
-        " at byte 8; this build reads versions " +
-        std::to_string(MultiresolutionHeader::OldestVersion) + " to " +
+      throw FileFormatError(path + ": format version " + std::to_string(version) +
+        " at byte 8; this build reads versions " + std::to_string(MultiresolutionHeader::OldestVersion) + " to " +
         std::to_string(MultiresolutionHeader::Version) +
         (version < MultiresolutionHeader::OldestVersion ? " (build the file again with resmr build)"
                                                         : " (a newer build wrote it)"));
@@ -1039,15 +932,14 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
     std::memcpy(&storedCrc, this->Data + HeaderBytes - 4, 4);
     if (Crc32(this->Data, HeaderBytes - 4) != storedCrc)
     {
-      throw FileFormatError(path + ": header checksum mismatch (bytes 0-" +
-                            std::to_string(HeaderBytes - 5) + " are corrupt)");
+      throw FileFormatError(
+        path + ": header checksum mismatch (bytes 0-" + std::to_string(HeaderBytes - 5) + " are corrupt)");
     }
     const uint32_t headerSize = head.Get<uint32_t>();
     if (headerSize != HeaderBytes)
     {
-      throw FileFormatError(path + ": header field 'header size' at byte 12 is " +
-                            std::to_string(headerSize) + ", must be " +
-                            std::to_string(HeaderBytes) + " (corrupt)");
+      throw FileFormatError(path + ": header field 'header size' at byte 12 is " + std::to_string(headerSize) +
+        ", must be " + std::to_string(HeaderBytes) + " (corrupt)");
     }
     head.Get(this->Head.dims);
     head.Get(this->Head.box);
@@ -1067,17 +959,13 @@ MultiresolutionFile::MultiresolutionFile(const std::string& path)
     }
     CheckHeader(this->Head, path);
 
-    const auto [indexOffset, indexSize] =
-      ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
-    if (indexSize !=
-        this->Head.regionCount * RecordBytes + this->Head.modelChunkCount * ModelRecordBytes)
+    const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
+    if (indexSize != this->Head.regionCount * RecordBytes + this->Head.modelChunkCount * ModelRecordBytes)
     {
       throw FileFormatError(path + ": index of " + std::to_string(indexSize) + " bytes at byte " +
-                            std::to_string(indexOffset) + " does not hold the header's " +
-                            std::to_string(this->Head.regionCount) + " regions and " +
-                            std::to_string(this->Head.modelChunkCount) +
-                            " model chunks (header field 'region count' or " +
-                            "'model chunk count' corrupt)");
+        std::to_string(indexOffset) + " does not hold the header's " + std::to_string(this->Head.regionCount) +
+        " regions and " + std::to_string(this->Head.modelChunkCount) +
+        " model chunks (header field 'region count' or " + "'model chunk count' corrupt)");
     }
     this->ReadIndex(indexOffset, indexSize);
   }
@@ -1093,20 +981,16 @@ void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
 {
   const std::string& path = this->FilePath;
   ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
-  const auto checkChunk = [&](const ChunkRef& chunk, const std::string& what)
-  {
-    if (chunk.offset < HeaderBytes || chunk.offset > indexOffset ||
-        chunk.stored > indexOffset - chunk.offset)
+  const auto checkChunk = [&](const ChunkRef& chunk, const std::string& what) {
+    if (chunk.offset < HeaderBytes || chunk.offset > indexOffset || chunk.stored > indexOffset - chunk.offset)
     {
-      throw FileFormatError(what + " at byte " + std::to_string(chunk.offset) + " of " +
-                            std::to_string(chunk.stored) +
-                            " bytes lies outside the data part of the file (corrupt)");
+      throw FileFormatError(what + " at byte " + std::to_string(chunk.offset) + " of " + std::to_string(chunk.stored) +
+        " bytes lies outside the data part of the file (corrupt)");
     }
     if (chunk.raw >= MaxChunkBytes || chunk.raw > MaxDecompressedBytes(chunk.stored))
     {
-      throw FileFormatError(what + " at byte " + std::to_string(chunk.offset) + ": " +
-                            std::to_string(chunk.stored) + " bytes cannot decompress to " +
-                            std::to_string(chunk.raw) + " (corrupt)");
+      throw FileFormatError(what + " at byte " + std::to_string(chunk.offset) + ": " + std::to_string(chunk.stored) +
+        " bytes cannot decompress to " + std::to_string(chunk.raw) + " (corrupt)");
     }
   };
   GeometryDigest digest;
@@ -1117,8 +1001,8 @@ void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
   {
     bool reservedZero = false;
     RegionRecord r = GetRecord(index, reservedZero);
-    const std::string place = path + ": index record " + std::to_string(i) + " (level " +
-                              std::to_string(r.level) + ", region " + std::to_string(r.index) + ")";
+    const std::string place = path + ": index record " + std::to_string(i) + " (level " + std::to_string(r.level) +
+      ", region " + std::to_string(r.index) + ")";
     if (!reservedZero)
     {
       throw FileFormatError(place + ": reserved bytes are not zero (corrupt)");
@@ -1146,15 +1030,12 @@ void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
   const double vertical = std::max(double(bottom) - double(top), 1.0);
   if (this->Head.latticeStep[2] > vertical)
   {
-    BadField(path,
-      "lattice step (depth)",
-      Number(this->Head.latticeStep[2]),
+    BadField(path, "lattice step (depth)", Number(this->Head.latticeStep[2]),
       "at most the regions' depth range " + Number(vertical));
   }
   if (deepest != this->Head.leafLevel)
   {
-    throw FileFormatError(
-      path + ": header field 'leaf level' is " + std::to_string(this->Head.leafLevel) +
+    throw FileFormatError(path + ": header field 'leaf level' is " + std::to_string(this->Head.leafLevel) +
       " but the deepest region of the index is at level " + std::to_string(deepest) + " (corrupt)");
   }
   for (uint64_t i = 0; i < this->Head.modelChunkCount; ++i)
@@ -1167,8 +1048,8 @@ void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
     m.chunk.raw = index.Get<uint32_t>();
     m.chunk.crc = index.Get<uint32_t>();
     const uint32_t reserved = index.Get<uint32_t>();
-    const std::string place = path + ": model chunk record " + std::to_string(i) + " (kind " +
-                              std::to_string(m.kind) + ", part " + std::to_string(m.part) + ")";
+    const std::string place = path + ": model chunk record " + std::to_string(i) + " (kind " + std::to_string(m.kind) +
+      ", part " + std::to_string(m.part) + ")";
     if (m.kind < ModelChunk::ActiveLayer || m.kind > ModelChunk::CellNormals || reserved != 0)
     {
       throw FileFormatError(place + ": unknown kind or reserved bytes set (corrupt)");
@@ -1180,8 +1061,7 @@ void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
   CheckModelChunks(this->Model, this->Head, path);
   if (digest.Id() != this->Head.geometryId)
   {
-    throw FileFormatError(
-      path + ": header field 'geometry id' does not match the chunks of the index (corrupt)");
+    throw FileFormatError(path + ": header field 'geometry id' does not match the chunks of the index (corrupt)");
   }
 }
 
@@ -1196,11 +1076,9 @@ void MultiresolutionFile::ReadMapPlacement(ByteReader& head)
   char text[2][UnitBytes];
   head.GetBytes(text[0], UnitBytes);
   head.GetBytes(text[1], UnitBytes);
-  const auto fail = [&](const std::string& what)
-  {
+  const auto fail = [&](const std::string& what) {
     throw FileFormatError(this->FilePath + ": header bytes " + std::to_string(at) + "-" +
-                          std::to_string(HeaderBytes - 5) + " (map placement): " + what +
-                          " (corrupt)");
+      std::to_string(HeaderBytes - 5) + " (map placement): " + what + " (corrupt)");
   };
   if (flags > (MapAxesFlag | GridInMapFlag))
   {
@@ -1209,8 +1087,7 @@ void MultiresolutionFile::ReadMapPlacement(ByteReader& head)
   map.hasMapAxes = (flags & MapAxesFlag) != 0;
   map.gridUnitIsMap = (flags & GridInMapFlag) != 0;
   std::array<double, 6> transform;
-  if (map.hasMapAxes && !map.gridUnitIsMap &&
-      !CornerPointGeometry::MapTransformOf(map.mapAxes, transform))
+  if (map.hasMapAxes && !map.gridUnitIsMap && !CornerPointGeometry::MapTransformOf(map.mapAxes, transform))
   {
     fail("MAPAXES axis points coincide with the origin or are not finite");
   }
@@ -1219,9 +1096,8 @@ void MultiresolutionFile::ReadMapPlacement(ByteReader& head)
   {
     const std::size_t length = std::find(text[u], text[u] + UnitBytes, '\0') - text[u];
     units[u]->assign(text[u], length);
-    if (std::any_of(
-          units[u]->begin(), units[u]->end(), [](char c) { return c < 0x20 || c > 0x7e; }) ||
-        std::any_of(text[u] + length, text[u] + UnitBytes, [](char c) { return c != '\0'; }))
+    if (std::any_of(units[u]->begin(), units[u]->end(), [](char c) { return c < 0x20 || c > 0x7e; }) ||
+      std::any_of(text[u] + length, text[u] + UnitBytes, [](char c) { return c != '\0'; }))
     {
       fail(std::string(u == 0 ? "MAPUNITS" : "GRIDUNIT") + " is not text");
     }
@@ -1253,13 +1129,11 @@ const RegionRecord* MultiresolutionFile::Find(int32_t level, int64_t index) cons
 std::vector<uint8_t> MultiresolutionFile::ReadChunk(const RegionRecord& record, int chunk) const
 {
   return this->ReadChunk(record.chunks[chunk],
-    this->FilePath + ": region (level " + std::to_string(record.level) + ", index " +
-      std::to_string(record.index) + ") " + ChunkNames[chunk] + " at byte " +
-      std::to_string(record.chunks[chunk].offset));
+    this->FilePath + ": region (level " + std::to_string(record.level) + ", index " + std::to_string(record.index) +
+      ") " + ChunkNames[chunk] + " at byte " + std::to_string(record.chunks[chunk].offset));
 }
 
-std::vector<uint8_t> MultiresolutionFile::ReadChunk(const ChunkRef& ref,
-  const std::string& place) const
+std::vector<uint8_t> MultiresolutionFile::ReadChunk(const ChunkRef& ref, const std::string& place) const
 {
   CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
   return DecompressChunk(this->Data, this->Size, ref, place);
@@ -1272,20 +1146,18 @@ std::vector<uint8_t> MultiresolutionFile::ReadActiveLayer(int64_t k) const
   {
     if (m.kind == ModelChunk::ActiveLayer && static_cast<int64_t>(m.part) == k)
     {
-      const std::string place = this->FilePath + ": active flags of layer " +
-                                std::to_string(k + 1) + " at byte " +
-                                std::to_string(m.chunk.offset);
+      const std::string place = this->FilePath + ": active flags of layer " + std::to_string(k + 1) + " at byte " +
+        std::to_string(m.chunk.offset);
       const auto bits = this->ReadChunk(m.chunk, place);
       if (static_cast<int64_t>(bits.size()) != (cells + 7) / 8)
       {
-        throw FileFormatError(place + ": " + std::to_string(bits.size()) + " bytes for " +
-                              std::to_string(cells) + " cells");
+        throw FileFormatError(
+          place + ": " + std::to_string(bits.size()) + " bytes for " + std::to_string(cells) + " cells");
       }
       std::vector<uint8_t> flags(static_cast<std::size_t>(cells));
       for (int64_t c = 0; c < cells; ++c)
       {
-        flags[static_cast<std::size_t>(c)] =
-          (bits[static_cast<std::size_t>(c >> 3)] >> (c & 7)) & 1;
+        flags[static_cast<std::size_t>(c)] = (bits[static_cast<std::size_t>(c >> 3)] >> (c & 7)) & 1;
       }
       return flags;
     }
@@ -1302,8 +1174,7 @@ PerfectSpatialHash MultiresolutionFile::ReadHash() const
   if (raw.size() != hash.OffsetTableSize() * 6)
   {
     throw FileFormatError(this->FilePath + ": hash offsets hold " + std::to_string(raw.size()) +
-                          " bytes for an offset table of " +
-                          std::to_string(hash.OffsetTableSize()) + " entries");
+      " bytes for an offset table of " + std::to_string(hash.OffsetTableSize()) + " entries");
   }
   hash.offsets.resize(static_cast<std::size_t>(hash.OffsetTableSize()));
   std::memcpy(hash.offsets.data(), raw.data(), raw.size());
@@ -1327,19 +1198,15 @@ std::vector<uint8_t> MultiresolutionFile::ReadModelArray(uint32_t kind) const
       pieces.push_back(&m);
     }
   }
-  std::sort(pieces.begin(),
-    pieces.end(),
-    [](const ModelChunk* a, const ModelChunk* b) { return a->part < b->part; });
+  std::sort(pieces.begin(), pieces.end(), [](const ModelChunk* a, const ModelChunk* b) { return a->part < b->part; });
   std::vector<uint8_t> out;
-  const char* const names[] = {
-    "model array", "active flags", "hash offset table", "hash cell table", "cell normal table"
-  };
+  const char* const names[] = { "model array", "active flags", "hash offset table", "hash cell table",
+    "cell normal table" };
   const std::string name = names[kind <= ModelChunk::CellNormals ? kind : 0];
   for (std::size_t p = 0; p < pieces.size(); ++p)
   {
-    const std::string place = this->FilePath + ": " + name + " (model chunk kind " +
-                              std::to_string(kind) + ") piece " + std::to_string(p) + " at byte " +
-                              std::to_string(pieces[p]->chunk.offset);
+    const std::string place = this->FilePath + ": " + name + " (model chunk kind " + std::to_string(kind) + ") piece " +
+      std::to_string(p) + " at byte " + std::to_string(pieces[p]->chunk.offset);
     if (pieces[p]->part != p || (p + 1 < pieces.size() && pieces[p]->chunk.raw != ModelPieceBytes))
     {
       throw FileFormatError(place + ": pieces missing or out of order");
@@ -1371,8 +1238,7 @@ MappedChunkFile::~MappedChunkFile()
   UnmapFile(this->Data, this->Size);
 }
 
-RegionMesh MappedChunkFile::ReadRegion(const RegionRecord& record,
-  const MultiresolutionHeader& header) const
+RegionMesh MappedChunkFile::ReadRegion(const RegionRecord& record, const MultiresolutionHeader& header) const
 {
   return DecodeRegion(this->Data, this->Size, this->FilePath, record, header);
 }

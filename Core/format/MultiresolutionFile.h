@@ -22,9 +22,9 @@
 //
 // Positions are stored on one lattice for the whole model (origin + integer * step), so a
 // vertex two regions share decodes to the same bits in both, at every level (no cracks);
-// steps are 2^-22 of the lateral extent and 2^-20 of the depth range (see ChooseLattice).
-// Topological coordinates are stored as floats: integers are exact and rounding never carries a
-// value across one, so no coordinate moves into another cell.
+// steps are 2^-22 of the lateral extent and 2^-20 of the depth range (see ChooseLattice). Topological coordinates are
+// stored as floats: integers are exact and rounding never carries a value across one, so no
+// coordinate moves into another cell.
 //
 // Positions keep depth down (Core's convention); the viewer shows z = -depth. They stay in
 // grid coordinates: MAPAXES is only recorded, for viewers to apply as the grid readers do.
@@ -155,10 +155,7 @@ public:
   /// cones (bounds and errors are the caller's).
   void AddRegion(const RegionMesh& mesh, const MultiresolutionHeader& header, RegionRecord& record);
   /// Appends a long array as model chunks of at most ModelPieceBytes each.
-  void AddModelArray(uint32_t kind,
-    const void* data,
-    std::size_t bytes,
-    std::vector<ModelChunk>& out);
+  void AddModelArray(uint32_t kind, const void* data, std::size_t bytes, std::vector<ModelChunk>& out);
   /// Flushes to disk; the bytes written so far.
   uint64_t Sync();
   const std::string& Path() const { return this->FilePath; }
@@ -182,10 +179,8 @@ struct PartRecord
 /// temporary name renamed into place (an older file stays untouched until then). Chunk
 /// offsets are moved from their part to the file. Sets header.regionCount,
 /// modelChunkCount and geometryId.
-void AssembleMultiresolutionFile(const std::string& path,
-  MultiresolutionHeader header,
-  const std::vector<std::string>& parts,
-  const std::vector<PartRecord<RegionRecord>>& regions,
+void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader header,
+  const std::vector<std::string>& parts, const std::vector<PartRecord<RegionRecord>>& regions,
   const std::vector<PartRecord<ModelChunk>>& model);
 
 /// A ChunkFile mapped for reading back regions before the file is assembled (the builder's

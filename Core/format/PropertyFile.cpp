@@ -41,10 +41,8 @@ ChunkRef GetRef(ByteReader& in)
   return c;
 }
 
-std::vector<uint8_t> HeaderOf(uint64_t geometry,
-  const std::array<int64_t, 3>& dims,
-  const std::array<uint32_t, 3>& tableSides,
-  uint32_t tables)
+std::vector<uint8_t> HeaderOf(
+  uint64_t geometry, const std::array<int64_t, 3>& dims, const std::array<uint32_t, 3>& tableSides, uint32_t tables)
 {
   ByteWriter head;
   head.PutBytes(Magic, 8);
@@ -64,8 +62,7 @@ std::vector<uint8_t> HeaderOf(uint64_t geometry,
 /// slots the way texture atlases pad charts paints them like their surroundings instead of in
 /// the NaN colour. Finest-level faces belong to active cells only, so exact views are unchanged.
 std::vector<uint64_t> NearestActiveSources(const std::vector<uint64_t>& slotCells,
-  const std::vector<std::vector<uint8_t>>& active,
-  const std::array<int64_t, 3>& dims)
+  const std::vector<std::vector<uint8_t>>& active, const std::array<int64_t, 3>& dims)
 {
   const uint64_t nx = static_cast<uint64_t>(dims[0]), ny = static_cast<uint64_t>(dims[1]);
   const uint64_t layer = nx * ny;
@@ -103,9 +100,7 @@ std::vector<uint64_t> NearestActiveSources(const std::vector<uint64_t>& slotCell
     {
       const uint32_t c = queue[head];
       const uint64_t i = c % nx, j = c / nx;
-      const uint64_t next[4] = { i > 0 ? c - 1 : layer,
-        i + 1 < nx ? c + 1 : layer,
-        j > 0 ? c - nx : layer,
+      const uint64_t next[4] = { i > 0 ? c - 1 : layer, i + 1 < nx ? c + 1 : layer, j > 0 ? c - nx : layer,
         j + 1 < ny ? c + nx : layer };
       for (uint64_t n : next)
       {
@@ -134,9 +129,9 @@ uint64_t TableRecordBytes(int64_t layers)
 
 std::string TableName(const PropertyTable& t)
 {
-  return t.step < 0 ? t.name
-                    : t.name + " of step " + std::to_string(t.step) + " (report " +
-                        std::to_string(t.reportNumber) + ")";
+  return t.step < 0
+    ? t.name
+    : t.name + " of step " + std::to_string(t.step) + " (report " + std::to_string(t.reportNumber) + ")";
 }
 } // namespace
 
@@ -148,8 +143,8 @@ PropertyFile::PropertyFile(const std::string& path)
   {
     UnmapFile(this->Data, this->Size);
     CloseDescriptor(this->Descriptor);
-    throw FileFormatError(path + ": " + std::to_string(this->Size) +
-                          " bytes, too short for a property file (truncated?)");
+    throw FileFormatError(
+      path + ": " + std::to_string(this->Size) + " bytes, too short for a property file (truncated?)");
   }
   try
   {
@@ -167,15 +162,14 @@ PropertyFile::PropertyFile(const std::string& path)
     const uint32_t version = head.Get<uint32_t>();
     if (version != Version)
     {
-      throw FileFormatError(path + ": format version " + std::to_string(version) +
-                            "; this build reads version " + std::to_string(Version));
+      throw FileFormatError(
+        path + ": format version " + std::to_string(version) + "; this build reads version " + std::to_string(Version));
     }
     this->Geometry = head.Get<uint64_t>();
     head.Get(this->Dims);
     head.Get(this->TableSides);
     const uint32_t tables = head.Get<uint32_t>();
-    const auto [indexOffset, indexSize] =
-      ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
+    const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
     this->CheckHeader(tables, indexSize);
     ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
     std::set<std::pair<std::string, int32_t>> seen;
@@ -184,9 +178,8 @@ PropertyFile::PropertyFile(const std::string& path)
       PropertyTable table = this->ReadTable(index, t, indexOffset);
       if (!seen.insert({ table.name, table.step }).second)
       {
-        throw FileFormatError(path + ": index table " + std::to_string(t) + " (" +
-                              TableName(table) +
-                              "): a second table of the same name and step (corrupt)");
+        throw FileFormatError(path + ": index table " + std::to_string(t) + " (" + TableName(table) +
+          "): a second table of the same name and step (corrupt)");
       }
       this->Entries.push_back(std::move(table));
     }
@@ -201,37 +194,33 @@ PropertyFile::PropertyFile(const std::string& path)
 
 void PropertyFile::CheckHeader(uint32_t tables, uint64_t indexSize) const
 {
-  const auto bad = [&](const std::string& field, const std::string& value, const std::string& must)
-  {
-    throw FileFormatError(this->FilePath + ": header field '" + field + "' is " + value +
-                          ", must be " + must + " (corrupt)");
+  const auto bad = [&](const std::string& field, const std::string& value, const std::string& must) {
+    throw FileFormatError(
+      this->FilePath + ": header field '" + field + "' is " + value + ", must be " + must + " (corrupt)");
   };
   const int64_t maxDim = int64_t(1) << 24;
   for (int a = 0; a < 3; ++a)
   {
     if (this->Dims[a] <= 0 || this->Dims[a] > maxDim)
     {
-      bad(std::string("dimensions (n") + "xyz"[a] + ")",
-        std::to_string(this->Dims[a]),
-        "1 to " + std::to_string(maxDim));
+      bad(
+        std::string("dimensions (n") + "xyz"[a] + ")", std::to_string(this->Dims[a]), "1 to " + std::to_string(maxDim));
     }
     if (this->TableSides[a] < 1 || this->TableSides[a] > PerfectSpatialHash::MaxSide)
     {
-      bad("hash table sides",
-        std::to_string(this->TableSides[a]),
-        "1 to " + std::to_string(PerfectSpatialHash::MaxSide));
+      bad(
+        "hash table sides", std::to_string(this->TableSides[a]), "1 to " + std::to_string(PerfectSpatialHash::MaxSide));
     }
   }
   // A layer's and the packed table's values fit one chunk (their sizes are 32-bit).
   const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
   if (layer * 4 > std::numeric_limits<uint32_t>::max())
   {
-    bad("dimensions",
-      std::to_string(this->Dims[0]) + " x " + std::to_string(this->Dims[1]),
+    bad("dimensions", std::to_string(this->Dims[0]) + " x " + std::to_string(this->Dims[1]),
       "at most 2^30 cells a layer");
   }
   if (uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2] * 4 >
-      std::numeric_limits<uint32_t>::max())
+    std::numeric_limits<uint32_t>::max())
   {
     bad("hash table sides",
       std::to_string(this->TableSides[0]) + " x " + std::to_string(this->TableSides[1]) + " x " +
@@ -242,18 +231,15 @@ void PropertyFile::CheckHeader(uint32_t tables, uint64_t indexSize) const
   {
     if (this->Data[at] != 0)
     {
-      bad("reserved bytes",
-        "byte " + std::to_string(at) + " = " + std::to_string(this->Data[at]),
-        "zero");
+      bad("reserved bytes", "byte " + std::to_string(at) + " = " + std::to_string(this->Data[at]), "zero");
     }
   }
   const uint64_t recordBytes = TableRecordBytes(this->Dims[2]);
   if (indexSize != tables * recordBytes)
   {
-    bad("table count",
-      std::to_string(tables),
-      "what the index of " + std::to_string(indexSize) + " bytes holds (" +
-        std::to_string(recordBytes) + " bytes a table)");
+    bad("table count", std::to_string(tables),
+      "what the index of " + std::to_string(indexSize) + " bytes holds (" + std::to_string(recordBytes) +
+        " bytes a table)");
   }
 }
 
@@ -274,30 +260,26 @@ PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t in
   {
     layer = GetRef(index);
   }
-  const std::string place =
-    this->FilePath + ": index table " + std::to_string(t) + " (" + TableName(table) + ")";
-  const auto fail = [&](const std::string& what)
-  { throw FileFormatError(place + ": " + what + " (corrupt)"); };
-  const bool text = std::all_of(
-    table.name.begin(), table.name.end(), [](char c) { return c >= 0x20 && c <= 0x7e; });
-  const bool padded = std::all_of(
-    name + std::min(table.name.size(), NameBytes), name + NameBytes, [](char c) { return c == 0; });
+  const std::string place = this->FilePath + ": index table " + std::to_string(t) + " (" + TableName(table) + ")";
+  const auto fail = [&](const std::string& what) { throw FileFormatError(place + ": " + what + " (corrupt)"); };
+  const bool text = std::all_of(table.name.begin(), table.name.end(), [](char c) { return c >= 0x20 && c <= 0x7e; });
+  const bool padded =
+    std::all_of(name + std::min(table.name.size(), NameBytes), name + NameBytes, [](char c) { return c == 0; });
   if (table.name.empty() || table.name.size() >= NameBytes || !text || !padded)
   {
     fail("the name is not 1 to 31 printable characters, NUL-padded");
   }
   if (table.step < -1 || table.reportNumber < 0 || !std::isfinite(table.days) ||
-      (table.step < 0 && (table.reportNumber != 0 || table.days != 0)))
+    (table.step < 0 && (table.reportNumber != 0 || table.days != 0)))
   {
-    fail("step " + std::to_string(table.step) + ", report " + std::to_string(table.reportNumber) +
-         " or day " + std::to_string(table.days) + " impossible");
+    fail("step " + std::to_string(table.step) + ", report " + std::to_string(table.reportNumber) + " or day " +
+      std::to_string(table.days) + " impossible");
   }
   // NaN both when no cell has a value, else an ordered range.
   const bool none = std::isnan(table.minimum) && std::isnan(table.maximum);
   if (!none && !(table.minimum <= table.maximum))
   {
-    fail("value range " + std::to_string(table.minimum) + " to " + std::to_string(table.maximum) +
-         " impossible");
+    fail("value range " + std::to_string(table.minimum) + " to " + std::to_string(table.maximum) + " impossible");
   }
   const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
   const uint64_t layerValues = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
@@ -308,12 +290,12 @@ PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t in
     if (c.offset < HeaderBytes || c.offset > indexOffset || c.stored > indexOffset - c.offset)
     {
       fail(what + " at byte " + std::to_string(c.offset) + " of " + std::to_string(c.stored) +
-           " bytes lies outside the file");
+        " bytes lies outside the file");
     }
     if (c.raw != (k < 0 ? slots : layerValues) * 4)
     {
-      fail(what + " of " + std::to_string(c.raw) + " bytes for " +
-           std::to_string(k < 0 ? slots : layerValues) + " values");
+      fail(what + " of " + std::to_string(c.raw) + " bytes for " + std::to_string(k < 0 ? slots : layerValues) +
+        " values");
     }
   }
   return table;
@@ -340,23 +322,21 @@ int PropertyFile::Find(const std::string& name, int32_t step) const
 void PropertyFile::CheckGeometry(const MultiresolutionFile& geometry) const
 {
   if (geometry.Header().geometryId != this->Geometry || geometry.Header().dims != this->Dims ||
-      geometry.Header().hashTableSides != this->TableSides)
+    geometry.Header().hashTableSides != this->TableSides)
   {
     throw FileFormatError(this->FilePath + ": made for another geometry than " + geometry.Path() +
-                          " (geometry id or grid differs): rebuild it with resmr add-properties");
+      " (geometry id or grid differs): rebuild it with resmr add-properties");
   }
 }
 
-std::vector<float> PropertyFile::ReadValues(const ChunkRef& ref,
-  uint64_t count,
-  const std::string& place) const
+std::vector<float> PropertyFile::ReadValues(const ChunkRef& ref, uint64_t count, const std::string& place) const
 {
   CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
   const auto raw = DecompressChunk(this->Data, this->Size, ref, place);
   if (raw.size() != count * 4)
   {
-    throw FileFormatError(place + ": " + std::to_string(raw.size()) + " bytes, " +
-                          std::to_string(count * 4) + " expected");
+    throw FileFormatError(
+      place + ": " + std::to_string(raw.size()) + " bytes, " + std::to_string(count * 4) + " expected");
   }
   std::vector<float> values(count);
   std::memcpy(values.data(), raw.data(), raw.size());
@@ -367,10 +347,8 @@ std::vector<float> PropertyFile::ReadPacked(std::size_t table) const
 {
   const PropertyTable& t = this->Entries.at(table);
   const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
-  return this->ReadValues(t.packed,
-    slots,
-    this->FilePath + ": packed table of " + TableName(t) + " at byte " +
-      std::to_string(t.packed.offset));
+  return this->ReadValues(t.packed, slots,
+    this->FilePath + ": packed table of " + TableName(t) + " at byte " + std::to_string(t.packed.offset));
 }
 
 std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
@@ -380,8 +358,7 @@ std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
   {
     throw std::out_of_range(this->FilePath + ": no layer " + std::to_string(k + 1));
   }
-  return this->ReadValues(t.layers[static_cast<std::size_t>(k)],
-    static_cast<uint64_t>(this->Dims[0] * this->Dims[1]),
+  return this->ReadValues(t.layers[static_cast<std::size_t>(k)], static_cast<uint64_t>(this->Dims[0] * this->Dims[1]),
     this->FilePath + ": layer " + std::to_string(k + 1) + " of " + TableName(t) + " at byte " +
       std::to_string(t.layers[static_cast<std::size_t>(k)].offset));
 }
@@ -399,7 +376,7 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
     if (cells.size() != slots * 8)
     {
       throw FileFormatError(geometry.Path() + ": hash cells hold " + std::to_string(cells.size()) +
-                            " bytes for a table of " + std::to_string(slots) + " slots");
+        " bytes for a table of " + std::to_string(slots) + " slots");
     }
     slotCells.resize(cells.size() / 8);
     std::memcpy(slotCells.data(), cells.data(), cells.size());
@@ -409,8 +386,8 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
   {
     if (cell != ~uint64_t(0) && cell >= total)
     {
-      throw FileFormatError(geometry.Path() + ": a hash slot names cell " + std::to_string(cell) +
-                            " of " + std::to_string(total));
+      throw FileFormatError(
+        geometry.Path() + ": a hash slot names cell " + std::to_string(cell) + " of " + std::to_string(total));
     }
   }
   for (int64_t k = 0; k < this->Dims[2]; ++k)
@@ -453,8 +430,8 @@ void PropertyFileWriter::Write(const void* data, std::size_t size, const std::st
 {
   if (!this->Output->Write(data, size))
   {
-    throw FileFormatError(this->Output->Path() + ": writing the " + what + " at byte " +
-                          std::to_string(this->Offset) + " failed: " + std::strerror(errno));
+    throw FileFormatError(this->Output->Path() + ": writing the " + what + " at byte " + std::to_string(this->Offset) +
+      " failed: " + std::strerror(errno));
   }
   this->Offset += size;
 }
@@ -475,8 +452,8 @@ ChunkRef PropertyFileWriter::CopyChunk(const PropertyFile& from, const ChunkRef&
 {
   if (Crc32(from.ChunkBytes(ref), ref.stored) != ref.crc)
   {
-    throw FileFormatError(from.Path() + ": chunk at byte " + std::to_string(ref.offset) +
-                          ": checksum mismatch (corrupt data)");
+    throw FileFormatError(
+      from.Path() + ": chunk at byte " + std::to_string(ref.offset) + ": checksum mismatch (corrupt data)");
   }
   ChunkRef moved = ref;
   moved.offset = this->Offset;
@@ -490,8 +467,7 @@ void PropertyFileWriter::Add(PropertyTable table, const std::vector<float>& cell
   if (static_cast<int64_t>(cellValues.size()) != layer * this->Dims[2])
   {
     throw std::invalid_argument(this->Output->Path() + ": " + TableName(table) + " has " +
-                                std::to_string(cellValues.size()) + " values for " +
-                                std::to_string(layer * this->Dims[2]) + " cells");
+      std::to_string(cellValues.size()) + " values for " + std::to_string(layer * this->Dims[2]) + " cells");
   }
   const std::size_t handle = this->BeginTable(std::move(table));
   for (int64_t k = 0; k < this->Dims[2]; ++k)
@@ -504,15 +480,14 @@ void PropertyFileWriter::Add(PropertyTable table, const std::vector<float>& cell
 std::size_t PropertyFileWriter::BeginTable(PropertyTable table)
 {
   // What PropertyFile accepts back.
-  const bool text = std::all_of(
-    table.name.begin(), table.name.end(), [](char c) { return c >= 0x20 && c <= 0x7e; });
+  const bool text = std::all_of(table.name.begin(), table.name.end(), [](char c) { return c >= 0x20 && c <= 0x7e; });
   if (table.name.empty() || table.name.size() >= NameBytes || !text)
   {
-    throw std::invalid_argument(this->Output->Path() + ": property name '" + table.name +
-                                "' must hold 1 to 31 printable characters");
+    throw std::invalid_argument(
+      this->Output->Path() + ": property name '" + table.name + "' must hold 1 to 31 printable characters");
   }
   if (table.step < -1 || table.reportNumber < 0 || !std::isfinite(table.days) ||
-      (table.step < 0 && (table.reportNumber != 0 || table.days != 0)))
+    (table.step < 0 && (table.reportNumber != 0 || table.days != 0)))
   {
     throw std::invalid_argument(
       this->Output->Path() + ": " + TableName(table) + ": step, report number or days impossible");
@@ -557,9 +532,8 @@ void PropertyFileWriter::AddLayer(std::size_t handle, const float* layerValues)
   const int64_t k = static_cast<int64_t>(t.table.layers.size());
   if (k >= this->Dims[2])
   {
-    throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) +
-                                " given more than its " + std::to_string(this->Dims[2]) +
-                                " layers");
+    throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) + " given more than its " +
+      std::to_string(this->Dims[2]) + " layers");
   }
   const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
   const std::vector<uint8_t>& active = this->Active[static_cast<std::size_t>(k)];
@@ -575,11 +549,9 @@ void PropertyFileWriter::AddLayer(std::size_t handle, const float* layerValues)
     }
     std::memcpy(&raw[static_cast<std::size_t>(c) * 4], &v, 4);
   }
-  t.table.layers.push_back(
-    this->PutChunk(raw, TableName(t.table) + " layer " + std::to_string(k + 1)));
+  t.table.layers.push_back(this->PutChunk(raw, TableName(t.table) + " layer " + std::to_string(k + 1)));
   for (uint64_t at = this->LayerSlotStart[static_cast<std::size_t>(k)];
-       at < this->LayerSlotStart[static_cast<std::size_t>(k) + 1];
-       ++at)
+       at < this->LayerSlotStart[static_cast<std::size_t>(k) + 1]; ++at)
   {
     const uint64_t s = this->SlotsByLayer[at];
     const uint64_t c = this->SlotSources[s] % layer;
@@ -594,8 +566,7 @@ void PropertyFileWriter::EndTable(std::size_t handle)
   if (static_cast<int64_t>(t.table.layers.size()) != this->Dims[2])
   {
     throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) + " ended after " +
-                                std::to_string(t.table.layers.size()) + " of its " +
-                                std::to_string(this->Dims[2]) + " layers");
+      std::to_string(t.table.layers.size()) + " of its " + std::to_string(this->Dims[2]) + " layers");
   }
   const float none = std::numeric_limits<float>::quiet_NaN();
   PropertyTable table = std::move(t.table);
@@ -623,8 +594,7 @@ void PropertyFileWriter::CopyFrom(const PropertyFile& older)
   }
   for (const PropertyTable& table : older.Tables())
   {
-    const bool held = std::any_of(this->Entries.begin(),
-      this->Entries.end(),
+    const bool held = std::any_of(this->Entries.begin(), this->Entries.end(),
       [&](const PropertyTable& t) { return t.name == table.name && t.step == table.step; });
     if (held)
     {
@@ -646,8 +616,7 @@ void PropertyFileWriter::Commit()
   {
     if (t.open)
     {
-      throw std::invalid_argument(
-        this->Output->Path() + ": " + TableName(t.table) + " was never ended");
+      throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) + " was never ended");
     }
   }
   ByteWriter index;
@@ -672,12 +641,10 @@ void PropertyFileWriter::Commit()
   const auto trailer = IndexTrailer(indexOffset, index.Bytes, TrailerMagic);
   this->Write(trailer.data(), trailer.size(), "trailer");
   // The table count goes in the header, which was written first: rewrite it in place.
-  const auto head = HeaderOf(
-    this->Geometry, this->Dims, this->TableSides, static_cast<uint32_t>(this->Entries.size()));
+  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, static_cast<uint32_t>(this->Entries.size()));
   if (!this->Output->WriteAt(head.data(), head.size(), 0))
   {
-    throw FileFormatError(
-      this->Output->Path() + ": rewriting the header failed: " + std::strerror(errno));
+    throw FileFormatError(this->Output->Path() + ": rewriting the header failed: " + std::strerror(errno));
   }
   this->Output->Commit();
 }

@@ -74,9 +74,7 @@ public:
 private:
   void CheckHeader(uint32_t tables, uint64_t indexSize) const;
   PropertyTable ReadTable(ByteReader& index, uint32_t t, uint64_t indexOffset) const;
-  std::vector<float> ReadValues(const ChunkRef& ref,
-    uint64_t count,
-    const std::string& place) const;
+  std::vector<float> ReadValues(const ChunkRef& ref, uint64_t count, const std::string& place) const;
   std::string FilePath;
   const uint8_t* Data = nullptr;
   uint64_t Size = 0;

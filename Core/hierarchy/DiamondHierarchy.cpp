@@ -42,11 +42,7 @@ DiamondHierarchy::Triangle Child(const DiamondHierarchy::Triangle& t, int which)
 }
 } // namespace
 
-DiamondHierarchy::DiamondHierarchy(double xmin,
-  double ymin,
-  double xmax,
-  double ymax,
-  int leafLevel)
+DiamondHierarchy::DiamondHierarchy(double xmin, double ymin, double xmax, double ymax, int leafLevel)
   : X0(xmin)
   , Y0(ymin)
   , Width(xmax > xmin ? xmax - xmin : 1.0)
@@ -55,8 +51,8 @@ DiamondHierarchy::DiamondHierarchy(double xmin,
 {
   if (leafLevel < 0 || leafLevel > MaxDepth)
   {
-    throw std::invalid_argument("diamond hierarchy: leaf level " + std::to_string(leafLevel) +
-                                " outside 0.." + std::to_string(MaxDepth));
+    throw std::invalid_argument(
+      "diamond hierarchy: leaf level " + std::to_string(leafLevel) + " outside 0.." + std::to_string(MaxDepth));
   }
 }
 
@@ -87,8 +83,7 @@ int DiamondHierarchy::ChooseLeafLevel(std::vector<uint64_t> codes, int64_t cmax)
 
 DiamondHierarchy::Point DiamondHierarchy::Normalise(double x, double y) const
 {
-  return { std::clamp((x - this->X0) / this->Width, 0.0, 1.0),
-    std::clamp((y - this->Y0) / this->Height, 0.0, 1.0) };
+  return { std::clamp((x - this->X0) / this->Width, 0.0, 1.0), std::clamp((y - this->Y0) / this->Height, 0.0, 1.0) };
 }
 
 int64_t DiamondHierarchy::Locate(double x, double y, int level) const
@@ -113,8 +108,8 @@ DiamondHierarchy::Triangle DiamondHierarchy::NormalisedTriangle(int level, int64
 {
   if (level < 0 || level > MaxDepth || index < 0 || index >= TriangleCount(level))
   {
-    throw std::out_of_range("diamond hierarchy: no triangle " + std::to_string(index) +
-                            " at level " + std::to_string(level));
+    throw std::out_of_range(
+      "diamond hierarchy: no triangle " + std::to_string(index) + " at level " + std::to_string(level));
   }
   Triangle t = Root(index >> level);
   for (int l = level - 1; l >= 0; --l)
@@ -174,9 +169,7 @@ std::vector<DiamondHierarchy::Diamond> DiamondHierarchy::Diamonds(int level) con
   {
     diamonds.push_back({ level, single.second, -1 });
   }
-  std::sort(diamonds.begin(),
-    diamonds.end(),
-    [](const Diamond& a, const Diamond& b) { return a.first < b.first; });
+  std::sort(diamonds.begin(), diamonds.end(), [](const Diamond& a, const Diamond& b) { return a.first < b.first; });
   return diamonds;
 }
 

@@ -56,10 +56,7 @@ public:
   /// The triangle of `level` holding (x, y) (model coordinates; outside points are clamped).
   int64_t Locate(double x, double y, int level) const;
   /// Locate at MaxDepth; the triangle of a shallower level L is code >> (MaxDepth - L).
-  uint64_t Code(double x, double y) const
-  {
-    return static_cast<uint64_t>(this->Locate(x, y, MaxDepth));
-  }
+  uint64_t Code(double x, double y) const { return static_cast<uint64_t>(this->Locate(x, y, MaxDepth)); }
 
   Triangle NormalisedTriangle(int level, int64_t index) const;
   /// The same in model coordinates.

@@ -55,8 +55,7 @@ void PutVector(std::FILE* file, const std::vector<T>& values, bool& ok)
 {
   const uint64_t count = values.size();
   ok = ok && std::fwrite(&count, sizeof(count), 1, file) == 1;
-  ok = ok &&
-       (count == 0 || std::fwrite(values.data(), sizeof(T), values.size(), file) == values.size());
+  ok = ok && (count == 0 || std::fwrite(values.data(), sizeof(T), values.size(), file) == values.size());
 }
 
 template<typename T>
@@ -145,9 +144,7 @@ int32_t Across(const ColumnMesh& mesh, int32_t column, int e)
 /// Open sides of every alive column's cells, from the columns across; edges flagged in `cut`
 /// (one mask a column slot) keep the flags in `openSides` (one byte a cell slot), since the
 /// cells across them lie in another region.
-void UpdateOpenSides(const ColumnMesh& mesh,
-  const std::vector<uint8_t>& cut,
-  std::vector<uint8_t>& openSides)
+void UpdateOpenSides(const ColumnMesh& mesh, const std::vector<uint8_t>& cut, std::vector<uint8_t>& openSides)
 {
   const std::size_t layers = static_cast<std::size_t>(mesh.Layers());
   openSides.resize(static_cast<std::size_t>(mesh.ColumnSlots()) * layers, 0);
@@ -175,9 +172,8 @@ void UpdateOpenSides(const ColumnMesh& mesh,
 }
 
 /// The cells of the columns flagged in `keep`, in order.
-std::vector<uint8_t> KeptCells(const std::vector<uint8_t>& perCell,
-  const std::vector<uint8_t>& keep,
-  std::size_t layers)
+std::vector<uint8_t> KeptCells(
+  const std::vector<uint8_t>& perCell, const std::vector<uint8_t>& keep, std::size_t layers)
 {
   std::vector<uint8_t> out;
   for (std::size_t c = 0; c < keep.size(); ++c)
@@ -190,10 +186,8 @@ std::vector<uint8_t> KeptCells(const std::vector<uint8_t>& perCell,
   return out;
 }
 
-RegionMesh ToRegionMesh(const ScratchRegion& region,
-  const MultiresolutionHeader& header,
-  float ownError,
-  double sideError)
+RegionMesh ToRegionMesh(
+  const ScratchRegion& region, const MultiresolutionHeader& header, float ownError, double sideError)
 {
   RegionMesh out;
   out.layers = region.mesh.layers;
@@ -254,8 +248,7 @@ double QuadricDistance(const ColumnMeshData& mesh)
     const double weight = q.q[0] + q.q[4] + q.q[7];
     if (weight > 0)
     {
-      const glm::dvec3 p(
-        mesh.positions[v * 3], mesh.positions[v * 3 + 1], mesh.positions[v * 3 + 2]);
+      const glm::dvec3 p(mesh.positions[v * 3], mesh.positions[v * 3 + 1], mesh.positions[v * 3 + 2]);
       largest = std::max(largest, q.Error(p) / weight);
     }
   }
@@ -277,8 +270,7 @@ void ParallelFor(int64_t count, int threads, const std::function<void(int64_t)>&
   std::atomic<int64_t> next{ 0 };
   std::exception_ptr failure;
   std::mutex failureLock;
-  auto work = [&]
-  {
+  auto work = [&] {
     for (;;)
     {
       const int64_t i = next++;
@@ -332,8 +324,7 @@ public:
   {
     const std::string temporary = path + ".part";
     std::FILE* file = std::fopen(temporary.c_str(), "wb");
-    bool ok =
-      file && std::fwrite(this->Bytes.data(), 1, this->Bytes.size(), file) == this->Bytes.size();
+    bool ok = file && std::fwrite(this->Bytes.data(), 1, this->Bytes.size(), file) == this->Bytes.size();
     ok = file && (std::fflush(file) == 0) && (fsync(fileno(file)) == 0) && ok;
     ok = file && (std::fclose(file) == 0) && ok;
     if (!ok || std::rename(temporary.c_str(), path.c_str()) != 0)
@@ -401,20 +392,16 @@ void RemoveTree(const std::string& path)
 /// The cells (natural index) an extracted face of the region may sample through its
 /// interpolated topological coordinates (Sec. 5.2): every cell of the face's box in (i, j,
 /// k) space, on the inner side of a top or bottom face and on both sides of a side face.
-void MarkTouchedCells(const RegionMesh& mesh,
-  const std::array<int64_t, 3>& dims,
-  std::vector<std::atomic<uint64_t>>& bits)
+void MarkTouchedCells(
+  const RegionMesh& mesh, const std::array<int64_t, 3>& dims, std::vector<std::atomic<uint64_t>>& bits)
 {
   const uint32_t interfaces = static_cast<uint32_t>(mesh.layers + 1);
-  const auto mark = [&](const uint32_t* vertices, int count, int kind)
-  {
+  const auto mark = [&](const uint32_t* vertices, int count, int kind) {
     std::array<double, 3> low{ 1e300, 1e300, 1e300 }, high{ -1e300, -1e300, -1e300 };
     for (int v = 0; v < count; ++v)
     {
       const uint32_t node = vertices[v] / interfaces;
-      const double t[3] = {
-        mesh.topology[node][0], mesh.topology[node][1], double(vertices[v] % interfaces)
-      };
+      const double t[3] = { mesh.topology[node][0], mesh.topology[node][1], double(vertices[v] % interfaces) };
       for (int a = 0; a < 3; ++a)
       {
         low[a] = std::min(low[a], t[a]);
@@ -475,10 +462,8 @@ void MarkTouchedCells(const RegionMesh& mesh,
 /// bitwise equal, topological coordinate and whole vertex stack. Only nodes of different
 /// children are joined: one child may hold two distinct nodes with equal data (where faults
 /// cross, the diagonal columns at a pillar can agree while their edge neighbours do not).
-ColumnMesh MergeRegions(const std::vector<ScratchRegion>& children,
-  std::vector<uint8_t>& childCut,
-  std::vector<uint8_t>& openSides,
-  int64_t& inputColumns)
+ColumnMesh MergeRegions(const std::vector<ScratchRegion>& children, std::vector<uint8_t>& childCut,
+  std::vector<uint8_t>& openSides, int64_t& inputColumns)
 {
   const int32_t layers = children.front().mesh.layers;
   const std::size_t interfaces = static_cast<std::size_t>(layers) + 1;
@@ -495,20 +480,16 @@ ColumnMesh MergeRegions(const std::vector<ScratchRegion>& children,
     for (std::size_t n = 0; n < m.topology.size(); ++n)
     {
       const double* stack = &m.positions[n * interfaces * 3];
-      uint64_t key =
-        Mix(std::hash<double>()(m.topology[n][0]) ^ Mix(std::hash<double>()(m.topology[n][1])));
-      key = Mix(
-        key ^ std::hash<double>()(stack[0]) ^ Mix(std::hash<double>()(stack[interfaces * 3 - 1])));
+      uint64_t key = Mix(std::hash<double>()(m.topology[n][0]) ^ Mix(std::hash<double>()(m.topology[n][1])));
+      key = Mix(key ^ std::hash<double>()(stack[0]) ^ Mix(std::hash<double>()(stack[interfaces * 3 - 1])));
       int32_t found = -1;
       const auto range = nodeByKey.equal_range(key);
       for (auto it = range.first; it != range.second && found < 0; ++it)
       {
         const int32_t candidate = it->second;
-        if (nodeChild[candidate] != static_cast<int>(which) &&
-            merged.topology[candidate] == m.topology[n] &&
-            std::equal(stack,
-              stack + interfaces * 3,
-              &merged.positions[static_cast<std::size_t>(candidate) * interfaces * 3]))
+        if (nodeChild[candidate] != static_cast<int>(which) && merged.topology[candidate] == m.topology[n] &&
+          std::equal(
+            stack, stack + interfaces * 3, &merged.positions[static_cast<std::size_t>(candidate) * interfaces * 3]))
         {
           found = candidate;
         }
@@ -518,9 +499,8 @@ ColumnMesh MergeRegions(const std::vector<ScratchRegion>& children,
         found = static_cast<int32_t>(merged.topology.size());
         merged.topology.push_back(m.topology[n]);
         merged.positions.insert(merged.positions.end(), stack, stack + interfaces * 3);
-        merged.quadrics.insert(merged.quadrics.end(),
-          m.quadrics.begin() + n * interfaces,
-          m.quadrics.begin() + (n + 1) * interfaces);
+        merged.quadrics.insert(
+          merged.quadrics.end(), m.quadrics.begin() + n * interfaces, m.quadrics.begin() + (n + 1) * interfaces);
         nodeByKey.emplace(key, found);
         nodeChild.push_back(-1);
       }
@@ -575,10 +555,8 @@ void LockCutColumns(ColumnMesh& mesh, std::vector<uint8_t>& childCut)
 class Builder
 {
 public:
-  Builder(LayerSource& source,
-    const std::string& output,
-    const HierarchyOptions& options,
-    const BuildProgress& progress)
+  Builder(
+    LayerSource& source, const std::string& output, const HierarchyOptions& options, const BuildProgress& progress)
     : Source(source)
     , Output(output)
     , Options(options)
@@ -587,16 +565,13 @@ public:
   {
     if (this->Options.cmax != 0 && this->Options.cmax < 16)
     {
-      throw std::invalid_argument(
-        "--cmax must be at least 16 columns (or 0: chosen from the model)");
+      throw std::invalid_argument("--cmax must be at least 16 columns (or 0: chosen from the model)");
     }
-    if (this->Options.ranks < 1 || this->Options.rank < 0 ||
-        this->Options.rank >= this->Options.ranks ||
-        (this->Options.ranks > 1 && !this->Options.barrier))
+    if (this->Options.ranks < 1 || this->Options.rank < 0 || this->Options.rank >= this->Options.ranks ||
+      (this->Options.ranks > 1 && !this->Options.barrier))
     {
-      throw std::invalid_argument("hierarchy build: rank " + std::to_string(this->Options.rank) +
-                                  " of " + std::to_string(this->Options.ranks) +
-                                  " (several ranks need a barrier)");
+      throw std::invalid_argument("hierarchy build: rank " + std::to_string(this->Options.rank) + " of " +
+        std::to_string(this->Options.ranks) + " (several ranks need a barrier)");
     }
   }
 
@@ -626,10 +601,8 @@ private:
   void BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns);
   void BuildDiamond(const DiamondHierarchy::Diamond& diamond);
   std::vector<ScratchRegion> LoadChildren(const DiamondHierarchy::Diamond& diamond) const;
-  void SplitAndEmit(const DiamondHierarchy::Diamond& diamond,
-    const ColumnMesh& mesh,
-    const std::vector<uint8_t>& childCut,
-    const std::vector<uint8_t>& openSides);
+  void SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const ColumnMesh& mesh,
+    const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides);
   void Emit(int level, int64_t index, const ScratchRegion& region, bool keepScratch);
   int ThreadsFor(int64_t bytesPerTask) const;
   void Barrier()
@@ -646,22 +619,14 @@ private:
   {
     return this->Scratch + "/level-" + std::to_string(level) + ".rank-" + std::to_string(rank);
   }
-  std::string ChunkPath(int rank) const
-  {
-    return this->Scratch + "/chunks-" + std::to_string(rank) + ".bin";
-  }
-  std::string NormalsPath(int64_t leaf) const
-  {
-    return this->Scratch + "/normals-" + std::to_string(leaf) + ".bin";
-  }
+  std::string ChunkPath(int rank) const { return this->Scratch + "/chunks-" + std::to_string(rank) + ".bin"; }
+  std::string NormalsPath(int64_t leaf) const { return this->Scratch + "/normals-" + std::to_string(leaf) + ".bin"; }
   void SaveLevel(int level);
   void LoadLevel(int level);
   bool ReadBuildManifest(MultiresolutionHeader& header, HierarchyReport& report);
   void WriteBuildManifest(const MultiresolutionHeader& header, const HierarchyReport& report) const;
   void FinishBoundsAndErrors(int leafLevel);
-  void BuildPropertySide(MultiresolutionHeader& header,
-    HierarchyReport& report,
-    std::vector<ModelChunk>& model);
+  void BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& report, std::vector<ModelChunk>& model);
 
   LayerSource& Source;
   std::string Output;
@@ -688,13 +653,11 @@ private:
 int Builder::ThreadsFor(int64_t bytesPerTask) const
 {
   constexpr int64_t cellsPerThread = 16384;
-  int threads = this->Options.threads > 0
-                  ? this->Options.threads
-                  : static_cast<int>(std::min<int64_t>(std::thread::hardware_concurrency(),
-                      (this->CellCount + cellsPerThread - 1) / cellsPerThread));
+  int threads = this->Options.threads > 0 ? this->Options.threads
+                                          : static_cast<int>(std::min<int64_t>(std::thread::hardware_concurrency(),
+                                              (this->CellCount + cellsPerThread - 1) / cellsPerThread));
   threads = std::max(threads, 1);
-  const int64_t budget =
-    this->Options.memoryBytes > 0 ? this->Options.memoryBytes : DefaultBuildMemoryBytes();
+  const int64_t budget = this->Options.memoryBytes > 0 ? this->Options.memoryBytes : DefaultBuildMemoryBytes();
   const int64_t fit = std::max<int64_t>(1, budget / std::max<int64_t>(bytesPerTask, 1));
   return static_cast<int>(std::min<int64_t>(threads, fit));
 }
@@ -751,9 +714,7 @@ void Builder::Emit(int level, int64_t index, const ScratchRegion& region, bool k
   record.ownError = static_cast<float>(ownError);
   // The file rounds positions to its lattice after simplification: allow one step more.
   const auto& step = this->Header.latticeStep;
-  const RegionMesh mesh = ToRegionMesh(region,
-    this->Header,
-    level == this->Header.leafLevel ? 0.f : record.ownError,
+  const RegionMesh mesh = ToRegionMesh(region, this->Header, level == this->Header.leafLevel ? 0.f : record.ownError,
     ownError + std::sqrt(step[0] * step[0] + step[1] * step[1] + step[2] * step[2]));
   this->Chunks->AddRegion(mesh, this->Header, record);
   std::lock_guard<std::mutex> guard(this->RecordLock);
@@ -793,12 +754,10 @@ void Builder::LoadLevel(int level)
     ManifestIn in;
     if (!in.Load(this->LevelManifest(level, r)))
     {
-      throw std::runtime_error(this->LevelManifest(level, r) + ": missing (rank " +
-                               std::to_string(r) + " did not finish level " +
-                               std::to_string(level) + ")");
+      throw std::runtime_error(this->LevelManifest(level, r) + ": missing (rank " + std::to_string(r) +
+        " did not finish level " + std::to_string(level) + ")");
     }
-    if (in.Get<uint64_t>() != BuildManifestMagic || in.Get<int32_t>() != level ||
-        in.Get<int32_t>() != r)
+    if (in.Get<uint64_t>() != BuildManifestMagic || in.Get<int32_t>() != level || in.Get<int32_t>() != r)
     {
       throw std::runtime_error(in.Path + ": not the manifest of this level and rank");
     }
@@ -816,8 +775,7 @@ void Builder::LoadLevel(int level)
   }
 }
 
-void Builder::WriteBuildManifest(const MultiresolutionHeader& header,
-  const HierarchyReport& report) const
+void Builder::WriteBuildManifest(const MultiresolutionHeader& header, const HierarchyReport& report) const
 {
   ManifestOut out;
   out.Put(BuildManifestMagic);
@@ -854,9 +812,8 @@ bool Builder::ReadBuildManifest(MultiresolutionHeader& header, HierarchyReport& 
   try
   {
     if (in.Get<uint64_t>() != BuildManifestMagic || in.GetString() != this->Source.Name() ||
-        in.Get<std::array<int64_t, 3>>() != this->Source.Dims() ||
-        in.Get<int64_t>() != this->Options.cmax || in.Get<uint64_t>() != this->Options.seed ||
-        in.Get<int32_t>() != this->Options.ranks)
+      in.Get<std::array<int64_t, 3>>() != this->Source.Dims() || in.Get<int64_t>() != this->Options.cmax ||
+      in.Get<uint64_t>() != this->Options.seed || in.Get<int32_t>() != this->Options.ranks)
     {
       return false;
     }
@@ -918,8 +875,7 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
       for (int64_t di = -1; di <= 1; ++di)
       {
         const int64_t i = ci + di, j = cj + dj;
-        if (i < i0 || j < j0 || i >= i1 || j >= j1 ||
-            !hasActive[static_cast<std::size_t>(j * nx + i)])
+        if (i < i0 || j < j0 || i >= i1 || j >= j1 || !hasActive[static_cast<std::size_t>(j * nx + i)])
         {
           continue;
         }
@@ -937,8 +893,7 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
     active[c] = activeBytes[c] != 0;
   }
   const LeafPartition& partition = *this->Partition;
-  const auto corners = [&](int64_t i, int64_t j, int64_t k, double out[8][3])
-  {
+  const auto corners = [&](int64_t i, int64_t j, int64_t k, double out[8][3]) {
     const float* z = &zcorn[static_cast<std::size_t>(((k * h + j) * w + i) * 8)];
     for (int c = 0; c < 8; ++c)
     {
@@ -958,8 +913,8 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
         corners(column % nx - i0, column / nx - j0, k, p);
         for (int face = 0; face < 2; ++face)
         {
-          const auto at = [&](int c)
-          { return glm::dvec3(p[4 * face + c][0], p[4 * face + c][1], -p[4 * face + c][2]); };
+          const auto at = [&](
+                            int c) { return glm::dvec3(p[4 * face + c][0], p[4 * face + c][1], -p[4 * face + c][2]); };
           glm::dvec3 n = glm::cross(at(1) - at(0) + at(3) - at(2), at(2) - at(0) + at(3) - at(1));
           if ((face == 0 && n.z < 0) || (face == 1 && n.z > 0))
           {
@@ -975,8 +930,7 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
     }
     normals.Save(this->NormalsPath(leaf));
   }
-  const ColumnMesh halo =
-    ColumnMesh::FromCells({ w, h, nz }, corners, active, 0, w, 0, h, &selected);
+  const ColumnMesh halo = ColumnMesh::FromCells({ w, h, nz }, corners, active, 0, w, 0, h, &selected);
   std::vector<uint8_t> keep(static_cast<std::size_t>(halo.ColumnSlots()), 0);
   for (int32_t c = 0; c < halo.ColumnSlots(); ++c)
   {
@@ -986,8 +940,7 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
   ScratchRegion region;
   region.mesh = halo.Export(&keep);
   std::vector<uint8_t> openSides;
-  UpdateOpenSides(
-    halo, std::vector<uint8_t>(static_cast<std::size_t>(halo.ColumnSlots()), 0), openSides);
+  UpdateOpenSides(halo, std::vector<uint8_t>(static_cast<std::size_t>(halo.ColumnSlots()), 0), openSides);
   region.openSides = KeptCells(openSides, keep, static_cast<std::size_t>(nz));
   for (int32_t c = 0; c < halo.ColumnSlots(); ++c)
   {
@@ -1018,8 +971,7 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
   }
   this->Emit(this->Tree.LeafLevel(), leaf, region, this->Tree.LeafLevel() > 0);
   this->WorkDone += static_cast<int64_t>(columns.size());
-  this->Report(this->Phase,
-    this->WorkStart + this->WorkSpan * static_cast<double>(this->WorkDone) / this->WorkTotal);
+  this->Report(this->Phase, this->WorkStart + this->WorkSpan * static_cast<double>(this->WorkDone) / this->WorkTotal);
 }
 
 /// The finished regions of a diamond's children (level + 1), read back from scratch.
@@ -1048,10 +1000,8 @@ std::vector<ScratchRegion> Builder::LoadChildren(const DiamondHierarchy::Diamond
 
 /// Splits the simplified diamond along its hypotenuse by column centre and emits each
 /// triangle's region with the edges cut towards the other triangle and other diamonds.
-void Builder::SplitAndEmit(const DiamondHierarchy::Diamond& diamond,
-  const ColumnMesh& mesh,
-  const std::vector<uint8_t>& childCut,
-  const std::vector<uint8_t>& openSides)
+void Builder::SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const ColumnMesh& mesh,
+  const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides)
 {
   const int32_t slots = mesh.ColumnSlots();
   const int32_t layers = mesh.Layers();
@@ -1132,16 +1082,14 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond)
   if (mesh.AliveColumns() > target)
   {
     ColumnCollapse collapse(mesh,
-      Mix(this->Options.seed ^
-          Mix(static_cast<uint64_t>(diamond.level) << 48 ^ static_cast<uint64_t>(diamond.first))));
+      Mix(this->Options.seed ^ Mix(static_cast<uint64_t>(diamond.level) << 48 ^ static_cast<uint64_t>(diamond.first))));
     collapse.Simplify(target);
   }
   // Cut edges left are on the diamond's boundary, where columns are locked and unchanged.
   UpdateOpenSides(mesh, childCut, openSides);
   this->SplitAndEmit(diamond, mesh, childCut, openSides);
   this->WorkDone += inputColumns;
-  this->Report(this->Phase,
-    this->WorkStart + this->WorkSpan * static_cast<double>(this->WorkDone) / this->WorkTotal);
+  this->Report(this->Phase, this->WorkStart + this->WorkSpan * static_cast<double>(this->WorkDone) / this->WorkTotal);
 }
 
 double Seconds()
@@ -1212,18 +1160,15 @@ void Builder::FinishBoundsAndErrors(int leafLevel)
         {
           // Rounded outward, so the float box still encloses the double one.
           record.bounds[i] = static_cast<float>(box[i]);
-          record.bounds[i] =
-            i < 3 ? std::nextafter(record.bounds[i], -std::numeric_limits<float>::infinity())
-                  : std::nextafter(record.bounds[i], std::numeric_limits<float>::infinity());
+          record.bounds[i] = i < 3 ? std::nextafter(record.bounds[i], -std::numeric_limits<float>::infinity())
+                                   : std::nextafter(record.bounds[i], std::numeric_limits<float>::infinity());
         }
       }
     }
   }
 }
 
-void Builder::BuildPropertySide(MultiresolutionHeader& header,
-  HierarchyReport& report,
-  std::vector<ModelChunk>& model)
+void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& report, std::vector<ModelChunk>& model)
 {
   const auto& dims = header.dims;
   const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
@@ -1247,18 +1192,13 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header,
   }
   const int threads = this->ThreadsFor(4 * this->Options.cmax * (nz + 1) * 64);
   this->Phase = "property side";
-  ParallelFor(static_cast<int64_t>(keys.size()),
-    threads,
-    [&](int64_t n)
-    {
-      const auto& key = keys[static_cast<std::size_t>(n)];
-      RegionMesh mesh =
-        parts[static_cast<std::size_t>(this->Parts[key])]->ReadRegion(this->Records[key], header);
-      ExtractSurfaces(mesh); // the exact side faces, which views draw for regions of small error
-      MarkTouchedCells(mesh, dims, touched);
-      this->Report(
-        this->Phase, 0.95 + 0.03 * static_cast<double>(n + 1) / static_cast<double>(keys.size()));
-    });
+  ParallelFor(static_cast<int64_t>(keys.size()), threads, [&](int64_t n) {
+    const auto& key = keys[static_cast<std::size_t>(n)];
+    RegionMesh mesh = parts[static_cast<std::size_t>(this->Parts[key])]->ReadRegion(this->Records[key], header);
+    ExtractSurfaces(mesh); // the exact side faces, which views draw for regions of small error
+    MarkTouchedCells(mesh, dims, touched);
+    this->Report(this->Phase, 0.95 + 0.03 * static_cast<double>(n + 1) / static_cast<double>(keys.size()));
+  });
   parts.clear();
 
   // Perfect spatial hash over them (Lefebvre and Hoppe), the cell of each slot.
@@ -1273,8 +1213,7 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header,
       const uint64_t n = word * 64 + static_cast<uint64_t>(bit);
       const uint64_t layer = static_cast<uint64_t>(nx * ny);
       hashed.push_back({ static_cast<uint32_t>(n % layer % static_cast<uint64_t>(nx)),
-        static_cast<uint32_t>(n % layer / static_cast<uint64_t>(nx)),
-        static_cast<uint32_t>(n / layer) });
+        static_cast<uint32_t>(n % layer / static_cast<uint64_t>(nx)), static_cast<uint32_t>(n / layer) });
     }
   }
   std::vector<std::atomic<uint64_t>>().swap(touched);
@@ -1296,8 +1235,7 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header,
     const uint64_t slot = hash.Slot(p[0], p[1], p[2]);
     slotCell[static_cast<std::size_t>(slot)] =
       p[0] + static_cast<uint64_t>(nx) * (p[1] + static_cast<uint64_t>(ny) * p[2]);
-    byColumn[c] = { (p[0] + static_cast<uint64_t>(nx) * p[1]) * static_cast<uint64_t>(nz) + p[2],
-      slot };
+    byColumn[c] = { (p[0] + static_cast<uint64_t>(nx) * p[1]) * static_cast<uint64_t>(nz) + p[2], slot };
   }
   std::vector<std::array<uint32_t, 3>>().swap(hashed);
   std::sort(byColumn.begin(), byColumn.end());
@@ -1310,17 +1248,15 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header,
     ManifestIn in;
     if (!in.Load(this->NormalsPath(entry.first.second)))
     {
-      throw std::runtime_error(
-        this->NormalsPath(entry.first.second) + ": missing scratch file of cell normals");
+      throw std::runtime_error(this->NormalsPath(entry.first.second) + ": missing scratch file of cell normals");
     }
     const uint64_t count = in.Get<uint64_t>();
     for (uint64_t c = 0; c < count; ++c)
     {
       const uint64_t column = static_cast<uint64_t>(in.Get<int64_t>());
       const uint8_t* stack = in.Skip(static_cast<std::size_t>(nz) * 4);
-      auto it = std::lower_bound(byColumn.begin(),
-        byColumn.end(),
-        std::make_pair(column * static_cast<uint64_t>(nz), uint64_t(0)));
+      auto it = std::lower_bound(
+        byColumn.begin(), byColumn.end(), std::make_pair(column * static_cast<uint64_t>(nz), uint64_t(0)));
       for (; it != byColumn.end() && it->first / static_cast<uint64_t>(nz) == column; ++it)
       {
         const uint64_t k = it->first % static_cast<uint64_t>(nz);
@@ -1335,8 +1271,7 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header,
   }
   this->Chunks->AddModelArray(ModelChunk::HashOffsets, offsets.data(), offsets.size() * 2, model);
   this->Chunks->AddModelArray(ModelChunk::HashCells, slotCell.data(), slotCell.size() * 8, model);
-  this->Chunks->AddModelArray(
-    ModelChunk::CellNormals, slotNormals.data(), slotNormals.size() * 4, model);
+  this->Chunks->AddModelArray(ModelChunk::CellNormals, slotNormals.data(), slotNormals.size() * 4, model);
 }
 
 /// Creates the scratch folder, or finds in it the last level every rank finished (-1: none,
@@ -1346,8 +1281,7 @@ int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& repo
   const bool lead = this->Options.rank == 0;
   if (mkdir(this->Scratch.c_str(), 0755) != 0 && errno != EEXIST)
   {
-    throw std::runtime_error(
-      this->Scratch + ": cannot create the scratch folder: " + std::strerror(errno));
+    throw std::runtime_error(this->Scratch + ": cannot create the scratch folder: " + std::strerror(errno));
   }
   int finished = -1;
   if (this->ReadBuildManifest(header, report))
@@ -1375,8 +1309,7 @@ int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& repo
       RemoveTree(this->Scratch);
       if (mkdir(this->Scratch.c_str(), 0755) != 0 && errno != EEXIST)
       {
-        throw std::runtime_error(
-          this->Scratch + ": cannot create the scratch folder: " + std::strerror(errno));
+        throw std::runtime_error(this->Scratch + ": cannot create the scratch folder: " + std::strerror(errno));
       }
     }
     for (int r = 0; r < this->Options.ranks; ++r)
@@ -1392,8 +1325,7 @@ int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& repo
 /// size it had then.
 void Builder::Resume(int finished, const MultiresolutionHeader& header)
 {
-  this->Tree =
-    DiamondHierarchy(header.box[0], header.box[1], header.box[2], header.box[3], header.leafLevel);
+  this->Tree = DiamondHierarchy(header.box[0], header.box[1], header.box[2], header.box[3], header.leafLevel);
   this->Options.cmax = header.cmax;
   for (int level = header.leafLevel; level >= finished; --level)
   {
@@ -1405,8 +1337,7 @@ void Builder::Resume(int finished, const MultiresolutionHeader& header)
   own.Get<int32_t>();
   own.Get<int32_t>();
   this->Header = header;
-  this->Chunks.reset(
-    new ChunkFile(this->ChunkPath(this->Options.rank), static_cast<int64_t>(own.Get<uint64_t>())));
+  this->Chunks.reset(new ChunkFile(this->ChunkPath(this->Options.rank), static_cast<int64_t>(own.Get<uint64_t>())));
 }
 
 /// The streaming pass (Sec. 4.2 and 7, "partitioning"): rank 0 reads the input once, layer by
@@ -1419,36 +1350,30 @@ void Builder::PartitionInput()
   this->Chunks.reset(new ChunkFile(this->ChunkPath(this->Options.rank)));
   // Tiles of about 64 x 64 columns, fewer and bigger for very wide grids (at most ~1000
   // files).
-  const int64_t tile = std::max<int64_t>(
-    64, static_cast<int64_t>(std::ceil(std::sqrt(double(dims[0]) * dims[1] / 1000.0))));
-  this->Collective(
-    [&]
+  const int64_t tile =
+    std::max<int64_t>(64, static_cast<int64_t>(std::ceil(std::sqrt(double(dims[0]) * dims[1] / 1000.0))));
+  this->Collective([&] {
+    if (!lead)
     {
-      if (!lead)
-      {
-        return;
-      }
-      std::vector<uint8_t> bits;
-      this->Partition.reset(new LeafPartition(
-        this->Source,
-        this->Scratch + "/tiles",
-        tile,
-        [this](double f) { this->Report("partition", 0.1 * f); },
-        [&](int64_t k, const std::vector<uint8_t>& active)
+      return;
+    }
+    std::vector<uint8_t> bits;
+    this->Partition.reset(new LeafPartition(
+      this->Source, this->Scratch + "/tiles", tile, [this](double f) { this->Report("partition", 0.1 * f); },
+      [&](int64_t k, const std::vector<uint8_t>& active) {
+        bits.assign((active.size() + 7) / 8, 0);
+        for (std::size_t c = 0; c < active.size(); ++c)
         {
-          bits.assign((active.size() + 7) / 8, 0);
-          for (std::size_t c = 0; c < active.size(); ++c)
-          {
-            bits[c >> 3] |= static_cast<uint8_t>((active[c] ? 1 : 0) << (c & 7));
-          }
-          ModelChunk chunk;
-          chunk.kind = ModelChunk::ActiveLayer;
-          chunk.part = static_cast<uint32_t>(k);
-          chunk.chunk = this->Chunks->Put(bits, "active flags of layer " + std::to_string(k + 1));
-          this->ActiveLayers.push_back(chunk);
-        }));
-      this->Partition->SaveState();
-    });
+          bits[c >> 3] |= static_cast<uint8_t>((active[c] ? 1 : 0) << (c & 7));
+        }
+        ModelChunk chunk;
+        chunk.kind = ModelChunk::ActiveLayer;
+        chunk.part = static_cast<uint32_t>(k);
+        chunk.chunk = this->Chunks->Put(bits, "active flags of layer " + std::to_string(k + 1));
+        this->ActiveLayers.push_back(chunk);
+      }));
+    this->Partition->SaveState();
+  });
   if (!lead)
   {
     this->Partition.reset(new LeafPartition(this->Scratch + "/tiles"));
@@ -1458,8 +1383,7 @@ void Builder::PartitionInput()
 /// The hierarchy over the pillars' extent, its leaf level chosen for Cmax columns a leaf, and
 /// the columns of each leaf (by column centre); fills the header and writes the build
 /// manifest.
-std::vector<Builder::Leaf> Builder::PlanLeaves(MultiresolutionHeader& header,
-  HierarchyReport& report)
+std::vector<Builder::Leaf> Builder::PlanLeaves(MultiresolutionHeader& header, HierarchyReport& report)
 {
   const auto dims = this->Source.Dims();
   const int64_t nx = dims[0], ny = dims[1];
@@ -1494,8 +1418,7 @@ std::vector<Builder::Leaf> Builder::PlanLeaves(MultiresolutionHeader& header,
   std::vector<Leaf> leaves;
   for (const auto& entry : coded)
   {
-    const int64_t leaf =
-      static_cast<int64_t>(entry.first >> (DiamondHierarchy::MaxDepth - leafLevel));
+    const int64_t leaf = static_cast<int64_t>(entry.first >> (DiamondHierarchy::MaxDepth - leafLevel));
     if (leaves.empty() || leaves.back().first != leaf)
     {
       leaves.push_back({ leaf, {} });
@@ -1533,18 +1456,13 @@ void Builder::BuildLeaves(const std::vector<Leaf>& leaves, int leafLevel, Hierar
   const int leafThreads = this->ThreadsFor(leafTask);
   report.threadsUsed = leafThreads;
   const std::vector<std::size_t> mine = this->Share(leaves.size());
-  this->Collective(
-    [&]
-    {
-      ParallelFor(static_cast<int64_t>(mine.size()),
-        leafThreads,
-        [&](int64_t n)
-        {
-          const auto& leaf = leaves[mine[static_cast<std::size_t>(n)]];
-          this->BuildLeaf(leaf.first, leaf.second);
-        });
-      this->SaveLevel(leafLevel);
+  this->Collective([&] {
+    ParallelFor(static_cast<int64_t>(mine.size()), leafThreads, [&](int64_t n) {
+      const auto& leaf = leaves[mine[static_cast<std::size_t>(n)]];
+      this->BuildLeaf(leaf.first, leaf.second);
     });
+    this->SaveLevel(leafLevel);
+  });
   this->LoadLevel(leafLevel);
   report.leafSeconds = Seconds() - leafStart;
   // Tiles are no longer needed: other ranks close theirs before rank 0 removes them.
@@ -1589,9 +1507,7 @@ void Builder::SimplifyLevels(int finished, HierarchyReport& report)
     std::vector<DiamondHierarchy::Diamond> busy;
     for (const auto& d : this->Tree.Diamonds(level))
     {
-      const int64_t children[4] = { 2 * d.first,
-        2 * d.first + 1,
-        d.second >= 0 ? 2 * d.second : -1,
+      const int64_t children[4] = { 2 * d.first, 2 * d.first + 1, d.second >= 0 ? 2 * d.second : -1,
         d.second >= 0 ? 2 * d.second + 1 : -1 };
       for (int64_t child : children)
       {
@@ -1603,14 +1519,11 @@ void Builder::SimplifyLevels(int finished, HierarchyReport& report)
       }
     }
     const std::vector<std::size_t> mine = this->Share(busy.size());
-    this->Collective(
-      [&]
-      {
-        ParallelFor(static_cast<int64_t>(mine.size()),
-          diamondThreads,
-          [&](int64_t n) { this->BuildDiamond(busy[mine[static_cast<std::size_t>(n)]]); });
-        this->SaveLevel(level);
-      });
+    this->Collective([&] {
+      ParallelFor(static_cast<int64_t>(mine.size()), diamondThreads,
+        [&](int64_t n) { this->BuildDiamond(busy[mine[static_cast<std::size_t>(n)]]); });
+      this->SaveLevel(level);
+    });
     this->LoadLevel(level);
     if (this->Options.rank == 0)
     {
@@ -1629,41 +1542,38 @@ void Builder::SimplifyLevels(int finished, HierarchyReport& report)
 /// Rank 0: errors and bounds, the property side, then the file from every rank's chunks.
 void Builder::WriteFile(MultiresolutionHeader& header, HierarchyReport& report)
 {
-  this->Collective(
-    [&]
+  this->Collective([&] {
+    if (this->Options.rank != 0)
     {
-      if (this->Options.rank != 0)
-      {
-        return;
-      }
-      this->FinishBoundsAndErrors(header.leafLevel);
-      std::vector<ModelChunk> model = this->ActiveLayers;
-      this->BuildPropertySide(header, report, model);
-      this->Chunks->Sync();
-      std::vector<std::string> paths;
-      for (int r = 0; r < this->Options.ranks; ++r)
-      {
-        paths.push_back(this->ChunkPath(r));
-      }
-      std::vector<PartRecord<RegionRecord>> regions;
-      for (const auto& entry : this->Records)
-      {
-        regions.push_back({ this->Parts[entry.first], entry.second });
-        report.nonEmptyRegions += entry.second.columns > 0 ? 1 : 0;
-      }
-      std::vector<PartRecord<ModelChunk>> modelParts;
-      for (const ModelChunk& m : model)
-      {
-        modelParts.push_back({ 0, m });
-      }
-      report.regions = static_cast<int64_t>(regions.size());
-      header.map = this->Source.Placement(); // recorded only: positions stay in grid coordinates
-      this->Report("writing", 0.99);
-      AssembleMultiresolutionFile(this->Output, header, paths, regions, modelParts);
-      struct stat info;
-      report.fileBytes =
-        stat(this->Output.c_str(), &info) == 0 ? static_cast<uint64_t>(info.st_size) : 0;
-    });
+      return;
+    }
+    this->FinishBoundsAndErrors(header.leafLevel);
+    std::vector<ModelChunk> model = this->ActiveLayers;
+    this->BuildPropertySide(header, report, model);
+    this->Chunks->Sync();
+    std::vector<std::string> paths;
+    for (int r = 0; r < this->Options.ranks; ++r)
+    {
+      paths.push_back(this->ChunkPath(r));
+    }
+    std::vector<PartRecord<RegionRecord>> regions;
+    for (const auto& entry : this->Records)
+    {
+      regions.push_back({ this->Parts[entry.first], entry.second });
+      report.nonEmptyRegions += entry.second.columns > 0 ? 1 : 0;
+    }
+    std::vector<PartRecord<ModelChunk>> modelParts;
+    for (const ModelChunk& m : model)
+    {
+      modelParts.push_back({ 0, m });
+    }
+    report.regions = static_cast<int64_t>(regions.size());
+    header.map = this->Source.Placement(); // recorded only: positions stay in grid coordinates
+    this->Report("writing", 0.99);
+    AssembleMultiresolutionFile(this->Output, header, paths, regions, modelParts);
+    struct stat info;
+    report.fileBytes = stat(this->Output.c_str(), &info) == 0 ? static_cast<uint64_t>(info.st_size) : 0;
+  });
 }
 
 HierarchyReport Builder::Run()
@@ -1709,8 +1619,8 @@ HierarchyReport Builder::Run()
       }
       throw;
     }
-    throw std::runtime_error(std::string(error.what()) + " (finished levels are kept in " +
-                             this->Scratch + ": run the same build again to resume)");
+    throw std::runtime_error(std::string(error.what()) + " (finished levels are kept in " + this->Scratch +
+      ": run the same build again to resume)");
   }
   this->Chunks.reset();
   this->Barrier();
@@ -1729,10 +1639,8 @@ std::string ScratchFolder(const std::string& output, const HierarchyOptions& opt
   return options.scratch.empty() ? output + ".scratch" : options.scratch;
 }
 
-HierarchyReport BuildHierarchy(LayerSource& source,
-  const std::string& output,
-  const HierarchyOptions& options,
-  const BuildProgress& progress)
+HierarchyReport BuildHierarchy(
+  LayerSource& source, const std::string& output, const HierarchyOptions& options, const BuildProgress& progress)
 {
   Builder builder(source, output, options, progress);
   return builder.Run();

@@ -88,9 +88,7 @@ std::string ScratchFolder(const std::string& output, const HierarchyOptions& opt
 /// Builds `output` (.resmr) from the layers of `source`. Throws std::runtime_error (or a
 /// subclass) naming the input or file on failure; the output is then not created and any
 /// older file of that name is left as it was.
-HierarchyReport BuildHierarchy(LayerSource& source,
-  const std::string& output,
-  const HierarchyOptions& options,
-  const BuildProgress& progress = {});
+HierarchyReport BuildHierarchy(
+  LayerSource& source, const std::string& output, const HierarchyOptions& options, const BuildProgress& progress = {});
 
 } // namespace resmr

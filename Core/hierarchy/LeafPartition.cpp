@@ -18,11 +18,7 @@ namespace resmr
 {
 namespace
 {
-void WriteAll(int descriptor,
-  const void* data,
-  std::size_t size,
-  off_t offset,
-  const std::string& path)
+void WriteAll(int descriptor, const void* data, std::size_t size, off_t offset, const std::string& path)
 {
   const auto* bytes = static_cast<const uint8_t*>(data);
   while (size > 0)
@@ -30,8 +26,8 @@ void WriteAll(int descriptor,
     const ssize_t written = pwrite(descriptor, bytes, size, offset);
     if (written <= 0)
     {
-      throw std::runtime_error(path + ": scratch write at byte " + std::to_string(offset) +
-                               " failed: " + std::strerror(errno));
+      throw std::runtime_error(
+        path + ": scratch write at byte " + std::to_string(offset) + " failed: " + std::strerror(errno));
     }
     bytes += written;
     size -= static_cast<std::size_t>(written);
@@ -47,10 +43,8 @@ void ReadAll(int descriptor, void* data, std::size_t size, off_t offset, const s
     const ssize_t got = pread(descriptor, bytes, size, offset);
     if (got <= 0)
     {
-      throw std::runtime_error(path + ": scratch read at byte " + std::to_string(offset) +
-                               " failed" +
-                               (got < 0 ? std::string(": ") + std::strerror(errno)
-                                        : std::string(" (file shorter than written)")));
+      throw std::runtime_error(path + ": scratch read at byte " + std::to_string(offset) + " failed" +
+        (got < 0 ? std::string(": ") + std::strerror(errno) : std::string(" (file shorter than written)")));
     }
     bytes += got;
     size -= static_cast<std::size_t>(got);
@@ -59,9 +53,7 @@ void ReadAll(int descriptor, void* data, std::size_t size, off_t offset, const s
 }
 } // namespace
 
-LeafPartition::LeafPartition(LayerSource& source,
-  const std::string& folder,
-  int64_t tileSize,
+LeafPartition::LeafPartition(LayerSource& source, const std::string& folder, int64_t tileSize,
   const std::function<void(double)>& progress,
   const std::function<void(int64_t k, const std::vector<uint8_t>& active)>& onLayer)
   : Dimensions(source.Dims())
@@ -72,14 +64,12 @@ LeafPartition::LeafPartition(LayerSource& source,
   const int64_t nx = this->Dimensions[0], ny = this->Dimensions[1], nz = this->Dimensions[2];
   if (static_cast<int64_t>(this->CoordValues.size()) != 6 * (nx + 1) * (ny + 1))
   {
-    throw std::invalid_argument(source.Name() + ": COORD holds " +
-                                std::to_string(this->CoordValues.size()) + " values, " +
-                                std::to_string(6 * (nx + 1) * (ny + 1)) + " expected");
+    throw std::invalid_argument(source.Name() + ": COORD holds " + std::to_string(this->CoordValues.size()) +
+      " values, " + std::to_string(6 * (nx + 1) * (ny + 1)) + " expected");
   }
   if (mkdir(folder.c_str(), 0755) != 0 && errno != EEXIST)
   {
-    throw std::runtime_error(
-      folder + ": cannot create the scratch folder: " + std::strerror(errno));
+    throw std::runtime_error(folder + ": cannot create the scratch folder: " + std::strerror(errno));
   }
   this->TilesX = (nx + this->Tile - 1) / this->Tile;
   this->TilesY = (ny + this->Tile - 1) / this->Tile;
@@ -116,7 +106,7 @@ LeafPartition::LeafPartition(LayerSource& source,
   for (int64_t k = 0; k < nz; ++k)
   {
     if (!source.Next(zcorn, active) || static_cast<int64_t>(zcorn.size()) != 8 * nx * ny ||
-        static_cast<int64_t>(active.size()) != nx * ny)
+      static_cast<int64_t>(active.size()) != nx * ny)
     {
       throw std::runtime_error(
         source.Name() + ": layer " + std::to_string(k + 1) + " is missing or has the wrong size");
@@ -141,9 +131,8 @@ LeafPartition::LeafPartition(LayerSource& source,
             (c >> 2) * 4 * nx * ny + (2 * j + ((c >> 1) & 1)) * 2 * nx + 2 * i + (c & 1))];
           if (!std::isfinite(z))
           {
-            throw std::runtime_error(source.Name() + ": cell (" + std::to_string(i + 1) + ", " +
-                                     std::to_string(j + 1) + ", " + std::to_string(k + 1) +
-                                     ") has a non-finite corner depth");
+            throw std::runtime_error(source.Name() + ": cell (" + std::to_string(i + 1) + ", " + std::to_string(j + 1) +
+              ", " + std::to_string(k + 1) + ") has a non-finite corner depth");
           }
           this->Bounds[2] = std::min(this->Bounds[2], z);
           this->Bounds[5] = std::max(this->Bounds[5], z);
@@ -169,8 +158,7 @@ LeafPartition::LeafPartition(LayerSource& source,
               out[c] = zcorn[static_cast<std::size_t>(
                 (c >> 2) * 4 * nx * ny + (2 * gj + ((c >> 1) & 1)) * 2 * nx + 2 * gi + (c & 1))];
             }
-            tileActive[static_cast<std::size_t>(j * w + i)] =
-              active[static_cast<std::size_t>(gj * nx + gi)];
+            tileActive[static_cast<std::size_t>(j * w + i)] = active[static_cast<std::size_t>(gj * nx + gi)];
           }
         }
         const std::size_t layerBytes = static_cast<std::size_t>(w * h) * 33;
@@ -178,11 +166,7 @@ LeafPartition::LeafPartition(LayerSource& source,
         std::memcpy(bytes.data(), tileZ.data(), tileZ.size() * 4);
         std::memcpy(bytes.data() + tileZ.size() * 4, tileActive.data(), tileActive.size());
         const int descriptor = this->Descriptors[static_cast<std::size_t>(tj * this->TilesX + ti)];
-        WriteAll(descriptor,
-          bytes.data(),
-          bytes.size(),
-          static_cast<off_t>(k * layerBytes),
-          this->TilePath(ti, tj));
+        WriteAll(descriptor, bytes.data(), bytes.size(), static_cast<off_t>(k * layerBytes), this->TilePath(ti, tj));
       }
     }
     if (progress)
@@ -254,23 +238,20 @@ LeafPartition::LeafPartition(const std::string& folder)
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (!file)
   {
-    throw std::runtime_error(
-      path + ": cannot open the partition written by rank 0: " + std::strerror(errno));
+    throw std::runtime_error(path + ": cannot open the partition written by rank 0: " + std::strerror(errno));
   }
   uint64_t coordCount = 0, columnCount = 0;
   bool ok = std::fread(this->Dimensions.data(), sizeof(int64_t), 3, file) == 3;
   ok = ok && std::fread(&this->Tile, sizeof(int64_t), 1, file) == 1 && this->Tile > 0;
   ok = ok && std::fread(&this->ActiveCount, sizeof(int64_t), 1, file) == 1;
   ok = ok && std::fread(this->Bounds.data(), sizeof(double), 6, file) == 6;
-  ok = ok && std::fread(&coordCount, sizeof(uint64_t), 1, file) == 1 &&
-       coordCount < (uint64_t(1) << 40);
+  ok = ok && std::fread(&coordCount, sizeof(uint64_t), 1, file) == 1 && coordCount < (uint64_t(1) << 40);
   if (ok)
   {
     this->CoordValues.resize(coordCount);
     ok = std::fread(this->CoordValues.data(), sizeof(double), coordCount, file) == coordCount;
   }
-  ok = ok && std::fread(&columnCount, sizeof(uint64_t), 1, file) == 1 &&
-       columnCount < (uint64_t(1) << 40);
+  ok = ok && std::fread(&columnCount, sizeof(uint64_t), 1, file) == 1 && columnCount < (uint64_t(1) << 40);
   if (ok)
   {
     this->AnyActive.resize(columnCount);
@@ -322,18 +303,11 @@ std::array<double, 2> LeafPartition::ColumnCentre(int64_t i, int64_t j) const
 
 void LeafPartition::PillarPoint(int64_t pi, int64_t pj, double depth, double xyz[3]) const
 {
-  PointOnPillar(
-    &this->CoordValues[static_cast<std::size_t>(6 * (pj * (this->Dimensions[0] + 1) + pi))],
-    depth,
-    xyz);
+  PointOnPillar(&this->CoordValues[static_cast<std::size_t>(6 * (pj * (this->Dimensions[0] + 1) + pi))], depth, xyz);
 }
 
-void LeafPartition::ReadBox(int64_t i0,
-  int64_t i1,
-  int64_t j0,
-  int64_t j1,
-  std::vector<float>& zcorn,
-  std::vector<uint8_t>& active) const
+void LeafPartition::ReadBox(
+  int64_t i0, int64_t i1, int64_t j0, int64_t j1, std::vector<float>& zcorn, std::vector<uint8_t>& active) const
 {
   const int64_t nx = this->Dimensions[0], ny = this->Dimensions[1], nz = this->Dimensions[2];
   if (i0 < 0 || j0 < 0 || i1 > nx || j1 > ny || i0 >= i1 || j0 >= j1)
@@ -362,16 +336,9 @@ void LeafPartition::ReadBox(int64_t i0,
       for (int64_t k = 0; k < nz; ++k)
       {
         const off_t base = static_cast<off_t>(k * layerBytes);
-        ReadAll(descriptor,
-          row.data(),
-          row.size(),
-          base + static_cast<off_t>((b0 - tj0) * tw * 32),
-          path);
-        ReadAll(descriptor,
-          flags.data(),
-          flags.size(),
-          base + static_cast<off_t>(tw * th * 32 + (b0 - tj0) * tw),
-          path);
+        ReadAll(descriptor, row.data(), row.size(), base + static_cast<off_t>((b0 - tj0) * tw * 32), path);
+        ReadAll(
+          descriptor, flags.data(), flags.size(), base + static_cast<off_t>(tw * th * 32 + (b0 - tj0) * tw), path);
         for (int64_t j = b0; j < b1; ++j)
         {
           for (int64_t i = a0; i < a1; ++i)

@@ -32,9 +32,7 @@ public:
   /// std::runtime_error naming the file on a failed write.
   /// `onLayer`, if given, sees each layer's active flags (one a cell, i fastest) as it
   /// streams by.
-  LeafPartition(LayerSource& source,
-    const std::string& folder,
-    int64_t tileSize,
+  LeafPartition(LayerSource& source, const std::string& folder, int64_t tileSize,
     const std::function<void(double)>& progress = {},
     const std::function<void(int64_t k, const std::vector<uint8_t>& active)>& onLayer = {});
   /// Opens the tiles another process wrote in `folder` (after its SaveState()), read-only;
@@ -56,12 +54,8 @@ public:
   const std::array<double, 6>& Extent() const { return this->Bounds; }
   int64_t ActiveCells() const { return this->ActiveCount; }
 
-  void ReadBox(int64_t i0,
-    int64_t i1,
-    int64_t j0,
-    int64_t j1,
-    std::vector<float>& zcorn,
-    std::vector<uint8_t>& active) const;
+  void ReadBox(
+    int64_t i0, int64_t i1, int64_t j0, int64_t j1, std::vector<float>& zcorn, std::vector<uint8_t>& active) const;
 
   /// Corner (x, y, depth) of a cell corner at `depth` on pillar (pi, pj), by COORD.
   void PillarPoint(int64_t pi, int64_t pj, double depth, double xyz[3]) const;

@@ -59,8 +59,7 @@ uint16_t EncodeUnitNormal(double x, double y, double z)
   const double nx = x / euclid, ny = y / euclid, nz = z / euclid;
   // Of the four codes around (u, v), the one nearest in angle; codes that would flip z's sign
   // lose to any that keep it (rounding both toward zero keeps z >= 0, away from zero z <= 0).
-  const int lowU = static_cast<int>(std::floor(u * Levels)),
-            lowV = static_cast<int>(std::floor(v * Levels));
+  const int lowU = static_cast<int>(std::floor(u * Levels)), lowV = static_cast<int>(std::floor(v * Levels));
   int bestU = 0, bestV = 0;
   bool bestKeepsSign = false;
   double bestCosine = -2;
@@ -68,12 +67,10 @@ uint16_t EncodeUnitNormal(double x, double y, double z)
   {
     for (int dv = 0; dv < 2; ++dv)
     {
-      const int su = std::clamp(lowU + du, -Levels, Levels),
-                sv = std::clamp(lowV + dv, -Levels, Levels);
+      const int su = std::clamp(lowU + du, -Levels, Levels), sv = std::clamp(lowV + dv, -Levels, Levels);
       const std::array<int, 3> p = Unfold(su, sv);
       const bool keepsSign = z > 0 ? p[2] >= 0 : z < 0 ? p[2] <= 0 : true;
-      const double length =
-        std::sqrt(double(p[0]) * p[0] + double(p[1]) * p[1] + double(p[2]) * p[2]);
+      const double length = std::sqrt(double(p[0]) * p[0] + double(p[1]) * p[1] + double(p[2]) * p[2]);
       const double cosine = (nx * p[0] + ny * p[1] + nz * p[2]) / length;
       if (keepsSign > bestKeepsSign || (keepsSign == bestKeepsSign && cosine > bestCosine))
       {
@@ -91,9 +88,7 @@ std::array<float, 3> DecodeUnitNormal(uint16_t code)
 {
   const std::array<int, 3> p = Unfold(Unpack(code & 0xFF), Unpack(code >> 8));
   const double length = std::sqrt(double(p[0]) * p[0] + double(p[1]) * p[1] + double(p[2]) * p[2]);
-  return { static_cast<float>(p[0] / length),
-    static_cast<float>(p[1] / length),
-    static_cast<float>(p[2] / length) };
+  return { static_cast<float>(p[0] / length), static_cast<float>(p[1] / length), static_cast<float>(p[2] / length) };
 }
 
 } // namespace resmr

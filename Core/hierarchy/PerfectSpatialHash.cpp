@@ -55,9 +55,8 @@ int LowestBit(uint64_t word)
 
 [[noreturn]] void ThrowDuplicate(const Cell& c)
 {
-  throw std::invalid_argument("perfect spatial hash: cell (" + std::to_string(uint64_t(c[0]) + 1) +
-                              ", " + std::to_string(uint64_t(c[1]) + 1) + ", " +
-                              std::to_string(uint64_t(c[2]) + 1) + ") listed twice");
+  throw std::invalid_argument("perfect spatial hash: cell (" + std::to_string(uint64_t(c[0]) + 1) + ", " +
+    std::to_string(uint64_t(c[1]) + 1) + ", " + std::to_string(uint64_t(c[2]) + 1) + ") listed twice");
 }
 
 /// Whether no two cells agree modulo m[a] r[a] on every axis a. With gcd(m[a], r[a]) = 1 that
@@ -74,9 +73,7 @@ bool Separable(const std::vector<Cell>& cells, const Sides& m, const Sides& r)
   for (uint32_t n = 0; n < cells.size(); ++n)
   {
     const Cell& c = cells[n];
-    keyed[n] = {
-      { uint32_t(c[0] % product[0]), uint32_t(c[1] % product[1]), uint32_t(c[2] % product[2]) }, n
-    };
+    keyed[n] = { { uint32_t(c[0] % product[0]), uint32_t(c[1] % product[1]), uint32_t(c[2] % product[2]) }, n };
   }
   std::sort(keyed.begin(), keyed.end());
   bool separable = true;
@@ -173,22 +170,15 @@ private:
         this->Order.push_back(q);
       }
     }
-    std::sort(this->Order.begin(),
-      this->Order.end(),
-      [this](uint32_t a, uint32_t b)
-      {
-        const uint32_t sizeA = this->First[a + 1] - this->First[a],
-                       sizeB = this->First[b + 1] - this->First[b];
-        return sizeA != sizeB ? sizeA > sizeB : a < b;
-      });
+    std::sort(this->Order.begin(), this->Order.end(), [this](uint32_t a, uint32_t b) {
+      const uint32_t sizeA = this->First[a + 1] - this->First[a], sizeB = this->First[b + 1] - this->First[b];
+      return sizeA != sizeB ? sizeA > sizeB : a < b;
+    });
   }
 
   bool Free(uint32_t slot) const { return !(this->Occupied[slot >> 6] >> (slot & 63) & 1); }
 
-  uint32_t Wrap(uint32_t value, int axis) const
-  {
-    return value >= this->M[axis] ? value - this->M[axis] : value;
-  }
+  uint32_t Wrap(uint32_t value, int axis) const { return value >= this->M[axis] ? value - this->M[axis] : value; }
 
   /// The permuted slot of a cell of permuted h0 `h` under permuted offset `psi`.
   uint32_t SlotOf(const Sides& h, const Sides& psi) const
@@ -273,8 +263,7 @@ private:
         const uint32_t slot = static_cast<uint32_t>(w * 64 + LowestBit(word));
         word &= word - 1;
         const uint32_t x = slot % m[0], y = slot / m[0] % m[1], z = slot / m[0] / m[1];
-        const Sides psi{ this->Wrap(x + m[0] - h[0], 0),
-          this->Wrap(y + m[1] - h[1], 1),
+        const Sides psi{ this->Wrap(x + m[0] - h[0], 0), this->Wrap(y + m[1] - h[1], 1),
           this->Wrap(z + m[2] - h[2], 2) };
         if (this->Fits(psi))
         {
@@ -330,10 +319,9 @@ Sides Extent(const std::vector<Cell>& cells)
   Sides extent{ 1, 1, 1 };
   for (int a = 0; a < 3; ++a)
   {
-    const auto [low, high] = std::minmax_element(
-      cells.begin(), cells.end(), [a](const Cell& x, const Cell& y) { return x[a] < y[a]; });
-    extent[a] =
-      static_cast<uint32_t>(std::min<uint64_t>(uint64_t((*high)[a]) - (*low)[a] + 1, UINT32_MAX));
+    const auto [low, high] =
+      std::minmax_element(cells.begin(), cells.end(), [a](const Cell& x, const Cell& y) { return x[a] < y[a]; });
+    extent[a] = static_cast<uint32_t>(std::min<uint64_t>(uint64_t((*high)[a]) - (*low)[a] + 1, UINT32_MAX));
   }
   return extent;
 }
@@ -397,20 +385,16 @@ Sides ProportionalSides(const Sides& extent, double target, const Sides& cap)
 std::vector<Sides> TableShapes(const Sides& extent, uint64_t n, uint64_t target, bool big)
 {
   constexpr uint32_t maxSide = PerfectSpatialHash::MaxSide;
-  const Sides cap{
-    std::min(extent[0], maxSide), std::min(extent[1], maxSide), std::min(extent[2], maxSide)
-  };
+  const Sides cap{ std::min(extent[0], maxSide), std::min(extent[1], maxSide), std::min(extent[2], maxSide) };
   std::vector<Sides> shapes;
   if (extent[2] <= maxSide)
   {
-    Sides deep = ProportionalSides(
-      { extent[0], extent[1], 1 }, double(target) / extent[2], { maxSide, maxSide, 1 });
+    Sides deep = ProportionalSides({ extent[0], extent[1], 1 }, double(target) / extent[2], { maxSide, maxSide, 1 });
     deep[2] = extent[2];
     shapes.push_back(deep);
   }
   shapes.push_back(ProportionalSides(extent, double(target), cap));
-  const uint32_t a =
-    static_cast<uint32_t>(std::max<double>(1, std::floor(std::cbrt(double(target)))));
+  const uint32_t a = static_cast<uint32_t>(std::max<double>(1, std::floor(std::cbrt(double(target)))));
   const uint32_t b = static_cast<uint32_t>(std::ceil(double(target) / a / a));
   const uint32_t c = static_cast<uint32_t>(std::ceil(std::sqrt(double(target) / a)));
   shapes.push_back({ a, a, b });
@@ -423,8 +407,8 @@ std::vector<Sides> TableShapes(const Sides& extent, uint64_t n, uint64_t target,
   for (const Sides& m : shapes)
   {
     const uint64_t slots = uint64_t(m[0]) * m[1] * m[2];
-    if (slots >= n && double(slots) <= double(target) * 1.005 + 1 && m[0] <= maxSide &&
-        m[1] <= maxSide && m[2] <= maxSide)
+    if (slots >= n && double(slots) <= double(target) * 1.005 + 1 && m[0] <= maxSide && m[1] <= maxSide &&
+      m[2] <= maxSide)
     {
       kept.push_back(m);
     }
@@ -471,21 +455,17 @@ std::vector<Sides> OffsetShapes(const Sides& extent, uint64_t n, const Sides& m,
 }
 } // namespace
 
-bool PackPerfectSpatialHash(const std::vector<Cell>& cells,
-  const Sides& tableSides,
-  const Sides& offsetSides,
-  PerfectSpatialHash& hash)
+bool PackPerfectSpatialHash(
+  const std::vector<Cell>& cells, const Sides& tableSides, const Sides& offsetSides, PerfectSpatialHash& hash)
 {
   ++hash.attempts;
   for (int a = 0; a < 3; ++a)
   {
     if (tableSides[a] < 1 || offsetSides[a] < 1 || tableSides[a] > PerfectSpatialHash::MaxSide ||
-        offsetSides[a] > PerfectSpatialHash::MaxSide ||
-        std::gcd(tableSides[a], offsetSides[a]) != 1)
+      offsetSides[a] > PerfectSpatialHash::MaxSide || std::gcd(tableSides[a], offsetSides[a]) != 1)
     {
       throw std::invalid_argument("perfect spatial hash: table sides must be 1 to " +
-                                  std::to_string(PerfectSpatialHash::MaxSide) +
-                                  " and coprime with the offset table's");
+        std::to_string(PerfectSpatialHash::MaxSide) + " and coprime with the offset table's");
     }
   }
   if (cells.empty())
@@ -525,8 +505,7 @@ PerfectSpatialHash BuildPerfectSpatialHash(const std::vector<Cell>& cells)
   const uint64_t n = cells.size();
   if (n > PerfectSpatialHash::MaxTableSize)
   {
-    throw std::invalid_argument(
-      "perfect spatial hash: " + std::to_string(n) + " cells are too many");
+    throw std::invalid_argument("perfect spatial hash: " + std::to_string(n) + " cells are too many");
   }
   const Sides extent = Extent(cells);
 
@@ -569,8 +548,7 @@ PerfectSpatialHash BuildPerfectSpatialHash(const std::vector<Cell>& cells)
     for (uint64_t r = CeilCbrt((n + 5) / 6); r <= m; r += 1 + r / 4)
     {
       const uint32_t coprime = CoprimeAtLeast(m, r);
-      if (coprime <= m &&
-          PackPerfectSpatialHash(cells, { m, m, m }, { coprime, coprime, coprime }, hash))
+      if (coprime <= m && PackPerfectSpatialHash(cells, { m, m, m }, { coprime, coprime, coprime }, hash))
       {
         return hash;
       }
@@ -581,8 +559,7 @@ PerfectSpatialHash BuildPerfectSpatialHash(const std::vector<Cell>& cells)
     }
   }
   throw std::invalid_argument("perfect spatial hash: " + std::to_string(n) +
-                              " cells spread too thinly for a table of side " +
-                              std::to_string(PerfectSpatialHash::MaxSide));
+    " cells spread too thinly for a table of side " + std::to_string(PerfectSpatialHash::MaxSide));
 }
 
 std::vector<uint64_t> CellSlots(const PerfectSpatialHash& hash, const std::vector<Cell>& cells)

@@ -54,20 +54,15 @@ struct PerfectSpatialHash
   uint32_t attempts = 0;                        // packings tried; diagnostic only
 
   uint64_t TableSize() const { return uint64_t(tableSides[0]) * tableSides[1] * tableSides[2]; }
-  uint64_t OffsetTableSize() const
-  {
-    return uint64_t(offsetSides[0]) * offsetSides[1] * offsetSides[2];
-  }
+  uint64_t OffsetTableSize() const { return uint64_t(offsetSides[0]) * offsetSides[1] * offsetSides[2]; }
 
   /// h(p) as in the contract; defined for any cell of a built hash.
   uint64_t Slot(uint32_t i, uint32_t j, uint32_t k) const
   {
     const Sides& m = this->tableSides;
     const Sides& r = this->offsetSides;
-    const std::array<uint16_t, 3>& phi =
-      offsets[i % r[0] + uint64_t(r[0]) * (j % r[1] + uint64_t(r[1]) * (k % r[2]))];
-    const uint64_t x = (i % m[0] + phi[0]) % m[0], y = (j % m[1] + phi[1]) % m[1],
-                   z = (k % m[2] + phi[2]) % m[2];
+    const std::array<uint16_t, 3>& phi = offsets[i % r[0] + uint64_t(r[0]) * (j % r[1] + uint64_t(r[1]) * (k % r[2]))];
+    const uint64_t x = (i % m[0] + phi[0]) % m[0], y = (j % m[1] + phi[1]) % m[1], z = (k % m[2] + phi[2]) % m[2];
     return x + m[0] * (y + m[1] * z);
   }
 };
@@ -80,13 +75,10 @@ PerfectSpatialHash BuildPerfectSpatialHash(const std::vector<std::array<uint32_t
 /// axis, both at most MaxSide): false when it fails or when two cells agree in both h0 and h1.
 /// What BuildPerfectSpatialHash tries, for callers exploring table shapes.
 bool PackPerfectSpatialHash(const std::vector<std::array<uint32_t, 3>>& cells,
-  const PerfectSpatialHash::Sides& tableSides,
-  const PerfectSpatialHash::Sides& offsetSides,
-  PerfectSpatialHash& hash);
+  const PerfectSpatialHash::Sides& tableSides, const PerfectSpatialHash::Sides& offsetSides, PerfectSpatialHash& hash);
 
 /// The slot of every cell, in the order given: the caller scatters per-cell values into a
 /// table of TableSize() entries at these slots.
-std::vector<uint64_t> CellSlots(const PerfectSpatialHash& hash,
-  const std::vector<std::array<uint32_t, 3>>& cells);
+std::vector<uint64_t> CellSlots(const PerfectSpatialHash& hash, const std::vector<std::array<uint32_t, 3>>& cells);
 
 } // namespace resmr

@@ -80,11 +80,8 @@ void ExtractSurfaces(RegionMesh& mesh);
 
 /// The single-layer view of layer k (Sec. 6.1): the top and bottom faces of its active cells
 /// and their side faces where the neighbour across is absent or inactive in that layer.
-void ExtractLayerSurfaces(const RegionMesh& mesh,
-  int32_t layer,
-  RegionSurface& top,
-  RegionSurface& bottom,
-  RegionSurface& side);
+void ExtractLayerSurfaces(
+  const RegionMesh& mesh, int32_t layer, RegionSurface& top, RegionSurface& bottom, RegionSurface& side);
 
 /// +1 if the columns turn counter-clockwise in (x, y) seen from above, -1 otherwise.
 int RegionOrientation(const RegionMesh& mesh);

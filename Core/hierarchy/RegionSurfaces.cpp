@@ -42,12 +42,8 @@ std::vector<std::array<int64_t, 4>> EdgeNeighbours(const RegionMesh& mesh)
   return across;
 }
 
-void AddTopBottom(const RegionMesh& mesh,
-  std::size_t column,
-  int32_t interface,
-  bool top,
-  int orientation,
-  RegionSurface& surface)
+void AddTopBottom(
+  const RegionMesh& mesh, std::size_t column, int32_t interface, bool top, int orientation, RegionSurface& surface)
 {
   const auto& q = mesh.corners[column];
   std::array<uint32_t, 4> quad;
@@ -60,12 +56,8 @@ void AddTopBottom(const RegionMesh& mesh,
   surface.quads.push_back(quad);
 }
 
-void AddSide(const RegionMesh& mesh,
-  std::size_t column,
-  int edge,
-  int32_t layer,
-  int orientation,
-  RegionSurface& surface)
+void AddSide(
+  const RegionMesh& mesh, std::size_t column, int edge, int32_t layer, int orientation, RegionSurface& surface)
 {
   uint32_t a = mesh.corners[column][edge], b = mesh.corners[column][(edge + 1) % 4];
   if (orientation < 0)
@@ -73,10 +65,8 @@ void AddSide(const RegionMesh& mesh,
     std::swap(a, b);
   }
   // The column lies left of a -> b seen from above: a-top, a-bottom, b-bottom, b-top faces right.
-  surface.quads.push_back({ mesh.Vertex(a, layer),
-    mesh.Vertex(a, layer + 1),
-    mesh.Vertex(b, layer + 1),
-    mesh.Vertex(b, layer) });
+  surface.quads.push_back(
+    { mesh.Vertex(a, layer), mesh.Vertex(a, layer + 1), mesh.Vertex(b, layer + 1), mesh.Vertex(b, layer) });
 }
 
 /// Cells of the pinched-out runs to seal (see RegionMesh.h), one flag a cell: inactive runs
@@ -87,15 +77,12 @@ std::vector<uint8_t> SealedCells(const RegionMesh& mesh)
   const std::size_t layers = static_cast<std::size_t>(mesh.layers);
   std::vector<uint8_t> sealed(mesh.corners.size() * layers, 0);
   if (!(mesh.sealedPinchThickness > 0) || mesh.cutEdges.size() != mesh.corners.size() ||
-      mesh.openSides.size() != sealed.size())
+    mesh.openSides.size() != sealed.size())
   {
     return sealed;
   }
-  const auto depth = [&](uint32_t node, std::size_t interface)
-  {
-    return mesh
-      .positions[static_cast<std::size_t>(mesh.Vertex(node, static_cast<int32_t>(interface))) * 3 +
-                 2];
+  const auto depth = [&](uint32_t node, std::size_t interface) {
+    return mesh.positions[static_cast<std::size_t>(mesh.Vertex(node, static_cast<int32_t>(interface))) * 3 + 2];
   };
   for (std::size_t c = 0; c < mesh.corners.size(); ++c)
   {
@@ -141,8 +128,7 @@ void ComputeCone(const RegionMesh& mesh, RegionSurface& surface)
   glm::dvec3 sum(0.0);
   for (const auto& q : surface.quads)
   {
-    const glm::dvec3 n =
-      glm::cross(ZUp(mesh, q[2]) - ZUp(mesh, q[0]), ZUp(mesh, q[3]) - ZUp(mesh, q[1]));
+    const glm::dvec3 n = glm::cross(ZUp(mesh, q[2]) - ZUp(mesh, q[0]), ZUp(mesh, q[3]) - ZUp(mesh, q[1]));
     const double length = glm::length(n);
     if (length > 0 && std::isfinite(length))
     {
@@ -163,9 +149,7 @@ void ComputeCone(const RegionMesh& mesh, RegionSurface& surface)
     lowest = std::min(lowest, glm::dot(n, axis));
   }
   // Rounded outward so the cone still holds every normal after the cast to float.
-  surface.cone = { static_cast<float>(axis.x),
-    static_cast<float>(axis.y),
-    static_cast<float>(axis.z),
+  surface.cone = { static_cast<float>(axis.x), static_cast<float>(axis.y), static_cast<float>(axis.z),
     static_cast<float>(std::max(-1.0, lowest - 1e-6)) };
 }
 } // namespace
@@ -202,8 +186,7 @@ int RegionOrientation(const RegionMesh& mesh)
     for (int e = 0; e < 4; ++e)
     {
       const double* a = &mesh.positions[static_cast<std::size_t>(mesh.Vertex(q[e], 0)) * 3];
-      const double* b =
-        &mesh.positions[static_cast<std::size_t>(mesh.Vertex(q[(e + 1) % 4], 0)) * 3];
+      const double* b = &mesh.positions[static_cast<std::size_t>(mesh.Vertex(q[(e + 1) % 4], 0)) * 3];
       area += a[0] * b[1] - b[0] * a[1];
     }
   }
@@ -256,11 +239,8 @@ void ExtractSurfaces(RegionMesh& mesh)
   ComputeCone(mesh, mesh.bottom);
 }
 
-void ExtractLayerSurfaces(const RegionMesh& mesh,
-  int32_t layer,
-  RegionSurface& top,
-  RegionSurface& bottom,
-  RegionSurface& side)
+void ExtractLayerSurfaces(
+  const RegionMesh& mesh, int32_t layer, RegionSurface& top, RegionSurface& bottom, RegionSurface& side)
 {
   top = {};
   bottom = {};

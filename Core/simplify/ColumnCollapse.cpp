@@ -67,8 +67,7 @@ glm::dvec3 LimitLean(const glm::dvec3& p, const glm::dvec3& above, double steepe
 {
   const glm::dvec2 lean(p.x - above.x, p.y - above.y);
   const double length = glm::length(lean), thickness = p.z - above.z;
-  const double factor =
-    std::max(steepest, slope > 0 ? 0.5 / slope : std::numeric_limits<double>::infinity());
+  const double factor = std::max(steepest, slope > 0 ? 0.5 / slope : std::numeric_limits<double>::infinity());
   if (!(length > thickness * factor))
   {
     return p;
@@ -110,25 +109,20 @@ void ColumnCollapse::Smooth(int32_t node)
       bounds.Add(p, k > 0 ? m.Position(other, k - 1) : p);
     }
     average.z = this->PlaceDepth(node, k, average, bounds, above.z);
-    average =
-      k > 0 && this->Stalled ? LimitLean(average, above, bounds.steepest, bounds.Slope()) : average;
+    average = k > 0 && this->Stalled ? LimitLean(average, above, bounds.steepest, bounds.Slope()) : average;
     above = average;
     m.SetPosition(node, k, average);
   }
 }
 
-double ColumnCollapse::PlaceDepth(int32_t node,
-  int32_t k,
-  const glm::dvec3& xy,
-  const DepthBounds& bounds,
-  double above) const
+double ColumnCollapse::PlaceDepth(
+  int32_t node, int32_t k, const glm::dvec3& xy, const DepthBounds& bounds, double above) const
 {
   // The z of least quadric error (Sec. 4.1), kept within the depths around it (a nearly
   // vertical side plane alone would throw it far), then below the interface above by a
   // thickness within those of the same layer around it: interfaces placed one by one would
   // otherwise cross or pinch thin layers, and a thin cell pinched at one corner inverts.
-  const double z =
-    std::clamp(this->Mesh.NodeQuadric(node, k).OptimalZ(xy.x, xy.y, xy.z), bounds.low, bounds.high);
+  const double z = std::clamp(this->Mesh.NodeQuadric(node, k).OptimalZ(xy.x, xy.y, xy.z), bounds.low, bounds.high);
   return k == 0 ? z : std::clamp(z, above + bounds.thinnest, above + bounds.thickest);
 }
 
@@ -245,7 +239,7 @@ bool ColumnCollapse::FoldsOver(int32_t column) const
         continue;
       }
       const double scale2 = ((b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y)) *
-                            ((c.x - b.x) * (c.x - b.x) + (c.y - b.y) * (c.y - b.y));
+        ((c.x - b.x) * (c.x - b.x) + (c.y - b.y) * (c.y - b.y));
       if (!(turn * turn <= 1e-18 * scale2))
       {
         return true;
@@ -263,8 +257,7 @@ void ColumnCollapse::SaveNodeState(NodeState& state, int32_t node) const
   state.node = node;
   state.alive = m.NodeAlive[node];
   state.topology = m.Topology[node];
-  state.positions.assign(
-    m.Positions.begin() + first * 3, m.Positions.begin() + (first + interfaces) * 3);
+  state.positions.assign(m.Positions.begin() + first * 3, m.Positions.begin() + (first + interfaces) * 3);
   state.quadrics.assign(m.Quadrics.begin() + first, m.Quadrics.begin() + first + interfaces);
   state.columns.assign(m.ColumnsOfNode[node].begin(), m.ColumnsOfNode[node].end());
 }
@@ -314,12 +307,10 @@ void ColumnCollapse::PlaceAtAverage(int32_t node, const NodeState* const* states
       const std::vector<double>& p = states[i]->positions;
       const glm::dvec3 at(p[k * 3], p[k * 3 + 1], p[k * 3 + 2]);
       average += at * weight;
-      bounds.Add(
-        at, k > 0 ? glm::dvec3(p[(k - 1) * 3], p[(k - 1) * 3 + 1], p[(k - 1) * 3 + 2]) : at);
+      bounds.Add(at, k > 0 ? glm::dvec3(p[(k - 1) * 3], p[(k - 1) * 3 + 1], p[(k - 1) * 3 + 2]) : at);
     }
     average.z = this->PlaceDepth(node, k, average, bounds, above.z);
-    average =
-      k > 0 && this->Stalled ? LimitLean(average, above, bounds.steepest, bounds.Slope()) : average;
+    average = k > 0 && this->Stalled ? LimitLean(average, above, bounds.steepest, bounds.Slope()) : average;
     above = average;
     m.SetPosition(node, k, average);
   }
@@ -354,8 +345,7 @@ bool ColumnCollapse::ShapeKeptAround(const std::vector<int32_t>& nodes)
   if (!this->Exempt.empty())
   {
     around.erase(
-      std::remove_if(around.begin(), around.end(), [&](int32_t c) { return this->Exempt[c] != 0; }),
-      around.end());
+      std::remove_if(around.begin(), around.end(), [&](int32_t c) { return this->Exempt[c] != 0; }), around.end());
   }
   for (int32_t column : around)
   {
@@ -431,8 +421,7 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
   }
 
   // Topology first: no column may repeat a node, and nodes must stay manifold.
-  bool valid = this->TopologyValidAt(survivor) &&
-               (plan.op != Strip || this->TopologyValidAt(plan.placeSecondAt));
+  bool valid = this->TopologyValidAt(survivor) && (plan.op != Strip || this->TopologyValidAt(plan.placeSecondAt));
   for (int i = 0; i < plan.keptCount && valid; ++i)
   {
     valid = this->Manifold(plan.kept[i]);
@@ -455,8 +444,7 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
     int count = 0;
     for (const NodeState& state : this->SavedNodes)
     {
-      if (std::find(plan.merged, plan.merged + plan.mergedCount, state.node) !=
-          plan.merged + plan.mergedCount)
+      if (std::find(plan.merged, plan.merged + plan.mergedCount, state.node) != plan.merged + plan.mergedCount)
       {
         merged[count++] = &state;
       }
@@ -487,8 +475,7 @@ bool ColumnCollapse::Apply(const Plan& plan, double& cost)
   }
   for (int i = 0; i < plan.keptCount && !plan.gentle; ++i)
   {
-    if (m.IsBoundaryNode(plan.kept[i]) && !this->Pinned(plan.kept[i]) &&
-        this->SlideAlongBoundary(plan.kept[i], cost))
+    if (m.IsBoundaryNode(plan.kept[i]) && !this->Pinned(plan.kept[i]) && this->SlideAlongBoundary(plan.kept[i], cost))
     {
       this->Scratch.push_back(plan.kept[i]);
     }
@@ -546,8 +533,7 @@ bool ColumnCollapse::SlideAlongBoundary(int32_t node, double allowed)
     bounds.Add(a, k > 0 ? m.Position(ends[0], k - 1) : a);
     bounds.Add(b, k > 0 ? m.Position(ends[1], k - 1) : b);
     middle.z = this->PlaceDepth(node, k, middle, bounds, above.z);
-    middle =
-      k > 0 && this->Stalled ? LimitLean(middle, above, bounds.steepest, bounds.Slope()) : middle;
+    middle = k > 0 && this->Stalled ? LimitLean(middle, above, bounds.steepest, bounds.Slope()) : middle;
     above = middle;
     m.SetPosition(node, k, middle);
   }
@@ -571,8 +557,7 @@ double ShapeQuality(const ColumnMesh& m, const std::array<int32_t, 4>& q, int32_
   double smallest = std::numeric_limits<double>::infinity(), squares = 0;
   for (int i = 0; i < 4; ++i)
   {
-    const glm::dvec3 a = m.Position(q[(i + 3) % 4], k), b = m.Position(q[i], k),
-                     c = m.Position(q[(i + 1) % 4], k);
+    const glm::dvec3 a = m.Position(q[(i + 3) % 4], k), b = m.Position(q[i], k), c = m.Position(q[(i + 1) % 4], k);
     const double ux = b.x - a.x, uy = b.y - a.y, vx = c.x - b.x, vy = c.y - b.y;
     smallest = std::min(smallest, m.Orientation() * (ux * vy - uy * vx));
     squares += vx * vx + vy * vy;
@@ -581,10 +566,7 @@ double ShapeQuality(const ColumnMesh& m, const std::array<int32_t, 4>& q, int32_
 }
 } // namespace
 
-bool ColumnCollapse::EdgeHexagon(int32_t column,
-  int corner,
-  int32_t& other,
-  int32_t hexagon[6]) const
+bool ColumnCollapse::EdgeHexagon(int32_t column, int corner, int32_t& other, int32_t hexagon[6]) const
 {
   const ColumnMesh& m = this->Mesh;
   const auto& a = m.Corners[column];
@@ -609,9 +591,7 @@ bool ColumnCollapse::EdgeHexagon(int32_t column,
   }
   const auto& b = m.Corners[other];
   // The hexagon of the two columns, in their orientation: h, b2, b3, x, a2, a3.
-  const int32_t nodes[6] = {
-    h, b[(at + 2) % 4], b[(at + 3) % 4], x, a[(corner + 2) % 4], a[(corner + 3) % 4]
-  };
+  const int32_t nodes[6] = { h, b[(at + 2) % 4], b[(at + 3) % 4], x, a[(corner + 2) % 4], a[(corner + 3) % 4] };
   for (int i = 0; i < 6; ++i)
   {
     hexagon[i] = nodes[i];
@@ -627,27 +607,22 @@ bool ColumnCollapse::EdgeHexagon(int32_t column,
 }
 
 std::pair<std::array<int32_t, 4>, std::array<int32_t, 4>> ColumnCollapse::SplitHexagon(
-  const int32_t hexagon[6],
-  int shift)
+  const int32_t hexagon[6], int shift)
 {
   // The two columns the diagonal from hexagon[shift] to hexagon[shift + 3] makes.
   return { { hexagon[shift], hexagon[shift + 1], hexagon[shift + 2], hexagon[shift + 3] },
     { hexagon[shift + 3], hexagon[(shift + 4) % 6], hexagon[(shift + 5) % 6], hexagon[shift] } };
 }
 
-void ColumnCollapse::Rewire(int32_t column,
-  int32_t other,
-  const int32_t hexagon[6],
-  const std::array<int32_t, 4>& first,
-  const std::array<int32_t, 4>& second)
+void ColumnCollapse::Rewire(int32_t column, int32_t other, const int32_t hexagon[6],
+  const std::array<int32_t, 4>& first, const std::array<int32_t, 4>& second)
 {
   ColumnMesh& m = this->Mesh;
   for (int i = 0; i < 6; ++i)
   {
     auto& list = m.ColumnsOfNode[hexagon[i]];
-    list.erase(std::remove_if(
-                 list.begin(), list.end(), [&](int32_t c) { return c == column || c == other; }),
-      list.end());
+    list.erase(
+      std::remove_if(list.begin(), list.end(), [&](int32_t c) { return c == column || c == other; }), list.end());
   }
   m.Corners[column] = first;
   m.Corners[other] = second;
@@ -664,14 +639,11 @@ bool ColumnCollapse::DiagonalIsEdge(const int32_t hexagon[6], int shift) const
 {
   const std::vector<int32_t>& columns = this->Mesh.ColumnsOfNode[hexagon[shift]];
   const int32_t to = hexagon[shift + 3];
-  return std::any_of(columns.begin(),
-    columns.end(),
-    [&](int32_t c)
-    {
-      const auto& q = this->Mesh.Corners[c];
-      const int at = IndexOf(q, hexagon[shift]);
-      return q[(at + 1) % 4] == to || q[(at + 3) % 4] == to;
-    });
+  return std::any_of(columns.begin(), columns.end(), [&](int32_t c) {
+    const auto& q = this->Mesh.Corners[c];
+    const int at = IndexOf(q, hexagon[shift]);
+    return q[(at + 1) % 4] == to || q[(at + 3) % 4] == to;
+  });
 }
 
 bool ColumnCollapse::HexagonManifold(const int32_t hexagon[6]) const
@@ -690,8 +662,9 @@ bool ColumnCollapse::RotateEdge(int32_t column, int corner)
   }
   const auto a = m.Corners[column];
   const auto b = m.Corners[other];
-  auto quality = [&](const std::array<int32_t, 4>& q)
-  { return std::min(ShapeQuality(m, q, 0), ShapeQuality(m, q, m.LayerCount)); };
+  auto quality = [&](const std::array<int32_t, 4>& q) {
+    return std::min(ShapeQuality(m, q, 0), ShapeQuality(m, q, m.LayerCount));
+  };
   const double before = std::min(quality(a), quality(b));
   double bestQuality = before;
   int bestShift = -1;
@@ -744,8 +717,7 @@ bool ColumnCollapse::MergeAlongBoundary(int32_t column, int corner)
   }
   const auto a = m.Corners[column];
   const auto b = m.Corners[other];
-  std::vector<uint8_t> activeA(
-    m.ActiveCells.begin() + static_cast<std::ptrdiff_t>(column) * m.LayerCount,
+  std::vector<uint8_t> activeA(m.ActiveCells.begin() + static_cast<std::ptrdiff_t>(column) * m.LayerCount,
     m.ActiveCells.begin() + static_cast<std::ptrdiff_t>(column + 1) * m.LayerCount);
   for (int shift = 1; shift <= 2; ++shift)
   {
@@ -762,17 +734,13 @@ bool ColumnCollapse::MergeAlongBoundary(int32_t column, int corner)
     for (int32_t corners : { column, other })
     {
       Plan plan;
-      if (valid && IndexOf(m.Corners[corners], hexagon[0]) >= 0 &&
-          this->PlanColumn(corners, plan) && plan.op == Corner)
+      if (valid && IndexOf(m.Corners[corners], hexagon[0]) >= 0 && this->PlanColumn(corners, plan) && plan.op == Corner)
       {
         const int32_t kept = corners == column ? other : column;
         for (int32_t k = 0; k < m.LayerCount; ++k)
         {
           uint8_t& flag = m.ActiveCells[static_cast<std::size_t>(kept) * m.LayerCount + k];
-          flag = (flag || activeA[k] ||
-                   m.ActiveCells[static_cast<std::size_t>(other) * m.LayerCount + k])
-                   ? 1
-                   : 0;
+          flag = (flag || activeA[k] || m.ActiveCells[static_cast<std::size_t>(other) * m.LayerCount + k]) ? 1 : 0;
         }
         this->Perform(plan);
         return true;
@@ -786,12 +754,9 @@ bool ColumnCollapse::MergeAlongBoundary(int32_t column, int corner)
 int64_t ColumnCollapse::MergeAlongBoundaries(int64_t targetColumns)
 {
   const int64_t before = this->Mesh.AliveColumns();
-  for (int32_t column = 0;
-       column < this->Mesh.ColumnSlots() && this->Mesh.AliveColumns() > targetColumns;
-       ++column)
+  for (int32_t column = 0; column < this->Mesh.ColumnSlots() && this->Mesh.AliveColumns() > targetColumns; ++column)
   {
-    for (int corner = 0; corner < 4 && this->Mesh.IsColumnAlive(column) &&
-                         this->Mesh.AliveColumns() > targetColumns;
+    for (int corner = 0; corner < 4 && this->Mesh.IsColumnAlive(column) && this->Mesh.AliveColumns() > targetColumns;
          ++corner)
     {
       this->MergeAlongBoundary(column, corner);
@@ -821,19 +786,15 @@ ColumnCollapse::MovedNode ColumnCollapse::SaveNode(int32_t node) const
 {
   const std::size_t first = static_cast<std::size_t>(node) * (this->Mesh.LayerCount + 1) * 3;
   const auto& positions = this->Mesh.Positions;
-  return { node,
-    this->Mesh.Topology[node],
-    std::vector<double>(
-      positions.begin() + first, positions.begin() + first + (this->Mesh.LayerCount + 1) * 3) };
+  return { node, this->Mesh.Topology[node],
+    std::vector<double>(positions.begin() + first, positions.begin() + first + (this->Mesh.LayerCount + 1) * 3) };
 }
 
 void ColumnCollapse::RestoreNode(const MovedNode& saved)
 {
   this->Mesh.Topology[saved.node] = saved.topology;
-  std::copy(saved.positions.begin(),
-    saved.positions.end(),
-    this->Mesh.Positions.begin() +
-      static_cast<std::size_t>(saved.node) * (this->Mesh.LayerCount + 1) * 3);
+  std::copy(saved.positions.begin(), saved.positions.end(),
+    this->Mesh.Positions.begin() + static_cast<std::size_t>(saved.node) * (this->Mesh.LayerCount + 1) * 3);
 }
 
 bool ColumnCollapse::KeepsShape(int32_t column) const
@@ -844,8 +805,7 @@ bool ColumnCollapse::KeepsShape(int32_t column) const
 bool ColumnCollapse::Pinned(int32_t node) const
 {
   const auto& columns = this->Mesh.ColumnsOfNode[node];
-  return std::any_of(
-    columns.begin(), columns.end(), [this](int32_t c) { return this->Mesh.IsLocked(c); });
+  return std::any_of(columns.begin(), columns.end(), [this](int32_t c) { return this->Mesh.IsLocked(c); });
 }
 
 int64_t ColumnCollapse::Relax(double allowed)
@@ -902,11 +862,10 @@ void ColumnCollapse::SmoothRing(bool smoothSurvivor)
     m.Neighbours(this->Scratch[i], neighbours, boundary);
     for (int32_t node : neighbours)
     {
-      const bool corner = std::any_of(this->SavedNodes.begin(),
-        this->SavedNodes.end(),
+      const bool corner = std::any_of(this->SavedNodes.begin(), this->SavedNodes.end(),
         [node](const NodeState& state) { return state.node == node; });
-      if (!corner && std::find(ring.begin(), ring.end(), node) == ring.end() &&
-          !m.IsBoundaryNode(node) && !this->Pinned(node))
+      if (!corner && std::find(ring.begin(), ring.end(), node) == ring.end() && !m.IsBoundaryNode(node) &&
+        !this->Pinned(node))
       {
         ring.push_back(node);
       }
@@ -996,8 +955,7 @@ void ColumnCollapse::TryOption(const Plan& option, Plan& best, bool& found)
   bool valid = this->Apply(option, cost);
   this->Undo();
   Plan chosen = option;
-  if (!valid && this->Stats.rejectedFoldOver + this->Stats.rejectedInverted > folds &&
-      !option.gentle)
+  if (!valid && this->Stats.rejectedFoldOver + this->Stats.rejectedInverted > folds && !option.gentle)
   {
     // The paper's smoothing folded a face: try without it, the survivor at the merged
     // nodes' midpoint, then at each of them.
@@ -1011,8 +969,7 @@ void ColumnCollapse::TryOption(const Plan& option, Plan& best, bool& found)
       this->Undo();
     }
   }
-  if (!valid && this->Stalled &&
-      this->Stats.rejectedFoldOver + this->Stats.rejectedInverted > folds)
+  if (!valid && this->Stalled && this->Stats.rejectedFoldOver + this->Stats.rejectedInverted > folds)
   {
     chosen = option;
     chosen.gentle = false;
@@ -1049,8 +1006,7 @@ bool ColumnCollapse::PlanColumn(int32_t column, Plan& best)
   bool found = false;
   Plan option;
   option.column = column;
-  auto diagonal = [&](int first, Operator op)
-  {
+  auto diagonal = [&](int first, Operator op) {
     // Merge corners first and first+2, keep the other two.
     const int a = first, b = first + 2;
     if (onBoundary[a] && onBoundary[b])
@@ -1067,8 +1023,7 @@ bool ColumnCollapse::PlanColumn(int32_t column, Plan& best)
     option.kept[1] = q[(a + 3) % 4];
     this->TryOption(option, best, found);
   };
-  auto threeIntoOne = [&](int keep, Operator op)
-  {
+  auto threeIntoOne = [&](int keep, Operator op) {
     // Corners keep+1..keep+3 become one, at whichever of their positions costs least.
     option.op = op;
     option.mergedCount = 3;
@@ -1105,8 +1060,8 @@ bool ColumnCollapse::PlanColumn(int32_t column, Plan& best)
       const int new0 = valence[0] + valence[2] - 2, new1 = valence[1] + valence[3] - 2;
       // A persisting tie goes one way at random, but the same way each time this column is
       // planned with the same corners (plans are compared again and again).
-      const uint64_t coin = Mix(
-        this->Seed ^ Mix(static_cast<uint64_t>(q[0]) * GoldenGamma + static_cast<uint64_t>(q[2])));
+      const uint64_t coin =
+        Mix(this->Seed ^ Mix(static_cast<uint64_t>(q[0]) * GoldenGamma + static_cast<uint64_t>(q[2])));
       first = new0 != new1 ? (new0 < new1 ? 0 : 1) : static_cast<int>(coin & 1);
     }
     diagonal(first, Internal);
@@ -1220,7 +1175,7 @@ void ColumnCollapse::RemoveDoublets(std::vector<int32_t> worklist)
     const int32_t node = worklist.back();
     worklist.pop_back();
     if (!m.IsNodeAlive(node) || m.ColumnsOfNode[node].size() != 2 || m.LateralValence(node) != 2 ||
-        m.IsBoundaryNode(node))
+      m.IsBoundaryNode(node))
     {
       continue;
     }
@@ -1277,18 +1232,14 @@ void ColumnCollapse::RemoveDoublets(std::vector<int32_t> worklist)
   }
 }
 
-bool ColumnCollapse::TraceChord(int32_t column,
-  int axis,
-  ChordPath& chord,
-  std::vector<uint8_t>* visited) const
+bool ColumnCollapse::TraceChord(int32_t column, int axis, ChordPath& chord, std::vector<uint8_t>* visited) const
 {
   const ColumnMesh& m = this->Mesh;
   chord.columns.clear();
   chord.edges.clear();
   chord.closed = false;
   // The column across edge `e` of column `c` and the index of that edge in it, or -1.
-  auto across = [&m](int32_t c, int e, int& entry)
-  {
+  auto across = [&m](int32_t c, int e, int& entry) {
     const auto& q = m.Corners[c];
     const int32_t u = q[e], v = q[(e + 1) % 4];
     for (int32_t other : m.ColumnsOfNode[u])
@@ -1338,8 +1289,8 @@ bool ColumnCollapse::TraceChord(int32_t column,
   chord.edges.push_back({ first[in], first[(in + 1) % 4] });
   for (;;)
   {
-    if (std::find(chord.columns.begin(), chord.columns.end(), c) != chord.columns.end() ||
-        m.IsLocked(c) || (m.IsBoundaryEdge(c, (in + 1) % 4) && m.IsBoundaryEdge(c, (in + 3) % 4)))
+    if (std::find(chord.columns.begin(), chord.columns.end(), c) != chord.columns.end() || m.IsLocked(c) ||
+      (m.IsBoundaryEdge(c, (in + 1) % 4) && m.IsBoundaryEdge(c, (in + 3) % 4)))
     {
       // Crosses itself or a locked column, or runs through a column with no neighbour on
       // either side, which would vanish with nothing to take its place (a strip of a model
@@ -1410,8 +1361,8 @@ bool ColumnCollapse::ApplyChord(const ChordPath& chord, bool ring, double& cost)
     const bool pinnedA = this->Pinned(a), pinnedB = this->Pinned(b);
     const bool boundaryA = m.IsBoundaryNode(a), boundaryB = m.IsBoundaryNode(b);
     const bool end = !chord.closed && (e == 0 || e + 1 == edgeCount);
-    if ((pinnedA && pinnedB) || (pinnedA && boundaryB && !boundaryA) ||
-        (pinnedB && boundaryA && !boundaryB) || (boundaryA && boundaryB && !end))
+    if ((pinnedA && pinnedB) || (pinnedA && boundaryB && !boundaryA) || (pinnedB && boundaryA && !boundaryB) ||
+      (boundaryA && boundaryB && !end))
     {
       // Two pinned nodes cannot merge, a boundary node must not be pulled inside, and an
       // inner edge between two boundary nodes would join two stretches of the boundary.
@@ -1479,10 +1430,8 @@ bool ColumnCollapse::ApplyChord(const ChordPath& chord, bool ring, double& cost)
       const NodeState* bestAt = nullptr;
       for (const NodeState* at : pair)
       {
-        std::copy(at->positions.begin(),
-          at->positions.end(),
-          m.Positions.begin() +
-            static_cast<std::size_t>(collapse.survivor) * (m.LayerCount + 1) * 3);
+        std::copy(at->positions.begin(), at->positions.end(),
+          m.Positions.begin() + static_cast<std::size_t>(collapse.survivor) * (m.LayerCount + 1) * 3);
         const double error = this->NodeError(collapse.survivor);
         if (error < best)
         {
@@ -1493,10 +1442,8 @@ bool ColumnCollapse::ApplyChord(const ChordPath& chord, bool ring, double& cost)
       this->RestoreNode(middle);
       if (bestAt)
       {
-        std::copy(bestAt->positions.begin(),
-          bestAt->positions.end(),
-          m.Positions.begin() +
-            static_cast<std::size_t>(collapse.survivor) * (m.LayerCount + 1) * 3);
+        std::copy(bestAt->positions.begin(), bestAt->positions.end(),
+          m.Positions.begin() + static_cast<std::size_t>(collapse.survivor) * (m.LayerCount + 1) * 3);
         m.Topology[collapse.survivor] = bestAt->topology;
       }
     }
@@ -1561,7 +1508,7 @@ int64_t ColumnCollapse::CollapseChord(int32_t column, int axis)
 {
   ChordPath chord;
   if (column < 0 || column >= this->Mesh.ColumnSlots() || !this->Mesh.IsColumnAlive(column) ||
-      !this->TraceChord(column, axis & 1, chord, nullptr))
+    !this->TraceChord(column, axis & 1, chord, nullptr))
   {
     return 0;
   }
@@ -1589,8 +1536,7 @@ int64_t ColumnCollapse::CollapseChords(int64_t targetColumns)
   {
     for (int axis = 0; axis < 2; ++axis)
     {
-      if (visited[static_cast<std::size_t>(column) * 2 + axis] ||
-          !this->TraceChord(column, axis, chord, &visited))
+      if (visited[static_cast<std::size_t>(column) * 2 + axis] || !this->TraceChord(column, axis, chord, &visited))
       {
         continue;
       }
@@ -1601,8 +1547,7 @@ int64_t ColumnCollapse::CollapseChords(int64_t targetColumns)
       this->Undo();
       if (plain || ringed)
       {
-        candidates.push_back(
-          { plain && ringed ? std::min(cost, ringCost) : (plain ? cost : ringCost), column, axis });
+        candidates.push_back({ plain && ringed ? std::min(cost, ringCost) : (plain ? cost : ringCost), column, axis });
       }
     }
   }
@@ -1618,10 +1563,8 @@ int64_t ColumnCollapse::CollapseChords(int64_t targetColumns)
     }
     // Earlier chords changed the mesh: trace again; one longer than what is left to remove
     // goes only if nothing else did.
-    if (!m.IsColumnAlive(candidate.column) ||
-        !this->TraceChord(candidate.column, candidate.axis, chord, nullptr) ||
-        (removed > 0 &&
-          static_cast<int64_t>(chord.columns.size()) > m.AliveColumns() - targetColumns))
+    if (!m.IsColumnAlive(candidate.column) || !this->TraceChord(candidate.column, candidate.axis, chord, nullptr) ||
+      (removed > 0 && static_cast<int64_t>(chord.columns.size()) > m.AliveColumns() - targetColumns))
     {
       continue;
     }
@@ -1630,8 +1573,7 @@ int64_t ColumnCollapse::CollapseChords(int64_t targetColumns)
   return removed;
 }
 
-SimplifyReport ColumnCollapse::Finish(int64_t targetColumns,
-  const std::function<void(double)>& progress)
+SimplifyReport ColumnCollapse::Finish(int64_t targetColumns, const std::function<void(double)>& progress)
 {
   this->Stats.columnsAfter = this->Mesh.AliveColumns();
   this->Stats.reachedTarget = this->Mesh.AliveColumns() <= targetColumns;
@@ -1648,9 +1590,7 @@ bool ColumnCollapse::Unblock(int64_t& relaxedAt, int64_t targetColumns)
   {
     // Rotations and smoothing freed nothing last time: boundary slivers in pairs, chords.
     const int64_t merged = this->MergeAlongBoundaries(targetColumns);
-    return merged +
-             (this->Mesh.AliveColumns() > targetColumns ? this->CollapseChords(targetColumns) : 0) >
-           0;
+    return merged + (this->Mesh.AliveColumns() > targetColumns ? this->CollapseChords(targetColumns) : 0) > 0;
   }
   relaxedAt = this->Mesh.AliveColumns();
   ++this->Stats.relaxations;
@@ -1752,8 +1692,7 @@ int64_t ColumnCollapse::StraightenReflexCorners()
           {
             continue;
           }
-          const double t =
-            std::clamp(glm::dot(glm::dvec2(b.x - a.x, b.y - a.y), chord) / length2, 0.0, 1.0);
+          const double t = std::clamp(glm::dot(glm::dvec2(b.x - a.x, b.y - a.y), chord) / length2, 0.0, 1.0);
           const glm::dvec2 foot = glm::dvec2(a.x, a.y) + t * chord;
           // Outward: across the chord from b, away from the column's interior.
           const glm::dvec2 normal = sign * glm::dvec2(chord.y, -chord.x) / std::sqrt(length2);
@@ -1860,8 +1799,7 @@ int64_t ColumnCollapse::CollapseInvertedColumns(int64_t targetColumns)
   return removed;
 }
 
-SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns,
-  const std::function<void(double)>& progress)
+SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns, const std::function<void(double)>& progress)
 {
   ColumnMesh& m = this->Mesh;
   this->Stats.columnsBefore = m.AliveColumns();
@@ -1876,11 +1814,10 @@ SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns,
     bool found = false;
     for (int candidate = 0; candidate < this->Candidates; ++candidate)
     {
-      const auto pick =
-        static_cast<std::size_t>(this->RandomUnit() * static_cast<double>(this->AliveList.size()));
+      const auto pick = static_cast<std::size_t>(this->RandomUnit() * static_cast<double>(this->AliveList.size()));
       Plan plan;
       if (this->PlanColumn(this->AliveList[std::min(pick, this->AliveList.size() - 1)], plan) &&
-          (!found || plan.cost < best.cost))
+        (!found || plan.cost < best.cost))
       {
         best = plan;
         found = true;
@@ -1907,16 +1844,14 @@ SimplifyReport ColumnCollapse::Simplify(int64_t targetColumns,
     if (progress && ++sinceProgress >= 256)
     {
       sinceProgress = 0;
-      progress(std::min(1.0,
-        static_cast<double>(this->Stats.columnsBefore - m.AliveColumns()) /
-          static_cast<double>(toRemove)));
+      progress(std::min(
+        1.0, static_cast<double>(this->Stats.columnsBefore - m.AliveColumns()) / static_cast<double>(toRemove)));
     }
   }
   return this->Finish(targetColumns, progress);
 }
 
-SimplifyReport ColumnCollapse::SimplifyGreedy(int64_t targetColumns,
-  const std::function<void(double)>& progress)
+SimplifyReport ColumnCollapse::SimplifyGreedy(int64_t targetColumns, const std::function<void(double)>& progress)
 {
   ColumnMesh& m = this->Mesh;
   this->Stats.columnsBefore = m.AliveColumns();
@@ -1935,8 +1870,7 @@ SimplifyReport ColumnCollapse::SimplifyGreedy(int64_t targetColumns,
   };
   std::priority_queue<Entry> queue;
   std::vector<uint32_t> stamps(static_cast<std::size_t>(m.ColumnSlots()), 0);
-  auto plan = [&](int32_t column)
-  {
+  auto plan = [&](int32_t column) {
     Plan found;
     ++stamps[column];
     if (this->PlanColumn(column, found))
@@ -2005,9 +1939,8 @@ SimplifyReport ColumnCollapse::SimplifyGreedy(int64_t targetColumns,
       if (progress && ++sinceProgress >= 256)
       {
         sinceProgress = 0;
-        progress(std::min(1.0,
-          static_cast<double>(this->Stats.columnsBefore - m.AliveColumns()) /
-            static_cast<double>(toRemove)));
+        progress(std::min(
+          1.0, static_cast<double>(this->Stats.columnsBefore - m.AliveColumns()) / static_cast<double>(toRemove)));
       }
     }
     // Nothing valid is left in the queue: unblock as Simplify does, and plan every column again.

@@ -36,22 +36,20 @@ namespace resmr
 struct SimplifyReport
 {
   int64_t columnsBefore = 0, columnsAfter = 0;
-  int64_t collapses = 0;          ///< operators 1-4, strip and chord collapses performed
-  int64_t doublets = 0;           ///< doublet collapses performed
-  int64_t operatorCounts[7] = {}; ///< by operator: 0 internal, 1 boundary, 2 corner, 3
-                                  ///< four-boundary, 4 doublet, 5 strip, 6 chord
-  int64_t rejectedFoldOver = 0;   ///< candidate options rejected by the fold-over test
-  int64_t rejectedInverted = 0;   ///< candidate options rejected for inverting a hexahedron
-  int64_t rejectedTopology = 0;   ///< candidate options rejected as non-manifold or degenerate
-  int64_t relaxations = 0;        ///< times the whole mesh was smoothed to unblock collapses
-  int64_t rotations = 0;          ///< edge rotations made to unblock collapses
-  int64_t straightenedColumns =
-    0; ///< inverted input columns made valid by moving a reflex outline corner
-  double straightenedMove = 0; ///< farthest a straightened corner moved (x, y)
-  int64_t invertedColumnsCollapsed =
-    0;                        ///< columns removed first for holding an inverted input cell
-  double maxError = 0;        ///< largest cost of a performed collapse
-  bool reachedTarget = false; ///< false: no valid collapse was left
+  int64_t collapses = 0;           ///< operators 1-4, strip and chord collapses performed
+  int64_t doublets = 0;            ///< doublet collapses performed
+  int64_t operatorCounts[7] = {};  ///< by operator: 0 internal, 1 boundary, 2 corner, 3 four-boundary, 4 doublet, 5
+                                   ///< strip, 6 chord
+  int64_t rejectedFoldOver = 0;    ///< candidate options rejected by the fold-over test
+  int64_t rejectedInverted = 0;    ///< candidate options rejected for inverting a hexahedron
+  int64_t rejectedTopology = 0;    ///< candidate options rejected as non-manifold or degenerate
+  int64_t relaxations = 0;         ///< times the whole mesh was smoothed to unblock collapses
+  int64_t rotations = 0;           ///< edge rotations made to unblock collapses
+  int64_t straightenedColumns = 0; ///< inverted input columns made valid by moving a reflex outline corner
+  double straightenedMove = 0;     ///< farthest a straightened corner moved (x, y)
+  int64_t invertedColumnsCollapsed = 0; ///< columns removed first for holding an inverted input cell
+  double maxError = 0;                  ///< largest cost of a performed collapse
+  bool reachedTarget = false;           ///< false: no valid collapse was left
 };
 
 class ColumnCollapse
@@ -121,8 +119,7 @@ public:
   /// Instead of random candidates, always perform the cheapest collapse of the whole mesh: a
   /// lazily updated priority queue in which only the columns a collapse touches are planned
   /// again.
-  SimplifyReport SimplifyGreedy(int64_t targetColumns,
-    const std::function<void(double)>& progress = {});
+  SimplifyReport SimplifyGreedy(int64_t targetColumns, const std::function<void(double)>& progress = {});
 
   /// Edge rotation (Tarini et al. 2010; ours, not the paper's), which Simplify runs when
   /// collapses run out: the edge two unlocked columns share turns to another diagonal of
@@ -200,13 +197,8 @@ private:
   /// Whether the diagonal from hexagon[shift] to hexagon[shift + 3] is an edge already.
   bool DiagonalIsEdge(const int32_t hexagon[6], int shift) const;
   bool HexagonManifold(const int32_t hexagon[6]) const;
-  static std::pair<std::array<int32_t, 4>, std::array<int32_t, 4>> SplitHexagon(
-    const int32_t hexagon[6],
-    int shift);
-  void Rewire(int32_t column,
-    int32_t other,
-    const int32_t hexagon[6],
-    const std::array<int32_t, 4>& first,
+  static std::pair<std::array<int32_t, 4>, std::array<int32_t, 4>> SplitHexagon(const int32_t hexagon[6], int shift);
+  void Rewire(int32_t column, int32_t other, const int32_t hexagon[6], const std::array<int32_t, 4>& first,
     const std::array<int32_t, 4>& second);
   /// Two columns sharing an edge from a boundary node become one (see
   /// MergeAlongBoundaries); kept only if valid.
@@ -248,10 +240,8 @@ private:
   /// layer above it there.
   struct DepthBounds
   {
-    double low = std::numeric_limits<double>::infinity(),
-           high = -std::numeric_limits<double>::infinity();
-    double thinnest = std::numeric_limits<double>::infinity(),
-           thickest = -std::numeric_limits<double>::infinity();
+    double low = std::numeric_limits<double>::infinity(), high = -std::numeric_limits<double>::infinity();
+    double thinnest = std::numeric_limits<double>::infinity(), thickest = -std::numeric_limits<double>::infinity();
     double steepest = 0; ///< largest lean (x, y offset over depth) from the vertex above
     glm::dvec2 lowXY = glm::dvec2(std::numeric_limits<double>::infinity());
     glm::dvec2 highXY = glm::dvec2(-std::numeric_limits<double>::infinity());
@@ -277,11 +267,7 @@ private:
       }
     }
   };
-  double PlaceDepth(int32_t node,
-    int32_t k,
-    const glm::dvec3& xy,
-    const DepthBounds& bounds,
-    double above) const;
+  double PlaceDepth(int32_t node, int32_t k, const glm::dvec3& xy, const DepthBounds& bounds, double above) const;
   bool Manifold(int32_t node) const;
   bool FoldsOver(int32_t column) const;
   bool InvertsCells(int32_t column) const;

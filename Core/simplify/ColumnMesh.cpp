@@ -26,73 +26,50 @@ int Find(std::array<int, 4>& parent, int x)
 }
 } // namespace
 
-ColumnMesh ColumnMesh::FromCornerPoints(const CornerPointGeometry& geometry,
-  const std::vector<bool>& active)
+ColumnMesh ColumnMesh::FromCornerPoints(const CornerPointGeometry& geometry, const std::vector<bool>& active)
 {
   return FromCornerPoints(geometry, active, 0, geometry.Dims()[0], 0, geometry.Dims()[1]);
 }
 
-ColumnMesh ColumnMesh::FromCornerPoints(const CornerPointGeometry& geometry,
-  const std::vector<bool>& active,
-  int64_t i0,
-  int64_t i1,
-  int64_t j0,
-  int64_t j1)
+ColumnMesh ColumnMesh::FromCornerPoints(
+  const CornerPointGeometry& geometry, const std::vector<bool>& active, int64_t i0, int64_t i1, int64_t j0, int64_t j1)
 {
   return FromCells(
     geometry.Dims(),
-    [&](int64_t i, int64_t j, int64_t k, double corners[8][3])
-    { geometry.CellCorners(i, j, k, corners); },
-    active,
-    i0,
-    i1,
-    j0,
-    j1);
+    [&](int64_t i, int64_t j, int64_t k, double corners[8][3]) { geometry.CellCorners(i, j, k, corners); }, active, i0,
+    i1, j0, j1);
 }
 
 namespace
 {
 /// FromCells' arguments checked: a non-empty box inside the grid, one active flag a cell, one
 /// selection flag a column of the box.
-void CheckCellBox(const std::array<int64_t, 3>& dims,
-  const std::vector<bool>& active,
-  int64_t i0,
-  int64_t i1,
-  int64_t j0,
-  int64_t j1,
-  const std::vector<uint8_t>* selected)
+void CheckCellBox(const std::array<int64_t, 3>& dims, const std::vector<bool>& active, int64_t i0, int64_t i1,
+  int64_t j0, int64_t j1, const std::vector<uint8_t>* selected)
 {
   const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
   if (i0 < 0 || j0 < 0 || i1 > nx || j1 > ny || i0 >= i1 || j0 >= j1 || nz < 1)
   {
-    throw std::invalid_argument("column mesh: empty or out-of-grid box [" + std::to_string(i0) +
-                                ", " + std::to_string(i1) + ") x [" + std::to_string(j0) + ", " +
-                                std::to_string(j1) + ") of a " + std::to_string(nx) + " x " +
-                                std::to_string(ny) + " x " + std::to_string(nz) + " grid");
+    throw std::invalid_argument("column mesh: empty or out-of-grid box [" + std::to_string(i0) + ", " +
+      std::to_string(i1) + ") x [" + std::to_string(j0) + ", " + std::to_string(j1) + ") of a " + std::to_string(nx) +
+      " x " + std::to_string(ny) + " x " + std::to_string(nz) + " grid");
   }
   if (static_cast<int64_t>(active.size()) != nx * ny * nz)
   {
-    throw std::invalid_argument("column mesh: " + std::to_string(active.size()) +
-                                " active flags for " + std::to_string(nx * ny * nz) + " cells");
+    throw std::invalid_argument(
+      "column mesh: " + std::to_string(active.size()) + " active flags for " + std::to_string(nx * ny * nz) + " cells");
   }
   const int64_t width = i1 - i0, height = j1 - j0;
   if (selected && static_cast<int64_t>(selected->size()) != width * height)
   {
     throw std::invalid_argument("column mesh: selection of " + std::to_string(selected->size()) +
-                                " flags for a box of " + std::to_string(width * height) +
-                                " columns");
+      " flags for a box of " + std::to_string(width * height) + " columns");
   }
 }
 } // namespace
 
-ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims,
-  const CellCornersFunction& cellCorners,
-  const std::vector<bool>& active,
-  int64_t i0,
-  int64_t i1,
-  int64_t j0,
-  int64_t j1,
-  const std::vector<uint8_t>* selected)
+ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims, const CellCornersFunction& cellCorners,
+  const std::vector<bool>& active, int64_t i0, int64_t i1, int64_t j0, int64_t j1, const std::vector<uint8_t>* selected)
 {
   CheckCellBox(dims, active, i0, i1, j0, j1, selected);
   const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
@@ -123,8 +100,7 @@ ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims,
         mesh.Origin.push_back({ static_cast<int32_t>(i), static_cast<int32_t>(j) });
         for (int64_t k = 0; k < nz; ++k)
         {
-          mesh.ActiveCells.push_back(
-            active[static_cast<std::size_t>((k * ny + j) * nx + i)] ? 1 : 0);
+          mesh.ActiveCells.push_back(active[static_cast<std::size_t>((k * ny + j) * nx + i)] ? 1 : 0);
         }
       }
     }
@@ -139,8 +115,7 @@ ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims,
   std::vector<double> rows[2];
   rows[0].assign(static_cast<std::size_t>(width) * stackSize, 0.0);
   rows[1].assign(static_cast<std::size_t>(width) * stackSize, 0.0);
-  auto fillRow = [&](std::vector<double>& row, int64_t j)
-  {
+  auto fillRow = [&](std::vector<double>& row, int64_t j) {
     double corners[8][3];
     for (int64_t i = i0; i < i1; ++i)
     {
@@ -156,12 +131,10 @@ ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims,
         {
           for (int d = 0; d < 3; ++d)
           {
-            if (!std::isfinite(corners[EclipseCorner[q]][d]) ||
-                !std::isfinite(corners[EclipseCorner[q] + 4][d]))
+            if (!std::isfinite(corners[EclipseCorner[q]][d]) || !std::isfinite(corners[EclipseCorner[q] + 4][d]))
             {
-              throw std::invalid_argument("column mesh: cell (" + std::to_string(i + 1) + ", " +
-                                          std::to_string(j + 1) + ", " + std::to_string(k + 1) +
-                                          ") has a non-finite corner");
+              throw std::invalid_argument("column mesh: cell (" + std::to_string(i + 1) + ", " + std::to_string(j + 1) +
+                ", " + std::to_string(k + 1) + ") has a non-finite corner");
             }
             stack[(q * interfaces + k) * 3 + d] = corners[EclipseCorner[q]][d];
             if (k == nz - 1)
@@ -173,14 +146,11 @@ ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims,
       }
     }
   };
-  auto stackOf = [&](int64_t i, int64_t j, int q) -> const double*
-  {
+  auto stackOf = [&](int64_t i, int64_t j, int q) -> const double* {
     const std::vector<double>& row = rows[(j - j0) & 1];
-    return &row[static_cast<std::size_t>(i - i0) * stackSize +
-                static_cast<std::size_t>(q * interfaces * 3)];
+    return &row[static_cast<std::size_t>(i - i0) * stackSize + static_cast<std::size_t>(q * interfaces * 3)];
   };
-  auto sameStack = [&](const double* a, const double* b)
-  { return std::equal(a, a + interfaces * 3, b); };
+  auto sameStack = [&](const double* a, const double* b) { return std::equal(a, a + interfaces * 3, b); };
 
   // Nodes, pillar by pillar: the (up to) four columns around a pillar share a node where
   // edge-adjacent columns agree at every interface.
@@ -208,8 +178,7 @@ ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims,
       for (const auto& pair : pairs)
       {
         const int a = pair[0], b = pair[1];
-        if (column[a] >= 0 && column[b] >= 0 &&
-            sameStack(stackOf(ci[a], cj[a], cq[a]), stackOf(ci[b], cj[b], cq[b])))
+        if (column[a] >= 0 && column[b] >= 0 && sameStack(stackOf(ci[a], cj[a], cq[a]), stackOf(ci[b], cj[b], cq[b])))
         {
           parent[Find(parent, a)] = Find(parent, b);
         }
@@ -237,15 +206,12 @@ ColumnMesh ColumnMesh::FromCells(const std::array<int64_t, 3>& dims,
   return mesh;
 }
 
-ColumnMesh ColumnMesh::FromParts(int32_t layers,
-  std::vector<double> positions,
-  std::vector<std::array<double, 2>> topology,
-  std::vector<std::array<int32_t, 4>> corners,
+ColumnMesh ColumnMesh::FromParts(int32_t layers, std::vector<double> positions,
+  std::vector<std::array<double, 2>> topology, std::vector<std::array<int32_t, 4>> corners,
   std::vector<uint8_t> activeCells)
 {
-  if (layers < 1 ||
-      positions.size() != topology.size() * static_cast<std::size_t>(layers + 1) * 3 ||
-      activeCells.size() != corners.size() * static_cast<std::size_t>(layers))
+  if (layers < 1 || positions.size() != topology.size() * static_cast<std::size_t>(layers + 1) * 3 ||
+    activeCells.size() != corners.size() * static_cast<std::size_t>(layers))
   {
     throw std::invalid_argument("column mesh: inconsistent parts");
   }
@@ -275,9 +241,9 @@ ColumnMesh ColumnMesh::FromData(ColumnMeshData data)
   const std::size_t nodes = data.topology.size();
   const std::size_t interfaces = static_cast<std::size_t>(data.layers) + 1;
   if (data.layers < 1 || data.positions.size() != nodes * interfaces * 3 ||
-      data.quadrics.size() != nodes * interfaces ||
-      data.activeCells.size() != data.corners.size() * static_cast<std::size_t>(data.layers) ||
-      data.origin.size() != data.corners.size())
+    data.quadrics.size() != nodes * interfaces ||
+    data.activeCells.size() != data.corners.size() * static_cast<std::size_t>(data.layers) ||
+    data.origin.size() != data.corners.size())
   {
     throw std::invalid_argument("column mesh: inconsistent saved arrays");
   }
@@ -304,8 +270,7 @@ ColumnMesh ColumnMesh::FromData(ColumnMeshData data)
   return mesh;
 }
 
-ColumnMeshData ColumnMesh::Export(const std::vector<uint8_t>* keepColumns,
-  std::vector<int32_t>* nodeMap) const
+ColumnMeshData ColumnMesh::Export(const std::vector<uint8_t>* keepColumns, std::vector<int32_t>* nodeMap) const
 {
   ColumnMeshData data;
   data.layers = this->LayerCount;
@@ -326,12 +291,10 @@ ColumnMeshData ColumnMesh::Export(const std::vector<uint8_t>* keepColumns,
         map[node] = static_cast<int32_t>(data.topology.size());
         data.topology.push_back(this->Topology[node]);
         const std::size_t first = static_cast<std::size_t>(node) * interfaces;
-        data.positions.insert(data.positions.end(),
-          this->Positions.begin() + first * 3,
+        data.positions.insert(data.positions.end(), this->Positions.begin() + first * 3,
           this->Positions.begin() + (first + interfaces) * 3);
-        data.quadrics.insert(data.quadrics.end(),
-          this->Quadrics.begin() + first,
-          this->Quadrics.begin() + first + interfaces);
+        data.quadrics.insert(
+          data.quadrics.end(), this->Quadrics.begin() + first, this->Quadrics.begin() + first + interfaces);
       }
       quad[q] = map[node];
     }
@@ -384,12 +347,8 @@ void ColumnMesh::BuildAdjacencyAndQuadrics()
       // Type 1: top and bottom faces.
       for (int32_t level : { k, k + 1 })
       {
-        if (Quadric::PlaneOfQuad(this->Position(q[0], level),
-              this->Position(q[1], level),
-              this->Position(q[2], level),
-              this->Position(q[3], level),
-              normal,
-              d))
+        if (Quadric::PlaneOfQuad(this->Position(q[0], level), this->Position(q[1], level), this->Position(q[2], level),
+              this->Position(q[3], level), normal, d))
         {
           const Quadric plane = Quadric::FromPlane(normal, d, 1.0);
           for (int32_t node : q)
@@ -422,12 +381,8 @@ void ColumnMesh::BuildAdjacencyAndQuadrics()
         {
           continue; // internal face
         }
-        if (Quadric::PlaneOfQuad(this->Position(a, k),
-              this->Position(b, k),
-              this->Position(b, k + 1),
-              this->Position(a, k + 1),
-              normal,
-              d))
+        if (Quadric::PlaneOfQuad(this->Position(a, k), this->Position(b, k), this->Position(b, k + 1),
+              this->Position(a, k + 1), normal, d))
         {
           const Quadric plane = Quadric::FromPlane(normal, d, SideWeight);
           this->NodeQuadric(a, k) += plane;
@@ -457,9 +412,7 @@ void ColumnMesh::ComputeOrientation()
   this->OrientationSign = area >= 0 ? 1 : -1;
 }
 
-void ColumnMesh::Neighbours(int32_t node,
-  std::vector<int32_t>& nodes,
-  std::vector<uint8_t>& boundary) const
+void ColumnMesh::Neighbours(int32_t node, std::vector<int32_t>& nodes, std::vector<uint8_t>& boundary) const
 {
   nodes.clear();
   boundary.clear();
@@ -539,8 +492,7 @@ int64_t ColumnMesh::ConnectedParts() const
   {
     parent[c] = static_cast<int32_t>(c);
   }
-  auto root = [&](int32_t c)
-  {
+  auto root = [&](int32_t c) {
     while (parent[c] != c)
     {
       c = parent[c] = parent[parent[c]];
@@ -572,8 +524,7 @@ int64_t ColumnMesh::ConnectedParts() const
   int64_t parts = 0;
   for (std::size_t c = 0; c < parent.size(); ++c)
   {
-    parts +=
-      this->ColumnAlive[c] && root(static_cast<int32_t>(c)) == static_cast<int32_t>(c) ? 1 : 0;
+    parts += this->ColumnAlive[c] && root(static_cast<int32_t>(c)) == static_cast<int32_t>(c) ? 1 : 0;
   }
   return parts;
 }

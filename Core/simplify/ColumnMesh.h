@@ -56,37 +56,25 @@ public:
   /// Columns of cells i in [i0, i1), j in [j0, j1) of `geometry` with at least one active
   /// cell (`active`: one flag a cell, ECLIPSE order). Throws std::invalid_argument for an
   /// empty box or non-finite corners.
-  static ColumnMesh FromCornerPoints(const CornerPointGeometry& geometry,
-    const std::vector<bool>& active,
-    int64_t i0,
-    int64_t i1,
-    int64_t j0,
-    int64_t j1);
+  static ColumnMesh FromCornerPoints(const CornerPointGeometry& geometry, const std::vector<bool>& active, int64_t i0,
+    int64_t i1, int64_t j0, int64_t j1);
   /// The whole grid.
-  static ColumnMesh FromCornerPoints(const CornerPointGeometry& geometry,
-    const std::vector<bool>& active);
+  static ColumnMesh FromCornerPoints(const CornerPointGeometry& geometry, const std::vector<bool>& active);
 
   /// The same from any source of cell corners: `corners(i, j, k, out)` gives the 8 corners
   /// (x, y, depth) of cell (i, j, k) in ECLIPSE order (di + 2 dj + 4 dk, dk = 1 deeper).
   using CellCornersFunction = std::function<void(int64_t, int64_t, int64_t, double[8][3])>;
   /// `selected` (optional, one flag a column of the box, i fastest) leaves out the columns
   /// whose flag is 0.
-  static ColumnMesh FromCells(const std::array<int64_t, 3>& dims,
-    const CellCornersFunction& corners,
-    const std::vector<bool>& active,
-    int64_t i0,
-    int64_t i1,
-    int64_t j0,
-    int64_t j1,
+  static ColumnMesh FromCells(const std::array<int64_t, 3>& dims, const CellCornersFunction& corners,
+    const std::vector<bool>& active, int64_t i0, int64_t i1, int64_t j0, int64_t j1,
     const std::vector<uint8_t>* selected = nullptr);
 
   /// A mesh from explicit data, for tests and other sources: `positions` holds
   /// (layers + 1) * 3 values a node, `corners` four nodes a column (counter-clockwise in
   /// (ti, tj)), `activeCells` `layers` flags a column. Quadrics are computed.
-  static ColumnMesh FromParts(int32_t layers,
-    std::vector<double> positions,
-    std::vector<std::array<double, 2>> topology,
-    std::vector<std::array<int32_t, 4>> corners,
+  static ColumnMesh FromParts(int32_t layers, std::vector<double> positions,
+    std::vector<std::array<double, 2>> topology, std::vector<std::array<int32_t, 4>> corners,
     std::vector<uint8_t> activeCells);
 
   /// A mesh from saved arrays; the quadrics are kept as given (not recomputed), so merged
@@ -97,8 +85,8 @@ public:
   /// The alive columns (those flagged in `keepColumns` too, when given, one flag a column
   /// slot) and the nodes they use, renumbered in order; `nodeMap` (optional) gets the new
   /// index of every node slot, -1 for those left out.
-  ColumnMeshData Export(const std::vector<uint8_t>* keepColumns = nullptr,
-    std::vector<int32_t>* nodeMap = nullptr) const;
+  ColumnMeshData Export(
+    const std::vector<uint8_t>* keepColumns = nullptr, std::vector<int32_t>* nodeMap = nullptr) const;
 
   int32_t Layers() const { return this->LayerCount; }
   int32_t NodeCount() const { return static_cast<int32_t>(this->Topology.size()); }
@@ -107,10 +95,7 @@ public:
   int64_t CellCount() const { return this->AliveColumnCount * this->LayerCount; }
 
   bool IsColumnAlive(int32_t column) const { return this->ColumnAlive[column] != 0; }
-  const std::array<int32_t, 4>& ColumnCorners(int32_t column) const
-  {
-    return this->Corners[column];
-  }
+  const std::array<int32_t, 4>& ColumnCorners(int32_t column) const { return this->Corners[column]; }
   bool IsCellActive(int32_t column, int32_t layer) const
   {
     return this->ActiveCells[static_cast<std::size_t>(column) * this->LayerCount + layer] != 0;
@@ -121,14 +106,12 @@ public:
   bool IsNodeAlive(int32_t node) const { return this->NodeAlive[node] != 0; }
   glm::dvec3 Position(int32_t node, int32_t interface) const
   {
-    const double* p =
-      &this->Positions[(static_cast<std::size_t>(node) * (this->LayerCount + 1) + interface) * 3];
+    const double* p = &this->Positions[(static_cast<std::size_t>(node) * (this->LayerCount + 1) + interface) * 3];
     return { p[0], p[1], p[2] };
   }
   void SetPosition(int32_t node, int32_t interface, const glm::dvec3& p)
   {
-    double* out =
-      &this->Positions[(static_cast<std::size_t>(node) * (this->LayerCount + 1) + interface) * 3];
+    double* out = &this->Positions[(static_cast<std::size_t>(node) * (this->LayerCount + 1) + interface) * 3];
     out[0] = p.x;
     out[1] = p.y;
     out[2] = p.z;
@@ -141,10 +124,7 @@ public:
   {
     return this->Quadrics[static_cast<std::size_t>(node) * (this->LayerCount + 1) + interface];
   }
-  const std::array<double, 2>& TopologicalCoordinate(int32_t node) const
-  {
-    return this->Topology[node];
-  }
+  const std::array<double, 2>& TopologicalCoordinate(int32_t node) const { return this->Topology[node]; }
   const std::vector<int32_t>& NodeColumns(int32_t node) const { return this->ColumnsOfNode[node]; }
 
   /// Lateral neighbours of a node (nodes joined to it by a column edge) and, for each, whether

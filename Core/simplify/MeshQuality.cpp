@@ -39,12 +39,8 @@ struct FaceHash
 /// The six faces of cell `cell`, as corner lists: top, bottom, then the four sides.
 std::array<std::array<int64_t, 4>, 6> Faces(const std::array<int64_t, 8>& c)
 {
-  return { { { c[0], c[1], c[2], c[3] },
-    { c[4], c[7], c[6], c[5] },
-    { c[0], c[4], c[5], c[1] },
-    { c[1], c[5], c[6], c[2] },
-    { c[2], c[6], c[7], c[3] },
-    { c[3], c[7], c[4], c[0] } } };
+  return { { { c[0], c[1], c[2], c[3] }, { c[4], c[7], c[6], c[5] }, { c[0], c[4], c[5], c[1] },
+    { c[1], c[5], c[6], c[2] }, { c[2], c[6], c[7], c[3] }, { c[3], c[7], c[4], c[0] } } };
 }
 
 struct Triangle
@@ -72,29 +68,24 @@ void ForEachActiveFace(const HexMesh& mesh, Visit visit)
 }
 
 /// External faces of active cells (those only one active cell has), split into triangles.
-std::vector<Triangle> BoundaryTriangles(const HexMesh& mesh,
-  std::vector<std::array<glm::dvec3, 4>>& quads)
+std::vector<Triangle> BoundaryTriangles(const HexMesh& mesh, std::vector<std::array<glm::dvec3, 4>>& quads)
 {
   std::unordered_map<FaceKey, int, FaceHash> count;
   count.reserve(mesh.cells.size() * 3);
   ForEachActiveFace(mesh, [&](const auto&, const FaceKey& key) { ++count[key]; });
   std::vector<Triangle> triangles;
   quads.clear();
-  ForEachActiveFace(mesh,
-    [&](const auto& face, const FaceKey& key)
+  ForEachActiveFace(mesh, [&](const auto& face, const FaceKey& key) {
+    if (count[key] != 1)
     {
-      if (count[key] != 1)
-      {
-        return;
-      }
-      const std::array<glm::dvec3, 4> p = { PointAt(mesh, face[0]),
-        PointAt(mesh, face[1]),
-        PointAt(mesh, face[2]),
-        PointAt(mesh, face[3]) };
-      quads.push_back(p);
-      triangles.push_back({ p[0], p[1], p[2] });
-      triangles.push_back({ p[0], p[2], p[3] });
-    });
+      return;
+    }
+    const std::array<glm::dvec3, 4> p = { PointAt(mesh, face[0]), PointAt(mesh, face[1]), PointAt(mesh, face[2]),
+      PointAt(mesh, face[3]) };
+    quads.push_back(p);
+    triangles.push_back({ p[0], p[1], p[2] });
+    triangles.push_back({ p[0], p[2], p[3] });
+  });
   return triangles;
 }
 
@@ -177,23 +168,19 @@ public:
     this->Size = std::max(size, 1e-9);
     for (int d = 0; d < 3; ++d)
     {
-      this->Count[d] =
-        static_cast<int64_t>(std::min(1024.0, std::max(1.0, std::ceil(extent[d] / this->Size))));
+      this->Count[d] = static_cast<int64_t>(std::min(1024.0, std::max(1.0, std::ceil(extent[d] / this->Size))));
     }
-    this->Start.assign(
-      static_cast<std::size_t>(this->Count[0] * this->Count[1] * this->Count[2] + 1), 0);
+    this->Start.assign(static_cast<std::size_t>(this->Count[0] * this->Count[1] * this->Count[2] + 1), 0);
     std::vector<std::pair<int64_t, int64_t>> entries; // bucket, triangle
     for (std::size_t t = 0; t < this->Triangles.size(); ++t)
     {
       const Triangle& tri = this->Triangles[t];
-      const glm::dvec3 lo = glm::min(tri.a, glm::min(tri.b, tri.c)),
-                       hi = glm::max(tri.a, glm::max(tri.b, tri.c));
+      const glm::dvec3 lo = glm::min(tri.a, glm::min(tri.b, tri.c)), hi = glm::max(tri.a, glm::max(tri.b, tri.c));
       const auto a = this->Bucket(lo), b = this->Bucket(hi);
       for (int64_t z = a[2]; z <= b[2]; ++z)
         for (int64_t y = a[1]; y <= b[1]; ++y)
           for (int64_t x = a[0]; x <= b[0]; ++x)
-            entries.push_back(
-              { (z * this->Count[1] + y) * this->Count[0] + x, static_cast<int64_t>(t) });
+            entries.push_back({ (z * this->Count[1] + y) * this->Count[0] + x, static_cast<int64_t>(t) });
     }
     std::sort(entries.begin(), entries.end());
     this->Items.reserve(entries.size());
@@ -226,11 +213,8 @@ public:
         for (int64_t y = centre[1] - ring; y <= centre[1] + ring; ++y)
           for (int64_t x = centre[0] - ring; x <= centre[0] + ring; ++x)
           {
-            if (std::max({ std::llabs(x - centre[0]),
-                  std::llabs(y - centre[1]),
-                  std::llabs(z - centre[2]) }) != ring ||
-                x < 0 || y < 0 || z < 0 || x >= this->Count[0] || y >= this->Count[1] ||
-                z >= this->Count[2])
+            if (std::max({ std::llabs(x - centre[0]), std::llabs(y - centre[1]), std::llabs(z - centre[2]) }) != ring ||
+              x < 0 || y < 0 || z < 0 || x >= this->Count[0] || y >= this->Count[1] || z >= this->Count[2])
             {
               continue;
             }
@@ -257,8 +241,7 @@ private:
     for (int d = 0; d < 3; ++d)
     {
       const double cell = std::floor((p[d] - this->Low[d]) / this->Size);
-      b[d] = static_cast<int64_t>(
-        std::min(static_cast<double>(this->Count[d] - 1), std::max(0.0, cell)));
+      b[d] = static_cast<int64_t>(std::min(static_cast<double>(this->Count[d] - 1), std::max(0.0, cell)));
     }
     return b;
   }
@@ -271,28 +254,20 @@ private:
   std::vector<int64_t> Items;
 };
 
-double LargestDistance(const std::vector<Triangle>& triangles,
-  const TriangleGrid& target,
-  int perTriangle,
-  int64_t& samples,
-  std::array<double, 3>& worst)
+double LargestDistance(const std::vector<Triangle>& triangles, const TriangleGrid& target, int perTriangle,
+  int64_t& samples, std::array<double, 3>& worst)
 {
   // Samples on the triangles themselves (so a surface is at distance 0 from itself): the
   // centroid, then points towards each corner.
-  static const double weights[6][3] = { { 4.0 / 6, 1.0 / 6, 1.0 / 6 },
-    { 1.0 / 6, 4.0 / 6, 1.0 / 6 },
-    { 1.0 / 6, 1.0 / 6, 4.0 / 6 },
-    { 1, 0, 0 },
-    { 0, 1, 0 },
-    { 0, 0, 1 } };
+  static const double weights[6][3] = { { 4.0 / 6, 1.0 / 6, 1.0 / 6 }, { 1.0 / 6, 4.0 / 6, 1.0 / 6 },
+    { 1.0 / 6, 1.0 / 6, 4.0 / 6 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
   double largest = 0;
   for (const Triangle& t : triangles)
   {
     for (int s = -1; s < perTriangle; ++s)
     {
       const glm::dvec3 p =
-        s < 0 ? (t.a + t.b + t.c) / 3.0
-              : weights[s % 6][0] * t.a + weights[s % 6][1] * t.b + weights[s % 6][2] * t.c;
+        s < 0 ? (t.a + t.b + t.c) / 3.0 : weights[s % 6][0] * t.a + weights[s % 6][1] * t.b + weights[s % 6][2] * t.c;
       const double distance = target.Distance(p);
       if (distance > largest)
       {
@@ -309,14 +284,8 @@ double LargestDistance(const std::vector<Triangle>& triangles,
 namespace
 {
 // Corner neighbours of a VTK-ordered hexahedron, in right-handed order.
-constexpr int CornerNeighbours[8][3] = { { 1, 3, 4 },
-  { 2, 0, 5 },
-  { 3, 1, 6 },
-  { 0, 2, 7 },
-  { 7, 5, 0 },
-  { 4, 6, 1 },
-  { 5, 7, 2 },
-  { 6, 4, 3 } };
+constexpr int CornerNeighbours[8][3] = { { 1, 3, 4 }, { 2, 0, 5 }, { 3, 1, 6 }, { 0, 2, 7 }, { 7, 5, 0 }, { 4, 6, 1 },
+  { 5, 7, 2 }, { 6, 4, 3 } };
 
 /// A HexMesh cell's corners in VTK order in a z-up frame: the bottom face (the deeper
 /// interface) first, counter-clockwise seen from above.
@@ -356,10 +325,8 @@ double HexScaledJacobian(const glm::dvec3 corners[8], int orientation, bool& deg
   double worst = 1;
   for (int i = 0; i < 8; ++i)
   {
-    const glm::dvec3 e1 = p[next[i][0]] - p[i], e2 = p[next[i][1]] - p[i],
-                     e3 = p[next[i][2]] - p[i];
-    worst = std::min(worst,
-      glm::dot(e1, glm::cross(e2, e3)) / (glm::length(e1) * glm::length(e2) * glm::length(e3)));
+    const glm::dvec3 e1 = p[next[i][0]] - p[i], e2 = p[next[i][1]] - p[i], e3 = p[next[i][2]] - p[i];
+    worst = std::min(worst, glm::dot(e1, glm::cross(e2, e3)) / (glm::length(e1) * glm::length(e2) * glm::length(e3)));
   }
   return worst;
 }
@@ -371,8 +338,7 @@ bool HexInverted(const glm::dvec3 corners[8], int orientation)
   ZUpVTKCorners(corners, orientation, p);
   for (int i = 0; i < 8; ++i)
   {
-    const glm::dvec3 e1 = p[next[i][0]] - p[i], e2 = p[next[i][1]] - p[i],
-                     e3 = p[next[i][2]] - p[i];
+    const glm::dvec3 e1 = p[next[i][0]] - p[i], e2 = p[next[i][1]] - p[i], e3 = p[next[i][2]] - p[i];
     const double det = glm::dot(e1, glm::cross(e2, e3));
     if (det >= 0)
     {
@@ -424,10 +390,8 @@ BoundaryDistance MeasureBoundaryDistance(const HexMesh& a, const HexMesh& b, int
   std::vector<std::array<glm::dvec3, 4>> quadsA, quadsB;
   const TriangleGrid gridA(BoundaryTriangles(a, quadsA));
   const TriangleGrid gridB(BoundaryTriangles(b, quadsB));
-  result.forward =
-    LargestDistance(gridA.All(), gridB, perFace, result.samples, result.worstForward);
-  result.backward =
-    LargestDistance(gridB.All(), gridA, perFace, result.samples, result.worstBackward);
+  result.forward = LargestDistance(gridA.All(), gridB, perFace, result.samples, result.worstForward);
+  result.backward = LargestDistance(gridB.All(), gridA, perFace, result.samples, result.worstBackward);
   result.hausdorff = std::max(result.forward, result.backward);
   glm::dvec3 low(std::numeric_limits<double>::max()), high(-std::numeric_limits<double>::max());
   for (const auto& q : quadsA)

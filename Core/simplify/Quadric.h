@@ -31,12 +31,8 @@ struct Quadric
 
   /// The plane through a quadrilateral face (best fit: normal from the diagonals, through
   /// the centroid); false for a face without area (a pinched-out cell).
-  static bool PlaneOfQuad(const glm::dvec3& p0,
-    const glm::dvec3& p1,
-    const glm::dvec3& p2,
-    const glm::dvec3& p3,
-    glm::dvec3& normal,
-    double& d)
+  static bool PlaneOfQuad(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2, const glm::dvec3& p3,
+    glm::dvec3& normal, double& d)
   {
     const glm::dvec3 cross = glm::cross(p2 - p0, p3 - p1);
     const double length = glm::length(cross);
@@ -64,9 +60,8 @@ struct Quadric
   {
     const double x = p.x, y = p.y, z = p.z;
     const auto& m = this->q;
-    const double error = m[0] * x * x + 2 * m[1] * x * y + 2 * m[2] * x * z + 2 * m[3] * x +
-                         m[4] * y * y + 2 * m[5] * y * z + 2 * m[6] * y + m[7] * z * z +
-                         2 * m[8] * z + m[9];
+    const double error = m[0] * x * x + 2 * m[1] * x * y + 2 * m[2] * x * z + 2 * m[3] * x + m[4] * y * y +
+      2 * m[5] * y * z + 2 * m[6] * y + m[7] * z * z + 2 * m[8] * z + m[9];
     return error > 0 ? error : 0; // rounding can give tiny negatives
   }
 

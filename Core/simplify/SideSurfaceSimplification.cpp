@@ -139,7 +139,7 @@ private:
   std::vector<uint32_t> Global;
   std::vector<Triangle> Triangles;
   std::vector<uint8_t> Alive;
-  std::vector<Vec> InputNormal; ///< unit normal of the input triangle a slot started as
+  std::vector<Vec> InputNormal;                  ///< unit normal of the input triangle a slot started as
   std::vector<uint32_t> InputStart, InputAround; ///< input triangles of each vertex (CSR)
   std::vector<std::vector<uint32_t>> Star;       ///< live triangles of each vertex
   std::vector<std::vector<uint32_t>> Riders;     ///< removed vertices nearest each triangle
@@ -284,8 +284,7 @@ Simplifier::Simplifier(const RegionMesh& mesh, const std::vector<Triangle>& inpu
     for (std::size_t i = 0; i < this->Ring.size(); ++i)
     {
       const uint32_t before = this->RingTriangle[(i + this->Ring.size() - 1) % this->Ring.size()];
-      if (glm::dot(this->InputNormal[before], this->InputNormal[this->RingTriangle[i]]) <
-          FoldCosine)
+      if (glm::dot(this->InputNormal[before], this->InputNormal[this->RingTriangle[i]]) < FoldCosine)
       {
         this->Locked[v] = 1;
       }
@@ -336,7 +335,7 @@ void Simplifier::Plan(uint32_t vertex, bool changed)
     for (uint32_t to : this->Triangles[t])
     {
       if (to == vertex || this->Mark[to] == this->MarkValue ||
-          std::find(refused.begin(), refused.end(), to) != refused.end())
+        std::find(refused.begin(), refused.end(), to) != refused.end())
       {
         continue;
       }
@@ -383,8 +382,7 @@ bool Simplifier::Fan(uint32_t vertex)
   {
     byStart[i] = static_cast<uint32_t>(i);
   }
-  std::sort(byStart.begin(),
-    byStart.end(),
+  std::sort(byStart.begin(), byStart.end(),
     [&](uint32_t a, uint32_t b) { return this->Links[a].first < this->Links[b].first; });
   for (std::size_t i = 1; i < byStart.size(); ++i)
   {
@@ -399,10 +397,8 @@ bool Simplifier::Fan(uint32_t vertex)
     this->Ring.push_back(this->Links[at].first);
     this->RingTriangle.push_back(star[at]);
     const uint32_t next = this->Links[at].second;
-    const auto found = std::lower_bound(byStart.begin(),
-      byStart.end(),
-      next,
-      [&](uint32_t i, uint32_t value) { return this->Links[i].first < value; });
+    const auto found = std::lower_bound(
+      byStart.begin(), byStart.end(), next, [&](uint32_t i, uint32_t value) { return this->Links[i].first < value; });
     if (found == byStart.end() || this->Links[*found].first != next)
     {
       return false; // the link ends: a border
@@ -468,11 +464,10 @@ bool Simplifier::Check(uint32_t from, uint32_t to)
     const Vec& p = this->Position[to];
     const Vec old = glm::cross(a - this->Position[from], b - this->Position[from]);
     const Vec now = glm::cross(a - p, b - p);
-    const bool turned =
-      glm::dot(now, old) < SmallestTurnCosine * glm::length(now) * glm::length(old) ||
+    const bool turned = glm::dot(now, old) < SmallestTurnCosine * glm::length(now) * glm::length(old) ||
       !(glm::dot(now, this->InputNormal[t]) > 0);
     if (turned || Thickness(p, a, b) < Thinnest || !this->FacesInput(to, now) ||
-        !this->FacesInput(this->Ring[j], now) || !this->FacesInput(this->Ring[(j + 1) % k], now))
+      !this->FacesInput(this->Ring[j], now) || !this->FacesInput(this->Ring[(j + 1) % k], now))
     {
       return false;
     }
@@ -484,8 +479,7 @@ bool Simplifier::Check(uint32_t from, uint32_t to)
   this->Carried.clear();
   double largest = 0;
   const double enough = this->Tolerance * this->Tolerance;
-  auto place = [&](uint32_t vertex, uint32_t was)
-  {
+  auto place = [&](uint32_t vertex, uint32_t was) {
     const Vec& q = this->Position[vertex];
     double best = std::numeric_limits<double>::infinity();
     uint32_t nearest = this->Kept[0];
@@ -500,8 +494,7 @@ bool Simplifier::Check(uint32_t from, uint32_t to)
       }
       Triangle c = this->Triangles[t];
       std::replace(c.begin(), c.end(), from, to);
-      const double d =
-        SquaredDistance(q, this->Position[c[0]], this->Position[c[1]], this->Position[c[2]]);
+      const double d = SquaredDistance(q, this->Position[c[0]], this->Position[c[1]], this->Position[c[2]]);
       if (d < best)
       {
         best = d;
@@ -626,9 +619,8 @@ std::vector<Triangle> TriangulateSideSurface(const RegionMesh& mesh)
   {
     const Vec p[4] = { At(mesh, q[0]), At(mesh, q[1]), At(mesh, q[2]), At(mesh, q[3]) };
     using Split = std::array<std::array<int, 3>, 2>;
-    const Split split = Dot2(p[2] - p[0]) <= Dot2(p[3] - p[1])
-                          ? Split{ { { 0, 1, 2 }, { 0, 2, 3 } } }
-                          : Split{ { { 0, 1, 3 }, { 1, 2, 3 } } };
+    const Split split = Dot2(p[2] - p[0]) <= Dot2(p[3] - p[1]) ? Split{ { { 0, 1, 2 }, { 0, 2, 3 } } }
+                                                               : Split{ { { 0, 1, 3 }, { 1, 2, 3 } } };
     for (const auto& s : split)
     {
       if (Thickness(p[s[0]], p[s[1]], p[s[2]]) > DegenerateInput)
@@ -640,9 +632,7 @@ std::vector<Triangle> TriangulateSideSurface(const RegionMesh& mesh)
   return triangles;
 }
 
-std::vector<Triangle> SimplifySideSurface(const RegionMesh& mesh,
-  double maxError,
-  SideSimplificationStats* stats)
+std::vector<Triangle> SimplifySideSurface(const RegionMesh& mesh, double maxError, SideSimplificationStats* stats)
 {
   SideSimplificationStats ignored;
   Simplifier simplifier(mesh, TriangulateSideSurface(mesh), maxError);

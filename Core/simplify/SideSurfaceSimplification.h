@@ -63,8 +63,7 @@ std::vector<std::array<uint32_t, 3>> TriangulateSideSurface(const RegionMesh& me
 
 /// Triangles of the region's side surface simplified by half-edge collapses within `maxError`
 /// (model units of distance, see the contract); `stats` is filled when given.
-std::vector<std::array<uint32_t, 3>> SimplifySideSurface(const RegionMesh& mesh,
-  double maxError,
-  SideSimplificationStats* stats = nullptr);
+std::vector<std::array<uint32_t, 3>> SimplifySideSurface(
+  const RegionMesh& mesh, double maxError, SideSimplificationStats* stats = nullptr);
 
 } // namespace resmr

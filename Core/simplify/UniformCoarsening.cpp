@@ -11,9 +11,7 @@
 namespace resmr
 {
 
-HexMesh CoarsenUniformly(const CornerPointGeometry& geometry,
-  const std::vector<bool>& active,
-  int64_t block)
+HexMesh CoarsenUniformly(const CornerPointGeometry& geometry, const std::vector<bool>& active, int64_t block)
 {
   const int64_t nx = geometry.Dims()[0], ny = geometry.Dims()[1], nz = geometry.Dims()[2];
   if (block < 1 || static_cast<int64_t>(active.size()) != nx * ny * nz)
@@ -24,8 +22,7 @@ HexMesh CoarsenUniformly(const CornerPointGeometry& geometry,
   out.layers = nz;
   // Points shared by exact position and interface.
   std::map<std::array<double, 4>, int64_t> pointIds;
-  auto pointOf = [&](const double xyz[3], int64_t k, double ti, double tj)
-  {
+  auto pointOf = [&](const double xyz[3], int64_t k, double ti, double tj) {
     const std::array<double, 4> key = { xyz[0], xyz[1], xyz[2], static_cast<double>(k) };
     const auto found = pointIds.find(key);
     if (found != pointIds.end())
@@ -84,14 +81,8 @@ HexMesh CoarsenUniformly(const CornerPointGeometry& geometry,
       }
       for (int64_t k = 0; k < nz; ++k)
       {
-        out.cells.push_back({ interfaces[k][0],
-          interfaces[k][1],
-          interfaces[k][2],
-          interfaces[k][3],
-          interfaces[k + 1][0],
-          interfaces[k + 1][1],
-          interfaces[k + 1][2],
-          interfaces[k + 1][3] });
+        out.cells.push_back({ interfaces[k][0], interfaces[k][1], interfaces[k][2], interfaces[k][3],
+          interfaces[k + 1][0], interfaces[k + 1][1], interfaces[k + 1][2], interfaces[k + 1][3] });
         out.active.push_back(layerActive[k]);
       }
     }

@@ -16,8 +16,6 @@ class CornerPointGeometry;
 /// One coarse column per block of `block` x `block` columns holding an active cell; its
 /// corners are the block's outer corner pillars as the block's corner columns see them; a
 /// coarse cell is active if any cell of its block in that layer is.
-HexMesh CoarsenUniformly(const CornerPointGeometry& geometry,
-  const std::vector<bool>& active,
-  int64_t block);
+HexMesh CoarsenUniformly(const CornerPointGeometry& geometry, const std::vector<bool>& active, int64_t block);
 
 } // namespace resmr

@@ -102,17 +102,11 @@ LatticeCoordinate Locate(double t, double wavelength)
   return { static_cast<int64_t>(cell), Smooth(g - cell) };
 }
 
-double LatticeInLayer(uint64_t seed,
-  uint64_t channel,
-  int octave,
-  int64_t a,
-  int64_t b,
-  LatticeCoordinate kc)
+double LatticeInLayer(uint64_t seed, uint64_t channel, int octave, int64_t a, int64_t b, LatticeCoordinate kc)
 {
   const uint64_t octaveChannel = channel * 16 + static_cast<uint64_t>(octave);
-  return Lerp(LatticeValue(seed, octaveChannel, a, b, kc.cell),
-    LatticeValue(seed, octaveChannel, a, b, kc.cell + 1),
-    kc.weight);
+  return Lerp(
+    LatticeValue(seed, octaveChannel, a, b, kc.cell), LatticeValue(seed, octaveChannel, a, b, kc.cell + 1), kc.weight);
 }
 
 double Quantile(std::vector<double> values, double fraction)
@@ -121,10 +115,8 @@ double Quantile(std::vector<double> values, double fraction)
   {
     return 0;
   }
-  const auto index =
-    static_cast<std::size_t>(Clamp(fraction, 0.0, 1.0) * static_cast<double>(values.size() - 1));
-  std::nth_element(
-    values.begin(), values.begin() + static_cast<std::ptrdiff_t>(index), values.end());
+  const auto index = static_cast<std::size_t>(Clamp(fraction, 0.0, 1.0) * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(index), values.end());
   return values[index];
 }
 
@@ -170,31 +162,29 @@ void SyntheticParameters::Validate() const
   auto fail = [](const std::string& what) { throw std::invalid_argument(what); };
   if (this->nx < 1 || this->ny < 1 || this->nz < 1)
   {
-    fail("dimensions must be at least 1 cell each (got " + std::to_string(this->nx) + " x " +
-         std::to_string(this->ny) + " x " + std::to_string(this->nz) + ")");
+    fail("dimensions must be at least 1 cell each (got " + std::to_string(this->nx) + " x " + std::to_string(this->ny) +
+      " x " + std::to_string(this->nz) + ")");
   }
   if (this->nx > 1000000 || this->ny > 1000000 || this->nz > 1000000)
   {
-    fail("each dimension is at most 1000000 cells (got " + std::to_string(this->nx) + " x " +
-         std::to_string(this->ny) + " x " + std::to_string(this->nz) + ")");
+    fail("each dimension is at most 1000000 cells (got " + std::to_string(this->nx) + " x " + std::to_string(this->ny) +
+      " x " + std::to_string(this->nz) + ")");
   }
   if (this->nx * this->ny > 100000000)
   {
     fail("nx * ny is at most 100 million columns: the generator keeps about 120 bytes per "
          "column in memory (got " +
-         std::to_string(this->nx * this->ny) + ")");
+      std::to_string(this->nx * this->ny) + ")");
   }
   if (this->faults < 0 || this->faults > 32)
   {
     fail("faults must be 0 to 32 (got " + std::to_string(this->faults) + ")");
   }
-  auto inRange = [&](double value, double low, double high, const char* name)
-  {
+  auto inRange = [&](double value, double low, double high, const char* name) {
     if (!(value >= low && value <= high))
     {
       char text[160];
-      std::snprintf(
-        text, sizeof(text), "%s must be within [%g, %g] (got %g)", name, low, high, value);
+      std::snprintf(text, sizeof(text), "%s must be within [%g, %g] (got %g)", name, low, high, value);
       fail(text);
     }
   };
@@ -218,16 +208,14 @@ bool IsSyntheticSpec(const std::string& text)
 
 SyntheticParameters ParseSyntheticSpec(const std::string& spec)
 {
-  const auto malformed = [&]()
-  { return std::invalid_argument(spec + ": expected synth:NIxNJxNK[:SEED[:STEPS]]"); };
+  const auto malformed = [&]() { return std::invalid_argument(spec + ": expected synth:NIxNJxNK[:SEED[:STEPS]]"); };
   if (!IsSyntheticSpec(spec))
   {
     throw malformed();
   }
   const char* at = spec.c_str() + 6;
   const char* const end = spec.c_str() + spec.size();
-  const auto number = [&](auto& value)
-  {
+  const auto number = [&](auto& value) {
     const auto result = std::from_chars(at, end, value);
     if (result.ec != std::errc() || result.ptr == at)
     {
@@ -235,8 +223,7 @@ SyntheticParameters ParseSyntheticSpec(const std::string& spec)
     }
     at = result.ptr;
   };
-  const auto expect = [&](char separator)
-  {
+  const auto expect = [&](char separator) {
     if (at == end || *at != separator)
     {
       throw malformed();
@@ -290,12 +277,11 @@ SyntheticReservoir::SyntheticReservoir(const SyntheticParameters& parameters)
 {
   this->Params.Validate();
   const int64_t maxDim = std::max(this->Params.nx, this->Params.ny);
-  this->Dx = this->Params.cellSize > 0 ? this->Params.cellSize
-                                       : Clamp(8000.0 / static_cast<double>(maxDim), 10.0, 100.0);
+  this->Dx =
+    this->Params.cellSize > 0 ? this->Params.cellSize : Clamp(8000.0 / static_cast<double>(maxDim), 10.0, 100.0);
   this->Dy = this->Dx;
-  this->Gross = this->Params.grossThickness > 0
-                  ? this->Params.grossThickness
-                  : Clamp(3.0 * static_cast<double>(this->Params.nz), 40.0, 400.0);
+  this->Gross = this->Params.grossThickness > 0 ? this->Params.grossThickness
+                                                : Clamp(3.0 * static_cast<double>(this->Params.nz), 40.0, 400.0);
 
   // Layers: nominal thicknesses and sand quality, both correlated over a few layers.
   const int64_t nz = this->Params.nz;
@@ -325,8 +311,7 @@ SyntheticReservoir::SyntheticReservoir(const SyntheticParameters& parameters)
 
 double SyntheticReservoir::Noise(uint64_t channel, double i, double j, double k) const
 {
-  const double base =
-    std::max(6.0, static_cast<double>(std::max(this->Params.nx, this->Params.ny)) / 3.0);
+  const double base = std::max(6.0, static_cast<double>(std::max(this->Params.nx, this->Params.ny)) / 3.0);
   double total = 0;
   for (int o = 0; o < Octaves; ++o)
   {
@@ -339,8 +324,7 @@ double SyntheticReservoir::Noise(uint64_t channel, double i, double j, double k)
     const double l10 = LatticeInLayer(seed, channel, o, x.cell + 1, y.cell, z);
     const double l01 = LatticeInLayer(seed, channel, o, x.cell, y.cell + 1, z);
     const double l11 = LatticeInLayer(seed, channel, o, x.cell + 1, y.cell + 1, z);
-    total = total +
-            OctaveAmplitude[o] * Lerp(Lerp(l00, l10, x.weight), Lerp(l01, l11, x.weight), y.weight);
+    total = total + OctaveAmplitude[o] * Lerp(Lerp(l00, l10, x.weight), Lerp(l01, l11, x.weight), y.weight);
   }
   return total;
 }
@@ -359,8 +343,7 @@ void SyntheticReservoir::BuildStructure()
   // tan of the dip by its series (no libm): exact to 1e-9 up to the 30 degree limit.
   const double angle = this->Params.dipDegrees * Pi / 180.0;
   const double a2 = angle * angle;
-  const double tanDip =
-    angle * (1 + a2 * (1.0 / 3 + a2 * (2.0 / 15 + a2 * (17.0 / 315 + a2 * (62.0 / 2835)))));
+  const double tanDip = angle * (1 + a2 * (1.0 / 3 + a2 * (2.0 / 15 + a2 * (17.0 / 315 + a2 * (62.0 / 2835)))));
   double dipX, dipY, axisX, axisY;
   random.Direction(dipX, dipY);
   random.Direction(axisX, axisY);
@@ -379,8 +362,7 @@ void SyntheticReservoir::BuildStructure()
       const double r2 = (u / longRadius) * (u / longRadius) + (v / shortRadius) * (v / shortRadius);
       const double bump = 1.0 / ((1.0 + r2) * (1.0 + r2));
       const double rough =
-        0.16 * this->Gross *
-        (this->Noise(RoughnessChannel, static_cast<double>(i), static_cast<double>(j), 0) - 0.5);
+        0.16 * this->Gross * (this->Noise(RoughnessChannel, static_cast<double>(i), static_cast<double>(j), 0) - 0.5);
       this->TopDepth[j * (nx + 1) + i] =
         2000.0 + tanDip * (dipX * (x - 0.5 * lx) + dipY * (y - 0.5 * ly)) - relief * bump + rough;
     }
@@ -435,8 +417,7 @@ void SyntheticReservoir::BuildFaults()
         const double along = 2.0 * (x * strikeX + y * strikeY) / fault.length;
         const double across = std::fabs(x * fault.normalX + y * fault.normalY);
         const double taper = std::fabs(along) < 1 ? (1 - along * along) * (1 - along * along) : 0.0;
-        pillarThrow[j * (nx + 1) + i] =
-          fault.throwMetres * taper / (1.0 + across / (0.5 * fault.length));
+        pillarThrow[j * (nx + 1) + i] = fault.throwMetres * taper / (1.0 + across / (0.5 * fault.length));
       }
     }
     // Cells whose centre lies in the hanging wall move down by the throw at their corners;
@@ -500,8 +481,7 @@ void SyntheticReservoir::BuildOutline()
     {
       const double u = (static_cast<double>(i) + 0.5) / static_cast<double>(nx) - 0.5;
       const double v = (static_cast<double>(j) + 0.5) / static_cast<double>(ny) - 0.5;
-      const double noise =
-        this->Noise(OutlineChannel, static_cast<double>(i) + 0.5, static_cast<double>(j) + 0.5, 0);
+      const double noise = this->Noise(OutlineChannel, static_cast<double>(i) + 0.5, static_cast<double>(j) + 0.5, 0);
       distance[j * nx + i] = std::sqrt(u * u + v * v) + 0.5 * (noise - 0.5);
     }
   }
@@ -531,10 +511,8 @@ void SyntheticReservoir::Calibrate()
   // matching the requested water fraction.
   const int64_t nx = this->Params.nx, ny = this->Params.ny, nz = this->Params.nz;
   const int64_t wanted = std::clamp<int64_t>((1 << 20) / nz, 64, 1024);
-  const int64_t side =
-    std::max<int64_t>(1, static_cast<int64_t>(std::sqrt(static_cast<double>(wanted))));
-  const int64_t strideI = std::max<int64_t>(1, nx / side),
-                strideJ = std::max<int64_t>(1, ny / side);
+  const int64_t side = std::max<int64_t>(1, static_cast<int64_t>(std::sqrt(static_cast<double>(wanted))));
+  const int64_t strideI = std::max<int64_t>(1, nx / side), strideJ = std::max<int64_t>(1, ny / side);
   std::vector<std::array<int64_t, 2>> columns;
   for (int64_t j = strideJ / 2; j < ny; j += strideJ)
   {
@@ -546,14 +524,10 @@ void SyntheticReservoir::Calibrate()
   // Noise at the four corner pillars of a sample column, recomputed when needed: only every
   // kStride-th layer is kept for the quantiles (at most 2^18 values, 2 MB), so memory does
   // not grow with nz.
-  const int64_t kStride =
-    std::max<int64_t>(1, (static_cast<int64_t>(columns.size()) * nz + (1 << 18) - 1) >> 18);
-  auto cornerNoise = [&](std::size_t c, int64_t k, int corner)
-  {
-    return this->Noise(ThicknessChannel,
-      static_cast<double>(columns[c][0] + (corner & 1)),
-      static_cast<double>(columns[c][1] + (corner >> 1)),
-      static_cast<double>(k));
+  const int64_t kStride = std::max<int64_t>(1, (static_cast<int64_t>(columns.size()) * nz + (1 << 18) - 1) >> 18);
+  auto cornerNoise = [&](std::size_t c, int64_t k, int corner) {
+    return this->Noise(ThicknessChannel, static_cast<double>(columns[c][0] + (corner & 1)),
+      static_cast<double>(columns[c][1] + (corner >> 1)), static_cast<double>(k));
   };
   std::vector<double> cornerNoiseMax;
   cornerNoiseMax.reserve(columns.size() * static_cast<std::size_t>((nz + kStride - 1) / kStride));
@@ -570,9 +544,8 @@ void SyntheticReservoir::Calibrate()
       cornerNoiseMax.push_back(highest);
     }
   }
-  this->PinchLevel = this->Params.pinchedFraction > 0
-                       ? Clamp(Quantile(cornerNoiseMax, this->Params.pinchedFraction), 0.0, 0.95)
-                       : 0.0;
+  this->PinchLevel =
+    this->Params.pinchedFraction > 0 ? Clamp(Quantile(cornerNoiseMax, this->Params.pinchedFraction), 0.0, 0.95) : 0.0;
   // Layers average their nominal thickness: the mean of max(0, noise - level) over the
   // sampled corners.
   double mean = 0;
@@ -616,8 +589,7 @@ void SyntheticReservoir::Calibrate()
           double centre = 0, thickness = 0;
           for (int corner = 0; corner < 4; ++corner)
           {
-            const double t =
-              this->LayerThickness[k] * this->ThicknessFactor(cornerNoise(c, k, corner));
+            const double t = this->LayerThickness[k] * this->ThicknessFactor(cornerNoise(c, k, corner));
             centre += top[corner] + 0.5 * t;
             thickness += t;
             top[corner] += t;
@@ -640,8 +612,7 @@ void SyntheticReservoir::PlaceWells()
 {
   // Injectors on the flanks just above the contact, producers near the crest.
   const int64_t nx = this->Params.nx, ny = this->Params.ny;
-  const double extent =
-    std::max(static_cast<double>(nx) * this->Dx, static_cast<double>(ny) * this->Dy);
+  const double extent = std::max(static_cast<double>(nx) * this->Dx, static_cast<double>(ny) * this->Dy);
   SplitMix random(this->Params.seed ^ 0x57454c4cull);
   struct Candidate
   {
@@ -650,28 +621,22 @@ void SyntheticReservoir::PlaceWells()
   std::vector<Candidate> candidates;
   for (int attempt = 0; attempt < 4000 && candidates.size() < 400; ++attempt)
   {
-    const auto i =
-      std::min<int64_t>(nx - 1, static_cast<int64_t>(random.Uniform() * static_cast<double>(nx)));
-    const auto j =
-      std::min<int64_t>(ny - 1, static_cast<int64_t>(random.Uniform() * static_cast<double>(ny)));
+    const auto i = std::min<int64_t>(nx - 1, static_cast<int64_t>(random.Uniform() * static_cast<double>(nx)));
+    const auto j = std::min<int64_t>(ny - 1, static_cast<int64_t>(random.Uniform() * static_cast<double>(ny)));
     const double depth = this->TopDepth[j * (nx + 1) + i] + this->Throw[4 * (j * nx + i)];
     if (this->Inside[j * nx + i] && depth < this->Contact)
     {
-      candidates.push_back({ depth,
-        (static_cast<double>(i) + 0.5) * this->Dx,
-        (static_cast<double>(j) + 0.5) * this->Dy });
+      candidates.push_back(
+        { depth, (static_cast<double>(i) + 0.5) * this->Dx, (static_cast<double>(j) + 0.5) * this->Dy });
     }
   }
   if (candidates.empty())
   {
-    candidates.push_back(
-      { 0, 0.5 * static_cast<double>(nx) * this->Dx, 0.5 * static_cast<double>(ny) * this->Dy });
+    candidates.push_back({ 0, 0.5 * static_cast<double>(nx) * this->Dx, 0.5 * static_cast<double>(ny) * this->Dy });
   }
-  std::stable_sort(candidates.begin(),
-    candidates.end(),
-    [](const Candidate& a, const Candidate& b) { return a.depth < b.depth; });
-  auto pick = [&](bool deepest, std::size_t count)
-  {
+  std::stable_sort(
+    candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.depth < b.depth; });
+  auto pick = [&](bool deepest, std::size_t count) {
     std::vector<Candidate> chosen;
     for (std::size_t n = 0; n < candidates.size() && chosen.size() < count; ++n)
     {
@@ -698,8 +663,7 @@ void SyntheticReservoir::PlaceWells()
   {
     for (int64_t i = 0; i < nx; ++i)
     {
-      const double x = (static_cast<double>(i) + 0.5) * this->Dx,
-                   y = (static_cast<double>(j) + 0.5) * this->Dy;
+      const double x = (static_cast<double>(i) + 0.5) * this->Dx, y = (static_cast<double>(j) + 0.5) * this->Dy;
       double nearest = std::numeric_limits<double>::infinity(), pressure = 0;
       for (const Candidate& w : injectors)
       {
@@ -719,8 +683,7 @@ void SyntheticReservoir::PlaceWells()
   double reach = 0;
   for (const Candidate& w : producers)
   {
-    reach += this->InjectorDistance[static_cast<int64_t>(w.y / this->Dy) * nx +
-                                    static_cast<int64_t>(w.x / this->Dx)];
+    reach += this->InjectorDistance[static_cast<int64_t>(w.y / this->Dy) * nx + static_cast<int64_t>(w.x / this->Dx)];
   }
   this->FrontReach = std::max(0.8 * reach / static_cast<double>(producers.size()), 0.2 * extent);
 }
@@ -745,11 +708,9 @@ std::vector<double> SyntheticReservoir::Coord() const
       const int64_t p = j * (nx + 1) + i;
       const double x = static_cast<double>(i) * this->Dx, y = static_cast<double>(j) * this->Dy;
       const double leanX =
-        lean *
-        (2 * this->Noise(LeanXChannel, static_cast<double>(i), static_cast<double>(j), 0) - 1);
+        lean * (2 * this->Noise(LeanXChannel, static_cast<double>(i), static_cast<double>(j), 0) - 1);
       const double leanY =
-        lean *
-        (2 * this->Noise(LeanYChannel, static_cast<double>(i), static_cast<double>(j), 0) - 1);
+        lean * (2 * this->Noise(LeanYChannel, static_cast<double>(i), static_cast<double>(j), 0) - 1);
       const double middle = this->TopDepth[p] + 0.5 * this->Gross;
       const double top = this->TopDepth[p] - 1.0;
       const double bottom = this->TopDepth[p] + thickest + maxThrow + 1.0;
@@ -778,17 +739,13 @@ SyntheticDate SyntheticReservoir::StepDate(int step) const
   return { date[0], date[1], date[2] };
 }
 
-void SyntheticReservoir::FillStep(int step,
-  const SyntheticLayer& layer,
-  float* pressure,
-  float* swat) const
+void SyntheticReservoir::FillStep(int step, const SyntheticLayer& layer, float* pressure, float* swat) const
 {
   const int64_t columns = this->Params.nx * this->Params.ny;
-  const double progress =
-    static_cast<double>(step) / static_cast<double>(std::max(1, this->Params.steps));
+  const double progress = static_cast<double>(step) / static_cast<double>(std::max(1, this->Params.steps));
   const double front = this->FrontReach * progress;
-  const double extent = std::max(static_cast<double>(this->Params.nx) * this->Dx,
-    static_cast<double>(this->Params.ny) * this->Dy);
+  const double extent =
+    std::max(static_cast<double>(this->Params.nx) * this->Dx, static_cast<double>(this->Params.ny) * this->Dy);
   const double frontWidth = 0.03 * extent;
   const double quality = this->LayerQuality[layer.k];
   const double connate = 0.12 + 0.13 * (1.0 - quality), residualOil = 0.2;
@@ -796,12 +753,11 @@ void SyntheticReservoir::FillStep(int step,
   for (int64_t c = 0; c < columns; ++c)
   {
     const double depth = layer.depth[c];
-    pressure[c] = static_cast<float>(
-      180.0 + 0.085 * (depth - 2000.0) + 35.0 * (1.0 - 0.5 * progress) * this->WellPressure[c]);
+    pressure[c] =
+      static_cast<float>(180.0 + 0.085 * (depth - 2000.0) + 35.0 * (1.0 - 0.5 * progress) * this->WellPressure[c]);
     // Water runs ahead in permeable layers and slumps to the bottom.
     const double speed = Clamp(std::sqrt(layer.permx[c] / 100.0), 0.35, 1.8);
-    const double sinking =
-      std::isfinite(this->Contact) ? Clamp((depth - contactTop) / this->Gross, 0.0, 1.0) : 0.0;
+    const double sinking = std::isfinite(this->Contact) ? Clamp((depth - contactTop) / this->Gross, 0.0, 1.0) : 0.0;
     const double travel = this->InjectorDistance[c] / speed * (1.0 - 0.25 * sinking);
     double water = connate;
     if (front > 0)
@@ -848,8 +804,7 @@ bool SyntheticLayerStream::Next(SyntheticLayer& layer)
     {
       for (int64_t a = 0; a < cellsX; ++a)
       {
-        this->LatticePlane[b * cellsX + a] =
-          LatticeInLayer(m.Params.seed, ThicknessChannel, o, a, b, z);
+        this->LatticePlane[b * cellsX + a] = LatticeInLayer(m.Params.seed, ThicknessChannel, o, a, b, z);
       }
     }
     std::vector<LatticeCoordinate> xs(static_cast<std::size_t>(nx + 1));
@@ -866,9 +821,10 @@ bool SyntheticLayerStream::Next(SyntheticLayer& layer)
       for (int64_t i = 0; i <= nx; ++i)
       {
         const LatticeCoordinate x = xs[i];
-        out[i] = out[i] + OctaveAmplitude[o] * Lerp(Lerp(row0[x.cell], row0[x.cell + 1], x.weight),
-                                                 Lerp(row1[x.cell], row1[x.cell + 1], x.weight),
-                                                 y.weight);
+        out[i] = out[i] +
+          OctaveAmplitude[o] *
+            Lerp(
+              Lerp(row0[x.cell], row0[x.cell + 1], x.weight), Lerp(row1[x.cell], row1[x.cell + 1], x.weight), y.weight);
       }
     }
   }
@@ -916,10 +872,10 @@ bool SyntheticLayerStream::Next(SyntheticLayer& layer)
       centre *= 0.125;
       thickness *= 0.25;
       noise *= 0.25;
-      SyntheticCellState state = !m.Inside[c]                 ? SyntheticCellState::Outside
-                                 : thickness < pinchThickness ? SyntheticCellState::Pinched
-                                 : centre > m.Contact         ? SyntheticCellState::Water
-                                                              : SyntheticCellState::Active;
+      SyntheticCellState state = !m.Inside[c] ? SyntheticCellState::Outside
+        : thickness < pinchThickness          ? SyntheticCellState::Pinched
+        : centre > m.Contact                  ? SyntheticCellState::Water
+                                              : SyntheticCellState::Active;
       // Clean sands are porous, thick and permeable; shales are none of these. Within a
       // layer, thicker parts are better sands (the layer noise, contrast stretched).
       const double lateral = Clamp((noise - 0.5) * 2.5 + 0.5, 0.0, 1.0);
@@ -932,9 +888,8 @@ bool SyntheticLayerStream::Next(SyntheticLayer& layer)
       layer.poro[c] = static_cast<float>(poro);
       layer.ntg[c] = static_cast<float>(ntg);
       layer.permx[c] = static_cast<float>(permx);
-      layer.poreVolume[c] = state == SyntheticCellState::Active
-                              ? static_cast<float>(area * thickness * poro * ntg)
-                              : 0.0f;
+      layer.poreVolume[c] =
+        state == SyntheticCellState::Active ? static_cast<float>(area * thickness * poro * ntg) : 0.0f;
       counts.active += state == SyntheticCellState::Active;
       counts.outside += state == SyntheticCellState::Outside;
       counts.pinched += state == SyntheticCellState::Pinched;

@@ -33,8 +33,7 @@ public:
   {
     if (this->Progress)
     {
-      this->Progress((this->Done + static_cast<double>(k + 1) / static_cast<double>(this->Layers)) /
-                     this->Passes);
+      this->Progress((this->Done + static_cast<double>(k + 1) / static_cast<double>(this->Layers)) / this->Passes);
     }
   }
   void EndPass() { ++this->Done; }
@@ -118,11 +117,8 @@ std::vector<int32_t> Intehead(const SyntheticReservoir& model, int64_t active, S
   return head;
 }
 
-void WriteHeaders(EclipseKeywordWriter& out,
-  const SyntheticReservoir& model,
-  int64_t active,
-  SyntheticDate date,
-  double days)
+void WriteHeaders(
+  EclipseKeywordWriter& out, const SyntheticReservoir& model, int64_t active, SyntheticDate date, double days)
 {
   out.Write("INTEHEAD", "INTE", Intehead(model, active, date));
   out.Write("LOGIHEAD", "LOGI", std::vector<int32_t>(121, 0));
@@ -134,34 +130,23 @@ void WriteHeaders(EclipseKeywordWriter& out,
 
 const std::vector<SyntheticInitArray>& SyntheticInitArrays()
 {
-  static const std::vector<SyntheticInitArray> arrays = { { "PORV", true },
-    { "DEPTH", false },
-    { "DX", false },
-    { "DY", false },
-    { "DZ", false },
-    { "PORO", false },
-    { "PERMX", false },
-    { "PERMY", false },
-    { "PERMZ", false },
+  static const std::vector<SyntheticInitArray> arrays = { { "PORV", true }, { "DEPTH", false }, { "DX", false },
+    { "DY", false }, { "DZ", false }, { "PORO", false }, { "PERMX", false }, { "PERMY", false }, { "PERMZ", false },
     { "NTG", false } };
   return arrays;
 }
 
-void FillSyntheticInitArray(const SyntheticReservoir& model,
-  std::size_t index,
-  const SyntheticLayer& layer,
-  float* values)
+void FillSyntheticInitArray(
+  const SyntheticReservoir& model, std::size_t index, const SyntheticLayer& layer, float* values)
 {
   const std::size_t cells = layer.state.size();
-  const auto copy = [&](const std::vector<float>& from, float scale)
-  {
+  const auto copy = [&](const std::vector<float>& from, float scale) {
     for (std::size_t c = 0; c < cells; ++c)
     {
       values[c] = from[c] * scale;
     }
   };
-  const auto fill = [&](double size)
-  { std::fill(values, values + cells, static_cast<float>(size)); };
+  const auto fill = [&](double size) { std::fill(values, values + cells, static_cast<float>(size)); };
   switch (index)
   {
     case 0:
@@ -199,24 +184,21 @@ void FillSyntheticInitArray(const SyntheticReservoir& model,
   }
 }
 
-SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model,
-  const std::string& egridPath,
-  const SyntheticProgress& progress)
+SyntheticOutput WriteSyntheticEclipse(
+  const SyntheticReservoir& model, const std::string& egridPath, const SyntheticProgress& progress)
 {
   const SyntheticParameters& p = model.Parameters();
   if (p.CellCount() > MaxEgridCells)
   {
-    throw InputError(egridPath,
-      0,
-      "",
+    throw InputError(egridPath, 0, "",
       "an EGRID holds at most 268,435,455 cells (ZCORN's 8 values a cell must fit the 32-bit "
       "count of an ECLIPSE keyword header), and " +
         std::to_string(p.nx) + " x " + std::to_string(p.ny) + " x " + std::to_string(p.nz) + " = " +
         std::to_string(p.CellCount()) +
         " cells were asked for. Models this large are not written to files: the hierarchy builder "
         "streams them straight from the generator (input synth:" +
-        std::to_string(p.nx) + "x" + std::to_string(p.ny) + "x" + std::to_string(p.nz) + ":" +
-        std::to_string(p.seed) + "), or write GRDECL for an ASCII deck");
+        std::to_string(p.nx) + "x" + std::to_string(p.ny) + "x" + std::to_string(p.nz) + ":" + std::to_string(p.seed) +
+        "), or write GRDECL for an ASCII deck");
   }
   const int64_t nz = p.nz;
   const int passes = 2 + static_cast<int>(SyntheticInitArrays().size()) + 2 * p.steps;
@@ -240,23 +222,18 @@ SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model,
   grid.Write("GRIDHEAD", "INTE", gridhead);
   grid.Write("COORD", "REAL", model.Coord());
   grid.Begin("ZCORN", "REAL", 8 * p.CellCount());
-  output.statistics = EachLayer(model,
-    counter,
-    [&](const SyntheticLayer& layer)
-    { grid.Append(layer.zcorn.data(), static_cast<int64_t>(layer.zcorn.size())); });
+  output.statistics = EachLayer(model, counter,
+    [&](const SyntheticLayer& layer) { grid.Append(layer.zcorn.data(), static_cast<int64_t>(layer.zcorn.size())); });
   grid.Begin("ACTNUM", "INTE", p.CellCount());
   std::vector<int32_t> actnum;
-  EachLayer(model,
-    counter,
-    [&](const SyntheticLayer& layer)
+  EachLayer(model, counter, [&](const SyntheticLayer& layer) {
+    actnum.resize(layer.state.size());
+    for (std::size_t c = 0; c < actnum.size(); ++c)
     {
-      actnum.resize(layer.state.size());
-      for (std::size_t c = 0; c < actnum.size(); ++c)
-      {
-        actnum[c] = layer.state[c] == SyntheticCellState::Active ? 1 : 0;
-      }
-      grid.Append(actnum.data(), static_cast<int64_t>(actnum.size()));
-    });
+      actnum[c] = layer.state[c] == SyntheticCellState::Active ? 1 : 0;
+    }
+    grid.Append(actnum.data(), static_cast<int64_t>(actnum.size()));
+  });
   grid.Write("ENDGRID", "INTE", std::vector<int32_t>());
   const int64_t active = output.statistics.active;
 
@@ -269,22 +246,19 @@ SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model,
   {
     const SyntheticInitArray& array = SyntheticInitArrays()[a];
     init.Begin(array.name, "REAL", array.everyCell ? p.CellCount() : active);
-    EachLayer(model,
-      counter,
-      [&](const SyntheticLayer& layer)
+    EachLayer(model, counter, [&](const SyntheticLayer& layer) {
+      values.resize(layer.state.size());
+      FillSyntheticInitArray(model, a, layer, values.data());
+      if (array.everyCell)
       {
-        values.resize(layer.state.size());
-        FillSyntheticInitArray(model, a, layer, values.data());
-        if (array.everyCell)
-        {
-          init.Append(values.data(), static_cast<int64_t>(values.size()));
-        }
-        else
-        {
-          const std::vector<float> written = ActiveValues(layer, values);
-          init.Append(written.data(), static_cast<int64_t>(written.size()));
-        }
-      });
+        init.Append(values.data(), static_cast<int64_t>(values.size()));
+      }
+      else
+      {
+        const std::vector<float> written = ActiveValues(layer, values);
+        init.Append(written.data(), static_cast<int64_t>(written.size()));
+      }
+    });
   }
 
   // UNRST: PRESSURE and SWAT per report step.
@@ -303,16 +277,13 @@ SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model,
       {
         const bool isPressure = name[0] == 'P';
         restart->Begin(name, "REAL", active);
-        EachLayer(model,
-          counter,
-          [&](const SyntheticLayer& layer)
-          {
-            pressure.resize(layer.state.size());
-            swat.resize(layer.state.size());
-            model.FillStep(step, layer, pressure.data(), swat.data());
-            const std::vector<float> values = ActiveValues(layer, isPressure ? pressure : swat);
-            restart->Append(values.data(), static_cast<int64_t>(values.size()));
-          });
+        EachLayer(model, counter, [&](const SyntheticLayer& layer) {
+          pressure.resize(layer.state.size());
+          swat.resize(layer.state.size());
+          model.FillStep(step, layer, pressure.data(), swat.data());
+          const std::vector<float> values = ActiveValues(layer, isPressure ? pressure : swat);
+          restart->Append(values.data(), static_cast<int64_t>(values.size()));
+        });
       }
       restart->Begin("ENDSOL", "MESS", 0);
     }
@@ -392,9 +363,8 @@ private:
       this->Buffer.append(text, std::to_chars(text, text + sizeof(text), this->Count).ptr);
       this->Buffer += '*';
     }
-    char* end = this->Integer
-                  ? std::to_chars(text, text + sizeof(text), static_cast<int64_t>(this->Last)).ptr
-                  : std::to_chars(text, text + sizeof(text), static_cast<float>(this->Last)).ptr;
+    char* end = this->Integer ? std::to_chars(text, text + sizeof(text), static_cast<int64_t>(this->Last)).ptr
+                              : std::to_chars(text, text + sizeof(text), static_cast<float>(this->Last)).ptr;
     this->Buffer.append(text, end);
     this->Buffer += ++this->OnLine % 10 == 0 ? '\n' : ' ';
     this->Count = 0;
@@ -413,10 +383,7 @@ private:
     {
       const int error = errno;
       this->Output.Discard();
-      throw InputError(this->Output.Path(),
-        0,
-        "",
-        std::string("write failed (disk full?): ") + std::strerror(error));
+      throw InputError(this->Output.Path(), 0, "", std::string("write failed (disk full?): ") + std::strerror(error));
     }
     this->Buffer.clear();
   }
@@ -430,16 +397,13 @@ private:
 };
 } // namespace
 
-SyntheticOutput WriteSyntheticGrdecl(const SyntheticReservoir& model,
-  const std::string& path,
-  const SyntheticProgress& progress)
+SyntheticOutput WriteSyntheticGrdecl(
+  const SyntheticReservoir& model, const std::string& path, const SyntheticProgress& progress)
 {
   const SyntheticParameters& p = model.Parameters();
   if (p.steps > 0)
   {
-    throw InputError(path,
-      0,
-      "",
+    throw InputError(path, 0, "",
       "report steps need EGRID output (they go to an UNRST beside "
       "it); a GRDECL deck holds the grid and static properties only");
   }
@@ -447,24 +411,13 @@ SyntheticOutput WriteSyntheticGrdecl(const SyntheticReservoir& model,
   SyntheticOutput output;
   GrdeclTextWriter out(path);
   char header[512];
-  std::snprintf(header,
-    sizeof(header),
+  std::snprintf(header, sizeof(header),
     "-- Synthetic reservoir written by resmr synth: %lld x %lld x %lld cells, seed %llu,\n"
     "-- %d faults, throw %g, dip %g deg, pinched %g, water %g, outside %g.\n\n"
     "SPECGRID\n%lld %lld %lld 1 F /\n\nCOORD\n",
-    static_cast<long long>(p.nx),
-    static_cast<long long>(p.ny),
-    static_cast<long long>(p.nz),
-    static_cast<unsigned long long>(p.seed),
-    p.faults,
-    p.maxThrow,
-    p.dipDegrees,
-    p.pinchedFraction,
-    p.waterFraction,
-    p.outsideFraction,
-    static_cast<long long>(p.nx),
-    static_cast<long long>(p.ny),
-    static_cast<long long>(p.nz));
+    static_cast<long long>(p.nx), static_cast<long long>(p.ny), static_cast<long long>(p.nz),
+    static_cast<unsigned long long>(p.seed), p.faults, p.maxThrow, p.dipDegrees, p.pinchedFraction, p.waterFraction,
+    p.outsideFraction, static_cast<long long>(p.nx), static_cast<long long>(p.ny), static_cast<long long>(p.nz));
   out.Text(header);
   for (double value : model.Coord())
   {
@@ -472,26 +425,20 @@ SyntheticOutput WriteSyntheticGrdecl(const SyntheticReservoir& model,
   }
   out.EndKeyword();
   out.Text("ZCORN\n");
-  output.statistics = EachLayer(model,
-    counter,
-    [&](const SyntheticLayer& layer)
+  output.statistics = EachLayer(model, counter, [&](const SyntheticLayer& layer) {
+    for (float value : layer.zcorn)
     {
-      for (float value : layer.zcorn)
-      {
-        out.Value(value, false);
-      }
-    });
+      out.Value(value, false);
+    }
+  });
   out.EndKeyword();
   out.Text("ACTNUM\n");
-  EachLayer(model,
-    counter,
-    [&](const SyntheticLayer& layer)
+  EachLayer(model, counter, [&](const SyntheticLayer& layer) {
+    for (SyntheticCellState state : layer.state)
     {
-      for (SyntheticCellState state : layer.state)
-      {
-        out.Value(state == SyntheticCellState::Active ? 1 : 0, true);
-      }
-    });
+      out.Value(state == SyntheticCellState::Active ? 1 : 0, true);
+    }
+  });
   out.EndKeyword();
   struct Array
   {
@@ -499,22 +446,17 @@ SyntheticOutput WriteSyntheticGrdecl(const SyntheticReservoir& model,
     std::vector<float> SyntheticLayer::*values;
     float scale;
   };
-  for (const Array& array : { Array{ "PORO", &SyntheticLayer::poro, 1 },
-         Array{ "PERMX", &SyntheticLayer::permx, 1 },
-         Array{ "PERMY", &SyntheticLayer::permx, 1 },
-         Array{ "PERMZ", &SyntheticLayer::permx, 0.1f },
+  for (const Array& array : { Array{ "PORO", &SyntheticLayer::poro, 1 }, Array{ "PERMX", &SyntheticLayer::permx, 1 },
+         Array{ "PERMY", &SyntheticLayer::permx, 1 }, Array{ "PERMZ", &SyntheticLayer::permx, 0.1f },
          Array{ "NTG", &SyntheticLayer::ntg, 1 } })
   {
     out.Text(std::string(array.name) + "\n");
-    EachLayer(model,
-      counter,
-      [&](const SyntheticLayer& layer)
+    EachLayer(model, counter, [&](const SyntheticLayer& layer) {
+      for (float value : layer.*(array.values))
       {
-        for (float value : layer.*(array.values))
-        {
-          out.Value(value * array.scale, false);
-        }
-      });
+        out.Value(value * array.scale, false);
+      }
+    });
     out.EndKeyword();
   }
   out.Commit();

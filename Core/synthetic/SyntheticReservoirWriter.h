@@ -46,22 +46,18 @@ const std::vector<SyntheticInitArray>& SyntheticInitArrays();
 
 /// Array `index` of SyntheticInitArrays() for every cell of `layer` (nx ny values, i fastest,
 /// inactive cells included): the values the INIT holds for its active cells, bit for bit.
-void FillSyntheticInitArray(const SyntheticReservoir& model,
-  std::size_t index,
-  const SyntheticLayer& layer,
-  float* values);
+void FillSyntheticInitArray(
+  const SyntheticReservoir& model, std::size_t index, const SyntheticLayer& layer, float* values);
 
 /// Called with the fraction done, 0 to 1.
 using SyntheticProgress = std::function<void(double)>;
 
 /// EGRID (+ INIT + UNRST beside it, same base name, extension case following the EGRID's).
-SyntheticOutput WriteSyntheticEclipse(const SyntheticReservoir& model,
-  const std::string& egridPath,
-  const SyntheticProgress& progress = {});
+SyntheticOutput WriteSyntheticEclipse(
+  const SyntheticReservoir& model, const std::string& egridPath, const SyntheticProgress& progress = {});
 
 /// One ASCII GRDECL deck: SPECGRID, COORD, ZCORN, ACTNUM, PORO, PERMX, PERMY, PERMZ, NTG.
-SyntheticOutput WriteSyntheticGrdecl(const SyntheticReservoir& model,
-  const std::string& path,
-  const SyntheticProgress& progress = {});
+SyntheticOutput WriteSyntheticGrdecl(
+  const SyntheticReservoir& model, const std::string& path, const SyntheticProgress& progress = {});
 
 } // namespace resmr

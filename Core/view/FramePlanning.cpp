@@ -8,14 +8,10 @@ namespace resmr
 
 double UploadBudgetMs(double targetFramesPerSecond)
 {
-  return targetFramesPerSecond > 0 ? UploadShareOfFrame * 1000 / targetFramesPerSecond
-                                   : UploadMsAtFixedTolerance;
+  return targetFramesPerSecond > 0 ? UploadShareOfFrame * 1000 / targetFramesPerSecond : UploadMsAtFixedTolerance;
 }
 
-uint32_t SlicesThisFrame(uint32_t slicesLeft,
-  std::size_t sliceBytes,
-  std::size_t& budget,
-  bool unbounded)
+uint32_t SlicesThisFrame(uint32_t slicesLeft, std::size_t sliceBytes, std::size_t& budget, bool unbounded)
 {
   if (slicesLeft == 0 || (!unbounded && budget == 0))
   {
@@ -24,8 +20,7 @@ uint32_t SlicesThisFrame(uint32_t slicesLeft,
   uint32_t slices = slicesLeft;
   if (!unbounded && sliceBytes > 0)
   {
-    slices = static_cast<uint32_t>(
-      std::min<std::size_t>(std::max<std::size_t>(budget / sliceBytes, 1), slicesLeft));
+    slices = static_cast<uint32_t>(std::min<std::size_t>(std::max<std::size_t>(budget / sliceBytes, 1), slicesLeft));
   }
   budget -= std::min(budget, slices * sliceBytes);
   return slices;
@@ -53,12 +48,8 @@ std::size_t DrawPieceCursor::Advance()
   return piece.bytes;
 }
 
-bool MayCopyPiece(bool bounded,
-  bool root,
-  const UploadPacer& pacer,
-  std::size_t pieceBytes,
-  std::size_t gpuBytes,
-  std::size_t gpuShare)
+bool MayCopyPiece(
+  bool bounded, bool root, const UploadPacer& pacer, std::size_t pieceBytes, std::size_t gpuBytes, std::size_t gpuShare)
 {
   return !(bounded && !root && !pacer.Admit(pieceBytes)) && gpuBytes + pieceBytes <= gpuShare;
 }
@@ -68,11 +59,8 @@ double ControllerStartTolerance(double pixelTolerance)
   return std::max(pixelTolerance, ControllerStartPixels);
 }
 
-double MeasuredFrameMs(double frameMs,
-  double rendererMs,
-  double intervalMs,
-  double targetFramesPerSecond,
-  bool afterAllocation)
+double MeasuredFrameMs(
+  double frameMs, double rendererMs, double intervalMs, double targetFramesPerSecond, bool afterAllocation)
 {
   double measured = afterAllocation ? frameMs : std::max(frameMs, rendererMs);
   if (intervalMs < 3000 / targetFramesPerSecond && !afterAllocation)

@@ -34,10 +34,7 @@ double UploadBudgetMs(double targetFramesPerSecond);
 /// Slices of a 3D table (`slicesLeft` still to copy, `sliceBytes` each) to copy now: whole
 /// slices while `budget` lasts, at least one if any budget is left, or all when `unbounded`;
 /// 0 when none may go. Takes what they cost from `budget` (never below 0).
-uint32_t SlicesThisFrame(uint32_t slicesLeft,
-  std::size_t sliceBytes,
-  std::size_t& budget,
-  bool unbounded);
+uint32_t SlicesThisFrame(uint32_t slicesLeft, std::size_t sliceBytes, std::size_t& budget, bool unbounded);
 
 /// A region's draw buffers walked a piece at a time (NextDrawPiece, at most `maxBytes` each),
 /// each piece measured once. The buffers must outlive the cursor.
@@ -63,11 +60,7 @@ private:
 /// interactive frames (`bounded`) copy the roots whatever it takes (they stand in for
 /// everything) and other regions only as `pacer` admits; the GPU's share of the memory budget
 /// (`gpuShare`, `gpuBytes` used) is never passed.
-bool MayCopyPiece(bool bounded,
-  bool root,
-  const UploadPacer& pacer,
-  std::size_t pieceBytes,
-  std::size_t gpuBytes,
+bool MayCopyPiece(bool bounded, bool root, const UploadPacer& pacer, std::size_t pieceBytes, std::size_t gpuBytes,
   std::size_t gpuShare);
 
 /// Tolerance (pixels) the frame-rate controller starts from when a frame rate is first
@@ -83,10 +76,7 @@ double ControllerStartTolerance(double pixelTolerance);
 /// between frames, which also holds compositing, buffer swaps and the application's work. A
 /// frame after one that allocated a table texture (`afterAllocation`) counts its own time
 /// only, since the renderer's time and the interval still hold that allocation.
-double MeasuredFrameMs(double frameMs,
-  double rendererMs,
-  double intervalMs,
-  double targetFramesPerSecond,
-  bool afterAllocation);
+double MeasuredFrameMs(
+  double frameMs, double rendererMs, double intervalMs, double targetFramesPerSecond, bool afterAllocation);
 
 } // namespace resmr

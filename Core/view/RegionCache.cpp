@@ -59,18 +59,15 @@ Vector Topological(const RegionMesh& mesh, uint32_t vertex)
 int CellHandedness(const RegionMesh& mesh, std::size_t column, int32_t layer)
 {
   const auto& q = mesh.corners[column];
-  const auto middle = [&](uint32_t node)
-  {
-    const Vector a = ZUp(mesh, mesh.Vertex(node, layer)),
-                 b = ZUp(mesh, mesh.Vertex(node, layer + 1));
+  const auto middle = [&](uint32_t node) {
+    const Vector a = ZUp(mesh, mesh.Vertex(node, layer)), b = ZUp(mesh, mesh.Vertex(node, layer + 1));
     return Vector{ (a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2 };
   };
   const Vector u = Minus(middle(q[2]), middle(q[0])), v = Minus(middle(q[3]), middle(q[1]));
   Vector w{ 0, 0, 0 };
   for (int n = 0; n < 4; ++n)
   {
-    const Vector d =
-      Minus(ZUp(mesh, mesh.Vertex(q[n], layer + 1)), ZUp(mesh, mesh.Vertex(q[n], layer)));
+    const Vector d = Minus(ZUp(mesh, mesh.Vertex(q[n], layer + 1)), ZUp(mesh, mesh.Vertex(q[n], layer)));
     w = { w[0] + d[0], w[1] + d[1], w[2] + d[2] };
   }
   const double physical = Dot(u, Cross(v, w));
@@ -90,11 +87,7 @@ int CellHandedness(const RegionMesh& mesh, std::size_t column, int32_t layer)
 
 /// Whether `offset` moves the triangle's centre into an active cell of the region whose open
 /// side lies on the triangle's plane along `axis`.
-bool OwnsSide(const RegionMesh& mesh,
-  const Vector& centre,
-  double plane,
-  int axis,
-  const std::array<double, 3>& offset,
+bool OwnsSide(const RegionMesh& mesh, const Vector& centre, double plane, int axis, const std::array<double, 3>& offset,
   const std::map<std::pair<int64_t, int64_t>, std::size_t>& columns)
 {
   const int64_t i = static_cast<int64_t>(std::floor(centre[0] + offset[0]));
@@ -105,13 +98,12 @@ bool OwnsSide(const RegionMesh& mesh,
   {
     return false;
   }
-  const std::size_t cell =
-    found->second * static_cast<std::size_t>(mesh.layers) + static_cast<std::size_t>(k);
+  const std::size_t cell = found->second * static_cast<std::size_t>(mesh.layers) + static_cast<std::size_t>(k);
   const auto& q = mesh.corners[found->second];
   for (int e = 0; mesh.active[cell] && e < 4; ++e)
   {
     if (mesh.topology[q[e]][axis] == plane && mesh.topology[q[(e + 1) % 4]][axis] == plane &&
-        ((mesh.openSides[cell] >> e) & 1))
+      ((mesh.openSides[cell] >> e) & 1))
     {
       return true;
     }
@@ -126,10 +118,8 @@ bool OwnsSide(const RegionMesh& mesh,
 /// off on each axis its vertices share, and takes the first active cell of the region whose
 /// open side lies on the triangle's plane. Only for regions of whole cells (integer
 /// topological coordinates, the leaves); a triangle spanning two faces keeps its offset.
-void CheckSideCell(const RegionMesh& mesh,
-  const std::array<Vector, 3>& t,
-  const std::map<std::pair<int64_t, int64_t>, std::size_t>& columns,
-  std::array<double, 3>& offset)
+void CheckSideCell(const RegionMesh& mesh, const std::array<Vector, 3>& t,
+  const std::map<std::pair<int64_t, int64_t>, std::size_t>& columns, std::array<double, 3>& offset)
 {
   bool shared[3];
   for (int a = 0; a < 3; ++a)
@@ -137,8 +127,7 @@ void CheckSideCell(const RegionMesh& mesh,
     shared[a] = t[0][a] == t[1][a] && t[1][a] == t[2][a];
   }
   // A point inside the triangle (or its segment) that falls on no cell boundary.
-  const double w0 = 1.0 / 3 + 1.4142135623730951e-3, w1 = 1.0 / 3 + 1.7320508075688772e-3,
-               w2 = 1 - w0 - w1;
+  const double w0 = 1.0 / 3 + 1.4142135623730951e-3, w1 = 1.0 / 3 + 1.7320508075688772e-3, w2 = 1 - w0 - w1;
   Vector centre;
   for (int a = 0; a < 3; ++a)
   {
@@ -214,10 +203,7 @@ std::map<std::pair<int64_t, int64_t>, std::size_t> ColumnsByCell(const RegionMes
 
 constexpr uint32_t Unused = std::numeric_limits<uint32_t>::max();
 
-void PushVertex(RegionDrawBuffers& out,
-  const Vector& position,
-  const std::array<double, 3>& origin,
-  const Vector& cell)
+void PushVertex(RegionDrawBuffers& out, const Vector& position, const std::array<double, 3>& origin, const Vector& cell)
 {
   out.vertices.push_back(static_cast<float>(position[0] - origin[0]));
   out.vertices.push_back(static_cast<float>(position[1] - origin[1]));
@@ -229,16 +215,11 @@ void PushVertex(RegionDrawBuffers& out,
 
 /// Top or bottom quads as triangles; vertices shared within the surface, the cell coordinate
 /// half a layer into the cell (down for a top face: k grows downward).
-void AddQuads(const RegionMesh& mesh,
-  const RegionSurface& surface,
-  double kOffset,
-  const std::array<double, 3>& origin,
-  std::vector<uint32_t>& map,
-  RegionDrawBuffers& out)
+void AddQuads(const RegionMesh& mesh, const RegionSurface& surface, double kOffset, const std::array<double, 3>& origin,
+  std::vector<uint32_t>& map, RegionDrawBuffers& out)
 {
   std::fill(map.begin(), map.end(), Unused);
-  const auto index = [&](uint32_t vertex)
-  {
+  const auto index = [&](uint32_t vertex) {
     uint32_t& slot = map[vertex];
     if (slot == Unused)
     {
@@ -301,11 +282,8 @@ void UseOriginalSideFaces(RegionMesh& mesh)
   }
 }
 
-RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file,
-  std::size_t region,
-  const std::array<double, 3>& origin,
-  int handedness,
-  int32_t layer)
+RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
+  const std::array<double, 3>& origin, int handedness, int32_t layer)
 {
   RegionMesh mesh = file.ReadRegion(region); // not ReadRegionSurfaces: the buffers need positions
   if (layer >= 0)
@@ -323,24 +301,18 @@ namespace
 {
 /// Appends side triangles, each with its own vertices (the cell offset belongs to the
 /// triangle); `checkCells` moves each one's offset to the cell that owns an exact side face.
-void AddSideTriangles(const RegionMesh& mesh,
-  const std::vector<std::array<uint32_t, 3>>& sideTriangles,
-  const std::array<double, 3>& origin,
-  int handedness,
-  bool checkCells,
-  RegionDrawBuffers& out)
+void AddSideTriangles(const RegionMesh& mesh, const std::vector<std::array<uint32_t, 3>>& sideTriangles,
+  const std::array<double, 3>& origin, int handedness, bool checkCells, RegionDrawBuffers& out)
 {
   // Side triangles: the face's constant axis is the largest component of its normal in
   // topological space n_T; the physical outward normal is det(A) A^-T n_T (A = d(x, y, z) /
   // d(i, j, k)), so the outward direction along that axis has the sign of
   // handedness * n_T[axis] and the cell lies on the other side. Each triangle has its own
   // vertices, since the offset belongs to the triangle.
-  const auto columns =
-    checkCells ? ColumnsByCell(mesh) : std::map<std::pair<int64_t, int64_t>, std::size_t>{};
+  const auto columns = checkCells ? ColumnsByCell(mesh) : std::map<std::pair<int64_t, int64_t>, std::size_t>{};
   for (const auto& t : sideTriangles)
   {
-    const Vector t0 = Topological(mesh, t[0]), t1 = Topological(mesh, t[1]),
-                 t2 = Topological(mesh, t[2]);
+    const Vector t0 = Topological(mesh, t[0]), t1 = Topological(mesh, t[1]), t2 = Topological(mesh, t[2]);
     const Vector n = Cross(Minus(t1, t0), Minus(t2, t0));
     int axis = 0;
     for (int a = 1; a < 3; ++a)
@@ -370,12 +342,8 @@ void AddSideTriangles(const RegionMesh& mesh,
   }
 }
 
-RegionDrawBuffers PrepareDrawBuffers(const RegionMesh& mesh,
-  const RegionSurface& top,
-  const RegionSurface& bottom,
-  const std::vector<std::array<uint32_t, 3>>& sideTriangles,
-  const std::array<double, 3>& origin,
-  int handedness)
+RegionDrawBuffers PrepareDrawBuffers(const RegionMesh& mesh, const RegionSurface& top, const RegionSurface& bottom,
+  const std::vector<std::array<uint32_t, 3>>& sideTriangles, const std::array<double, 3>& origin, int handedness)
 {
   RegionDrawBuffers out;
   out.topCone = top.cone;
@@ -393,11 +361,8 @@ RegionDrawBuffers PrepareDrawBuffers(const RegionMesh& mesh,
 }
 } // namespace
 
-void AddCoarseSide(const RegionMesh& mesh,
-  const std::vector<std::array<uint32_t, 3>>& simplifiedSide,
-  const std::array<double, 3>& origin,
-  int handedness,
-  RegionDrawBuffers& out)
+void AddCoarseSide(const RegionMesh& mesh, const std::vector<std::array<uint32_t, 3>>& simplifiedSide,
+  const std::array<double, 3>& origin, int handedness, RegionDrawBuffers& out)
 {
   const std::size_t before = out.indices.size();
   AddSideTriangles(mesh, simplifiedSide, origin, handedness, false, out);
@@ -411,8 +376,7 @@ DrawPiece NextDrawPiece(const RegionDrawBuffers& buffers, std::size_t first, std
   for (std::size_t n = first; n + 3 <= indices.size(); n += 3)
   {
     const uint32_t low = std::min({ piece.lowVertex, indices[n], indices[n + 1], indices[n + 2] });
-    const uint32_t high =
-      std::max({ piece.highVertex, indices[n], indices[n + 1], indices[n + 2] });
+    const uint32_t high = std::max({ piece.highVertex, indices[n], indices[n + 1], indices[n + 2] });
     const std::size_t bytes = (std::size_t(high - low) + 1) * 24 + (n + 3 - first) * 4;
     if (n > first && bytes > maxBytes)
     {
@@ -423,22 +387,18 @@ DrawPiece NextDrawPiece(const RegionDrawBuffers& buffers, std::size_t first, std
   return piece;
 }
 
-RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh,
-  const std::array<double, 3>& origin,
-  int handedness)
+RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin, int handedness)
 {
   return PrepareDrawBuffers(mesh, mesh.top, mesh.bottom, mesh.sideTriangles, origin, handedness);
 }
 
-RegionDrawBuffers PrepareLayerDrawBuffers(const RegionMesh& mesh,
-  int32_t layer,
-  const std::array<double, 3>& origin,
-  int handedness)
+RegionDrawBuffers PrepareLayerDrawBuffers(
+  const RegionMesh& mesh, int32_t layer, const std::array<double, 3>& origin, int handedness)
 {
   if (layer < 0 || layer >= mesh.layers)
   {
-    throw std::out_of_range("layer " + std::to_string(layer) + " of a region mesh of " +
-                            std::to_string(mesh.layers) + " layers");
+    throw std::out_of_range(
+      "layer " + std::to_string(layer) + " of a region mesh of " + std::to_string(mesh.layers) + " layers");
   }
   RegionSurface top, bottom, side;
   ExtractLayerSurfaces(mesh, layer, top, bottom, side);
@@ -457,8 +417,7 @@ RegionDrawBuffers PrepareLayerDrawBuffers(const RegionMesh& mesh,
 }
 
 RegionCache::RegionCache(std::shared_ptr<const MultiresolutionFile> file,
-  std::shared_ptr<const PropertyFile> properties,
-  std::size_t budgetBytes)
+  std::shared_ptr<const PropertyFile> properties, std::size_t budgetBytes)
   : File(std::move(file))
   , Properties(std::move(properties))
   , BudgetBytes(budgetBytes)
@@ -481,8 +440,7 @@ RegionCache::RegionCache(std::shared_ptr<const MultiresolutionFile> file,
 #ifdef __linux__
   {
     std::lock_guard<std::mutex> lock(this->Lock);
-    this->HaveLoaderClock =
-      pthread_getcpuclockid(this->Loader.native_handle(), &this->LoaderClock) == 0;
+    this->HaveLoaderClock = pthread_getcpuclockid(this->Loader.native_handle(), &this->LoaderClock) == 0;
     this->WindowStart = std::chrono::steady_clock::now();
   }
 #endif
@@ -562,8 +520,7 @@ bool RegionCache::IsResident(std::size_t region) const
   return this->Get(region) != nullptr;
 }
 
-void RegionCache::Request(const std::vector<std::size_t>& wanted,
-  const std::vector<std::size_t>& predicted)
+void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vector<std::size_t>& predicted)
 {
   {
     std::lock_guard<std::mutex> lock(this->Lock);
@@ -585,8 +542,7 @@ void RegionCache::Request(const std::vector<std::size_t>& wanted,
         this->Entries[key].lastRequested = this->Clock;
       }
     }
-    const auto predict = [&](std::size_t r, int32_t l)
-    {
+    const auto predict = [&](std::size_t r, int32_t l) {
       const Key key = this->KeyOf(r, l);
       if (r < count && !this->InWanted.count(key) && this->InPredicted.insert(key).second)
       {
@@ -623,9 +579,8 @@ void RegionCache::RequestProperty(const std::string& name, int32_t step, int32_t
     this->PropertyName = name;
     this->PropertyStep = step;
     this->PropertyLayer = layer;
-    this->PropertyWanted =
-      !(this->CurrentProperty && this->CurrentProperty->name == name &&
-        this->CurrentProperty->step == step && this->CurrentProperty->layer == layer);
+    this->PropertyWanted = !(this->CurrentProperty && this->CurrentProperty->name == name &&
+      this->CurrentProperty->step == step && this->CurrentProperty->layer == layer);
   }
   this->Wake.notify_all();
   this->StandbyWake.notify_all();
@@ -665,7 +620,7 @@ bool RegionCache::PendingLocked() const
     return true;
   }
   return !this->WantedBlocked && !this->PredictedBlocked &&
-         std::any_of(this->Predicted.begin(), this->Predicted.end(), missing);
+    std::any_of(this->Predicted.begin(), this->Predicted.end(), missing);
 }
 
 bool RegionCache::Pending() const
@@ -695,9 +650,8 @@ bool RegionCache::WaitIdle(std::chrono::milliseconds timeout) const
 
 bool RegionCache::RootsMissingLocked() const
 {
-  return this->Error.empty() && std::any_of(this->Pinned.begin(),
-                                  this->Pinned.end(),
-                                  [&](Key key) { return this->MissingLocked(key); });
+  return this->Error.empty() &&
+    std::any_of(this->Pinned.begin(), this->Pinned.end(), [&](Key key) { return this->MissingLocked(key); });
 }
 
 bool RegionCache::RootsMissing() const
@@ -803,7 +757,7 @@ std::vector<RegionCache::Key> RegionCache::EvictableLocked(Key key) const
   {
     const Key k = entry.first;
     if (entry.second.buffers && k != key && !this->IsPinnedLocked(k) && !this->InWanted.count(k) &&
-        (wanted || !this->InPredicted.count(k)))
+      (wanted || !this->InPredicted.count(k)))
     {
       order.emplace_back(entry.second.lastRequested, k);
     }
@@ -881,10 +835,8 @@ void RegionCache::InsertLocked(Key key, std::shared_ptr<const RegionDrawBuffers>
   entry.bytes = need;
   if (!this->IsPinnedLocked(key) && this->Bytes + need > this->BudgetBytes)
   {
-    const bool inWanted = this->InWanted.count(key) != 0,
-               inPredicted = this->InPredicted.count(key) != 0;
-    const std::vector<Key> evictable =
-      inWanted || inPredicted ? this->EvictableLocked(key) : std::vector<Key>();
+    const bool inWanted = this->InWanted.count(key) != 0, inPredicted = this->InPredicted.count(key) != 0;
+    const std::vector<Key> evictable = inWanted || inPredicted ? this->EvictableLocked(key) : std::vector<Key>();
     std::size_t freeable = 0;
     for (Key e : evictable)
     {
@@ -1032,8 +984,8 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock)
   }
   // The roots first (the first image), then the model's tables and the property (colour),
   // then the regions the view wants.
-  const bool rootMissing = std::any_of(
-    this->Pinned.begin(), this->Pinned.end(), [&](Key key) { return this->MissingLocked(key); });
+  const bool rootMissing =
+    std::any_of(this->Pinned.begin(), this->Pinned.end(), [&](Key key) { return this->MissingLocked(key); });
   if (!this->TablesTried && !this->TablesLoading && !rootMissing)
   {
     this->TablesLoading = true;
@@ -1075,8 +1027,8 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock)
       const int index = this->Properties ? this->Properties->Find(name, step) : -1;
       if (index < 0)
       {
-        error = (this->Properties ? this->Properties->Path() : std::string("no property file")) +
-                ": property " + name + " step " + std::to_string(step) + " not found";
+        error = (this->Properties ? this->Properties->Path() : std::string("no property file")) + ": property " + name +
+          " step " + std::to_string(step) + " not found";
       }
       else
       {
@@ -1084,17 +1036,15 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock)
         table->name = name;
         table->step = step;
         table->layer = layer;
-        table->values = layer < 0
-                          ? this->Properties->ReadPacked(static_cast<std::size_t>(index))
-                          : this->Properties->ReadLayer(static_cast<std::size_t>(index), layer);
+        table->values = layer < 0 ? this->Properties->ReadPacked(static_cast<std::size_t>(index))
+                                  : this->Properties->ReadLayer(static_cast<std::size_t>(index), layer);
       }
     }
     catch (const std::exception& e)
     {
       table.reset();
       error = "property " + name + " step " + std::to_string(step) +
-              (layer >= 0 ? " layer " + std::to_string(layer + 1) : std::string()) + ": " +
-              e.what();
+        (layer >= 0 ? " layer " + std::to_string(layer + 1) : std::string()) + ": " + e.what();
     }
     lock.lock();
     this->PropertyLoading = false;

@@ -63,8 +63,8 @@ namespace resmr
 
 struct RegionDrawBuffers
 {
-  std::vector<float> vertices;   ///< per vertex: x, y, z, ci, cj, ck
-  std::vector<uint32_t> indices; ///< triangles: top, bottom, side, coarse side
+  std::vector<float> vertices;                                 ///< per vertex: x, y, z, ci, cj, ck
+  std::vector<uint32_t> indices;                               ///< triangles: top, bottom, side, coarse side
   uint32_t topIndices = 0, bottomIndices = 0, sideIndices = 0; ///< index counts of each part
   /// The file's simplified side (Sec. 4.3), after the exact one: far fewer triangles on models
   /// of many layers, within the region's error, but its layer boundaries are interpolated
@@ -85,40 +85,30 @@ int TopologyHandedness(const MultiresolutionFile& file);
 /// Replaces the file's simplified side triangles (Sec. 4.3) by the side faces of the region's
 /// own column mesh, two triangles a quad. The simplified side keeps the geometry within the
 /// region's error but not the layer boundaries its topological coordinates interpolate, so
-/// side faces would be painted with the wrong cells. Column collapse keeps every layer interface,
-/// so the mesh's side faces carry exact k; what they cost is triangles.
+/// side faces would be painted with the wrong cells. Column collapse keeps every layer interface, so the
+/// mesh's side faces carry exact k; what they cost is triangles.
 void UseOriginalSideFaces(RegionMesh& mesh);
 
 /// Appends `simplifiedSide` (the file's side triangles of the region, before
 /// UseOriginalSideFaces) as the coarse side of `out`.
-void AddCoarseSide(const RegionMesh& mesh,
-  const std::vector<std::array<uint32_t, 3>>& simplifiedSide,
-  const std::array<double, 3>& origin,
-  int handedness,
-  RegionDrawBuffers& out);
+void AddCoarseSide(const RegionMesh& mesh, const std::vector<std::array<uint32_t, 3>>& simplifiedSide,
+  const std::array<double, 3>& origin, int handedness, RegionDrawBuffers& out);
 
 /// Draw buffers of a decoded region (surfaces and topological coordinates are enough).
-RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh,
-  const std::array<double, 3>& origin,
-  int handedness);
+RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin, int handedness);
 
 /// Draw buffers of layer `layer` (0-based) of a decoded region, laid out as the whole model's:
 /// the top and bottom faces of the layer's active cells and their side faces open in that
 /// layer (no active cell across in the same layer, a fault, the model's limit;
 /// ExtractLayerSurfaces). Cell coordinates lie in the layer: k + 0.5 on top and bottom faces,
 /// k to k + 1 (its interfaces) on side faces.
-RegionDrawBuffers PrepareLayerDrawBuffers(const RegionMesh& mesh,
-  int32_t layer,
-  const std::array<double, 3>& origin,
-  int handedness);
+RegionDrawBuffers PrepareLayerDrawBuffers(
+  const RegionMesh& mesh, int32_t layer, const std::array<double, 3>& origin, int handedness);
 
 /// What the cache loads for a region: its mesh read and checked, its own side faces, buffers;
 /// of one layer (0-based) when `layer` >= 0.
-RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file,
-  std::size_t region,
-  const std::array<double, 3>& origin,
-  int handedness,
-  int32_t layer = -1);
+RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
+  const std::array<double, 3>& origin, int handedness, int32_t layer = -1);
 
 /// A run of a region's triangles copied to the GPU as one piece: indices [first, end) and
 /// the vertices [lowVertex, highVertex] they use.
@@ -155,8 +145,7 @@ class RegionCache
 {
 public:
   /// Starts the loader thread. `properties` may be null.
-  RegionCache(std::shared_ptr<const MultiresolutionFile> file,
-    std::shared_ptr<const PropertyFile> properties,
+  RegionCache(std::shared_ptr<const MultiresolutionFile> file, std::shared_ptr<const PropertyFile> properties,
     std::size_t budgetBytes);
   ~RegionCache(); ///< stops and joins the loader thread
   RegionCache(const RegionCache&) = delete;
@@ -183,8 +172,7 @@ public:
 
   /// The frame's wanted regions in loading order (replaces the previous request), then regions
   /// wanted by predicted frames, loaded after and evicted first.
-  void Request(const std::vector<std::size_t>& wanted,
-    const std::vector<std::size_t>& predicted = {});
+  void Request(const std::vector<std::size_t>& wanted, const std::vector<std::size_t>& predicted = {});
   /// Asks for a property table (name, step): the packed table, or the 2D table of `layer`
   /// (0-based); Property() keeps the previous one until it loads.
   void RequestProperty(const std::string& name, int32_t step, int32_t layer = -1);

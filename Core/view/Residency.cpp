@@ -14,12 +14,8 @@ std::size_t GpuShare(int budgetMB)
   return (std::size_t(budgetMB) << 20) - MainMemoryShare(budgetMB);
 }
 
-std::vector<std::size_t> CopiesToRelease(
-  const std::vector<std::pair<std::size_t, std::size_t>>& mirrored,
-  const std::set<std::size_t>& wanted,
-  std::size_t gpuBytes,
-  std::size_t pieceBytes,
-  std::size_t gpuShare)
+std::vector<std::size_t> CopiesToRelease(const std::vector<std::pair<std::size_t, std::size_t>>& mirrored,
+  const std::set<std::size_t>& wanted, std::size_t gpuBytes, std::size_t pieceBytes, std::size_t gpuShare)
 {
   std::vector<std::size_t> release;
   for (const auto& copy : mirrored)
@@ -37,10 +33,7 @@ std::vector<std::size_t> CopiesToRelease(
   return release;
 }
 
-PropertyRequest RequestFor(const PropertyFile* properties,
-  const std::string& name,
-  int32_t step,
-  int32_t layer)
+PropertyRequest RequestFor(const PropertyFile* properties, const std::string& name, int32_t step, int32_t layer)
 {
   PropertyRequest request;
   request.name = name;
@@ -56,8 +49,7 @@ PropertyRequest RequestFor(const PropertyFile* properties,
 
 bool IsRequested(const PropertyTableData* table, const PropertyRequest& request)
 {
-  return table && table->name == request.name && table->step == request.step &&
-         table->layer == request.layer;
+  return table && table->name == request.name && table->step == request.step && table->layer == request.layer;
 }
 
 bool MayStandIn(const PropertyTableData* table, const PropertyRequest& request)
@@ -65,11 +57,8 @@ bool MayStandIn(const PropertyTableData* table, const PropertyRequest& request)
   return request.wanted && table && table->name == request.name && table->layer == request.layer;
 }
 
-std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers,
-  const DrawnRegion& drawn,
-  bool layerView,
-  const RegionRecord& region,
-  const ViewParameters& view)
+std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers, const DrawnRegion& drawn, bool layerView,
+  const RegionRecord& region, const ViewParameters& view)
 {
   const bool top = !layerView ? drawn.top : !SurfaceCulled(buffers.topCone, region, view);
   const bool bottom = !layerView ? drawn.bottom : !SurfaceCulled(buffers.bottomCone, region, view);
@@ -80,8 +69,7 @@ std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers,
   {
     side = DrawPart{ drawn.side, exactSide + buffers.sideIndices, buffers.coarseSideIndices, 2 };
   }
-  return { DrawPart{ top, 0, buffers.topIndices, 0 },
-    DrawPart{ bottom, buffers.topIndices, buffers.bottomIndices, 1 },
+  return { DrawPart{ top, 0, buffers.topIndices, 0 }, DrawPart{ bottom, buffers.topIndices, buffers.bottomIndices, 1 },
     side };
 }
 

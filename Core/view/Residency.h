@@ -31,12 +31,8 @@ std::size_t GpuShare(int budgetMB);
 /// `wanted` this frame (the cache still has them), taken from `mirrored` (region, bytes on the
 /// GPU) in its order until `gpuBytes` plus the piece fit `gpuShare`. The result may not be
 /// enough: then uploads wait.
-std::vector<std::size_t> CopiesToRelease(
-  const std::vector<std::pair<std::size_t, std::size_t>>& mirrored,
-  const std::set<std::size_t>& wanted,
-  std::size_t gpuBytes,
-  std::size_t pieceBytes,
-  std::size_t gpuShare);
+std::vector<std::size_t> CopiesToRelease(const std::vector<std::pair<std::size_t, std::size_t>>& mirrored,
+  const std::set<std::size_t>& wanted, std::size_t gpuBytes, std::size_t pieceBytes, std::size_t gpuShare);
 
 /// The property table a frame asks for.
 struct PropertyRequest
@@ -50,10 +46,7 @@ struct PropertyRequest
 /// The table for property `name` at `step` in the single-layer `layer` (-1: whole model): a
 /// static property has one table, step -1, for every step. Not wanted when `properties` is
 /// null, `name` empty or the file has no such table.
-PropertyRequest RequestFor(const PropertyFile* properties,
-  const std::string& name,
-  int32_t step,
-  int32_t layer);
+PropertyRequest RequestFor(const PropertyFile* properties, const std::string& name, int32_t step, int32_t layer);
 
 /// Whether `table` is the one `request` asks for.
 bool IsRequested(const PropertyTableData* table, const PropertyRequest& request);
@@ -80,10 +73,7 @@ struct DrawPart
 /// already shows (over CoarseSidePixels) its simplified side is drawn, when it has one: the
 /// geometry is no closer than that error anyway, and on models of many layers it is most of
 /// the triangles.
-std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers,
-  const DrawnRegion& drawn,
-  bool layerView,
-  const RegionRecord& region,
-  const ViewParameters& view);
+std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers, const DrawnRegion& drawn, bool layerView,
+  const RegionRecord& region, const ViewParameters& view);
 
 } // namespace resmr

@@ -24,8 +24,7 @@ Box Corners(const RegionRecord& record)
   Box corners;
   for (int c = 0; c < 8; ++c)
   {
-    corners[c] = { static_cast<double>((c & 1) ? b[3] : b[0]),
-      static_cast<double>((c & 2) ? b[4] : b[1]),
+    corners[c] = { static_cast<double>((c & 1) ? b[3] : b[0]), static_cast<double>((c & 2) ? b[4] : b[1]),
       -static_cast<double>((c & 4) ? b[2] : b[5]) };
   }
   return corners;
@@ -116,8 +115,7 @@ bool BackFacing(const std::array<float, 4>& cone, const Box& corners, const View
   const double sine = std::sqrt(std::max(0.0, 1 - cosine * cosine));
   const double axis[3] = { cone[0], cone[1], cone[2] };
   const double margin = 1e-6;
-  const auto away = [&](double x, double y, double z)
-  {
+  const auto away = [&](double x, double y, double z) {
     const double length = std::sqrt(x * x + y * y + z * z);
     return length > 0 && axis[0] * x + axis[1] * y + axis[2] * z < -(sine + margin) * length;
   };
@@ -180,8 +178,7 @@ ViewSelector::ViewSelector(const MultiresolutionFile& file)
       this->RootRegions.push_back(r);
     }
   }
-  const auto find = [&](int32_t level, int64_t index) -> int64_t
-  {
+  const auto find = [&](int32_t level, int64_t index) -> int64_t {
     const auto found = byName.find({ level, index });
     return found == byName.end() ? -1 : static_cast<int64_t>(found->second);
   };
@@ -193,8 +190,7 @@ ViewSelector::ViewSelector(const MultiresolutionFile& file)
         find(regions[r].level + 1, 2 * regions[r].index + 1) };
     }
   }
-  const DiamondHierarchy tree(
-    header.box[0], header.box[1], header.box[2], header.box[3], header.leafLevel);
+  const DiamondHierarchy tree(header.box[0], header.box[1], header.box[2], header.box[3], header.leafLevel);
   for (int level = 0; level <= std::min(deepest, static_cast<int>(header.leafLevel)); ++level)
   {
     for (const auto& diamond : tree.Diamonds(level))
@@ -224,12 +220,8 @@ namespace
 /// is missing, at least one is visible, and every visible child of its visible triangles is
 /// resident (a culled child is never drawn, so it need not be).
 template<typename Nodes>
-Traversal Traverse(const MultiresolutionFile& file,
-  const Nodes& nodes,
-  const std::vector<std::size_t>& roots,
-  const ViewParameters& view,
-  const std::function<bool(std::size_t)>& resident,
-  bool ideal)
+Traversal Traverse(const MultiresolutionFile& file, const Nodes& nodes, const std::vector<std::size_t>& roots,
+  const ViewParameters& view, const std::function<bool(std::size_t)>& resident, bool ideal)
 {
   const auto& regions = file.Regions();
   const int leaves = file.Header().leafLevel;
@@ -237,8 +229,7 @@ Traversal Traverse(const MultiresolutionFile& file,
   out.split.assign(regions.size(), 0);
   std::vector<int8_t> culled(regions.size(), -1); // -1: not computed yet
   std::vector<uint8_t> inCut(regions.size(), 0);
-  const auto isCulled = [&](std::size_t r)
-  {
+  const auto isCulled = [&](std::size_t r) {
     if (culled[r] < 0)
     {
       culled[r] = OutsideFrustum(Corners(regions[r]), view.worldToClip) ? 1 : 0;
@@ -264,8 +255,7 @@ Traversal Traverse(const MultiresolutionFile& file,
     for (std::size_t r : level)
     {
       const int64_t partner = nodes[r].partner;
-      if (partner >= 0 && static_cast<std::size_t>(partner) < r &&
-          inCut[static_cast<std::size_t>(partner)])
+      if (partner >= 0 && static_cast<std::size_t>(partner) < r && inCut[static_cast<std::size_t>(partner)])
       {
         continue; // decided with its partner
       }
@@ -298,8 +288,7 @@ Traversal Traverse(const MultiresolutionFile& file,
         }
         for (int64_t c : nodes[t].children)
         {
-          if (c >= 0 && !ideal && !isCulled(static_cast<std::size_t>(c)) &&
-              !resident(static_cast<std::size_t>(c)))
+          if (c >= 0 && !ideal && !isCulled(static_cast<std::size_t>(c)) && !resident(static_cast<std::size_t>(c)))
           {
             ready = false;
           }
@@ -342,21 +331,16 @@ Traversal Traverse(const MultiresolutionFile& file,
 }
 } // namespace
 
-bool SurfaceCulled(const std::array<float, 4>& cone,
-  const RegionRecord& region,
-  const ViewParameters& view)
+bool SurfaceCulled(const std::array<float, 4>& cone, const RegionRecord& region, const ViewParameters& view)
 {
   return !(cone[3] > -1.5f) || BackFacing(cone, Corners(region), view);
 }
 
-ViewSelection ViewSelector::Select(const ViewParameters& view,
-  const std::function<bool(std::size_t)>& resident) const
+ViewSelection ViewSelector::Select(const ViewParameters& view, const std::function<bool(std::size_t)>& resident) const
 {
   const auto& regions = this->File->Regions();
-  const Traversal actual =
-    Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, false);
-  const Traversal ideal =
-    Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, true);
+  const Traversal actual = Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, false);
+  const Traversal ideal = Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, true);
 
   ViewSelection selection;
   selection.largestProjectedError = actual.largest;
@@ -373,9 +357,7 @@ ViewSelection ViewSelector::Select(const ViewParameters& view,
     }
     // A margin of a millionth of the box: float bounds, double eye.
     const double margin =
-      1e-6 *
-      std::max(
-        { box[1] - box[0], box[3] - box[2], box[5] - box[4], std::abs(box[0]), std::abs(box[2]) });
+      1e-6 * std::max({ box[1] - box[0], box[3] - box[2], box[5] - box[4], std::abs(box[0]), std::abs(box[2]) });
     selection.backFacesHidden = std::sqrt(squared) > 2 * std::max(view.nearDistance, 0.0) + margin;
   }
   // Front to back: nearer regions fill the depth buffer first, so the hidden fragments of

@@ -52,13 +52,12 @@ struct DrawnRegion
 {
   std::size_t region = 0;                      ///< index into MultiresolutionFile::Regions()
   bool top = true, bottom = true, side = true; ///< surfaces not culled by their normal cones
-  double projectedError = 0; ///< the region's error in pixels this frame (Lindstrom's bound)
+  double projectedError = 0;                   ///< the region's error in pixels this frame (Lindstrom's bound)
 };
 
 struct ViewSelection
 {
-  std::vector<DrawnRegion>
-    drawn; ///< what to draw this frame (resident regions only), nearest first
+  std::vector<DrawnRegion> drawn;  ///< what to draw this frame (resident regions only), nearest first
   std::vector<std::size_t> wanted; ///< the loading order (see the contract)
   /// Largest projected error (pixels) of a drawn region's diamond; what the tolerance holds
   /// once everything wanted is resident.
@@ -86,8 +85,7 @@ public:
   explicit ViewSelector(const MultiresolutionFile& file);
 
   /// Selects for `view`; `resident(region)` says whether a region's mesh is ready to draw.
-  ViewSelection Select(const ViewParameters& view,
-    const std::function<bool(std::size_t)>& resident) const;
+  ViewSelection Select(const ViewParameters& view, const std::function<bool(std::size_t)>& resident) const;
 
   /// The root regions (level 0), which the caller keeps resident.
   const std::vector<std::size_t>& Roots() const { return this->RootRegions; }
@@ -101,17 +99,14 @@ private:
   const MultiresolutionFile* File = nullptr;
   std::vector<Node> Nodes;
   std::vector<std::size_t> RootRegions;
-  std::array<double, 6>
-    ModelBox{}; ///< every region's box: xmin, xmax, ymin, ymax, zmin, zmax (z up)
+  std::array<double, 6> ModelBox{}; ///< every region's box: xmin, xmax, ymin, ymax, zmin, zmax (z up)
 };
 
 /// Whether a surface of `region` whose normals lie in `cone` (RegionSurface::cone; cosine -2:
 /// empty) need not be drawn: empty, or facing away from the eye from every point of the
 /// region's bounding volume. Select culls the stored top and bottom with it; the single-layer
 /// view, whose faces are not those surfaces, culls its layer's top and bottom the same way.
-bool SurfaceCulled(const std::array<float, 4>& cone,
-  const RegionRecord& region,
-  const ViewParameters& view);
+bool SurfaceCulled(const std::array<float, 4>& cone, const RegionRecord& region, const ViewParameters& view);
 
 /// Where the camera will probably be a frame ahead: the last two views extrapolated linearly
 /// (eye and clip matrix), for loading ahead of need.

@@ -58,8 +58,7 @@ double Minor(const Matrix4& m, int row, int column)
       }
     }
   }
-  return e[0] * (e[4] * e[8] - e[5] * e[7]) - e[1] * (e[3] * e[8] - e[5] * e[6]) +
-         e[2] * (e[3] * e[7] - e[4] * e[6]);
+  return e[0] * (e[4] * e[8] - e[5] * e[7]) - e[1] * (e[3] * e[8] - e[5] * e[6]) + e[2] * (e[3] * e[7] - e[4] * e[6]);
 }
 } // namespace
 
@@ -154,8 +153,8 @@ std::array<float, 9> NormalMatrix(const Matrix4& modelToView)
 
 double LinearDeterminant(const Matrix4& m)
 {
-  return m[0] * m[5] * m[10] + m[1] * m[6] * m[8] + m[2] * m[4] * m[9] - m[0] * m[6] * m[9] -
-         m[1] * m[4] * m[10] - m[2] * m[5] * m[8];
+  return m[0] * m[5] * m[10] + m[1] * m[6] * m[8] + m[2] * m[4] * m[9] - m[0] * m[6] * m[9] - m[1] * m[4] * m[10] -
+    m[2] * m[5] * m[8];
 }
 
 ViewParameters ViewFromCamera(const CameraState& camera, const Matrix4& modelToWorld)
@@ -168,14 +167,11 @@ ViewParameters ViewFromCamera(const CameraState& camera, const Matrix4& modelToW
     Transform(worldToModel, { camera.position[0], camera.position[1], camera.position[2], 1 });
   view.eye = { eye[0], eye[1], eye[2] };
   const std::array<double, 4> direction = Transform(worldToModel,
-    { camera.directionOfProjection[0],
-      camera.directionOfProjection[1],
-      camera.directionOfProjection[2],
-      0 });
+    { camera.directionOfProjection[0], camera.directionOfProjection[1], camera.directionOfProjection[2], 0 });
   // The camera's direction is a unit vector in the world: its length in the model converts
   // the near distance to model units.
-  const double length = std::sqrt(
-    direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
+  const double length =
+    std::sqrt(direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2]);
   view.nearDistance = camera.nearClip * length;
   view.direction = { direction[0], direction[1], direction[2] };
   if (length != 0)
@@ -187,10 +183,9 @@ ViewParameters ViewFromCamera(const CameraState& camera, const Matrix4& modelToW
   }
   view.parallel = camera.parallel;
   const double degreesToRadians = 0.017453292519943295; // pi / 180
-  view.pixelsPerUnit =
-    view.parallel
-      ? camera.viewportHeight / (2.0 * std::max(camera.parallelScale, 1e-30))
-      : camera.viewportHeight / (2.0 * std::tan(camera.viewAngleDegrees * degreesToRadians / 2));
+  view.pixelsPerUnit = view.parallel
+    ? camera.viewportHeight / (2.0 * std::max(camera.parallelScale, 1e-30))
+    : camera.viewportHeight / (2.0 * std::tan(camera.viewAngleDegrees * degreesToRadians / 2));
   return view;
 }
 

@@ -14,23 +14,22 @@ namespace resmr_testing
 inline int Failures = 0;
 }
 
-#define CHECK(condition)                                                                           \
-  do                                                                                               \
-  {                                                                                                \
-    if (!(condition))                                                                              \
-    {                                                                                              \
-      std::fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #condition);           \
-      ++resmr_testing::Failures;                                                                   \
-    }                                                                                              \
+#define CHECK(condition)                                                                                               \
+  do                                                                                                                   \
+  {                                                                                                                    \
+    if (!(condition))                                                                                                  \
+    {                                                                                                                  \
+      std::fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #condition);                               \
+      ++resmr_testing::Failures;                                                                                       \
+    }                                                                                                                  \
   } while (0)
 
 namespace resmr_testing
 {
 /// Runs `action`, which must throw `Error` with every fragment in its message.
 template<typename Error>
-void ExpectError(const std::string& label,
-  const std::function<void()>& action,
-  const std::vector<std::string>& fragments)
+void ExpectError(
+  const std::string& label, const std::function<void()>& action, const std::vector<std::string>& fragments)
 {
   try
   {
@@ -44,8 +43,7 @@ void ExpectError(const std::string& label,
     {
       if (std::string(error.what()).find(fragment) == std::string::npos)
       {
-        std::fprintf(
-          stderr, "%s: message lacks '%s': %s\n", label.c_str(), fragment.c_str(), error.what());
+        std::fprintf(stderr, "%s: message lacks '%s': %s\n", label.c_str(), fragment.c_str(), error.what());
         ++Failures;
       }
     }

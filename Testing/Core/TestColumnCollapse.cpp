@@ -67,8 +67,7 @@ void TestQuadric()
   CHECK(resmr::Quadric::FromPlane({ 1, 0, 0 }, 0, 1).OptimalZ(0, 0, 42) == 42);
   glm::dvec3 normal;
   double d;
-  CHECK(
-    !resmr::Quadric::PlaneOfQuad({ 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 }, normal, d));
+  CHECK(!resmr::Quadric::PlaneOfQuad({ 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 }, normal, d));
 }
 
 void TestQuadricsOfFaces()
@@ -88,45 +87,8 @@ void TestQuadricsOfFaces()
   // An inactive cell beside an active one makes their shared side face external (type 2):
   // in a 2 x 1 row whose right cell is inactive, the middle nodes get the side plane x = 1.
   resmr::ColumnMesh row = resmr::ColumnMesh::FromParts(1,
-    { 0,
-      0,
-      0,
-      0,
-      0,
-      1,
-      1,
-      0,
-      0,
-      1,
-      0,
-      1,
-      2,
-      0,
-      0,
-      2,
-      0,
-      1,
-      0,
-      1,
-      0,
-      0,
-      1,
-      1,
-      1,
-      1,
-      0,
-      1,
-      1,
-      1,
-      2,
-      1,
-      0,
-      2,
-      1,
-      1 },
-    { { 0, 0 }, { 1, 0 }, { 2, 0 }, { 0, 1 }, { 1, 1 }, { 2, 1 } },
-    { { 0, 1, 4, 3 }, { 1, 2, 5, 4 } },
-    { 1, 0 });
+    { 0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 0, 1, 2, 0, 0, 2, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 0, 1, 1, 1, 2, 1, 0, 2, 1, 1 },
+    { { 0, 0 }, { 1, 0 }, { 2, 0 }, { 0, 1 }, { 1, 1 }, { 2, 1 } }, { { 0, 1, 4, 3 }, { 1, 2, 5, 4 } }, { 1, 0 });
   CHECK(std::fabs(row.NodeQuadric(1, 0).Error({ 1.5, 0, 0 }) - 0.25 * 10000) < 1e-6);
   CHECK(row.NodeQuadric(2, 0).Error({ 5, 5, 5 }) == 0); // touches only the inactive cell
   CHECK(mesh.IsBoundaryNode(0) && !mesh.IsBoundaryNode(4));
@@ -223,8 +185,7 @@ void TestBoundaryCornerAndFourBoundary()
     resmr::ColumnCollapse rowCollapse(row, 1);
     CHECK(rowCollapse.PlanColumn(1, plan));
     CHECK(plan.op == resmr::ColumnCollapse::Strip && plan.keptCount == 0);
-    const glm::dvec3 first = row.Position(plan.placeAt, 1),
-                     second = row.Position(plan.placeSecondAt, 1);
+    const glm::dvec3 first = row.Position(plan.placeAt, 1), second = row.Position(plan.placeSecondAt, 1);
     rowCollapse.Perform(plan);
     CHECK(row.AliveColumns() == 2 && !row.IsColumnAlive(1));
     CHECK(row.Position(plan.placeAt, 1) == first && row.Position(plan.placeSecondAt, 1) == second);
@@ -263,8 +224,7 @@ void TestRandomSimplificationInvariants()
   CHECK(resmr::MeasureHexahedra(hex, mesh.Orientation()).inverted == 0);
   for (std::size_t p = 0; p < hex.topology.size(); p += 3)
   {
-    CHECK(hex.topology[p] >= 0 && hex.topology[p] <= 12 && hex.topology[p + 1] >= 0 &&
-          hex.topology[p + 1] <= 10);
+    CHECK(hex.topology[p] >= 0 && hex.topology[p] <= 12 && hex.topology[p + 1] >= 0 && hex.topology[p + 1] <= 10);
   }
 }
 
@@ -305,8 +265,7 @@ void TestDoubletCascade()
   const resmr::Quadric total0 = TotalQuadric(mesh, 0), total2 = TotalQuadric(mesh, 2);
   resmr::ColumnCollapse collapse(mesh, 1);
   auto node = [](int i, int j) { return 7 * j + i; };
-  auto internal = [&](int column, int32_t a, int32_t b, int32_t keepA, int32_t keepB)
-  {
+  auto internal = [&](int column, int32_t a, int32_t b, int32_t keepA, int32_t keepB) {
     resmr::ColumnCollapse::Plan plan;
     plan.column = column;
     plan.op = resmr::ColumnCollapse::Internal;
@@ -328,11 +287,8 @@ void TestDoubletCascade()
   internal(6 * 2 + 1, node(2, 1), node(2, 3), A, node(1, 3)); // A: a doublet, then B
   const resmr::SimplifyReport& report = collapse.Report();
   CHECK(report.collapses == 3);
-  std::printf(
-    "doublet test: %lld doublets, %lld fold-over, %lld inverted, %lld topology rejections\n",
-    (long long)report.doublets,
-    (long long)report.rejectedFoldOver,
-    (long long)report.rejectedInverted,
+  std::printf("doublet test: %lld doublets, %lld fold-over, %lld inverted, %lld topology rejections\n",
+    (long long)report.doublets, (long long)report.rejectedFoldOver, (long long)report.rejectedInverted,
     (long long)report.rejectedTopology);
   CHECK(report.doublets >= 2);
   CHECK(report.operatorCounts[resmr::ColumnCollapse::Doublet] == report.doublets);
@@ -376,8 +332,7 @@ void TestFault()
   // i = 2 carry two nodes each (one a side), the fault edges are boundaries of both sides,
   // and fault nodes get the side planes (type 3) with the weight 10,000.
   const std::array<int64_t, 3> dims = { 4, 3, 2 };
-  auto corners = [](int64_t i, int64_t j, int64_t k, double out[8][3])
-  {
+  auto corners = [](int64_t i, int64_t j, int64_t k, double out[8][3]) {
     const double throwDown = i >= 2 ? 5.0 : 0.0;
     for (int c = 0; c < 8; ++c)
     {
@@ -386,8 +341,7 @@ void TestFault()
       out[c][2] = 1000.0 + throwDown + static_cast<double>(k + (c >> 2));
     }
   };
-  resmr::ColumnMesh mesh =
-    resmr::ColumnMesh::FromCells(dims, corners, std::vector<bool>(24, true), 0, 4, 0, 3);
+  resmr::ColumnMesh mesh = resmr::ColumnMesh::FromCells(dims, corners, std::vector<bool>(24, true), 0, 4, 0, 3);
   CHECK(mesh.AliveColumns() == 12);
   CHECK(mesh.NodeCount() == 5 * 4 + 4); // the four fault pillars split
   // Column (1, 1) = 5 has the fault on its edge from corner 1 to corner 2; column (2, 1) = 6
@@ -399,8 +353,7 @@ void TestFault()
     CHECK(std::find(right.begin(), right.end(), a) == right.end());
   }
   CHECK(mesh.IsBoundaryEdge(5, 1) && mesh.IsBoundaryEdge(6, 3) && !mesh.IsBoundaryEdge(5, 0));
-  CHECK(
-    mesh.IsBoundaryNode(left[1]) && mesh.IsBoundaryNode(left[2]) && !mesh.IsBoundaryNode(left[0]));
+  CHECK(mesh.IsBoundaryNode(left[1]) && mesh.IsBoundaryNode(left[2]) && !mesh.IsBoundaryNode(left[0]));
   // The fault plane x = 20 is in the fault node's quadric, heavily weighted: 1 m off it
   // costs at least 10,000; 1 m up along it, a top face's weight.
   const glm::dvec3 onFault = mesh.Position(left[2], 1);
@@ -454,8 +407,7 @@ resmr::ColumnMesh Reek(std::vector<bool>& active, resmr::CornerPointGeometry*& g
 {
   static resmr::EclipseGrid grid =
     resmr::ReadEclipseGrid(DataDirectory + "/reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID");
-  static resmr::CornerPointGeometry geometry =
-    resmr::CornerPointGeometry::FromDeck(grid.deck, false);
+  static resmr::CornerPointGeometry geometry = resmr::CornerPointGeometry::FromDeck(grid.deck, false);
   active.resize(static_cast<std::size_t>(geometry.CellCount()));
   for (int64_t c = 0; c < geometry.CellCount(); ++c)
   {
@@ -495,16 +447,12 @@ void TestRealModel()
   const int64_t before = mesh.AliveColumns();
   resmr::ColumnCollapse collapse(mesh, 11);
   const resmr::SimplifyReport report = collapse.Simplify(before / 2);
-  std::printf("Reek: %lld -> %lld columns, %lld collapses, %lld doublets, ops %lld/%lld/%lld/%lld, "
-              "%lld fold-overs rejected\n",
-    static_cast<long long>(before),
-    static_cast<long long>(mesh.AliveColumns()),
-    static_cast<long long>(report.collapses),
-    static_cast<long long>(report.doublets),
-    static_cast<long long>(report.operatorCounts[0]),
-    static_cast<long long>(report.operatorCounts[1]),
-    static_cast<long long>(report.operatorCounts[2]),
-    static_cast<long long>(report.operatorCounts[3]),
+  std::printf(
+    "Reek: %lld -> %lld columns, %lld collapses, %lld doublets, ops %lld/%lld/%lld/%lld, %lld fold-overs rejected\n",
+    static_cast<long long>(before), static_cast<long long>(mesh.AliveColumns()),
+    static_cast<long long>(report.collapses), static_cast<long long>(report.doublets),
+    static_cast<long long>(report.operatorCounts[0]), static_cast<long long>(report.operatorCounts[1]),
+    static_cast<long long>(report.operatorCounts[2]), static_cast<long long>(report.operatorCounts[3]),
     static_cast<long long>(report.rejectedFoldOver));
   CHECK(report.reachedTarget);
   const resmr::HexMesh simplified = resmr::ToHexMesh(mesh);
@@ -525,17 +473,13 @@ void TestRealModel()
     }
   }
   const resmr::BoundaryDistance distance = resmr::MeasureBoundaryDistance(original, simplified);
-  std::printf(
-    "Reek at 50%%: min scaled Jacobian %.3f, boundary Hausdorff %.1f m (%.4f of the diagonal)\n",
-    quality.minScaledJacobian,
-    distance.hausdorff,
-    distance.relative);
+  std::printf("Reek at 50%%: min scaled Jacobian %.3f, boundary Hausdorff %.1f m (%.4f of the diagonal)\n",
+    quality.minScaledJacobian, distance.hausdorff, distance.relative);
   CHECK(distance.relative < 0.05);
   CHECK(resmr::MeasureBoundaryDistance(original, original).hausdorff < 1e-6);
 
   // Deterministic for a seed; another seed, another mesh.
-  auto run = [&](uint64_t seed)
-  {
+  auto run = [&](uint64_t seed) {
     std::vector<bool> flags;
     resmr::CornerPointGeometry* g = nullptr;
     resmr::ColumnMesh again = Reek(flags, g);
@@ -554,8 +498,7 @@ void TestRealModel()
   resmr::ColumnCollapse down(small, 1);
   const resmr::SimplifyReport smallReport = down.Simplify(before / 100);
   std::printf("Reek at 1%%: %lld columns, %lld rotations, %lld relaxations\n",
-    static_cast<long long>(small.AliveColumns()),
-    static_cast<long long>(smallReport.rotations),
+    static_cast<long long>(small.AliveColumns()), static_cast<long long>(smallReport.rotations),
     static_cast<long long>(smallReport.relaxations));
   CHECK(smallReport.reachedTarget);
   CHECK(resmr::MeasureHexahedra(resmr::ToHexMesh(small), small.Orientation()).inverted == 0);
@@ -563,8 +506,7 @@ void TestRealModel()
   resmr::ColumnMesh greedyMesh = Reek(flags, g);
   resmr::ColumnCollapse greedy(greedyMesh, 1);
   CHECK(greedy.SimplifyGreedy(before / 100).reachedTarget);
-  CHECK(
-    resmr::MeasureHexahedra(resmr::ToHexMesh(greedyMesh), greedyMesh.Orientation()).inverted == 0);
+  CHECK(resmr::MeasureHexahedra(resmr::ToHexMesh(greedyMesh), greedyMesh.Orientation()).inverted == 0);
 }
 
 void TestLockedColumns()
@@ -627,10 +569,9 @@ void TestEdgeRotation()
     topology.push_back({ p[0], p[1] });
     positions.insert(positions.end(), { p[0], p[1], 0.0, p[0], p[1], 1.0 });
   }
-  resmr::ColumnMesh mesh = resmr::ColumnMesh::FromParts(
-    1, positions, topology, { { 0, 1, 2, 3 }, { 3, 4, 5, 0 } }, { 1, 0 });
-  const double before =
-    resmr::MeasureHexahedra(resmr::ToHexMesh(mesh), mesh.Orientation()).minScaledJacobian;
+  resmr::ColumnMesh mesh =
+    resmr::ColumnMesh::FromParts(1, positions, topology, { { 0, 1, 2, 3 }, { 3, 4, 5, 0 } }, { 1, 0 });
+  const double before = resmr::MeasureHexahedra(resmr::ToHexMesh(mesh), mesh.Orientation()).minScaledJacobian;
   CHECK(mesh.LateralValence(0) == 3 && mesh.LateralValence(3) == 3);
   resmr::ColumnCollapse collapse(mesh, 1);
   CHECK(collapse.RotateEdges() == 1);
@@ -649,8 +590,7 @@ void TestEdgeRotation()
   {
     CHECK(mesh.Position(node, 0) == glm::dvec3(hexagon[node][0], hexagon[node][1], 0.0));
   }
-  const resmr::HexQuality after =
-    resmr::MeasureHexahedra(resmr::ToHexMesh(mesh), mesh.Orientation());
+  const resmr::HexQuality after = resmr::MeasureHexahedra(resmr::ToHexMesh(mesh), mesh.Orientation());
   std::printf("Edge rotation: min scaled Jacobian %.3f -> %.3f\n", before, after.minScaledJacobian);
   CHECK(std::fabs(before - 0.2425) < 1e-3);
   CHECK(after.inverted == 0 && std::fabs(after.minScaledJacobian - 0.8575) < 1e-3);
@@ -662,10 +602,7 @@ int NodesAtY(const resmr::ColumnMesh& mesh, double y)
   int count = 0;
   for (int32_t node = 0; node < mesh.NodeCount(); ++node)
   {
-    count +=
-      mesh.IsNodeAlive(node) && !mesh.NodeColumns(node).empty() && mesh.Position(node, 0).y == y
-        ? 1
-        : 0;
+    count += mesh.IsNodeAlive(node) && !mesh.NodeColumns(node).empty() && mesh.Position(node, 0).y == y ? 1 : 0;
   }
   return count;
 }
@@ -723,8 +660,7 @@ void TestChordCollapse()
   CHECK(SameQuadric(mesh.NodeQuadric(end, 0), sum));
   const auto& left = mesh.ColumnCorners(0);
   const auto& right = mesh.ColumnCorners(2);
-  CHECK(std::count_if(left.begin(),
-          left.end(),
+  CHECK(std::count_if(left.begin(), left.end(),
           [&](int32_t n) { return std::find(right.begin(), right.end(), n) != right.end(); }) == 2);
 
   // Refused: a chord along a strip one column wide (it would vanish), and one through a
@@ -732,15 +668,13 @@ void TestChordCollapse()
   resmr::ColumnMesh strip = Grid(1, 3, 1);
   resmr::ColumnCollapse stripCollapse(strip, 1);
   CHECK(stripCollapse.CollapseChord(1, 0) == 0 && strip.AliveColumns() == 3);
-  CHECK(stripCollapse.CollapseChord(1, 1) == 1 && strip.AliveColumns() == 2 &&
-        strip.ConnectedParts() == 1);
+  CHECK(stripCollapse.CollapseChord(1, 1) == 1 && strip.AliveColumns() == 2 && strip.ConnectedParts() == 1);
   CHECK(AllColumnsValid(strip));
   resmr::ColumnMesh locked = Grid(4, 3, 1);
   locked.SetLocked(9, true);
   resmr::ColumnCollapse lockedCollapse(locked, 1);
   CHECK(lockedCollapse.CollapseChord(5, 0) == 0 && locked.AliveColumns() == 12);
-  CHECK(lockedCollapse.CollapseChord(6, 1) == 4 && locked.AliveColumns() == 8 &&
-        AllColumnsValid(locked));
+  CHECK(lockedCollapse.CollapseChord(6, 1) == 4 && locked.AliveColumns() == 8 && AllColumnsValid(locked));
 }
 
 void TestMergeAlongBoundary()
@@ -775,17 +709,14 @@ void TestRepairInvertedColumns()
   CHECK(!AllColumnsValid(outline));
   resmr::ColumnCollapse straighten(outline, 1);
   straighten.RepairInvertedColumns(11);
-  CHECK(straighten.Report().straightenedColumns == 1 &&
-        straighten.Report().invertedColumnsCollapsed == 0);
+  CHECK(straighten.Report().straightenedColumns == 1 && straighten.Report().invertedColumnsCollapsed == 0);
   CHECK(outline.AliveColumns() == 12 && AllColumnsValid(outline));
   for (int k = 0; k <= 1; ++k)
   {
     const glm::dvec3 p = outline.Position(corner, k);
-    CHECK(std::abs(p.x - 3.5) < 1e-3 && std::abs(p.y - 0.5) < 1e-3 && p.x > 3.5 && p.y < 0.5 &&
-          p.z == k);
+    CHECK(std::abs(p.x - 3.5) < 1e-3 && std::abs(p.y - 0.5) < 1e-3 && p.x > 3.5 && p.y < 0.5 && p.z == k);
   }
-  CHECK(
-    outline.TopologicalCoordinate(corner)[0] == 4 && outline.TopologicalCoordinate(corner)[1] == 0);
+  CHECK(outline.TopologicalCoordinate(corner)[0] == 4 && outline.TopologicalCoordinate(corner)[1] == 0);
 
   // The interior node (2, 1), moved to (1.4, 0.4), turns inward in column 1 only; four
   // columns share it, so it cannot move out: column 1 is collapsed first, before any other.
@@ -798,8 +729,7 @@ void TestRepairInvertedColumns()
   CHECK(!AllColumnsValid(inside));
   resmr::ColumnCollapse collapse(inside, 1);
   CHECK(collapse.Simplify(11).reachedTarget);
-  CHECK(
-    collapse.Report().straightenedColumns == 0 && collapse.Report().invertedColumnsCollapsed == 1);
+  CHECK(collapse.Report().straightenedColumns == 0 && collapse.Report().invertedColumnsCollapsed == 1);
   CHECK(!inside.IsColumnAlive(1) && inside.AliveColumns() == 11 && AllColumnsValid(inside));
 
   // Nothing to remove: the mesh stays as it came, inverted column included.
@@ -807,8 +737,7 @@ void TestRepairInvertedColumns()
   kept.SetPosition(corner, 0, glm::dvec3(3.4, 0.6, 0));
   resmr::ColumnCollapse keep(kept, 1);
   keep.RepairInvertedColumns(12);
-  CHECK(
-    kept.Position(corner, 0) == glm::dvec3(3.4, 0.6, 0) && keep.Report().straightenedColumns == 0);
+  CHECK(kept.Position(corner, 0) == glm::dvec3(3.4, 0.6, 0) && keep.Report().straightenedColumns == 0);
 }
 
 void TestSyntheticEndGame()
@@ -832,8 +761,7 @@ void TestSyntheticEndGame()
   const int64_t columns = parameters.nx * parameters.ny;
   while (stream.Next(layer))
   {
-    std::copy(
-      layer.zcorn.begin(), layer.zcorn.end(), deck.zcornSingle.begin() + 8 * columns * layer.k);
+    std::copy(layer.zcorn.begin(), layer.zcorn.end(), deck.zcornSingle.begin() + 8 * columns * layer.k);
     for (int64_t c = 0; c < columns; ++c)
     {
       active[layer.k * columns + c] = layer.state[c] == resmr::SyntheticCellState::Active;
@@ -845,8 +773,7 @@ void TestSyntheticEndGame()
   resmr::ColumnCollapse collapse(mesh, 1);
   const resmr::SimplifyReport report = collapse.Simplify(73);
   std::printf("Synthetic 1M at 1%%: %lld columns, %lld rotations, %lld relaxations\n",
-    static_cast<long long>(mesh.AliveColumns()),
-    static_cast<long long>(report.rotations),
+    static_cast<long long>(mesh.AliveColumns()), static_cast<long long>(report.rotations),
     static_cast<long long>(report.relaxations));
   CHECK(report.reachedTarget && mesh.AliveColumns() <= 73);
   CHECK(mesh.ConnectedParts() == 17);
@@ -859,17 +786,8 @@ void TestConnectedParts()
   // Two unit columns touching at one corner only, and a third far away: three parts.
   std::vector<double> positions;
   std::vector<std::array<double, 2>> topology;
-  const double xy[11][2] = { { 0, 0 },
-    { 1, 0 },
-    { 1, 1 },
-    { 0, 1 },
-    { 2, 1 },
-    { 2, 2 },
-    { 1, 2 },
-    { 5, 5 },
-    { 6, 5 },
-    { 6, 6 },
-    { 5, 6 } };
+  const double xy[11][2] = { { 0, 0 }, { 1, 0 }, { 1, 1 }, { 0, 1 }, { 2, 1 }, { 2, 2 }, { 1, 2 }, { 5, 5 }, { 6, 5 },
+    { 6, 6 }, { 5, 6 } };
   for (const auto& p : xy)
   {
     topology.push_back({ p[0], p[1] });
@@ -887,18 +805,14 @@ void TestBadInput()
   resmr::CornerPointGeometry* geometry = nullptr;
   Reek(active, geometry);
   ExpectError<std::invalid_argument>("empty box",
-    [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, active, 5, 5, 0, 10); },
-    { "empty or out-of-grid box" });
+    [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, active, 5, 5, 0, 10); }, { "empty or out-of-grid box" });
   ExpectError<std::invalid_argument>("box outside",
-    [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, active, 0, 1000, 0, 10); },
-    { "out-of-grid box" });
+    [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, active, 0, 1000, 0, 10); }, { "out-of-grid box" });
   const std::vector<bool> none(active.size(), false);
-  ExpectError<std::invalid_argument>("all inactive",
-    [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, none); },
-    { "no active cell" });
+  ExpectError<std::invalid_argument>(
+    "all inactive", [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, none); }, { "no active cell" });
   ExpectError<std::invalid_argument>("wrong flags",
-    [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, std::vector<bool>(3, true)); },
-    { "3 active flags" });
+    [&] { resmr::ColumnMesh::FromCornerPoints(*geometry, std::vector<bool>(3, true)); }, { "3 active flags" });
   ExpectError<std::invalid_argument>("bad parts",
     [&] {
       resmr::ColumnMesh::FromParts(1, { 0, 0, 0 }, { { 0, 0 } }, { { 0, 0, 0, 9 } }, { 1 });
@@ -912,8 +826,7 @@ void TestBadInput()
   }
   resmr::ColumnCollapse collapse(flat, 1);
   collapse.Simplify(18);
-  const resmr::HexQuality quality =
-    resmr::MeasureHexahedra(resmr::ToHexMesh(flat), flat.Orientation());
+  const resmr::HexQuality quality = resmr::MeasureHexahedra(resmr::ToHexMesh(flat), flat.Orientation());
   CHECK(quality.inverted == 0 && quality.degenerate == flat.AliveColumns());
 }
 } // namespace

@@ -75,18 +75,13 @@ Element Text(const std::string& v, std::size_t width = 8)
 }
 
 /// An unformatted keyword: header record, then data records of `perBlock` elements.
-std::string Keyword(const std::string& name,
-  const std::string& type,
-  const std::vector<Element>& elements,
-  std::size_t perBlock = 0,
-  int32_t declaredCount = INT32_MIN)
+std::string Keyword(const std::string& name, const std::string& type, const std::vector<Element>& elements,
+  std::size_t perBlock = 0, int32_t declaredCount = INT32_MIN)
 {
   std::string out;
   Put32(out, 16);
   out += Text(name);
-  Put32(out,
-    static_cast<uint32_t>(
-      declaredCount != INT32_MIN ? declaredCount : static_cast<int32_t>(elements.size())));
+  Put32(out, static_cast<uint32_t>(declaredCount != INT32_MIN ? declaredCount : static_cast<int32_t>(elements.size())));
   out += type;
   Put32(out, 16);
   if (perBlock == 0)
@@ -125,9 +120,8 @@ std::string Write(const std::string& name, const std::string& bytes)
   return path;
 }
 
-void ExpectError(const std::string& label,
-  const std::function<void()>& action,
-  const std::vector<std::string>& fragments)
+void ExpectError(
+  const std::string& label, const std::function<void()>& action, const std::vector<std::string>& fragments)
 {
   resmr_testing::ExpectError<resmr::InputError>(label, action, fragments);
 }
@@ -137,12 +131,11 @@ void ExpectError(const std::string& label,
 void TestEveryType()
 {
   const std::string bytes = Keyword("INTS", "INTE", Elements<int32_t>({ -1, 0, 2147483647 }, Int)) +
-                            Keyword("REALS", "REAL", Elements<float>({ 1.5f, -2.25e10f }, Real)) +
-                            Keyword("DOUBS", "DOUB", Elements<double>({ 1e-300, M_PI }, Doub)) +
-                            Keyword("LOGIS", "LOGI", Elements<int32_t>({ 1, 0 }, Int)) +
-                            Keyword("CHARS", "CHAR", { Text("METRES"), Text("A B") }) +
-                            Keyword("LONG", "C010", { Text("TEN CHARS!", 10) }) +
-                            Keyword("MESSAGE", "MESS", {}) + Keyword("EMPTY", "INTE", {});
+    Keyword("REALS", "REAL", Elements<float>({ 1.5f, -2.25e10f }, Real)) +
+    Keyword("DOUBS", "DOUB", Elements<double>({ 1e-300, M_PI }, Doub)) +
+    Keyword("LOGIS", "LOGI", Elements<int32_t>({ 1, 0 }, Int)) +
+    Keyword("CHARS", "CHAR", { Text("METRES"), Text("A B") }) + Keyword("LONG", "C010", { Text("TEN CHARS!", 10) }) +
+    Keyword("MESSAGE", "MESS", {}) + Keyword("EMPTY", "INTE", {});
   const resmr::EclipseKeywordFile file(Write("types.bin", bytes));
   CHECK(!file.IsFormatted());
   CHECK(file.Records().size() == 8);
@@ -161,8 +154,7 @@ void TestEveryType()
   CHECK(file.ReadStrings(*file.Find("LONG")) == std::vector<std::string>({ "TEN CHARS!" }));
   CHECK(file.Find("MESSAGE")->type == resmr::EclipseDataType::Message);
   CHECK(file.Find("EMPTY")->count == 0);
-  ExpectError("strings read as numbers",
-    [&] { file.ReadNumbers(*file.Find("CHARS"), values); },
+  ExpectError("strings read as numbers", [&] { file.ReadNumbers(*file.Find("CHARS"), values); },
     { "types.bin", "CHARS", "numeric" });
 }
 
@@ -187,8 +179,7 @@ void TestBlockSplits()
   for (std::size_t perBlock : { std::size_t(0), std::size_t(333) })
   {
     const std::string bytes = Keyword("BIG", "INTE", Elements(ints, Int), perBlock) +
-                              Keyword("NAMES", "CHAR", texts, perBlock ? 50 : 0) +
-                              Keyword("AFTER", "INTE", { Int(42) });
+      Keyword("NAMES", "CHAR", texts, perBlock ? 50 : 0) + Keyword("AFTER", "INTE", { Int(42) });
     const resmr::EclipseKeywordFile file(Write("blocks.bin", bytes));
     CHECK(file.Records().size() == 3);
     std::vector<int32_t> back(2500);
@@ -205,13 +196,12 @@ void TestBlockSplits()
 
 void TestFormatted()
 {
-  const std::string text =
-    " 'INTS    '           3 'INTE'\n           -1           0  2147483647\n"
-    " 'REALS   '           2 'REAL'\n   0.15000000E+01  -0.22500000E+11\n"
-    " 'DOUBS   '           2 'DOUB'\n   0.10000000000000D-299   0.31415926535898D+01\n"
-    " 'LOGIS   '           2 'LOGI'\n  T  F\n"
-    " 'CHARS   '           2 'CHAR'\n 'METRES  ' 'A B     '\n"
-    " 'MESSAGE '           0 'MESS'\n";
+  const std::string text = " 'INTS    '           3 'INTE'\n           -1           0  2147483647\n"
+                           " 'REALS   '           2 'REAL'\n   0.15000000E+01  -0.22500000E+11\n"
+                           " 'DOUBS   '           2 'DOUB'\n   0.10000000000000D-299   0.31415926535898D+01\n"
+                           " 'LOGIS   '           2 'LOGI'\n  T  F\n"
+                           " 'CHARS   '           2 'CHAR'\n 'METRES  ' 'A B     '\n"
+                           " 'MESSAGE '           0 'MESS'\n";
   const resmr::EclipseKeywordFile file(Write("types.FINIT", text));
   CHECK(file.IsFormatted());
   CHECK(file.Records().size() == 6);
@@ -228,16 +218,11 @@ void TestFormatted()
   CHECK(file.ReadStrings(*file.Find("CHARS")) == std::vector<std::string>({ "METRES", "A B" }));
 
   ExpectError("formatted count too large",
-    [&] {
-      resmr::EclipseKeywordFile(
-        Write("short.FEGRID", " 'COORD   '           5 'REAL'\n 1.0 2.0\n"));
-    },
+    [&] { resmr::EclipseKeywordFile(Write("short.FEGRID", " 'COORD   '           5 'REAL'\n 1.0 2.0\n")); },
     { "short.FEGRID", "COORD", "file ends after 2 of 5" });
   ExpectError("formatted bad number",
-    [&]
-    {
-      const resmr::EclipseKeywordFile bad(
-        Write("bad.FEGRID", " 'COORD   '           2 'REAL'\n 1.0 x.5\n"));
+    [&] {
+      const resmr::EclipseKeywordFile bad(Write("bad.FEGRID", " 'COORD   '           2 'REAL'\n 1.0 x.5\n"));
       std::vector<double> v;
       bad.ReadNumbers(bad.Records()[0], v);
     },
@@ -246,25 +231,21 @@ void TestFormatted()
 
 void TestBadUnformatted()
 {
-  const std::string good =
-    Keyword("ZCORN", "REAL", Elements<float>(std::vector<float>(1500, 1.0f), Real));
+  const std::string good = Keyword("ZCORN", "REAL", Elements<float>(std::vector<float>(1500, 1.0f), Real));
   const auto write = [&](const std::string& name, std::string bytes) { return Write(name, bytes); };
-  ExpectError("truncated",
-    [&] { resmr::EclipseKeywordFile(write("truncated.bin", good.substr(0, 3000))); },
+  ExpectError("truncated", [&] { resmr::EclipseKeywordFile(write("truncated.bin", good.substr(0, 3000))); },
     { "truncated.bin", "ZCORN", "too short" });
   std::string markers = good;
   markers[24 + 4 + 4000 + 3] = 1; // first block's end marker
   ExpectError("markers",
-    [&]
-    {
+    [&] {
       const resmr::EclipseKeywordFile file(write("markers.bin", markers));
       std::vector<double> v;
       file.ReadNumbers(file.Records()[0], v);
     },
     { "markers.bin", "ZCORN", "marker" });
   ExpectError("count",
-    [&]
-    {
+    [&] {
       resmr::EclipseKeywordFile(
         write("count.bin", Keyword("ZCORN", "REAL", Elements<float>({ 1.0f }, Real), 0, 1 << 30)));
     },
@@ -272,20 +253,16 @@ void TestBadUnformatted()
   ExpectError("negative count",
     [&] { resmr::EclipseKeywordFile(write("negative.bin", Keyword("ZCORN", "REAL", {}, 0, -5))); },
     { "negative.bin", "ZCORN", "negative" });
-  ExpectError("type",
-    [&] { resmr::EclipseKeywordFile(write("type.bin", Keyword("COORD", "QUAD", {}))); },
+  ExpectError("type", [&] { resmr::EclipseKeywordFile(write("type.bin", Keyword("COORD", "QUAD", {}))); },
     { "type.bin", "COORD", "unknown data type 'QUAD'" });
-  ExpectError("C000",
-    [&] { resmr::EclipseKeywordFile(write("c000.bin", Keyword("NAMES", "C000", {}))); },
+  ExpectError("C000", [&] { resmr::EclipseKeywordFile(write("c000.bin", Keyword("NAMES", "C000", {}))); },
     { "c000.bin", "NAMES", "unknown data type 'C000'" });
   std::string header = good + Keyword("PORO", "REAL", {});
   header[good.size() + 20 + 3] = 17; // second header's end marker
-  ExpectError("header marker",
-    [&] { resmr::EclipseKeywordFile(write("header.bin", header)); },
+  ExpectError("header marker", [&] { resmr::EclipseKeywordFile(write("header.bin", header)); },
     { "header.bin", "record markers disagree", std::to_string(good.size()) });
-  ExpectError("missing",
-    [&] { resmr::EclipseKeywordFile(Directory + "/nowhere.EGRID"); },
-    { "nowhere.EGRID", "cannot open" });
+  ExpectError(
+    "missing", [&] { resmr::EclipseKeywordFile(Directory + "/nowhere.EGRID"); }, { "nowhere.EGRID", "cannot open" });
 }
 
 // A 2 x 1 x 1 grid, second cell inactive.
@@ -315,14 +292,11 @@ std::string SmallGrid()
     zcorn[c] = c < 8 ? 1000.0f : 1010.0f;
   }
   return Keyword("FILEHEAD", "INTE", Elements(std::vector<int32_t>(100, 0), Int)) +
-         Keyword("GRIDUNIT", "CHAR", { Text("METRES"), Text("") }) +
-         Keyword("GRIDHEAD", "INTE", Elements(gridhead, Int)) +
-         Keyword("COORD", "REAL", Elements(coord, Real)) +
-         Keyword("ZCORN", "REAL", Elements(zcorn, Real)) +
-         Keyword("ACTNUM", "INTE", Elements<int32_t>({ 1, 0 }, Int)) +
-         Keyword("ENDGRID", "INTE", {}) + Keyword("LGR", "CHAR", { Text("LOCAL1") }) +
-         Keyword("GRIDHEAD", "INTE", Elements(gridhead, Int)) + Keyword("ENDGRID", "INTE", {}) +
-         Keyword("ENDLGR", "INTE", {});
+    Keyword("GRIDUNIT", "CHAR", { Text("METRES"), Text("") }) + Keyword("GRIDHEAD", "INTE", Elements(gridhead, Int)) +
+    Keyword("COORD", "REAL", Elements(coord, Real)) + Keyword("ZCORN", "REAL", Elements(zcorn, Real)) +
+    Keyword("ACTNUM", "INTE", Elements<int32_t>({ 1, 0 }, Int)) + Keyword("ENDGRID", "INTE", {}) +
+    Keyword("LGR", "CHAR", { Text("LOCAL1") }) + Keyword("GRIDHEAD", "INTE", Elements(gridhead, Int)) +
+    Keyword("ENDGRID", "INTE", {}) + Keyword("ENDLGR", "INTE", {});
 }
 
 std::vector<Element> Header(int active, int day, int month, int year)
@@ -338,24 +312,20 @@ std::vector<Element> Header(int active, int day, int month, int year)
 std::string Step(int seqnum, int active, double days, int day, float pressure, bool unified)
 {
   return (unified ? Keyword("SEQNUM", "INTE", { Int(seqnum) }) : std::string()) +
-         Keyword("INTEHEAD", "INTE", Header(active, day, 1, 2020)) +
-         Keyword("DOUBHEAD", "DOUB", Elements<double>({ days, 0.0 }, Doub)) +
-         Keyword("STARTSOL", "MESS", {}) +
-         Keyword("PRESSURE", "REAL", Elements<float>(std::vector<float>(active, pressure), Real)) +
-         Keyword("ENDSOL", "MESS", {}) + Keyword("LGR", "CHAR", { Text("LOCAL1") }) +
-         Keyword("PRESSURE", "REAL", Elements<float>({ -1.0f }, Real)) +
-         Keyword("ENDLGR", "INTE", {});
+    Keyword("INTEHEAD", "INTE", Header(active, day, 1, 2020)) +
+    Keyword("DOUBHEAD", "DOUB", Elements<double>({ days, 0.0 }, Doub)) + Keyword("STARTSOL", "MESS", {}) +
+    Keyword("PRESSURE", "REAL", Elements<float>(std::vector<float>(active, pressure), Real)) +
+    Keyword("ENDSOL", "MESS", {}) + Keyword("LGR", "CHAR", { Text("LOCAL1") }) +
+    Keyword("PRESSURE", "REAL", Elements<float>({ -1.0f }, Real)) + Keyword("ENDLGR", "INTE", {});
 }
 
 void TestGridAndResults()
 {
   const std::string gridPath = Write("SMALL.EGRID", SmallGrid());
   Write("SMALL.INIT",
-    Keyword("INTEHEAD", "INTE", Header(1, 1, 1, 2020)) +
-      Keyword("PORO", "REAL", Elements<float>({ 0.25f }, Real)) +
+    Keyword("INTEHEAD", "INTE", Header(1, 1, 1, 2020)) + Keyword("PORO", "REAL", Elements<float>({ 0.25f }, Real)) +
       Keyword("PORV", "REAL", Elements<float>({ 5.0f, 0.0f }, Real)) +
-      Keyword("SATNUM", "INTE", Elements<int32_t>({ 3 }, Int)) +
-      Keyword("TABDIMS", "INTE", { Int(1) }));
+      Keyword("SATNUM", "INTE", Elements<int32_t>({ 3 }, Int)) + Keyword("TABDIMS", "INTE", { Int(1) }));
   Write("SMALL.UNRST", Step(1, 1, 31.0, 1, 200.0f, true) + Step(2, 1, 60.0, 1, 190.0f, true));
 
   const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath);
@@ -363,8 +333,7 @@ void TestGridAndResults()
   CHECK(grid.activeCells == 1 && !grid.dualPorosity);
   CHECK(grid.localGridNames == std::vector<std::string>({ "LOCAL1" }));
   CHECK(grid.units == "METRES");
-  CHECK(
-    grid.deck.coord.size() == 36 && grid.deck.zcornSingle.size() == 16 && grid.deck.zcorn.empty());
+  CHECK(grid.deck.coord.size() == 36 && grid.deck.zcornSingle.size() == 16 && grid.deck.zcorn.empty());
 
   const resmr::EclipseResults results(gridPath, grid);
   CHECK(results.UnifiedRestart());
@@ -399,8 +368,7 @@ void TestGridAndResults()
   {
     warnedInit |= warning.find("no INIT file") != std::string::npos;
     warnedForeign |= warning.find("STEPS.X0003") != std::string::npos &&
-                     warning.find("INTEHEAD") != std::string::npos &&
-                     warning.find("2 active cells") != std::string::npos;
+      warning.find("INTEHEAD") != std::string::npos && warning.find("2 active cells") != std::string::npos;
   }
   CHECK(warnedInit && warnedForeign);
 
@@ -408,19 +376,15 @@ void TestGridAndResults()
   std::string grid3 = SmallGrid();
   const std::size_t actnum = grid3.find("ACTNUM");
   grid3[actnum - 4 + 4 + 8 + 3] = 3; // ACTNUM count 3 for 2 cells
-  ExpectError("ACTNUM count",
-    [&] { resmr::ReadEclipseGrid(Write("BAD.EGRID", grid3)); },
-    { "BAD.EGRID", "ACTNUM" });
+  ExpectError("ACTNUM count", [&] { resmr::ReadEclipseGrid(Write("BAD.EGRID", grid3)); }, { "BAD.EGRID", "ACTNUM" });
   std::string nanGrid = SmallGrid();
   const std::size_t zcornData = nanGrid.find("ZCORN") - 4 + 24 + 4; // first depth
   const float nan = std::nanf("");
   const Element bits = Real(nan);
   nanGrid.replace(zcornData + 4 * 5, 4, bits); // 6th depth
-  ExpectError("ZCORN NaN",
-    [&] { resmr::ReadEclipseGrid(Write("NAN.EGRID", nanGrid)); },
+  ExpectError("ZCORN NaN", [&] { resmr::ReadEclipseGrid(Write("NAN.EGRID", nanGrid)); },
     { "NAN.EGRID", "ZCORN", "value 6 is not finite" });
-  ExpectError("no GRIDHEAD",
-    [&] { resmr::ReadEclipseGrid(Write("INIT.EGRID", Keyword("PORO", "REAL", {}))); },
+  ExpectError("no GRIDHEAD", [&] { resmr::ReadEclipseGrid(Write("INIT.EGRID", Keyword("PORO", "REAL", {}))); },
     { "INIT.EGRID", "GRIDHEAD" });
 }
 // Large records are split over threads by block ranges; with the threshold lowered, a grid
@@ -464,14 +428,12 @@ void TestParallelPieces()
   }
   const std::string gridPath = Write("WIDE.EGRID",
     Keyword("FILEHEAD", "INTE", Elements(std::vector<int32_t>(100, 0), Int)) +
-      Keyword("GRIDHEAD", "INTE", Elements(gridhead, Int)) +
-      Keyword("COORD", "REAL", Elements(coord, Real)) +
-      Keyword("ZCORN", "REAL", Elements(zcorn, Real)) +
-      Keyword("ACTNUM", "INTE", Elements(actnum, Int)) + Keyword("ENDGRID", "INTE", {}));
+      Keyword("GRIDHEAD", "INTE", Elements(gridhead, Int)) + Keyword("COORD", "REAL", Elements(coord, Real)) +
+      Keyword("ZCORN", "REAL", Elements(zcorn, Real)) + Keyword("ACTNUM", "INTE", Elements(actnum, Int)) +
+      Keyword("ENDGRID", "INTE", {}));
   Write("WIDE.INIT",
     Keyword("INTEHEAD", "INTE", Header(static_cast<int>(poro.size()), 1, 1, 2020)) +
-      Keyword("PORO", "REAL", Elements(poro, Real)) +
-      Keyword("PORV", "REAL", Elements(porv, Real)));
+      Keyword("PORO", "REAL", Elements(poro, Real)) + Keyword("PORV", "REAL", Elements(porv, Real)));
   const resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath);
   CHECK(grid.deck.zcornSingle == zcorn);
   CHECK(grid.actnum == actnum);
@@ -553,8 +515,7 @@ void TestWriter()
   // Errors: the writer removes its temporary and never touches the final name.
   const std::string failed = Directory + "/FAILED.EGRID";
   ExpectError("short keyword",
-    [&]
-    {
+    [&] {
       resmr::EclipseKeywordWriter writer(failed);
       writer.Begin("ZCORN", "REAL", 10);
       writer.Append(std::vector<float>(4).data(), 4);
@@ -562,22 +523,19 @@ void TestWriter()
     },
     { "FAILED.EGRID", "6 values missing" });
   ExpectError("too many",
-    [&]
-    {
+    [&] {
       resmr::EclipseKeywordWriter writer(failed);
       writer.Begin("ZCORN", "REAL", 2);
       writer.Append(std::vector<float>(3).data(), 3);
     },
     { "FAILED.EGRID", "ZCORN", "only 2 left" });
   ExpectError("32-bit count",
-    [&]
-    {
+    [&] {
       resmr::EclipseKeywordWriter writer(failed);
       writer.Begin("ZCORN", "REAL", int64_t(1) << 31);
     },
     { "FAILED.EGRID", "ZCORN", "32-bit count" });
-  ExpectError("unwritable folder",
-    [&] { resmr::EclipseKeywordWriter(Directory + "/no/such/X.EGRID"); },
+  ExpectError("unwritable folder", [&] { resmr::EclipseKeywordWriter(Directory + "/no/such/X.EGRID"); },
     { "X.EGRID", "cannot create" });
   // A full disk, simulated by a file-size limit: writes past 64 KiB fail (EFBIG).
   struct rlimit saved;
@@ -587,8 +545,7 @@ void TestWriter()
   std::signal(SIGXFSZ, SIG_IGN);
   setrlimit(RLIMIT_FSIZE, &small);
   ExpectError("disk full",
-    [&]
-    {
+    [&] {
       resmr::EclipseKeywordWriter writer(failed);
       std::vector<float> values(100000, 1.0f);
       writer.Write("ZCORN", "REAL", values);

@@ -45,10 +45,8 @@ void Spit(const std::string& path, const std::string& bytes)
 
 /// A fresh folder holding links to `files` (in `from`, named `stem` + extension), so that one
 /// of them can be replaced by a damaged copy.
-std::string LinkedRun(const std::string& name,
-  const std::string& from,
-  const std::string& stem,
-  const std::vector<std::string>& extensions)
+std::string LinkedRun(
+  const std::string& name, const std::string& from, const std::string& stem, const std::vector<std::string>& extensions)
 {
   const std::string folder = TempDir + "/" + name;
   fs::remove_all(folder);
@@ -80,25 +78,18 @@ std::vector<int64_t> CutOffsets(std::mt19937_64& random, int64_t size)
 
 bool HasWarning(const EclipseResults& results, const std::vector<std::string>& fragments)
 {
-  return std::any_of(results.Warnings().begin(),
-    results.Warnings().end(),
-    [&](const std::string& warning)
-    {
-      return std::all_of(fragments.begin(),
-        fragments.end(),
-        [&](const std::string& fragment) { return warning.find(fragment) != std::string::npos; });
-    });
+  return std::any_of(results.Warnings().begin(), results.Warnings().end(), [&](const std::string& warning) {
+    return std::all_of(fragments.begin(), fragments.end(),
+      [&](const std::string& fragment) { return warning.find(fragment) != std::string::npos; });
+  });
 }
 
 /// Every array of every step `cut` offers equals the same step's of `whole`, bit for bit;
 /// `offered[s]` is the index in `whole` of cut's step s.
-void CheckSameValues(const EclipseResults& whole,
-  const EclipseResults& cut,
-  const std::vector<std::size_t>& offered,
-  int64_t cells)
+void CheckSameValues(
+  const EclipseResults& whole, const EclipseResults& cut, const std::vector<std::size_t>& offered, int64_t cells)
 {
-  std::vector<float> expected(static_cast<std::size_t>(cells)),
-    got(static_cast<std::size_t>(cells));
+  std::vector<float> expected(static_cast<std::size_t>(cells)), got(static_cast<std::size_t>(cells));
   for (std::size_t s = 0; s < offered.size(); ++s)
   {
     const EclipseReportStep& step = whole.Steps()[offered[s]];
@@ -150,11 +141,8 @@ void UnifiedRestartCut()
     {
       ++complete;
     }
-    std::printf("UNRST cut at byte %lld: %zu steps offered (expected %zu), %zu left out\n",
-      static_cast<long long>(cut),
-      results.Steps().size(),
-      complete,
-      results.SkippedSteps().size());
+    std::printf("UNRST cut at byte %lld: %zu steps offered (expected %zu), %zu left out\n", static_cast<long long>(cut),
+      results.Steps().size(), complete, results.SkippedSteps().size());
     CHECK(results.Steps().size() == complete);
     CHECK(results.StaticArrays().size() == whole.StaticArrays().size());
     std::vector<std::size_t> offered;
@@ -179,9 +167,7 @@ void UnifiedRestartCut()
       const bool numbered = cut >= starts[complete] + 36;
       CHECK(skipped.reportNumber == (numbered ? whole.Steps()[complete].reportNumber : -1));
       CHECK(HasWarning(results,
-        { cutPath,
-          "left out",
-          "byte " + std::to_string(skipped.offset),
+        { cutPath, "left out", "byte " + std::to_string(skipped.offset),
           numbered ? "report step " + std::to_string(skipped.reportNumber) : "after report" }));
     }
   }
@@ -217,11 +203,8 @@ void PerStepRestartCut()
     {
       Replace(cutPath, bytes.substr(0, static_cast<std::size_t>(cut)));
       const EclipseResults results(folder + "/" + stem + ".EGRID", eclipseGrid);
-      std::printf("X%04d cut at byte %lld: %zu steps offered, %zu left out\n",
-        victim,
-        static_cast<long long>(cut),
-        results.Steps().size(),
-        results.SkippedSteps().size());
+      std::printf("X%04d cut at byte %lld: %zu steps offered, %zu left out\n", victim, static_cast<long long>(cut),
+        results.Steps().size(), results.SkippedSteps().size());
       CHECK(results.Steps().size() == whole.Steps().size() - 1);
       CHECK(results.SkippedSteps().size() == 1);
       std::vector<std::size_t> offered;
@@ -245,10 +228,8 @@ void PerStepRestartCut()
         const EclipseSkippedStep& skipped = results.SkippedSteps()[0];
         CHECK(skipped.file == cutPath && skipped.reportNumber == victim);
         CHECK(skipped.offset >= 0 && skipped.offset <= cut);
-        CHECK(HasWarning(results,
-          { cutPath,
-            "report step " + std::to_string(victim),
-            "byte " + std::to_string(skipped.offset) }));
+        CHECK(HasWarning(
+          results, { cutPath, "report step " + std::to_string(victim), "byte " + std::to_string(skipped.offset) }));
       }
     }
   }
@@ -267,8 +248,7 @@ void FormattedRestartCut()
   const std::string bytes = Slurp(from + "/SPE1_TESTCASE.FUNRST");
   // Each step ends with its ENDSOL record: the closing quote of its 'MESS' type.
   std::vector<int64_t> ends;
-  for (std::size_t at = bytes.find("'ENDSOL  '"); at != std::string::npos;
-       at = bytes.find("'ENDSOL  '", at + 1))
+  for (std::size_t at = bytes.find("'ENDSOL  '"); at != std::string::npos; at = bytes.find("'ENDSOL  '", at + 1))
   {
     ends.push_back(static_cast<int64_t>(bytes.find("'MESS'", at) + 6));
   }
@@ -282,13 +262,10 @@ void FormattedRestartCut()
   {
     Spit(path, bytes.substr(0, static_cast<std::size_t>(cut)));
     const EclipseResults results(folder + "/SPE1_TESTCASE.EGRID", grid);
-    const auto complete = static_cast<std::size_t>(
-      std::count_if(ends.begin(), ends.end(), [&](int64_t end) { return end <= cut; }));
+    const auto complete =
+      static_cast<std::size_t>(std::count_if(ends.begin(), ends.end(), [&](int64_t end) { return end <= cut; }));
     std::printf("FUNRST cut at byte %lld: %zu steps offered (expected %zu), %zu left out\n",
-      static_cast<long long>(cut),
-      results.Steps().size(),
-      complete,
-      results.SkippedSteps().size());
+      static_cast<long long>(cut), results.Steps().size(), complete, results.SkippedSteps().size());
     CHECK(results.Steps().size() == complete);
     CHECK(results.SkippedSteps().size() == (cut == ends[3] ? 0u : 1u));
   }
@@ -313,9 +290,7 @@ void BadInit()
     std::vector<std::string> fragments;
   } cases[] = {
     { "empty", std::string(), { "the file is empty" } },
-    { "bit-flipped",
-      flipped,
-      { "damaged or cut short at byte " + std::to_string(file.Records()[4].headerOffset) } },
+    { "bit-flipped", flipped, { "damaged or cut short at byte " + std::to_string(file.Records()[4].headerOffset) } },
     { "cut", init.substr(0, init.size() / 2), { "damaged or cut short at byte" } },
     { "foreign", foreign, { "does not belong to this grid" } },
   };
@@ -325,11 +300,8 @@ void BadInit()
     const std::string path = folder + "/" + stem + ".INIT";
     Replace(path, item.bytes);
     const EclipseResults results(folder + "/" + stem + ".EGRID", grid);
-    std::printf("%s INIT: %zu static arrays, %zu steps; %s\n",
-      item.label,
-      results.StaticArrays().size(),
-      results.Steps().size(),
-      results.Warnings().empty() ? "" : results.Warnings().front().c_str());
+    std::printf("%s INIT: %zu static arrays, %zu steps; %s\n", item.label, results.StaticArrays().size(),
+      results.Steps().size(), results.Warnings().empty() ? "" : results.Warnings().front().c_str());
     CHECK(!results.InitUsable());
     CHECK(results.StaticArrays().empty());
     CHECK(results.Steps().size() == 4);
@@ -365,25 +337,18 @@ void AppendedRun()
     {
       Spit(path, bytes.substr(0, static_cast<std::size_t>(end)));
       const EclipseResults results(folder + "/" + stem + ".EGRID", eclipseGrid);
-      const std::size_t expected =
-        closed + (end == record.endOffset && record.name == "ENDSOL" ? 1 : 0);
+      const std::size_t expected = closed + (end == record.endOffset && record.name == "ENDSOL" ? 1 : 0);
       if (results.Steps().size() != expected)
       {
         ++mismatches;
-        std::fprintf(stderr,
-          "UNRST of %lld bytes (in or after %s): %zu steps offered, %zu closed\n",
-          static_cast<long long>(end),
-          record.name.c_str(),
-          results.Steps().size(),
-          expected);
+        std::fprintf(stderr, "UNRST of %lld bytes (in or after %s): %zu steps offered, %zu closed\n",
+          static_cast<long long>(end), record.name.c_str(), results.Steps().size(), expected);
       }
       ++stages;
     }
     closed += record.name == "ENDSOL";
   }
-  std::printf("appended run: %zu stages, %zu offered a step count other than the closed steps'\n",
-    stages,
-    mismatches);
+  std::printf("appended run: %zu stages, %zu offered a step count other than the closed steps'\n", stages, mismatches);
   CHECK(stages > 40 && mismatches == 0);
 }
 } // namespace

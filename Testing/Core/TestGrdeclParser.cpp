@@ -34,9 +34,7 @@ resmr::CornerPointModel Parse(const std::string& name, const std::string& text)
 }
 
 /// Expects parsing to throw a InputError whose message holds every fragment.
-void ExpectError(const std::string& name,
-  const std::string& text,
-  const std::vector<std::string>& fragments,
+void ExpectError(const std::string& name, const std::string& text, const std::vector<std::string>& fragments,
   resmr::GrdeclParseOptions options = {})
 {
   const std::string path = Write(name, text);
@@ -54,8 +52,7 @@ void ExpectError(const std::string& name,
     {
       if (message.find(fragment) == std::string::npos)
       {
-        std::fprintf(
-          stderr, "error for %s lacks '%s': %s\n", name.c_str(), fragment.c_str(), message.c_str());
+        std::fprintf(stderr, "error for %s lacks '%s': %s\n", name.c_str(), fragment.c_str(), message.c_str());
         ++resmr_testing::Failures;
       }
     }
@@ -102,8 +99,8 @@ void TestNumbers()
 
 void TestTokenizer()
 {
-  const std::string path = Write(
-    "tokens.txt", "KEY -- comment / not a slash\n  'quoted name' 1 2*3/ trailing comment\nNEXT\n");
+  const std::string path =
+    Write("tokens.txt", "KEY -- comment / not a slash\n  'quoted name' 1 2*3/ trailing comment\nNEXT\n");
   resmr::GrdeclTokenizer tokens(path, 4096);
   const resmr::Token* t = &tokens.Next();
   CHECK(t->kind == resmr::TokenKind::Word && t->text == "KEY" && t->atLineStart && t->line == 1);
@@ -128,8 +125,7 @@ void TestTokenizer()
   resmr::GrdeclTokenizer chunked(Write("chunked.txt", many), 4096);
   int count = 0;
   bool allRight = true;
-  for (const resmr::Token* token = &chunked.Next(); token->kind != resmr::TokenKind::End;
-       token = &chunked.Next())
+  for (const resmr::Token* token = &chunked.Next(); token->kind != resmr::TokenKind::End; token = &chunked.Next())
   {
     double v = 0;
     allRight &= resmr::ParseDouble(token->text, v) && v == count * 1.25;
@@ -140,8 +136,8 @@ void TestTokenizer()
 
 void TestCornerPointDeck()
 {
-  resmr::CornerPointModel deck = Parse("two.grdecl",
-    std::string(TwoCells) + "ACTNUM\n 1 0 /\nPORO\n 0.25 0.5 /\nSATNUM\n 2*3 /\nNTG\n 2* /\n");
+  resmr::CornerPointModel deck =
+    Parse("two.grdecl", std::string(TwoCells) + "ACTNUM\n 1 0 /\nPORO\n 0.25 0.5 /\nSATNUM\n 2*3 /\nNTG\n 2* /\n");
   CHECK(deck.dims[0] == 2 && deck.dims[1] == 1 && deck.dims[2] == 1);
   CHECK(deck.zcorn.size() == 16 && deck.coord.size() == 36);
   const resmr::CellArray* poro = deck.FindArray("PORO");
@@ -184,8 +180,7 @@ FAULTS
   resmr::CornerPointModel deck = Parse("faulted.grdecl", faulted);
   CHECK(deck.faults.size() == 2 && deck.faults[0].name == "F1" && deck.faults[0].faces.size() == 2);
   CHECK(deck.faults[1].faces[0].face == resmr::FaultFace::IMinus);
-  CHECK(
-    deck.faults[0].faces[0].box[0] == 0 && deck.faults[0].faces[0].face == resmr::FaultFace::IPlus);
+  CHECK(deck.faults[0].faces[0].box[0] == 0 && deck.faults[0].faces[0].face == resmr::FaultFace::IPlus);
   const auto shared = resmr::CornerPointGeometry::FromDeck(deck, true).BuildSharedCorners();
   CHECK(shared.cellPoints[1] != shared.cellPoints[8 + 0]);
   CHECK(shared.points.size() == 3 * 16); // the middle pillars carry 4 depths each
@@ -282,23 +277,20 @@ void TestBinaryGrdecl()
 {
   // SPECGRID (INTE) and ... written as Fortran big-endian records.
   std::string bytes;
-  const auto be32 = [&](uint32_t v)
-  {
+  const auto be32 = [&](uint32_t v) {
     for (int s = 24; s >= 0; s -= 8)
     {
       bytes += static_cast<char>((v >> s) & 0xff);
     }
   };
-  const auto header = [&](const char* name, uint32_t count, const char* type)
-  {
+  const auto header = [&](const char* name, uint32_t count, const char* type) {
     be32(16);
     bytes += std::string(name) + std::string(8 - std::string(name).size(), ' ');
     be32(count);
     bytes += type;
     be32(16);
   };
-  const auto floats = [&](const std::vector<float>& values)
-  {
+  const auto floats = [&](const std::vector<float>& values) {
     be32(static_cast<uint32_t>(4 * values.size()));
     for (float v : values)
     {
@@ -316,41 +308,7 @@ void TestBinaryGrdecl()
   }
   be32(16);
   header("COORD", 36, "REAL");
-  floats({ 0,
-    0,
-    0,
-    0,
-    0,
-    10,
-    1,
-    0,
-    0,
-    1,
-    0,
-    10,
-    2,
-    0,
-    0,
-    2,
-    0,
-    10,
-    0,
-    1,
-    0,
-    0,
-    1,
-    10,
-    1,
-    1,
-    0,
-    1,
-    1,
-    10,
-    2,
-    1,
-    0,
-    2,
-    1,
+  floats({ 0, 0, 0, 0, 0, 10, 1, 0, 0, 1, 0, 10, 2, 0, 0, 2, 0, 10, 0, 1, 0, 0, 1, 10, 1, 1, 0, 1, 1, 10, 2, 1, 0, 2, 1,
     10 });
   header("ZCORN", 16, "REAL");
   floats({ 100, 100, 100, 100, 100, 100, 100, 100, 101, 101, 101, 101, 101, 101, 101, 101 });
@@ -360,9 +318,7 @@ void TestBinaryGrdecl()
   CHECK(deck.dims[0] == 2 && deck.zcorn.size() == 16 && deck.zcorn[15] == 101);
   CHECK(deck.FindArray("PORO") && deck.FindArray("PORO")->values[1] == 0.5);
   // Truncated copy: a clear error naming the byte offset.
-  ExpectError("truncated.bgrdecl",
-    bytes.substr(0, bytes.size() - 6),
-    { "truncated.bgrdecl", "PORO", "byte" });
+  ExpectError("truncated.bgrdecl", bytes.substr(0, bytes.size() - 6), { "truncated.bgrdecl", "PORO", "byte" });
   std::string corrupt = bytes;
   corrupt[24 + 3] = '\x7f'; // low byte of SPECGRID's data record marker
   ExpectError("corrupt.bgrdecl", corrupt, { "corrupt.bgrdecl", "SPECGRID" });
@@ -370,85 +326,57 @@ void TestBinaryGrdecl()
 
 void TestBadInput()
 {
-  ExpectError("missing_slash.grdecl",
-    "SPECGRID\n 2 1 1 1 F /\nZCORN\n 1 2 3\nPORO\n 1 2 /\n",
+  ExpectError("missing_slash.grdecl", "SPECGRID\n 2 1 1 1 F /\nZCORN\n 1 2 3\nPORO\n 1 2 /\n",
     { "missing_slash.grdecl:5", "ZCORN", "missing '/'" });
-  ExpectError("unterminated.grdecl",
-    "SPECGRID\n 2 1 1 1 F /\nZCORN\n 1 2 3\n",
+  ExpectError("unterminated.grdecl", "SPECGRID\n 2 1 1 1 F /\nZCORN\n 1 2 3\n",
     { "unterminated.grdecl", "ZCORN", "end of file" });
-  ExpectError("count.grdecl",
-    std::string(TwoCells) + "PORO\n 0.1 0.2 0.3 /\n",
-    { "count.grdecl:14", "PORO", "too many values" });
-  ExpectError("few.grdecl",
-    std::string(TwoCells) + "PORO\n 0.1 /\n",
-    { "few.grdecl", "PORO", "expected 2, got 1" });
-  ExpectError("garbage.grdecl",
-    "SPECGRID\n 2 1 1 1 F /\nCOORD\n 0 0 0 0 0 1 x$%! /\n",
-    { "garbage.grdecl:4", "COORD", "expected a number", "x$%!" });
-  ExpectError("nan.grdecl",
-    "SPECGRID\n 2 1 1 1 F /\nCOORD\n 0 0 0 nan 0 1 /\n",
-    { "nan.grdecl:4", "COORD", "'nan'" });
-  ExpectError("inf.grdecl",
-    "SPECGRID\n 2 1 1 1 F /\nCOORD\n 0 0 1e400 /\n",
-    { "inf.grdecl:4", "COORD", "'1e400'" });
   ExpectError(
-    "zero.grdecl", "SPECGRID\n 0 1 1 1 F /\n", { "zero.grdecl:1", "SPECGRID", "between 1" });
+    "count.grdecl", std::string(TwoCells) + "PORO\n 0.1 0.2 0.3 /\n", { "count.grdecl:14", "PORO", "too many values" });
+  ExpectError("few.grdecl", std::string(TwoCells) + "PORO\n 0.1 /\n", { "few.grdecl", "PORO", "expected 2, got 1" });
+  ExpectError("garbage.grdecl", "SPECGRID\n 2 1 1 1 F /\nCOORD\n 0 0 0 0 0 1 x$%! /\n",
+    { "garbage.grdecl:4", "COORD", "expected a number", "x$%!" });
+  ExpectError("nan.grdecl", "SPECGRID\n 2 1 1 1 F /\nCOORD\n 0 0 0 nan 0 1 /\n", { "nan.grdecl:4", "COORD", "'nan'" });
+  ExpectError("inf.grdecl", "SPECGRID\n 2 1 1 1 F /\nCOORD\n 0 0 1e400 /\n", { "inf.grdecl:4", "COORD", "'1e400'" });
+  ExpectError("zero.grdecl", "SPECGRID\n 0 1 1 1 F /\n", { "zero.grdecl:1", "SPECGRID", "between 1" });
   ExpectError("negative.grdecl", "DIMENS\n 4 -2 1 /\n", { "negative.grdecl:1", "DIMENS" });
-  ExpectError("overflow.grdecl",
-    "SPECGRID\n 2000000000 2000000000 2000000000 1 F /\n",
+  ExpectError("overflow.grdecl", "SPECGRID\n 2000000000 2000000000 2000000000 1 F /\n",
     { "overflow.grdecl:1", "SPECGRID", "larger than this machine" });
-  ExpectError("huge.grdecl",
-    "SPECGRID\n 100000 100000 1000 1 F /\n",
+  ExpectError("huge.grdecl", "SPECGRID\n 100000 100000 1000 1 F /\n",
     { "huge.grdecl:1", "SPECGRID", "larger than this machine" });
-  ExpectError("redefined.grdecl",
-    "DIMENS\n 2 2 2 /\nBOX\n 2 2 2 2 2 2 /\nSPECGRID\n 1 1 1 1 F /\n",
+  ExpectError("redefined.grdecl", "DIMENS\n 2 2 2 /\nBOX\n 2 2 2 2 2 2 /\nSPECGRID\n 1 1 1 1 F /\n",
     { "redefined.grdecl:5", "SPECGRID", "differ from the 2 x 2 x 2" });
-  ExpectError("record.grdecl",
-    "SPECGRID\n 2 1 1 1 F\nCOORD\n 1 2 3 /\n",
+  ExpectError("record.grdecl", "SPECGRID\n 2 1 1 1 F\nCOORD\n 1 2 3 /\n",
     { "record.grdecl:3", "SPECGRID", "not terminated by '/'" });
   CHECK(resmr::LooksLikeGrdeclFile(Write("looks.inc", "-- header\nPORO\n 1 /\n")));
   CHECK(!resmr::LooksLikeGrdeclFile(Write("plain.txt", "just some text, no keyword\n")));
-  ExpectError("mapaxes.grdecl",
-    std::string("MAPAXES\n 0 0 0 0 1 0 /\n") + TwoCells,
+  ExpectError("mapaxes.grdecl", std::string("MAPAXES\n 0 0 0 0 1 0 /\n") + TwoCells,
     { "mapaxes.grdecl", "MAPAXES", "coincide with the origin" });
-  ExpectError(
-    "noint.grdecl", "SPECGRID\n 2.5 1 1 1 F /\n", { "noint.grdecl:1", "must be an integer" });
-  ExpectError("include.DATA",
-    "INCLUDE\n 'does_not_exist.inc' /\n",
-    { "include.DATA",
-      "no SPECGRID",
-      "INCLUDE of 'does_not_exist.inc' at",
-      "include.DATA:1 was not found" });
+  ExpectError("noint.grdecl", "SPECGRID\n 2.5 1 1 1 F /\n", { "noint.grdecl:1", "must be an integer" });
+  ExpectError("include.DATA", "INCLUDE\n 'does_not_exist.inc' /\n",
+    { "include.DATA", "no SPECGRID", "INCLUDE of 'does_not_exist.inc' at", "include.DATA:1 was not found" });
   Write("self.inc", "INCLUDE\n 'self.inc' /\n");
-  ExpectError(
-    "cycle.DATA", "INCLUDE\n 'self.inc' /\n", { "self.inc:1", "INCLUDE", "nested deeper" });
+  ExpectError("cycle.DATA", "INCLUDE\n 'self.inc' /\n", { "self.inc:1", "INCLUDE", "nested deeper" });
   ExpectError("before.grdecl", "PORO\n 1 2 /\n", { "before.grdecl:1", "PORO", "before SPECGRID" });
   ExpectError("nogeometry.grdecl", "SPECGRID\n 2 1 1 1 F /\n", { "no grid geometry" });
-  ExpectError("badface.grdecl",
-    "SPECGRID\n 2 1 1 1 F /\nFAULTS\n 'F' 1 1 1 1 1 1 Q /\n/\n",
+  ExpectError("badface.grdecl", "SPECGRID\n 2 1 1 1 F /\nFAULTS\n 'F' 1 1 1 1 1 1 Q /\n/\n",
     { "badface.grdecl:3", "FAULTS", "unknown face 'Q'" });
-  ExpectError("badbox.grdecl",
-    "SPECGRID\n 2 1 1 1 F /\nFAULTS\n 'F' 1 3 1 1 1 1 I /\n/\n",
+  ExpectError("badbox.grdecl", "SPECGRID\n 2 1 1 1 F /\nFAULTS\n 'F' 1 3 1 1 1 1 I /\n/\n",
     { "badbox.grdecl:3", "FAULTS", "outside the grid" });
-  ExpectError("multiply.grdecl",
-    std::string(TwoCells) + "MULTIPLY\n PERMZ 0.1 /\n/\n",
+  ExpectError("multiply.grdecl", std::string(TwoCells) + "MULTIPLY\n PERMZ 0.1 /\n/\n",
     { "multiply.grdecl", "MULTIPLY", "PERMZ has not been defined" });
   ExpectError("binary_garbage.grdecl",
     std::string("SPECGRID\n 2 1 1 1 F /\nZCORN\n") + std::string("\x01\x02\xff\xfe", 4) + " /\n",
     { "binary_garbage.grdecl:4", "ZCORN", "expected a number" });
-  ExpectError("long_token.grdecl",
-    "SPECGRID\n" + std::string(3 << 20, 'A') + "\n",
-    { "long_token.grdecl", "longer than 1 MiB" });
+  ExpectError(
+    "long_token.grdecl", "SPECGRID\n" + std::string(3 << 20, 'A') + "\n", { "long_token.grdecl", "longer than 1 MiB" });
   // A missing INCLUDE is tolerated with a warning naming it; refused on request.
   resmr::GrdeclParseOptions strict;
   strict.skipMissingIncludes = false;
-  ExpectError("strict.DATA",
-    std::string(TwoCells) + "INCLUDE\n 'gone.inc' /\n",
-    { "strict.DATA:13", "INCLUDE", "gone.inc", "not found" },
-    strict);
+  ExpectError("strict.DATA", std::string(TwoCells) + "INCLUDE\n 'gone.inc' /\n",
+    { "strict.DATA:13", "INCLUDE", "gone.inc", "not found" }, strict);
   resmr::GrdeclParseOptions lenient;
-  resmr::CornerPointModel deck = resmr::ParseGrdeclFile(
-    Write("lenient.DATA", std::string(TwoCells) + "INCLUDE\n 'gone.inc' /\n"), lenient);
+  resmr::CornerPointModel deck =
+    resmr::ParseGrdeclFile(Write("lenient.DATA", std::string(TwoCells) + "INCLUDE\n 'gone.inc' /\n"), lenient);
   CHECK(deck.warnings.size() == 1 && deck.warnings[0].find("gone.inc") != std::string::npos);
 }
 
@@ -608,8 +536,7 @@ void TestDeckEditsAndSkips()
 {
   const std::string path = Write("edited.DATA", EditedDeck);
   const resmr::CornerPointModel deck = resmr::ParseGrdeclFile(path);
-  const auto values = [&](const char* name)
-  {
+  const auto values = [&](const char* name) {
     const resmr::CellArray* array = deck.FindArray(name);
     CHECK(array != nullptr);
     return array ? array->values : std::vector<double>(12, -1.0);
@@ -654,61 +581,39 @@ void TestDeckEditsAndSkips()
     CHECK(std::fabs(swl[c] - (region2 ? 0.3 : 0.1)) < 1e-15);
   }
   // Nothing the viewer does not build became an array.
-  for (const char* name :
-    { "MULTX", "MULTZ", "TRANX", "TRANY", "PORV", "DEPTH", "FOOBAR", "MULTPV" })
+  for (const char* name : { "MULTX", "MULTZ", "TRANX", "TRANY", "PORV", "DEPTH", "FOOBAR", "MULTPV" })
   {
     CHECK(deck.FindArray(name) == nullptr);
   }
   // One warning each, naming the file, the line, the keyword and the array.
   const std::string file = path + ":";
+  CHECK(WarningsWith(
+          deck, { file + LineOf(EditedDeck, "MULTX 0.5") + ":", "keyword EQUALS", "MULTX", "flow multiplier" }) == 1);
   CHECK(WarningsWith(deck,
-          { file + LineOf(EditedDeck, "MULTX 0.5") + ":",
-            "keyword EQUALS",
-            "MULTX",
-            "flow multiplier" }) == 1);
-  CHECK(WarningsWith(deck,
-          { file + LineOf(EditedDeck, " FOOBAR 7") + ":",
-            "keyword EQUALS",
-            "FOOBAR",
+          { file + LineOf(EditedDeck, " FOOBAR 7") + ":", "keyword EQUALS", "FOOBAR",
             "not an array the viewer knows" }) == 1);
-  CHECK(WarningsWith(deck,
-          { file + LineOf(EditedDeck, "MULTIPLY\n TRANX") + ":",
-            "keyword MULTIPLY",
-            "TRANX",
-            "transmissibility" }) == 1);
-  CHECK(WarningsWith(
-          deck, { file + LineOf(EditedDeck, "MULTZ\n") + ":", "keyword MULTZ", "MULTZ" }) == 1);
-  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTFLT") + ":", "keyword MULTFLT" }) == 1);
   CHECK(
-    WarningsWith(deck, { file + LineOf(EditedDeck, "MULTREGT") + ":", "keyword MULTREGT" }) == 1);
+    WarningsWith(deck,
+      { file + LineOf(EditedDeck, "MULTIPLY\n TRANX") + ":", "keyword MULTIPLY", "TRANX", "transmissibility" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTZ\n") + ":", "keyword MULTZ", "MULTZ" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTFLT") + ":", "keyword MULTFLT" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTREGT") + ":", "keyword MULTREGT" }) == 1);
   CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "NNC\n") + ":", "keyword NNC" }) == 1);
-  CHECK(WarningsWith(
-          deck, { file + LineOf(EditedDeck, "MINPV") + ":", "keyword MINPV", "inactive" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MINPV") + ":", "keyword MINPV", "inactive" }) == 1);
   CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "PINCH") + ":", "keyword PINCH" }) == 1);
   CHECK(
-    WarningsWith(deck,
-      { file + LineOf(EditedDeck, "CARFIN") + ":", "keyword CARFIN", "'LGR1'", "global grid" }) ==
-    1);
+    WarningsWith(deck, { file + LineOf(EditedDeck, "CARFIN") + ":", "keyword CARFIN", "'LGR1'", "global grid" }) == 1);
   CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "AQUNUM") + ":", "keyword AQUNUM" }) == 1);
   CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "AQUCON") + ":", "keyword AQUCON" }) == 1);
-  CHECK(
-    WarningsWith(deck,
-      { file + LineOf(EditedDeck, "MULTIPLY\n TRANY") + ":", "keyword MULTIPLY", "TRANY" }) == 1);
-  CHECK(WarningsWith(deck,
-          { file + LineOf(EditedDeck, "EQUALS\n PORV") + ":",
-            "keyword EQUALS",
-            "PORV",
-            "pore volume" }) == 1);
-  CHECK(
-    WarningsWith(deck,
-      { file + LineOf(EditedDeck, "ADD\n DEPTH") + ":", "keyword ADD", "DEPTH", "depth" }) == 1);
-  CHECK(
-    WarningsWith(deck, { file + LineOf(EditedDeck, "MULTREGP") + ":", "keyword MULTREGP" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTIPLY\n TRANY") + ":", "keyword MULTIPLY", "TRANY" }) == 1);
+  CHECK(WarningsWith(
+          deck, { file + LineOf(EditedDeck, "EQUALS\n PORV") + ":", "keyword EQUALS", "PORV", "pore volume" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "ADD\n DEPTH") + ":", "keyword ADD", "DEPTH", "depth" }) == 1);
+  CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "MULTREGP") + ":", "keyword MULTREGP" }) == 1);
   CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "EDITNNC") + ":", "keyword EDITNNC" }) == 1);
   CHECK(WarningsWith(deck, { file + LineOf(EditedDeck, "THPRES") + ":", "keyword THPRES" }) == 1);
   CHECK(
-    WarningsWith(deck,
-      { file + LineOf(EditedDeck, "MULTIPLY\n MULTPV") + ":", "keyword MULTIPLY", "MULTPV" }) == 1);
+    WarningsWith(deck, { file + LineOf(EditedDeck, "MULTIPLY\n MULTPV") + ":", "keyword MULTIPLY", "MULTPV" }) == 1);
   CHECK(deck.warnings.size() == 19);
   for (const std::string& warning : deck.warnings)
   {
@@ -724,47 +629,33 @@ void TestDeckEditsAndSkips()
 
   // Edits the viewer cannot honour on arrays it needs stay errors naming file, line, keyword.
   const std::string twoCells(TwoCells);
-  ExpectError("copy_tran.grdecl",
-    twoCells + "COPY\n TRANX PORO /\n/\n",
+  ExpectError("copy_tran.grdecl", twoCells + "COPY\n TRANX PORO /\n/\n",
     { "copy_tran.grdecl:13", "keyword COPY", "source array TRANX has not been defined" });
-  ExpectError("operate.grdecl",
-    twoCells + "PORO\n 2*0.1 /\nOPERATE\n PORO 4* 1 1 SQRT PORO /\n/\n",
+  ExpectError("operate.grdecl", twoCells + "PORO\n 2*0.1 /\nOPERATE\n PORO 4* 1 1 SQRT PORO /\n/\n",
     { "operate.grdecl:15", "keyword OPERATE", "unknown operation 'SQRT'" });
-  ExpectError("operate_poly.grdecl",
-    twoCells + "PORO\n 2*0.1 /\nOPERATE\n NTG 4* 1 1 POLY PORO 1 1 /\n/\n",
+  ExpectError("operate_poly.grdecl", twoCells + "PORO\n 2*0.1 /\nOPERATE\n NTG 4* 1 1 POLY PORO 1 1 /\n/\n",
     { "operate_poly.grdecl:15", "keyword OPERATE", "array NTG has not been defined" });
-  ExpectError("minvalue.grdecl",
-    twoCells + "MINVALUE\n PORO 0.1 /\n/\n",
+  ExpectError("minvalue.grdecl", twoCells + "MINVALUE\n PORO 0.1 /\n/\n",
     { "minvalue.grdecl:13", "keyword MINVALUE", "array PORO has not been defined" });
-  ExpectError("copybox.grdecl",
-    twoCells + "PORO\n 2*0.1 /\nCOPYBOX\n PORO 1 1 1 1 1 1 1 2 1 1 1 1 /\n/\n",
+  ExpectError("copybox.grdecl", twoCells + "PORO\n 2*0.1 /\nCOPYBOX\n PORO 1 1 1 1 1 1 1 2 1 1 1 1 /\n/\n",
     { "copybox.grdecl:15", "keyword COPYBOX", "differ in size along I" });
-  ExpectError("carfin.grdecl",
-    twoCells + "CARFIN\n 'L1' 1 1 1 1 1 1 2 2 2 /\nPORO\n 8*0.1 /\n",
+  ExpectError("carfin.grdecl", twoCells + "CARFIN\n 'L1' 1 1 1 1 1 1 2 2 2 /\nPORO\n 8*0.1 /\n",
     { "carfin.grdecl:13", "keyword CARFIN", "'L1' has no ENDFIN" });
-  ExpectError("region.grdecl",
-    twoCells + "EQUALREG\n PORO 0.1 1 Q /\n/\n",
+  ExpectError("region.grdecl", twoCells + "EQUALREG\n PORO 0.1 1 Q /\n/\n",
     { "region.grdecl:13", "keyword EQUALREG", "region array 'Q'" });
 
   // A missing INCLUDE is a warning; when it held what the grid needs, the error names it.
   Write("grid_only.inc", twoCells);
-  const resmr::CornerPointModel missingSolution = Parse("missing_solution.DATA",
-    "GRID\nINCLUDE\n 'grid_only.inc' /\nSOLUTION\nINCLUDE\n 'not_shipped.inc' /\n");
-  CHECK(WarningsWith(missingSolution,
-          { "missing_solution.DATA:5", "INCLUDE", "not_shipped.inc", "not found" }) == 1);
+  const resmr::CornerPointModel missingSolution =
+    Parse("missing_solution.DATA", "GRID\nINCLUDE\n 'grid_only.inc' /\nSOLUTION\nINCLUDE\n 'not_shipped.inc' /\n");
+  CHECK(WarningsWith(missingSolution, { "missing_solution.DATA:5", "INCLUDE", "not_shipped.inc", "not found" }) == 1);
   CHECK(missingSolution.CellCount() == 2);
-  ExpectError("missing_grid.DATA",
-    "GRID\nINCLUDE\n 'gone_grid.inc' /\nPORO\n 2*0.1 /\n",
-    { "missing_grid.DATA:4",
-      "PORO",
-      "before SPECGRID",
-      "INCLUDE of 'gone_grid.inc' at",
+  ExpectError("missing_grid.DATA", "GRID\nINCLUDE\n 'gone_grid.inc' /\nPORO\n 2*0.1 /\n",
+    { "missing_grid.DATA:4", "PORO", "before SPECGRID", "INCLUDE of 'gone_grid.inc' at",
       "missing_grid.DATA:2 was not found" });
-  ExpectError("missing_zcorn.DATA",
-    "SPECGRID\n 2 1 1 1 F /\nINCLUDE\n 'gone_zcorn.inc' /\n",
+  ExpectError("missing_zcorn.DATA", "SPECGRID\n 2 1 1 1 F /\nINCLUDE\n 'gone_zcorn.inc' /\n",
     { "missing_zcorn.DATA", "no grid geometry", "INCLUDE of 'gone_zcorn.inc'" });
-  ExpectError("missing_poro.DATA",
-    twoCells + "INCLUDE\n 'gone_poro.inc' /\nMULTIPLY\n PORO 2 /\n/\n",
+  ExpectError("missing_poro.DATA", twoCells + "INCLUDE\n 'gone_poro.inc' /\nMULTIPLY\n PORO 2 /\n/\n",
     { "missing_poro.DATA:15", "keyword MULTIPLY", "PORO has not been defined", "gone_poro.inc" });
 }
 } // namespace
@@ -777,16 +668,11 @@ int main()
     return 2;
   }
   Directory = pattern;
-  const std::vector<std::pair<const char*, std::function<void()>>> tests = { { "numbers",
-                                                                               TestNumbers },
-    { "tokenizer", TestTokenizer },
-    { "corner-point deck", TestCornerPointDeck },
-    { "faulted sharing", TestFaultedSharing },
-    { "cartesian and edits", TestCartesianAndEdits },
-    { "includes and mapaxes", TestIncludesAndMapAxes },
-    { "binary grdecl", TestBinaryGrdecl },
-    { "bad input", TestBadInput },
-    { "deck edits and skipped keywords", TestDeckEditsAndSkips } };
+  const std::vector<std::pair<const char*, std::function<void()>>> tests = { { "numbers", TestNumbers },
+    { "tokenizer", TestTokenizer }, { "corner-point deck", TestCornerPointDeck },
+    { "faulted sharing", TestFaultedSharing }, { "cartesian and edits", TestCartesianAndEdits },
+    { "includes and mapaxes", TestIncludesAndMapAxes }, { "binary grdecl", TestBinaryGrdecl },
+    { "bad input", TestBadInput }, { "deck edits and skipped keywords", TestDeckEditsAndSkips } };
   const bool passed = resmr_testing::RunNamedTests(tests);
   std::system(("rm -rf '" + Directory + "'").c_str());
   return passed ? 0 : 1;

@@ -62,8 +62,7 @@ void TestDiamondTree()
       if (d.second >= 0)
       {
         ++seen[static_cast<std::size_t>(d.second)];
-        const auto a = tree.NormalisedTriangle(level, d.first),
-                   b = tree.NormalisedTriangle(level, d.second);
+        const auto a = tree.NormalisedTriangle(level, d.first), b = tree.NormalisedTriangle(level, d.second);
         CHECK(a.left == b.right && a.right == b.left);
       }
     }
@@ -77,8 +76,8 @@ void TestDiamondTree()
   for (int n = 0; n < 2000; ++n)
   {
     const int level = static_cast<int>(random() % 7);
-    const int64_t index = static_cast<int64_t>(
-      random() % static_cast<uint64_t>(DiamondHierarchy::TriangleCount(level)));
+    const int64_t index =
+      static_cast<int64_t>(random() % static_cast<uint64_t>(DiamondHierarchy::TriangleCount(level)));
     const auto t = tree.ModelTriangle(level, index);
     double a = unit(random), b = unit(random);
     if (a + b > 1)
@@ -137,12 +136,8 @@ FaceKey KeyOf(const RegionMesh& mesh, const std::array<uint32_t, 4>& quad)
     d1[a] = corners[2][a] - corners[0][a];
     d2[a] = corners[3][a] - corners[1][a];
   }
-  const double n[3] = {
-    d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2], d1[0] * d2[1] - d1[1] * d2[0]
-  };
-  std::array<int, 3> direction{
-    (n[0] > 0) - (n[0] < 0), (n[1] > 0) - (n[1] < 0), (n[2] > 0) - (n[2] < 0)
-  };
+  const double n[3] = { d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2], d1[0] * d2[1] - d1[1] * d2[0] };
+  std::array<int, 3> direction{ (n[0] > 0) - (n[0] < 0), (n[1] > 0) - (n[1] < 0), (n[2] > 0) - (n[2] < 0) };
   std::sort(corners.begin(), corners.end());
   return { corners, direction };
 }
@@ -173,12 +168,10 @@ std::multiset<FaceKey> OriginalFaces(const SyntheticParameters& p)
   SyntheticLayer layer;
   while (stream.Next(layer))
   {
-    std::copy(
-      layer.zcorn.begin(), layer.zcorn.end(), deck.zcornSingle.begin() + 8 * p.nx * p.ny * layer.k);
+    std::copy(layer.zcorn.begin(), layer.zcorn.end(), deck.zcornSingle.begin() + 8 * p.nx * p.ny * layer.k);
     for (int64_t c = 0; c < p.nx * p.ny; ++c)
     {
-      active[static_cast<std::size_t>(layer.k * p.nx * p.ny + c)] =
-        layer.state[c] == SyntheticCellState::Active;
+      active[static_cast<std::size_t>(layer.k * p.nx * p.ny + c)] = layer.state[c] == SyntheticCellState::Active;
     }
   }
   const CornerPointGeometry geometry = CornerPointGeometry::FromDeck(deck, false);
@@ -211,8 +204,8 @@ NodeData NodeOf(const RegionMesh& mesh, uint32_t node)
 {
   const std::size_t interfaces = static_cast<std::size_t>(mesh.layers) + 1;
   return { mesh.topology[node],
-    std::vector<double>(mesh.positions.begin() + node * interfaces * 3,
-      mesh.positions.begin() + (node + 1) * interfaces * 3) };
+    std::vector<double>(
+      mesh.positions.begin() + node * interfaces * 3, mesh.positions.begin() + (node + 1) * interfaces * 3) };
 }
 
 std::vector<EdgeKey> CutEdgesOf(const RegionMesh& mesh)
@@ -224,8 +217,7 @@ std::vector<EdgeKey> CutEdgesOf(const RegionMesh& mesh)
     {
       if (mesh.cutEdges[c] & (1u << e))
       {
-        edges.push_back(
-          { NodeOf(mesh, mesh.corners[c][e]), NodeOf(mesh, mesh.corners[c][(e + 1) % 4]) });
+        edges.push_back({ NodeOf(mesh, mesh.corners[c][e]), NodeOf(mesh, mesh.corners[c][(e + 1) % 4]) });
       }
     }
   }
@@ -239,12 +231,8 @@ VertexData VertexOf(const RegionMesh& mesh, uint32_t vertex)
 {
   const uint32_t node = vertex / static_cast<uint32_t>(mesh.layers + 1);
   const double* p = &mesh.positions[static_cast<std::size_t>(vertex) * 3];
-  return { mesh.topology[node][0],
-    mesh.topology[node][1],
-    double(vertex % static_cast<uint32_t>(mesh.layers + 1)),
-    p[0],
-    p[1],
-    p[2] };
+  return { mesh.topology[node][0], mesh.topology[node][1], double(vertex % static_cast<uint32_t>(mesh.layers + 1)),
+    p[0], p[1], p[2] };
 }
 
 /// Two checks that the cut has no crack. (1) Every cut edge of every region is walked the
@@ -252,10 +240,8 @@ VertexData VertexOf(const RegionMesh& mesh, uint32_t vertex)
 /// the cut flags: the external surfaces of all regions of the cut, joined by vertex data, are
 /// closed (every directed edge is matched by one walked the other way), as the original
 /// model's surface is. Returns the cut edges checked.
-int64_t CheckCut(const MultiresolutionFile& file,
-  const std::set<std::pair<int, int64_t>>& cut,
-  std::map<std::pair<int, int64_t>, RegionMesh>& cache,
-  const std::string& label)
+int64_t CheckCut(const MultiresolutionFile& file, const std::set<std::pair<int, int64_t>>& cut,
+  std::map<std::pair<int, int64_t>, RegionMesh>& cache, const std::string& label)
 {
   std::multiset<EdgeKey> open;
   std::map<std::pair<VertexData, VertexData>, int> balance;
@@ -270,10 +256,7 @@ int64_t CheckCut(const MultiresolutionFile& file,
     auto found = cache.find(region);
     if (found == cache.end())
     {
-      found = cache
-                .emplace(
-                  region, file.ReadRegion(static_cast<std::size_t>(record - file.Regions().data())))
-                .first;
+      found = cache.emplace(region, file.ReadRegion(static_cast<std::size_t>(record - file.Regions().data()))).first;
     }
     for (const EdgeKey& edge : CutEdgesOf(found->second))
     {
@@ -336,27 +319,13 @@ int64_t CheckCut(const MultiresolutionFile& file,
     {
       const auto& a = entry.first.first;
       const auto& b = entry.first.second;
-      std::fprintf(stderr,
-        "  open %d: (%g %g %g | %.3f %.3f %.3f) - (%g %g %g | %.3f %.3f %.3f)\n",
-        entry.second,
-        a[0],
-        a[1],
-        a[2],
-        a[3],
-        a[4],
-        a[5],
-        b[0],
-        b[1],
-        b[2],
-        b[3],
-        b[4],
-        b[5]);
+      std::fprintf(stderr, "  open %d: (%g %g %g | %.3f %.3f %.3f) - (%g %g %g | %.3f %.3f %.3f)\n", entry.second, a[0],
+        a[1], a[2], a[3], a[4], a[5], b[0], b[1], b[2], b[3], b[4], b[5]);
     }
   }
   if (unbalanced)
   {
-    std::fprintf(
-      stderr, "%s: %lld surface edges open\n", label.c_str(), static_cast<long long>(unbalanced));
+    std::fprintf(stderr, "%s: %lld surface edges open\n", label.c_str(), static_cast<long long>(unbalanced));
   }
   CHECK(unbalanced == 0 && !balance.empty());
   if (!open.empty())
@@ -405,8 +374,7 @@ void TestHierarchyFile()
   CHECK(leafFaces == original);
   if (leafFaces != original)
   {
-    std::fprintf(
-      stderr, "finest level: %zu faces, original %zu\n", leafFaces.size(), original.size());
+    std::fprintf(stderr, "finest level: %zu faces, original %zu\n", leafFaces.size(), original.size());
   }
   // Property side (Sec. 5.3-5.4): active flags per layer, the perfect hash of the touched
   // cells, and their normals.
@@ -440,8 +408,7 @@ void TestHierarchyFile()
       }
       ++filled;
       hashedCells.insert(n);
-      const uint32_t i = uint32_t(n % uint64_t(p.nx)),
-                     j = uint32_t(n / uint64_t(p.nx) % uint64_t(p.ny)),
+      const uint32_t i = uint32_t(n % uint64_t(p.nx)), j = uint32_t(n / uint64_t(p.nx) % uint64_t(p.ny)),
                      k = uint32_t(n / uint64_t(p.nx * p.ny));
       CHECK(hash.Slot(i, j, k) == slot); // the hash finds every cell where its data lies
       uint16_t codes[2];
@@ -457,10 +424,8 @@ void TestHierarchyFile()
     CHECK(filled == static_cast<int64_t>(h.hashedCells) && filled > 0);
     if (upward != tops)
     {
-      std::fprintf(stderr,
-        "%lld of %lld cells have a top normal down or a bottom normal up\n",
-        static_cast<long long>(tops - upward),
-        static_cast<long long>(tops));
+      std::fprintf(stderr, "%lld of %lld cells have a top normal down or a bottom normal up\n",
+        static_cast<long long>(tops - upward), static_cast<long long>(tops));
     }
     CHECK(upward == tops); // top normals look up, bottom normals down
     // Every cell under a top face and over a bottom face of the finest level is hashed.
@@ -484,21 +449,16 @@ void TestHierarchyFile()
             tj += mesh.topology[v / interfaces][1] / 4;
           }
           const uint64_t k = q[0] % interfaces - (which ? 1 : 0);
-          const uint64_t n = uint64_t(std::floor(ti)) +
-                             uint64_t(p.nx) * (uint64_t(std::floor(tj)) + uint64_t(p.ny) * k);
+          const uint64_t n =
+            uint64_t(std::floor(ti)) + uint64_t(p.nx) * (uint64_t(std::floor(tj)) + uint64_t(p.ny) * k);
           missing += hashedCells.count(n) == 0;
         }
       }
     }
     CHECK(missing == 0);
     // Packed: the table holds few empty slots (Sec. 5.4; target 1.25 x the cells).
-    std::fprintf(stderr,
-      "hash: %lld cells in %llu slots (%ux%ux%u), offsets %llu\n",
-      static_cast<long long>(filled),
-      static_cast<unsigned long long>(hash.TableSize()),
-      hash.tableSides[0],
-      hash.tableSides[1],
-      hash.tableSides[2],
+    std::fprintf(stderr, "hash: %lld cells in %llu slots (%ux%ux%u), offsets %llu\n", static_cast<long long>(filled),
+      static_cast<unsigned long long>(hash.TableSize()), hash.tableSides[0], hash.tableSides[1], hash.tableSides[2],
       static_cast<unsigned long long>(hash.OffsetTableSize()));
     CHECK(double(hash.TableSize()) <= 1.25 * double(filled));
   }
@@ -515,11 +475,8 @@ void TestHierarchyFile()
   CHECK(above <= 1.2 * columnsAtLevel[report.leafLevel]);
 
   // Errors and bounding volumes: equal within a diamond, monotone up the tree.
-  const DiamondHierarchy tree(file.Header().box[0],
-    file.Header().box[1],
-    file.Header().box[2],
-    file.Header().box[3],
-    file.Header().leafLevel);
+  const DiamondHierarchy tree(
+    file.Header().box[0], file.Header().box[1], file.Header().box[2], file.Header().box[3], file.Header().leafLevel);
   int64_t pairs = 0;
   for (const RegionRecord& r : file.Regions())
   {
@@ -618,8 +575,7 @@ void TestHierarchyFile()
     {
       const RegionMesh a = file.ReadRegion(i);
       const RegionMesh b = other.ReadRegion(static_cast<std::size_t>(s - other.Regions().data()));
-      CHECK(a.positions == b.positions && a.corners == b.corners && a.active == b.active &&
-            a.cutEdges == b.cutEdges);
+      CHECK(a.positions == b.positions && a.corners == b.corners && a.active == b.active && a.cutEdges == b.cutEdges);
     }
   }
   std::remove(single.c_str());
@@ -628,8 +584,7 @@ void TestHierarchyFile()
   std::ifstream in(path, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string damaged = TempPath("damaged.resmr");
-  const auto writeBytes = [&](const std::string& content)
-  {
+  const auto writeBytes = [&](const std::string& content) {
     std::ofstream out(damaged, std::ios::binary | std::ios::trunc);
     out.write(content.data(), static_cast<std::streamsize>(content.size()));
   };
@@ -641,14 +596,12 @@ void TestHierarchyFile()
     "stub", [&] { MultiresolutionFile f(damaged); }, { damaged, "too short" });
   std::string flipped = bytes;
   const RegionRecord& victim = file.Regions()[file.Regions().size() / 2];
-  flipped[victim.chunks[RegionRecord::Mesh].offset +
-          victim.chunks[RegionRecord::Mesh].stored / 2] ^= 0x5a;
+  flipped[victim.chunks[RegionRecord::Mesh].offset + victim.chunks[RegionRecord::Mesh].stored / 2] ^= 0x5a;
   writeBytes(flipped);
   {
     const MultiresolutionFile f(damaged); // the index is intact: opening works, the chunk does not
     const std::size_t at = file.Regions().size() / 2;
-    resmr_testing::ExpectError<FileFormatError>("flipped chunk",
-      [&] { f.ReadRegion(at); },
+    resmr_testing::ExpectError<FileFormatError>("flipped chunk", [&] { f.ReadRegion(at); },
       { damaged, "level " + std::to_string(victim.level), "mesh", "checksum" });
   }
   flipped = bytes;
@@ -673,8 +626,7 @@ void WriteMapDeck(const std::string& path, const std::string& placement)
 {
   std::ofstream out(path);
   out << "RUNSPEC\nDIMENS\n 12 10 3 /\nGRID\n"
-      << placement
-      << "DX\n 360*50 /\nDY\n 360*40 /\nDZ\n 360*5 /\nTOPS\n 120*1500 /\nACTNUM\n 300*1 60*0 /\n";
+      << placement << "DX\n 360*50 /\nDY\n 360*40 /\nDZ\n 360*5 /\nTOPS\n 120*1500 /\nACTNUM\n 300*1 60*0 /\n";
 }
 
 /// Bytes of `bytes` with the header's CRC made right again.
@@ -690,8 +642,7 @@ void TestMapAxesInFile()
   // MAPAXES (a 30 degree turn), MAPUNITS and GRIDUNIT of a deck go to the header, exactly.
   const std::string deckPath = TempPath("map.GRDECL");
   WriteMapDeck(deckPath,
-    "MAPUNITS\n 'METRES' /\nMAPAXES\n 455000.25 6781866.525404 455500.25 6781000.5 456366.275404 "
-    "6781500.5 /\n"
+    "MAPUNITS\n 'METRES' /\nMAPAXES\n 455000.25 6781866.525404 455500.25 6781000.5 456366.275404 6781500.5 /\n"
     "GRIDUNIT\n 'METRES' ' ' /\n");
   const std::string path = TempPath("map.resmr");
   HierarchyOptions options;
@@ -707,11 +658,9 @@ void TestMapAxesInFile()
   const MultiresolutionFile file(path);
   const MapPlacement& map = file.Header().map;
   CHECK(file.Header().version == MultiresolutionHeader::Version);
-  CHECK(
-    map.hasMapAxes && !map.gridUnitIsMap && map.mapUnits == "METRES" && map.gridUnit == "METRES");
-  CHECK(map.mapAxes.yAxisPoint == deck.mapAxes.yAxisPoint &&
-        map.mapAxes.origin == deck.mapAxes.origin &&
-        map.mapAxes.xAxisPoint == deck.mapAxes.xAxisPoint);
+  CHECK(map.hasMapAxes && !map.gridUnitIsMap && map.mapUnits == "METRES" && map.gridUnit == "METRES");
+  CHECK(map.mapAxes.yAxisPoint == deck.mapAxes.yAxisPoint && map.mapAxes.origin == deck.mapAxes.origin &&
+    map.mapAxes.xAxisPoint == deck.mapAxes.xAxisPoint);
 
   // The header's transform places every corner where the grid readers put it (FromDeck with
   // MAPAXES applied), bit for bit.
@@ -735,14 +684,11 @@ void TestMapAxesInFile()
     }
   }
   CHECK(same == corners);
-  std::printf(
-    "map axes: %lld of %lld corners placed by the header's MAPAXES as FromDeck places them\n",
-    static_cast<long long>(same),
-    static_cast<long long>(corners));
+  std::printf("map axes: %lld of %lld corners placed by the header's MAPAXES as FromDeck places them\n",
+    static_cast<long long>(same), static_cast<long long>(corners));
 
   // Geometry stays in grid coordinates: the hierarchy box is the grid's.
-  CHECK(file.Header().box[0] >= -1 && file.Header().box[2] <= 12 * 50 + 1 &&
-        file.Header().box[3] <= 10 * 40 + 1);
+  CHECK(file.Header().box[0] >= -1 && file.Header().box[2] <= 12 * 50 + 1 && file.Header().box[3] <= 10 * 40 + 1);
 
   // GRIDUNIT ... 'MAP': COORD is already in map coordinates, nothing to apply.
   const std::string inMapPath = TempPath("inmap.GRDECL");
@@ -762,13 +708,11 @@ void TestMapAxesInFile()
   std::ifstream in(path, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string damaged = TempPath("map-damaged.resmr");
-  const auto writeBytes = [&](const std::string& content)
-  {
+  const auto writeBytes = [&](const std::string& content) {
     std::ofstream out(damaged, std::ios::binary | std::ios::trunc);
     out.write(content.data(), static_cast<std::streamsize>(content.size()));
   };
-  const auto withVersion = [&](uint32_t version)
-  {
+  const auto withVersion = [&](uint32_t version) {
     std::string b = bytes;
     std::memcpy(&b[8], &version, 4);
     std::fill(b.begin() + 184, b.begin() + 252, '\0');
@@ -777,16 +721,13 @@ void TestMapAxesInFile()
   writeBytes(withVersion(3));
   {
     const MultiresolutionFile old(damaged);
-    CHECK(old.Header().version == 3 && !old.Header().map.hasMapAxes &&
-          old.Header().map.mapUnits.empty());
+    CHECK(old.Header().version == 3 && !old.Header().map.hasMapAxes && old.Header().map.mapUnits.empty());
     CHECK(!CornerPointGeometry::PlacementTransform(old.Header().map, transform));
-    CHECK(old.Regions().size() == file.Regions().size() &&
-          old.Header().geometryId == file.Header().geometryId);
+    CHECK(old.Regions().size() == file.Regions().size() && old.Header().geometryId == file.Header().geometryId);
   }
   // Versions this build does not know are refused by number.
   writeBytes(withVersion(2));
-  resmr_testing::ExpectError<FileFormatError>("version 2",
-    [&] { MultiresolutionFile f(damaged); },
+  resmr_testing::ExpectError<FileFormatError>("version 2", [&] { MultiresolutionFile f(damaged); },
     { damaged, "format version 2", "versions 3 to 5", "resmr build" });
   writeBytes(withVersion(6));
   resmr_testing::ExpectError<FileFormatError>(
@@ -796,9 +737,8 @@ void TestMapAxesInFile()
   std::string broken = bytes;
   broken[184] = 7;
   writeBytes(WithHeaderCrc(broken));
-  resmr_testing::ExpectError<FileFormatError>("flags",
-    [&] { MultiresolutionFile f(damaged); },
-    { damaged, "map placement", "unknown flags" });
+  resmr_testing::ExpectError<FileFormatError>(
+    "flags", [&] { MultiresolutionFile f(damaged); }, { damaged, "map placement", "unknown flags" });
   broken = bytes;
   std::memcpy(&broken[188 + 32], &broken[188 + 16], 16); // x axis point onto the origin
   writeBytes(WithHeaderCrc(broken));

@@ -1,9 +1,9 @@
 // Streaming grid input of the hierarchy builder (paper Sec. 4.2: the model is read layer by
 // layer, never held whole): OpenLayerSource on every real EGRID/FEGRID and deck of the shared
 // data gives exactly the layers and map placement (MAPAXES, units) of the in-memory path
-// (ReadCornerPointModel, FromDeck, CornerPointLayerSource); decks with ACTNUM/DZ edits match too;
-// corrupt files and the refused COPY into a spooled array fail with InputError naming file and
-// keyword; spool files never show in the folder.
+// (ReadCornerPointModel, FromDeck, CornerPointLayerSource); decks with ACTNUM/DZ edits match too; corrupt files and the
+// refused COPY into a spooled array fail with InputError naming file and keyword; spool files
+// never show in the folder.
 #include "CoreTesting.h"
 #include "CornerPointGeometry.h"
 #include "CornerPointModel.h"
@@ -62,8 +62,7 @@ bool CompareWithInMemory(const std::string& path)
   try
   {
     resmr::ReadCornerPointModel(path, deck, flags);
-    geometry.reset(
-      new resmr::CornerPointGeometry(resmr::CornerPointGeometry::FromDeck(deck, false)));
+    geometry.reset(new resmr::CornerPointGeometry(resmr::CornerPointGeometry::FromDeck(deck, false)));
     memory.reset(new resmr::CornerPointLayerSource(*geometry, flags, path, deck.Placement()));
   }
   catch (const resmr::InputError& error)
@@ -80,12 +79,11 @@ bool CompareWithInMemory(const std::string& path)
       CHECK(stream->Dims() == memory->Dims());
       CHECK(stream->Name() == path);
       CHECK(stream->Coord().size() == memory->Coord().size() &&
-            SameBits(stream->Coord().data(), memory->Coord().data(), 8 * memory->Coord().size()));
+        SameBits(stream->Coord().data(), memory->Coord().data(), 8 * memory->Coord().size()));
       const resmr::MapPlacement a = stream->Placement(), b = memory->Placement();
-      CHECK(a.hasMapAxes == b.hasMapAxes && a.gridUnitIsMap == b.gridUnitIsMap &&
-            a.mapUnits == b.mapUnits && a.gridUnit == b.gridUnit &&
-            a.mapAxes.origin == b.mapAxes.origin && a.mapAxes.xAxisPoint == b.mapAxes.xAxisPoint &&
-            a.mapAxes.yAxisPoint == b.mapAxes.yAxisPoint);
+      CHECK(a.hasMapAxes == b.hasMapAxes && a.gridUnitIsMap == b.gridUnitIsMap && a.mapUnits == b.mapUnits &&
+        a.gridUnit == b.gridUnit && a.mapAxes.origin == b.mapAxes.origin &&
+        a.mapAxes.xAxisPoint == b.mapAxes.xAxisPoint && a.mapAxes.yAxisPoint == b.mapAxes.yAxisPoint);
       MapAxesModels += a.hasMapAxes ? 1 : 0;
     }
     std::vector<float> z1, z2;
@@ -108,16 +106,11 @@ bool CompareWithInMemory(const std::string& path)
         break;
       }
       ++layers;
-      const bool same =
-        z1.size() == z2.size() && SameBits(z1.data(), z2.data(), 4 * z1.size()) && a1 == a2;
+      const bool same = z1.size() == z2.size() && SameBits(z1.data(), z2.data(), 4 * z1.size()) && a1 == a2;
       if (!same)
       {
-        std::fprintf(stderr,
-          "%s: layer %lld differs (depths %s, active flags %s)\n",
-          path.c_str(),
-          static_cast<long long>(layers),
-          z1 == z2 ? "same" : "differ",
-          a1 == a2 ? "same" : "differ");
+        std::fprintf(stderr, "%s: layer %lld differs (depths %s, active flags %s)\n", path.c_str(),
+          static_cast<long long>(layers), z1 == z2 ? "same" : "differ", a1 == a2 ? "same" : "differ");
       }
       CHECK(same);
     }
@@ -132,11 +125,8 @@ bool CompareWithInMemory(const std::string& path)
   }
   if (memoryError.empty() != streamError.empty())
   {
-    std::fprintf(stderr,
-      "%s: in memory: '%s', streamed: '%s'\n",
-      path.c_str(),
-      memoryError.c_str(),
-      streamError.c_str());
+    std::fprintf(
+      stderr, "%s: in memory: '%s', streamed: '%s'\n", path.c_str(), memoryError.c_str(), streamError.c_str());
   }
   CHECK(memoryError.empty() == streamError.empty());
   CHECK(EntriesIn(SpoolDirectory) == 0);
@@ -183,11 +173,8 @@ void TestRealModels(const std::string& data)
     }
     (CompareWithInMemory(data + "/" + file) ? compared : rejected)++;
   }
-  std::printf(
-    "  %d real models identical layer by layer (%d with MAPAXES), %d rejected by both paths\n",
-    compared,
-    MapAxesModels,
-    rejected);
+  std::printf("  %d real models identical layer by layer (%d with MAPAXES), %d rejected by both paths\n", compared,
+    MapAxesModels, rejected);
   CHECK(compared >= 60);
   CHECK(MapAxesModels >= 5);
 }
@@ -228,11 +215,9 @@ void TestCorruptEgrid(const std::string& data)
   }
   // Cut in the middle of ZCORN: refused when opened, naming the file and keyword.
   const std::string truncated = Directory + "/TRUNCATED.EGRID";
-  WriteAll(truncated,
-    bytes.substr(0, static_cast<std::size_t>((zcorn->dataOffset + zcorn->endOffset) / 2)));
+  WriteAll(truncated, bytes.substr(0, static_cast<std::size_t>((zcorn->dataOffset + zcorn->endOffset) / 2)));
   resmr_testing::ExpectError<resmr::InputError>("truncated EGRID",
-    [&] { resmr::OpenLayerSource(truncated, SpoolDirectory); },
-    { truncated, "keyword ZCORN", "truncated" });
+    [&] { resmr::OpenLayerSource(truncated, SpoolDirectory); }, { truncated, "keyword ZCORN", "truncated" });
 
   // A data record's end marker broken deep inside ZCORN: found when that layer is read.
   const int64_t blockBytes = 1000 * 4 + 8;
@@ -242,8 +227,7 @@ void TestCorruptEgrid(const std::string& data)
   const std::string marker = Directory + "/MARKER.EGRID";
   WriteAll(marker, broken);
   resmr_testing::ExpectError<resmr::InputError>("broken marker",
-    [&]
-    {
+    [&] {
       auto source = resmr::OpenLayerSource(marker, SpoolDirectory);
       Drain(*source);
     },
@@ -258,8 +242,7 @@ void TestCorruptEgrid(const std::string& data)
   const std::string nanPath = Directory + "/NAN.EGRID";
   WriteAll(nanPath, nan);
   resmr_testing::ExpectError<resmr::InputError>("NaN depth",
-    [&]
-    {
+    [&] {
       auto source = resmr::OpenLayerSource(nanPath, SpoolDirectory);
       Drain(*source);
     },
@@ -350,8 +333,7 @@ EQUALS
   }
   // By region when MULTNUM is given: resmr build does not keep region arrays, so refused.
   const std::string byRegion = Directory + "/BY_REGION.grdecl";
-  WriteAll(
-    byRegion, std::string(CornerPointGrid) + "MULTNUM\n 12*1 /\nEQUALREG\n ACTNUM 0 1 M /\n/\n");
+  WriteAll(byRegion, std::string(CornerPointGrid) + "MULTNUM\n 12*1 /\nEQUALREG\n ACTNUM 0 1 M /\n/\n");
   resmr_testing::ExpectError<resmr::InputError>("EQUALREG on ACTNUM",
     [&] { resmr::OpenLayerSource(byRegion, SpoolDirectory); },
     { byRegion + ":", "keyword EQUALREG", "ACTNUM", "region" });
@@ -386,11 +368,9 @@ PORO
 
   // COPY of a dropped property into ACTNUM: refused, naming file, line and keyword.
   const std::string refused = Directory + "/COPY.grdecl";
-  WriteAll(
-    refused, std::string(CornerPointGrid) + "PORO\n 12*0.3 /\nCOPY\n 'PORO' 'ACTNUM' /\n/\n");
+  WriteAll(refused, std::string(CornerPointGrid) + "PORO\n 12*0.3 /\nCOPY\n 'PORO' 'ACTNUM' /\n/\n");
   resmr_testing::ExpectError<resmr::InputError>("COPY into ACTNUM",
-    [&] { resmr::OpenLayerSource(refused, SpoolDirectory); },
-    { refused + ":", "keyword COPY", "ACTNUM" });
+    [&] { resmr::OpenLayerSource(refused, SpoolDirectory); }, { refused + ":", "keyword COPY", "ACTNUM" });
   CHECK(EntriesIn(SpoolDirectory) == 0);
 
   // A spool folder that does not exist yet is made (the builder's scratch folder).
@@ -419,11 +399,9 @@ int main(int argc, char** argv)
   SpoolDirectory = Directory + "/spool";
   std::system(("mkdir -p '" + SpoolDirectory + "'").c_str());
   const std::string data = argv[1];
-  const std::vector<std::pair<const char*, std::function<void()>>> tests = {
-    { "real models", [&] { TestRealModels(data); } },
-    { "corrupt egrid", [&] { TestCorruptEgrid(data); } },
-    { "deck edits", TestDeckEdits }
-  };
+  const std::vector<std::pair<const char*, std::function<void()>>> tests = { { "real models",
+                                                                               [&] { TestRealModels(data); } },
+    { "corrupt egrid", [&] { TestCorruptEgrid(data); } }, { "deck edits", TestDeckEdits } };
   const bool passed = resmr_testing::RunNamedTests(tests);
   std::system(("rm -rf '" + Directory + "'").c_str());
   return passed ? 0 : 1;

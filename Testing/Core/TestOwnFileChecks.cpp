@@ -46,8 +46,7 @@ Bytes Slurp(const std::string& path)
 void Spill(const std::string& path, const Bytes& bytes)
 {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(
-    reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
 
 const double NaN = std::numeric_limits<double>::quiet_NaN();
@@ -64,10 +63,7 @@ using Change = std::function<void(Bytes&)>;
 /// `valid` with `change` made and every checksum recomputed; `late` is made after that (for
 /// what the repair recomputes itself: the geometry id, the trailer), with the header CRC
 /// recomputed again.
-Bytes Changed(const Bytes& valid,
-  const resmr_fuzz::FileLayout& layout,
-  const Change& change,
-  const Change& late = {})
+Bytes Changed(const Bytes& valid, const resmr_fuzz::FileLayout& layout, const Change& change, const Change& late = {})
 {
   Bytes file = valid;
   if (change)
@@ -85,11 +81,8 @@ Bytes Changed(const Bytes& valid,
 
 /// The geometry file with the change must be refused at open with the file and `fragment`
 /// named.
-void ExpectGeometryRefused(const std::string& label,
-  const Bytes& valid,
-  const std::string& fragment,
-  const Change& change,
-  const Change& late = {})
+void ExpectGeometryRefused(const std::string& label, const Bytes& valid, const std::string& fragment,
+  const Change& change, const Change& late = {})
 {
   const std::string path = Temp + "/changed.resmr";
   Spill(path, Changed(valid, resmr_fuzz::ResmrLayout(), change, late));
@@ -97,16 +90,12 @@ void ExpectGeometryRefused(const std::string& label,
     "resmr " + label, [&] { MultiresolutionFile file(path); }, { path, fragment });
 }
 
-void ExpectPropertiesRefused(const std::string& label,
-  const Bytes& valid,
-  const std::string& fragment,
-  const Change& change,
-  const Change& late = {})
+void ExpectPropertiesRefused(const std::string& label, const Bytes& valid, const std::string& fragment,
+  const Change& change, const Change& late = {})
 {
   const std::string path = Temp + "/changed.resmrp";
   Spill(path, Changed(valid, resmr_fuzz::ResmrpLayout(), change, late));
-  resmr_testing::ExpectError<FileFormatError>(
-    "resmrp " + label, [&] { PropertyFile file(path); }, { path, fragment });
+  resmr_testing::ExpectError<FileFormatError>("resmrp " + label, [&] { PropertyFile file(path); }, { path, fragment });
 }
 
 template<typename T>
@@ -119,15 +108,13 @@ Change Set(std::size_t at, T value)
 template<typename T>
 Change SetRecord(std::size_t record, std::size_t field, T value)
 {
-  return [=](Bytes& file)
-  { Store<T>(file, static_cast<std::size_t>(IndexAt(file)) + record * 192 + field, value); };
+  return [=](Bytes& file) { Store<T>(file, static_cast<std::size_t>(IndexAt(file)) + record * 192 + field, value); };
 }
 
 // .resmr header fields (MultiresolutionFile.cpp, PutHeader).
-constexpr std::size_t Version = 8, HeaderSize = 12, Dims = 16, Box = 40, Origin = 72, Step = 96,
-                      LeafLevel = 120, Cmax = 124, Regions = 128, ModelChunks = 136,
-                      TableSides = 144, OffsetSides = 156, HashedCells = 168, GeometryId = 176,
-                      MapFlags = 184;
+constexpr std::size_t Version = 8, HeaderSize = 12, Dims = 16, Box = 40, Origin = 72, Step = 96, LeafLevel = 120,
+                      Cmax = 124, Regions = 128, ModelChunks = 136, TableSides = 144, OffsetSides = 156,
+                      HashedCells = 168, GeometryId = 176, MapFlags = 184;
 
 void GeometryFields(const Bytes& valid, const std::string& validPath)
 {
@@ -148,43 +135,27 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
   ExpectGeometryRefused("header size", valid, "'header size'", Set<uint32_t>(HeaderSize, 255));
   ExpectGeometryRefused("nx 0", valid, "'dimensions (nx)' is 0", Set<int64_t>(Dims, 0));
   ExpectGeometryRefused("ny -1", valid, "'dimensions (ny)' is -1", Set<int64_t>(Dims + 8, -1));
-  ExpectGeometryRefused(
-    "nz 2^25", valid, "'dimensions (nz)'", Set<int64_t>(Dims + 16, int64_t(1) << 25));
-  ExpectGeometryRefused("nx ny nz 2^24",
-    valid,
-    "'dimensions' is 16777216 x 16777216 x 16777216",
-    [](Bytes& f)
+  ExpectGeometryRefused("nz 2^25", valid, "'dimensions (nz)'", Set<int64_t>(Dims + 16, int64_t(1) << 25));
+  ExpectGeometryRefused("nx ny nz 2^24", valid, "'dimensions' is 16777216 x 16777216 x 16777216", [](Bytes& f) {
+    for (int a = 0; a < 3; ++a)
     {
-      for (int a = 0; a < 3; ++a)
-      {
-        Store<int64_t>(f, Dims + 8 * a, int64_t(1) << 24);
-      }
-    });
+      Store<int64_t>(f, Dims + 8 * a, int64_t(1) << 24);
+    }
+  });
   ExpectGeometryRefused("nz 3 (of 2)", valid, "'model chunk count'", Set<int64_t>(Dims + 16, 3));
   ExpectGeometryRefused("box xmin NaN", valid, "'hierarchy box (x)'", Set<double>(Box, NaN));
-  ExpectGeometryRefused(
-    "box ymax < ymin", valid, "'hierarchy box (y)'", Set<double>(Box + 24, h.box[1] - 1));
-  ExpectGeometryRefused(
-    "box xmax = xmin", valid, "'hierarchy box (x)'", Set<double>(Box + 16, h.box[0]));
-  ExpectGeometryRefused(
-    "origin inf", valid, "'lattice origin (y)'", Set<double>(Origin + 8, Infinity));
-  ExpectGeometryRefused(
-    "depth step 0", valid, "'lattice step (depth)' is 0", Set<double>(Step + 16, 0.0));
+  ExpectGeometryRefused("box ymax < ymin", valid, "'hierarchy box (y)'", Set<double>(Box + 24, h.box[1] - 1));
+  ExpectGeometryRefused("box xmax = xmin", valid, "'hierarchy box (x)'", Set<double>(Box + 16, h.box[0]));
+  ExpectGeometryRefused("origin inf", valid, "'lattice origin (y)'", Set<double>(Origin + 8, Infinity));
+  ExpectGeometryRefused("depth step 0", valid, "'lattice step (depth)' is 0", Set<double>(Step + 16, 0.0));
   ExpectGeometryRefused("x step -1", valid, "'lattice step (x)' is -1", Set<double>(Step, -1.0));
-  ExpectGeometryRefused(
-    "y step NaN", valid, "'lattice step (y)' is nan", Set<double>(Step + 8, NaN));
+  ExpectGeometryRefused("y step NaN", valid, "'lattice step (y)' is nan", Set<double>(Step + 8, NaN));
   ExpectGeometryRefused("x step too fine", valid, "'lattice step (x)'", Set<double>(Step, 1e-300));
-  ExpectGeometryRefused("x step 1e300",
-    valid,
-    "'lattice step (x)' is 1.0000000000000001e+300",
-    Set<double>(Step, 1e300));
-  ExpectGeometryRefused("y step 2000",
-    valid,
-    "'lattice step (y)' is 2000, must be at most",
-    Set<double>(Step + 8, 2000.0));
-  ExpectGeometryRefused("depth step 1e300",
-    valid,
-    "'lattice step (depth)' is 1.0000000000000001e+300, must be at most",
+  ExpectGeometryRefused(
+    "x step 1e300", valid, "'lattice step (x)' is 1.0000000000000001e+300", Set<double>(Step, 1e300));
+  ExpectGeometryRefused(
+    "y step 2000", valid, "'lattice step (y)' is 2000, must be at most", Set<double>(Step + 8, 2000.0));
+  ExpectGeometryRefused("depth step 1e300", valid, "'lattice step (depth)' is 1.0000000000000001e+300, must be at most",
     Set<double>(Step + 16, 1e300));
   ExpectGeometryRefused("leaf level -1", valid, "'leaf level' is -1", Set<int32_t>(LeafLevel, -1));
   ExpectGeometryRefused("leaf level 41", valid, "'leaf level' is 41", Set<int32_t>(LeafLevel, 41));
@@ -195,114 +166,74 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
   ExpectGeometryRefused("region count 0", valid, "'region count' is 0", Set<uint64_t>(Regions, 0));
   ExpectGeometryRefused("region count 7", valid, "'region count'", Set<uint64_t>(Regions, 7));
   ExpectGeometryRefused("region count 5", valid, "'region count'", Set<uint64_t>(Regions, 5));
-  ExpectGeometryRefused("model chunk count + 1",
-    valid,
-    "'model chunk count'",
-    Set<uint64_t>(ModelChunks, h.modelChunkCount + 1));
   ExpectGeometryRefused(
-    "table side 0", valid, "'hash table sides' is 0", Set<uint32_t>(TableSides, 0));
+    "model chunk count + 1", valid, "'model chunk count'", Set<uint64_t>(ModelChunks, h.modelChunkCount + 1));
+  ExpectGeometryRefused("table side 0", valid, "'hash table sides' is 0", Set<uint32_t>(TableSides, 0));
+  ExpectGeometryRefused("table side 4096", valid, "'hash table sides' is 4096", Set<uint32_t>(TableSides + 8, 4096));
+  ExpectGeometryRefused("table side + 1", valid, "hash cell table", Set<uint32_t>(TableSides, h.hashTableSides[0] + 1));
+  ExpectGeometryRefused("offset side 0", valid, "'hash offset sides' is 0", Set<uint32_t>(OffsetSides + 4, 0));
   ExpectGeometryRefused(
-    "table side 4096", valid, "'hash table sides' is 4096", Set<uint32_t>(TableSides + 8, 4096));
-  ExpectGeometryRefused(
-    "table side + 1", valid, "hash cell table", Set<uint32_t>(TableSides, h.hashTableSides[0] + 1));
-  ExpectGeometryRefused(
-    "offset side 0", valid, "'hash offset sides' is 0", Set<uint32_t>(OffsetSides + 4, 0));
-  ExpectGeometryRefused("offset side + 1",
-    valid,
-    "hash offset table",
-    Set<uint32_t>(OffsetSides, h.hashOffsetSides[0] + 1));
-  ExpectGeometryRefused(
-    "hashed cells 0", valid, "'hashed cells' is 0", Set<uint64_t>(HashedCells, 0));
-  ExpectGeometryRefused(
-    "hashed cells > slots", valid, "'hashed cells'", Set<uint64_t>(HashedCells, slots + 1));
-  ExpectGeometryRefused(
-    "geometry id", valid, "'geometry id'", {}, Set<uint64_t>(GeometryId, h.geometryId ^ 1));
+    "offset side + 1", valid, "hash offset table", Set<uint32_t>(OffsetSides, h.hashOffsetSides[0] + 1));
+  ExpectGeometryRefused("hashed cells 0", valid, "'hashed cells' is 0", Set<uint64_t>(HashedCells, 0));
+  ExpectGeometryRefused("hashed cells > slots", valid, "'hashed cells'", Set<uint64_t>(HashedCells, slots + 1));
+  ExpectGeometryRefused("geometry id", valid, "'geometry id'", {}, Set<uint64_t>(GeometryId, h.geometryId ^ 1));
   ExpectGeometryRefused("map flags", valid, "map placement", Set<uint32_t>(MapFlags, 4));
-  ExpectGeometryRefused("trailer reserved",
-    valid,
-    "(reserved) are not zero",
-    {},
-    [](Bytes& f) { Store<uint32_t>(f, f.size() - 12, 1); });
+  ExpectGeometryRefused(
+    "trailer reserved", valid, "(reserved) are not zero", {}, [](Bytes& f) { Store<uint32_t>(f, f.size() - 12, 1); });
 
   // Index records: level 4, reserved 4, index 8, columns 8, active cells 8, vertices 8,
   // bounds 6 floats, error, own error, two cones of 4 floats, four chunk references.
-  ExpectGeometryRefused(
-    "record level", valid, "level or region index", SetRecord<int32_t>(0, 0, 2));
+  ExpectGeometryRefused("record level", valid, "level or region index", SetRecord<int32_t>(0, 0, 2));
   ExpectGeometryRefused("record reserved", valid, "reserved bytes", SetRecord<int32_t>(0, 4, 7));
   ExpectGeometryRefused("record padding", valid, "reserved bytes", SetRecord<uint8_t>(0, 190, 1));
-  ExpectGeometryRefused(
-    "record index", valid, "level or region index", SetRecord<int64_t>(0, 8, 4));
+  ExpectGeometryRefused("record index", valid, "level or region index", SetRecord<int64_t>(0, 8, 4));
   ExpectGeometryRefused("record columns 0", valid, "0 columns", SetRecord<int64_t>(0, 16, 0));
-  ExpectGeometryRefused(
-    "record active cells", valid, "-1 active cells", SetRecord<int64_t>(0, 24, -1));
+  ExpectGeometryRefused("record active cells", valid, "-1 active cells", SetRecord<int64_t>(0, 24, -1));
   ExpectGeometryRefused("record vertices", valid, "7 vertices", SetRecord<int64_t>(0, 32, 7));
-  ExpectGeometryRefused(
-    "record bounds NaN", valid, "bounding volume", SetRecord<float>(1, 40, NAN));
-  ExpectGeometryRefused(
-    "record bounds empty", valid, "bounding volume", SetRecord<float>(1, 48, 1e30f));
+  ExpectGeometryRefused("record bounds NaN", valid, "bounding volume", SetRecord<float>(1, 40, NAN));
+  ExpectGeometryRefused("record bounds empty", valid, "bounding volume", SetRecord<float>(1, 48, 1e30f));
   ExpectGeometryRefused("record error", valid, "error -1", SetRecord<float>(2, 64, -1.0f));
-  ExpectGeometryRefused(
-    "record own error", valid, "own error inf", SetRecord<float>(2, 68, INFINITY));
+  ExpectGeometryRefused("record own error", valid, "own error inf", SetRecord<float>(2, 68, INFINITY));
   ExpectGeometryRefused("record cone", valid, "normal cone", SetRecord<float>(3, 72 + 12, 3.0f));
-  ExpectGeometryRefused("record cone axis",
-    valid,
-    "normal cone",
-    [](Bytes& f)
+  ExpectGeometryRefused("record cone axis", valid, "normal cone", [](Bytes& f) {
+    const std::size_t at = static_cast<std::size_t>(IndexAt(f)) + 3 * 192 + 88; // the bottom cone
+    if (Load<float>(f, at + 12) == -2.0f)
     {
-      const std::size_t at = static_cast<std::size_t>(IndexAt(f)) + 3 * 192 + 88; // the bottom cone
-      if (Load<float>(f, at + 12) == -2.0f)
-      {
-        Store<float>(f, at + 12, 0.5f);
-      }
-      Store<float>(f, at + 8, Load<float>(f, at + 8) + 0.5f);
-    });
+      Store<float>(f, at + 12, 0.5f);
+    }
+    Store<float>(f, at + 8, Load<float>(f, at + 8) + 0.5f);
+  });
+  ExpectGeometryRefused("record chunk offset", valid, "mesh at byte", SetRecord<uint64_t>(0, 104, 1u << 30));
   ExpectGeometryRefused(
-    "record chunk offset", valid, "mesh at byte", SetRecord<uint64_t>(0, 104, 1u << 30));
-  ExpectGeometryRefused("record chunk raw",
-    valid,
-    "cannot decompress",
-    SetRecord<uint32_t>(0, 104 + 20 + 12, 1u << 30));
-  ExpectGeometryRefused("record duplicate",
-    valid,
-    "a second record",
-    [](Bytes& f)
-    {
-      const std::size_t index = static_cast<std::size_t>(IndexAt(f));
-      std::memcpy(&f[index + 192], &f[index], 16);
-    });
+    "record chunk raw", valid, "cannot decompress", SetRecord<uint32_t>(0, 104 + 20 + 12, 1u << 30));
+  ExpectGeometryRefused("record duplicate", valid, "a second record", [](Bytes& f) {
+    const std::size_t index = static_cast<std::size_t>(IndexAt(f));
+    std::memcpy(&f[index + 192], &f[index], 16);
+  });
 
   // Model chunk records (after the regions, 32 bytes each: kind, part, reference, reserved).
   const std::size_t model = 6 * 192;
-  const auto setModel = [&](std::size_t record, std::size_t field, uint32_t value) -> Change
-  {
-    return [=](Bytes& f) {
-      Store<uint32_t>(f, static_cast<std::size_t>(IndexAt(f)) + model + record * 32 + field, value);
-    };
+  const auto setModel = [&](std::size_t record, std::size_t field, uint32_t value) -> Change {
+    return
+      [=](Bytes& f) { Store<uint32_t>(f, static_cast<std::size_t>(IndexAt(f)) + model + record * 32 + field, value); };
   };
   ExpectGeometryRefused("model kind", valid, "unknown kind", setModel(0, 0, 9));
   ExpectGeometryRefused("model reserved", valid, "reserved bytes set", setModel(0, 28, 1));
   ExpectGeometryRefused("model layer", valid, "no such layer", setModel(0, 4, 5));
   ExpectGeometryRefused("model layer twice", valid, "a second chunk", setModel(1, 4, 0));
-  ExpectGeometryRefused(
-    "model layer size", valid, "active flags part 0: 11 bytes", setModel(0, 20, 11));
+  ExpectGeometryRefused("model layer size", valid, "active flags part 0: 11 bytes", setModel(0, 20, 11));
 }
 
 /// The geometry file with the change opens, but region `region` is refused when read, naming
 /// the file, the region and `fragment`; every other region still reads.
-void ExpectRegionRefused(const std::string& label,
-  const Bytes& file,
-  std::size_t region,
-  const std::string& fragment)
+void ExpectRegionRefused(const std::string& label, const Bytes& file, std::size_t region, const std::string& fragment)
 {
   const std::string path = Temp + "/region.resmr";
   Spill(path, file);
   const MultiresolutionFile opened(path);
   const auto& record = opened.Regions()[region];
-  resmr_testing::ExpectError<FileFormatError>("region " + label,
-    [&] { opened.ReadRegion(region); },
-    { path,
-      "region (level " + std::to_string(record.level) + ", index " + std::to_string(record.index) +
-        ")",
+  resmr_testing::ExpectError<FileFormatError>("region " + label, [&] { opened.ReadRegion(region); },
+    { path, "region (level " + std::to_string(record.level) + ", index " + std::to_string(record.index) + ")",
       fragment });
   for (std::size_t r = 0; r < opened.Regions().size(); ++r)
   {
@@ -318,10 +249,8 @@ void ExpectRegionRefused(const std::string& label,
 void RegionContents(const Bytes& valid)
 {
   const auto layout = resmr_fuzz::ResmrLayout();
-  ExpectRegionRefused("active cells",
-    Changed(valid, layout, SetRecord<int64_t>(1, 24, 0)),
-    1,
-    "active cells, the index says 0");
+  ExpectRegionRefused(
+    "active cells", Changed(valid, layout, SetRecord<int64_t>(1, 24, 0)), 1, "active cells, the index says 0");
   Bytes unpacked = resmr_fuzz::UnpackChunks(valid, layout);
   const std::size_t record = static_cast<std::size_t>(IndexAt(unpacked)) + 2 * 192;
   const uint64_t mesh = Load<uint64_t>(unpacked, record + 104);
@@ -329,13 +258,11 @@ void RegionContents(const Bytes& valid)
   // The mesh chunk ends with one byte of cut edges a column (bits 0-3).
   Bytes cut = unpacked;
   cut[static_cast<std::size_t>(mesh + meshBytes - 1)] = 0x10;
-  ExpectRegionRefused(
-    "cut edges", resmr_fuzz::Repair(cut.data(), cut.size(), layout), 2, "cut edges 16 of column");
+  ExpectRegionRefused("cut edges", resmr_fuzz::Repair(cut.data(), cut.size(), layout), 2, "cut edges 16 of column");
   // Its magic (MESH), then the layer count.
   Bytes layers = unpacked;
   Store<uint32_t>(layers, static_cast<std::size_t>(mesh + 4), 3);
-  ExpectRegionRefused(
-    "layers", resmr_fuzz::Repair(layers.data(), layers.size(), layout), 2, "3 layers");
+  ExpectRegionRefused("layers", resmr_fuzz::Repair(layers.data(), layers.size(), layout), 2, "3 layers");
   // Unchanged, the unpacked form packs into a file that reads as the original.
   const Bytes repacked = resmr_fuzz::Repair(unpacked.data(), unpacked.size(), layout);
   Spill(Temp + "/repacked.resmr", repacked);
@@ -349,9 +276,7 @@ void RegionContents(const Bytes& valid)
 // .resmrp header fields (PropertyFile.cpp, HeaderOf).
 constexpr std::size_t PVersion = 8, PDims = 20, PSides = 44, PTables = 56;
 
-void PropertyFields(const Bytes& valid,
-  const std::string& validPath,
-  const std::string& geometryPath)
+void PropertyFields(const Bytes& valid, const std::string& validPath, const std::string& geometryPath)
 {
   {
     const Bytes same = Changed(valid, resmr_fuzz::ResmrpLayout(), [](Bytes&) {});
@@ -372,80 +297,51 @@ void PropertyFields(const Bytes& valid,
   ExpectPropertiesRefused("tables - 1", valid, "'table count'", Set<uint32_t>(PTables, tables - 1));
   ExpectPropertiesRefused("nx 0", valid, "'dimensions (nx)' is 0", Set<int64_t>(PDims, 0));
   ExpectPropertiesRefused("ny -3", valid, "'dimensions (ny)' is -3", Set<int64_t>(PDims + 8, -3));
-  ExpectPropertiesRefused(
-    "nz 2^25", valid, "'dimensions (nz)'", Set<int64_t>(PDims + 16, int64_t(1) << 25));
+  ExpectPropertiesRefused("nz 2^25", valid, "'dimensions (nz)'", Set<int64_t>(PDims + 16, int64_t(1) << 25));
   ExpectPropertiesRefused("nz 3 (of 2)", valid, "'table count'", Set<int64_t>(PDims + 16, 3));
-  ExpectPropertiesRefused("nx ny 2^24",
-    valid,
-    "'dimensions' is 16777216 x 16777216",
-    [](Bytes& f) {
-      Store<int64_t>(f, PDims, int64_t(1) << 24), Store<int64_t>(f, PDims + 8, int64_t(1) << 24);
-    });
+  ExpectPropertiesRefused("nx ny 2^24", valid, "'dimensions' is 16777216 x 16777216",
+    [](Bytes& f) { Store<int64_t>(f, PDims, int64_t(1) << 24), Store<int64_t>(f, PDims + 8, int64_t(1) << 24); });
   ExpectPropertiesRefused("side 0", valid, "'hash table sides' is 0", Set<uint32_t>(PSides + 4, 0));
-  ExpectPropertiesRefused(
-    "side 4096", valid, "'hash table sides' is 4096", Set<uint32_t>(PSides, 4096));
-  ExpectPropertiesRefused("sides 2048^3",
-    valid,
-    "at most 2^30 slots",
-    [](Bytes& f)
+  ExpectPropertiesRefused("side 4096", valid, "'hash table sides' is 4096", Set<uint32_t>(PSides, 4096));
+  ExpectPropertiesRefused("sides 2048^3", valid, "at most 2^30 slots", [](Bytes& f) {
+    for (int a = 0; a < 3; ++a)
     {
-      for (int a = 0; a < 3; ++a)
-      {
-        Store<uint32_t>(f, PSides + 4 * a, 2048);
-      }
-    });
-  ExpectPropertiesRefused("side + 1",
-    valid,
-    "packed table of",
-    [&](Bytes& f) { Store<uint32_t>(f, PSides, Load<uint32_t>(f, PSides) + 1); });
+      Store<uint32_t>(f, PSides + 4 * a, 2048);
+    }
+  });
+  ExpectPropertiesRefused(
+    "side + 1", valid, "packed table of", [&](Bytes& f) { Store<uint32_t>(f, PSides, Load<uint32_t>(f, PSides) + 1); });
   ExpectPropertiesRefused("reserved", valid, "'reserved bytes'", Set<uint8_t>(100, 1));
   // Index: name 32, step, report, days, minimum, maximum, then the references.
   ExpectPropertiesRefused("name empty", valid, "the name is not", setTable(0, 0, uint8_t(0)));
   ExpectPropertiesRefused("name control", valid, "the name is not", setTable(0, 1, uint8_t(7)));
-  ExpectPropertiesRefused("name unterminated",
-    valid,
-    "the name is not",
+  ExpectPropertiesRefused("name unterminated", valid, "the name is not",
     [&](Bytes& f) { std::memset(&f[static_cast<std::size_t>(index)], 'A', 32); });
   ExpectPropertiesRefused("name padding", valid, "NUL-padded", setTable(0, 31, uint8_t('x')));
   ExpectPropertiesRefused("step -5", valid, "step -5", setTable(0, 32, int32_t(-5)));
   ExpectPropertiesRefused("report -1", valid, "report -1", setTable(tables - 1, 36, int32_t(-1)));
   ExpectPropertiesRefused("days NaN", valid, "day", setTable(tables - 1, 40, NaN));
-  ExpectPropertiesRefused("static with days",
-    valid,
-    "day",
-    [&](Bytes& f)
+  ExpectPropertiesRefused("static with days", valid, "day", [&](Bytes& f) {
+    for (uint32_t t = 0; t < tables; ++t)
     {
-      for (uint32_t t = 0; t < tables; ++t)
+      if (Load<int32_t>(f, static_cast<std::size_t>(index + t * table + 32)) < 0)
       {
-        if (Load<int32_t>(f, static_cast<std::size_t>(index + t * table + 32)) < 0)
-        {
-          Store<double>(f, static_cast<std::size_t>(index + t * table + 40), 3.0);
-          return;
-        }
+        Store<double>(f, static_cast<std::size_t>(index + t * table + 40), 3.0);
+        return;
       }
-    });
-  ExpectPropertiesRefused("range reversed",
-    valid,
-    "value range",
-    [&](Bytes& f)
-    {
-      Store<float>(f, static_cast<std::size_t>(index + 48), 5.0f);
-      Store<float>(f, static_cast<std::size_t>(index + 52), 1.0f);
-    });
+    }
+  });
+  ExpectPropertiesRefused("range reversed", valid, "value range", [&](Bytes& f) {
+    Store<float>(f, static_cast<std::size_t>(index + 48), 5.0f);
+    Store<float>(f, static_cast<std::size_t>(index + 52), 1.0f);
+  });
   ExpectPropertiesRefused("range half NaN", valid, "value range", setTable(1, 48, NAN));
-  ExpectPropertiesRefused(
-    "packed raw", valid, "packed table of", setTable(0, 56 + 12, uint32_t(12)));
+  ExpectPropertiesRefused("packed raw", valid, "packed table of", setTable(0, 56 + 12, uint32_t(12)));
   ExpectPropertiesRefused("layer raw", valid, "layer 2 of", setTable(0, 56 + 40 + 12, uint32_t(8)));
-  ExpectPropertiesRefused(
-    "layer offset", valid, "layer 1 at byte", setTable(0, 56 + 20, uint64_t(1) << 40));
-  ExpectPropertiesRefused("duplicate table",
-    valid,
-    "a second table",
-    [&](Bytes& f)
-    {
-      std::memcpy(
-        &f[static_cast<std::size_t>(index + table)], &f[static_cast<std::size_t>(index)], 48);
-    });
+  ExpectPropertiesRefused("layer offset", valid, "layer 1 at byte", setTable(0, 56 + 20, uint64_t(1) << 40));
+  ExpectPropertiesRefused("duplicate table", valid, "a second table", [&](Bytes& f) {
+    std::memcpy(&f[static_cast<std::size_t>(index + table)], &f[static_cast<std::size_t>(index)], 48);
+  });
 
   // Valid on its own, but made for another grid: refused against the geometry.
   const std::string other = Temp + "/other-grid.resmrp";
@@ -465,8 +361,7 @@ void ToolRefusesFlatModel(const Bytes& valid)
   const Bytes text = Slurp(report);
   const std::string message(text.begin(), text.end());
   CHECK(message.find(flat) != std::string::npos);
-  CHECK(
-    message.find("'lattice step (depth)' is 0, must be positive and finite") != std::string::npos);
+  CHECK(message.find("'lattice step (depth)' is 0, must be positive and finite") != std::string::npos);
   std::fprintf(stderr, "%s", message.c_str());
 }
 } // namespace
@@ -484,12 +379,10 @@ int main(int argc, char** argv)
   const std::string egrid = Temp + "/synth.EGRID", geometry = Temp + "/synth.resmr",
                     properties = Temp + "/synth.resmrp";
   // 9 x 8 x 2 cells, Cmax 16: two levels, 6 regions; one report step.
-  CHECK(Run("'" + Tool + "' synth 9 8 2 --seed 11 --steps 1 -o '" + egrid +
-            "' --quiet > /dev/null") == 0);
-  CHECK(Run("'" + Tool + "' build '" + egrid + "' -o '" + geometry +
-            "' --cmax 16 --quiet > /dev/null") == 0);
+  CHECK(Run("'" + Tool + "' synth 9 8 2 --seed 11 --steps 1 -o '" + egrid + "' --quiet > /dev/null") == 0);
+  CHECK(Run("'" + Tool + "' build '" + egrid + "' -o '" + geometry + "' --cmax 16 --quiet > /dev/null") == 0);
   CHECK(Run("'" + Tool + "' add-properties '" + geometry + "' '" + egrid + "' -o '" + properties +
-            "' > /dev/null 2>&1") == 0);
+          "' > /dev/null 2>&1") == 0);
   const Bytes validGeometry = Slurp(geometry), validProperties = Slurp(properties);
   CHECK(validGeometry.size() > 1000 && validProperties.size() > 1000);
   if (resmr_testing::Failures > 0)
@@ -499,8 +392,7 @@ int main(int argc, char** argv)
   const bool ok = resmr_testing::RunNamedTests({
     { "geometry header and index fields", [&] { GeometryFields(validGeometry, geometry); } },
     { "region decoder against the index", [&] { RegionContents(validGeometry); } },
-    { "property header and index fields",
-      [&] { PropertyFields(validProperties, properties, geometry); } },
+    { "property header and index fields", [&] { PropertyFields(validProperties, properties, geometry); } },
     { "resmr info refuses a flat lattice", [&] { ToolRefusesFlatModel(validGeometry); } },
   });
   return ok ? 0 : 1;

@@ -78,14 +78,11 @@ PerfectSpatialHash CheckPerfect(const char* label, const Cells& cells)
   const PerfectSpatialHash::Sides m = hash.tableSides, r = hash.offsetSides;
   for (int a = 0; a < 3; ++a)
   {
-    CHECK(m[a] >= 1 && r[a] >= 1 && m[a] <= PerfectSpatialHash::MaxSide &&
-          r[a] <= PerfectSpatialHash::MaxSide);
+    CHECK(m[a] >= 1 && r[a] >= 1 && m[a] <= PerfectSpatialHash::MaxSide && r[a] <= PerfectSpatialHash::MaxSide);
   }
   CHECK(hash.TableSize() == uint64_t(m[0]) * m[1] * m[2] && hash.TableSize() >= cells.size());
-  CHECK(hash.offsets.size() == uint64_t(r[0]) * r[1] * r[2] &&
-        hash.OffsetTableSize() == hash.offsets.size());
-  CHECK(std::all_of(hash.offsets.begin(),
-    hash.offsets.end(),
+  CHECK(hash.offsets.size() == uint64_t(r[0]) * r[1] * r[2] && hash.OffsetTableSize() == hash.offsets.size());
+  CHECK(std::all_of(hash.offsets.begin(), hash.offsets.end(),
     [m](const std::array<uint16_t, 3>& o) { return o[0] < m[0] && o[1] < m[1] && o[2] < m[2]; }));
   const std::vector<uint64_t> slots = CellSlots(hash, cells);
   CHECK(slots.size() == cells.size());
@@ -103,25 +100,14 @@ PerfectSpatialHash CheckPerfect(const char* label, const Cells& cells)
   for (std::size_t n = 0; n < cells.size(); n += 1 + cells.size() / 1000)
   {
     const auto& p = cells[n];
-    const auto& phi =
-      hash.offsets[p[0] % r[0] + uint64_t(r[0]) * (p[1] % r[1] + uint64_t(r[1]) * (p[2] % r[2]))];
+    const auto& phi = hash.offsets[p[0] % r[0] + uint64_t(r[0]) * (p[1] % r[1] + uint64_t(r[1]) * (p[2] % r[2]))];
     const uint64_t x = (p[0] % m[0] + phi[0]) % m[0], y = (p[1] % m[1] + phi[1]) % m[1],
                    z = (p[2] % m[2] + phi[2]) % m[2];
     CHECK(slots[n] == x + m[0] * (y + uint64_t(m[1]) * z));
   }
-  std::printf(
-    "%-22s %9zu cells: m %4ux%4ux%4u (fill %.3f), r %3ux%3ux%3u (r / cells %.3f), %u tries\n",
-    label,
-    cells.size(),
-    m[0],
-    m[1],
-    m[2],
-    cells.empty() ? 0.0 : double(cells.size()) / double(hash.TableSize()),
-    r[0],
-    r[1],
-    r[2],
-    cells.empty() ? 0.0 : double(hash.OffsetTableSize()) / double(cells.size()),
-    hash.attempts);
+  std::printf("%-22s %9zu cells: m %4ux%4ux%4u (fill %.3f), r %3ux%3ux%3u (r / cells %.3f), %u tries\n", label,
+    cells.size(), m[0], m[1], m[2], cells.empty() ? 0.0 : double(cells.size()) / double(hash.TableSize()), r[0], r[1],
+    r[2], cells.empty() ? 0.0 : double(hash.OffsetTableSize()) / double(cells.size()), hash.attempts);
   return hash;
 }
 
@@ -145,14 +131,13 @@ void TestPerfectHash()
   // Thin and small shells, as real models' touched cells are (a few layers: SPE1 10x10x3,
   // Brugge 139x48x9): the packed-texture target, 1.25 x the cells, holds. Cubic tables gave
   // 1.3-1.5 here.
-  const std::array<uint32_t, 3> thinShells[] = {
-    { 10, 10, 3 }, { 139, 48, 9 }, { 60, 48, 6 }, { 24, 25, 15 }, { 400, 90, 4 }, { 7, 5, 2 }
-  };
+  const std::array<uint32_t, 3> thinShells[] = { { 10, 10, 3 }, { 139, 48, 9 }, { 60, 48, 6 }, { 24, 25, 15 },
+    { 400, 90, 4 }, { 7, 5, 2 } };
   for (const auto& dims : thinShells)
   {
     const Cells thin = Shell(dims[0], dims[1], dims[2]);
-    const std::string label = "shell " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) +
-                              "x" + std::to_string(dims[2]);
+    const std::string label =
+      "shell " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" + std::to_string(dims[2]);
     const PerfectSpatialHash thinHash = CheckPerfect(label.c_str(), thin);
     CHECK(double(thinHash.TableSize()) <= 1.25 * double(thin.size()));
     CHECK(double(thinHash.OffsetTableSize()) <= 0.4 * double(thin.size()));
@@ -171,8 +156,7 @@ void TestPerfectHash()
   }
   const PerfectSpatialHash lineHash = CheckPerfect("line of 1000", line);
   CHECK(lineHash.TableSize() == 1000); // the line's box itself
-  CheckPerfect(
-    "far apart", { { 4294967295u, 0, 0 }, { 0, 4294967295u, 4294967295u }, { 123, 456, 789 } });
+  CheckPerfect("far apart", { { 4294967295u, 0, 0 }, { 0, 4294967295u, 4294967295u }, { 123, 456, 789 } });
 
   const PerfectSpatialHash single = CheckPerfect("single cell", { { 5, 6, 7 } });
   CHECK(single.TableSize() == 1 && single.Slot(5, 6, 7) == 0);
@@ -182,11 +166,10 @@ void TestPerfectHash()
   // Deterministic and independent of the input order.
   Cells shuffled = shell;
   std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937_64(5));
-  const PerfectSpatialHash again = BuildPerfectSpatialHash(shell),
-                           other = BuildPerfectSpatialHash(shuffled);
+  const PerfectSpatialHash again = BuildPerfectSpatialHash(shell), other = BuildPerfectSpatialHash(shuffled);
   CHECK(again.offsets == shellHash.offsets && again.tableSides == shellHash.tableSides);
   CHECK(other.offsets == shellHash.offsets && other.tableSides == shellHash.tableSides &&
-        other.offsetSides == shellHash.offsetSides);
+    other.offsetSides == shellHash.offsetSides);
 
   // A cell listed twice is named 1-based, whether found while packing or while separating.
   Cells twice = Box(6, 5, 4);
@@ -214,8 +197,7 @@ void TestNormals()
   bool signKept = true, unit = true;
   for (int n = 0; n < 120000; ++n)
   {
-    const double x = gauss(random), y = gauss(random),
-                 z = gauss(random) * (n % 4 == 0 ? 1e-3 : 1.0);
+    const double x = gauss(random), y = gauss(random), z = gauss(random) * (n % 4 == 0 ? 1e-3 : 1.0);
     const std::array<float, 3> d = DecodeUnitNormal(EncodeUnitNormal(x, y, z));
     worst = std::max(worst, AngleDegrees(d, x, y, z));
     signKept = signKept && !(z > 0 && d[2] < 0) && !(z < 0 && d[2] > 0);
@@ -225,14 +207,11 @@ void TestNormals()
   CHECK(worst <= boundDegrees && worst > 0.3); // > 0.3: the test reaches the worst case's order
   CHECK(signKept && unit);
   // The axes come back exactly; zero and non-finite input give +z (code 0).
-  const double axes[6][3] = {
-    { 1, 0, 0 }, { -1, 0, 0 }, { 0, 1, 0 }, { 0, -1, 0 }, { 0, 0, 1 }, { 0, 0, -1 }
-  };
+  const double axes[6][3] = { { 1, 0, 0 }, { -1, 0, 0 }, { 0, 1, 0 }, { 0, -1, 0 }, { 0, 0, 1 }, { 0, 0, -1 } };
   for (const auto& a : axes)
   {
     const std::array<float, 3> d = DecodeUnitNormal(EncodeUnitNormal(3 * a[0], 3 * a[1], 3 * a[2]));
-    CHECK(
-      std::abs(d[0] - a[0]) < 1e-6 && std::abs(d[1] - a[1]) < 1e-6 && std::abs(d[2] - a[2]) < 1e-6);
+    CHECK(std::abs(d[0] - a[0]) < 1e-6 && std::abs(d[1] - a[1]) < 1e-6 && std::abs(d[2] - a[2]) < 1e-6);
   }
   CHECK(EncodeUnitNormal(0, 0, 0) == 0 && EncodeUnitNormal(std::nan(""), 1, 0) == 0);
   const std::array<float, 3> up = DecodeUnitNormal(0);

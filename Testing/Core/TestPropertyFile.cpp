@@ -76,9 +76,7 @@ std::size_t StepTables(const std::vector<std::string>& names)
   return names.size() + (water && !oil ? 1 : 0);
 }
 
-int CheckTables(const MultiresolutionFile& geometry,
-  const PropertyFile& properties,
-  const EclipseGrid& grid,
+int CheckTables(const MultiresolutionFile& geometry, const PropertyFile& properties, const EclipseGrid& grid,
   const EclipseResults& results)
 {
   const auto& dims = geometry.Header().dims;
@@ -95,9 +93,8 @@ int CheckTables(const MultiresolutionFile& geometry,
   {
     const PropertyTable& table = properties.Tables()[t];
     bool found = table.step < 0
-                   ? results.ReadStatic<float>(table.name, expected.data(), none)
-                   : results.ReadDynamic<float>(
-                       static_cast<std::size_t>(table.step), table.name, expected.data(), none);
+      ? results.ReadStatic<float>(table.name, expected.data(), none)
+      : results.ReadDynamic<float>(static_cast<std::size_t>(table.step), table.name, expected.data(), none);
     if (!found && table.name == "SOIL" && table.step >= 0)
     {
       found = DerivedOil(results, static_cast<std::size_t>(table.step), expected);
@@ -123,8 +120,7 @@ int CheckTables(const MultiresolutionFile& geometry,
       {
         continue;
       }
-      const uint32_t i = uint32_t(n % uint64_t(dims[0])),
-                     j = uint32_t(n / uint64_t(dims[0]) % uint64_t(dims[1])),
+      const uint32_t i = uint32_t(n % uint64_t(dims[0])), j = uint32_t(n / uint64_t(dims[0]) % uint64_t(dims[1])),
                      k = uint32_t(n / uint64_t(layer));
       // What a shader does: the cell's slot from the hash, then the packed value there.
       const float got = packed[static_cast<std::size_t>(hash.Slot(i, j, k))];
@@ -145,15 +141,13 @@ int CheckTables(const MultiresolutionFile& geometry,
         {
           continue;
         }
-        const int64_t steps =
-          std::llabs(c % dims[0] - int64_t(i)) + std::llabs(c / dims[0] - int64_t(j));
+        const int64_t steps = std::llabs(c % dims[0] - int64_t(i)) + std::llabs(c / dims[0] - int64_t(j));
         if (steps < best)
         {
           best = steps;
           matches = false;
         }
-        matches =
-          matches || (steps == best && SameValue(got, expected[static_cast<std::size_t>(other)]));
+        matches = matches || (steps == best && SameValue(got, expected[static_cast<std::size_t>(other)]));
       }
       wrong += best == std::numeric_limits<int64_t>::max() ? !std::isnan(got) : !matches;
     }
@@ -162,23 +156,19 @@ int CheckTables(const MultiresolutionFile& geometry,
       const std::vector<float> values = properties.ReadLayer(t, k);
       for (int64_t c = 0; c < layer; ++c)
       {
-        wrong += !SameValue(
-          values[static_cast<std::size_t>(c)], expected[static_cast<std::size_t>(k * layer + c)]);
+        wrong += !SameValue(values[static_cast<std::size_t>(c)], expected[static_cast<std::size_t>(k * layer + c)]);
       }
     }
     if (wrong)
     {
-      std::fprintf(stderr,
-        "%s step %d: %lld values differ\n",
-        table.name.c_str(),
-        table.step,
-        static_cast<long long>(wrong));
+      std::fprintf(
+        stderr, "%s step %d: %lld values differ\n", table.name.c_str(), table.step, static_cast<long long>(wrong));
     }
     CHECK(wrong == 0);
     ++checked;
   }
-  std::printf("%lld inactive cells' slots checked against their nearest active cell\n",
-    static_cast<long long>(inactiveSlots));
+  std::printf(
+    "%lld inactive cells' slots checked against their nearest active cell\n", static_cast<long long>(inactiveSlots));
   return checked;
 }
 /// The number after `"key": ` in a JSON line, or -1.
@@ -192,12 +182,8 @@ long long JsonNumber(const std::string& json, const std::string& key)
 /// add-properties writes the complete steps and reports the cut one (exit 0); run again, it
 /// adds only the steps completed since and keeps the others; every table equals the whole
 /// run's. Nothing readable at all is an error.
-void GrowingRun(const std::string& resmrTool,
-  const std::string& egrid,
-  const std::string& geometryPath,
-  const std::string& temp,
-  const EclipseGrid& grid,
-  const EclipseResults& whole)
+void GrowingRun(const std::string& resmrTool, const std::string& egrid, const std::string& geometryPath,
+  const std::string& temp, const EclipseGrid& grid, const EclipseResults& whole)
 {
   const std::string folder = temp + "/reek-run", stem = "/2_R001_REEK-0";
   const std::string source = egrid.substr(0, egrid.size() - 6);
@@ -224,14 +210,13 @@ void GrowingRun(const std::string& resmrTool,
   {
     return;
   }
-  const auto writeRestart = [&](int64_t size)
-  {
+  const auto writeRestart = [&](int64_t size) {
     std::ofstream out(folder + stem + ".UNRST", std::ios::binary | std::ios::trunc);
     out.write(unrst.data(), static_cast<std::streamsize>(size));
   };
   const std::string output = folder + "/out.json", errors = folder + "/err.txt";
-  const std::string command = resmrTool + " add-properties '" + geometryPath + "' '" + run +
-                              "' -o '" + properties + "' > '" + output + "' 2> '" + errors + "'";
+  const std::string command = resmrTool + " add-properties '" + geometryPath + "' '" + run + "' -o '" + properties +
+    "' > '" + output + "' 2> '" + errors + "'";
 
   // No INIT and an empty restart: nothing readable, an error.
   writeRestart(0);
@@ -239,8 +224,7 @@ void GrowingRun(const std::string& resmrTool,
   CHECK(Slurp(errors).find("no property found") != std::string::npos);
 
   CHECK(symlink((source + ".INIT").c_str(), (folder + stem + ".INIT").c_str()) == 0);
-  const std::size_t names = StepTables(whole.Steps()[0].names),
-                    statics = whole.StaticArrays().size();
+  const std::size_t names = StepTables(whole.Steps()[0].names), statics = whole.StaticArrays().size();
   const struct
   {
     int64_t size;
@@ -260,24 +244,19 @@ void GrowingRun(const std::string& resmrTool,
     CHECK(Run(resmrTool + " info '" + run + "' > '" + output + "' 2> '" + errors + "'") == 0);
     const std::string info = Slurp(output);
     std::size_t offered = 0;
-    for (std::size_t at = info.find("\"days\": "); at != std::string::npos;
-         at = info.find("\"days\": ", at + 1))
+    for (std::size_t at = info.find("\"days\": "); at != std::string::npos; at = info.find("\"days\": ", at + 1))
     {
       ++offered;
     }
     CHECK(offered == stage.complete);
-    const std::string leftOut =
-      cut ? "\"steps_left_out\": [{\"file\": \"" + folder + stem + ".UNRST\", \"report\": " +
-              // (-1 while the cut step's SEQNUM record is not whole)
-              std::to_string(stage.size >= starts[stage.complete] + 36
-                               ? whole.Steps()[stage.complete].reportNumber
-                               : -1) +
-              ", \"offset\": "
-          : std::string("\"steps_left_out\": []");
+    const std::string leftOut = cut ? "\"steps_left_out\": [{\"file\": \"" + folder + stem + ".UNRST\", \"report\": " +
+        // (-1 while the cut step's SEQNUM record is not whole)
+        std::to_string(stage.size >= starts[stage.complete] + 36 ? whole.Steps()[stage.complete].reportNumber : -1) +
+        ", \"offset\": "
+                                    : std::string("\"steps_left_out\": []");
     CHECK(info.find(leftOut) != std::string::npos);
     // The INIT's arrays are read again each time; only the new steps' arrays are added.
-    CHECK(JsonNumber(json, "tables_added") ==
-          static_cast<long long>(statics + (stage.complete - before) * names));
+    CHECK(JsonNumber(json, "tables_added") == static_cast<long long>(statics + (stage.complete - before) * names));
     CHECK(JsonNumber(json, "tables_kept") == static_cast<long long>(before * names));
     const MultiresolutionFile geometry(geometryPath);
     const PropertyFile written(properties);
@@ -322,14 +301,12 @@ int main(int argc, char** argv)
   const std::string deck = data + "/spe9/opm-data_deck/SPE9_CP.DATA";
   const std::string geometryPath = temp + "/spe9.resmr", propertyPath = temp + "/spe9.resmrp";
   std::remove(propertyPath.c_str());
-  CHECK(
-    Run(resmrTool + " build '" + egrid + "' -o '" + geometryPath + "' --quiet > /dev/null") == 0);
+  CHECK(Run(resmrTool + " build '" + egrid + "' -o '" + geometryPath + "' --quiet > /dev/null") == 0);
   const std::string before = Slurp(geometryPath);
   CHECK(before.size() > 1000);
 
   // Every INIT array and every array of every step.
-  CHECK(Run(resmrTool + " add-properties '" + geometryPath + "' '" + egrid +
-            "' > /dev/null 2>&1") == 0);
+  CHECK(Run(resmrTool + " add-properties '" + geometryPath + "' '" + egrid + "' > /dev/null 2>&1") == 0);
   CHECK(Slurp(geometryPath) == before); // geometry untouched, byte for byte
   const EclipseGrid grid = ReadEclipseGrid(egrid);
   const EclipseResults results(egrid, grid);
@@ -343,8 +320,7 @@ int main(int argc, char** argv)
     const PropertyFile properties(propertyPath);
     properties.CheckGeometry(geometry);
     CHECK(properties.Tables().size() == expectedTables);
-    CHECK(results.Steps().size() > 1 &&
-          properties.Find("PRESSURE", int32_t(results.Steps().size() - 1)) >= 0);
+    CHECK(results.Steps().size() > 1 && properties.Find("PRESSURE", int32_t(results.Steps().size() - 1)) >= 0);
     CHECK(properties.Find("PORO", -1) >= 0);
     CHECK(CheckTables(geometry, properties, grid, results) == static_cast<int>(expectedTables));
     const int pressure = properties.Find("PRESSURE", 0);
@@ -356,16 +332,13 @@ int main(int argc, char** argv)
     const std::string reek = data + "/reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID";
     const std::string reekGeometry = temp + "/reek.resmr", reekProperties = temp + "/reek.resmrp";
     std::remove(reekProperties.c_str());
-    CHECK(
-      Run(resmrTool + " build '" + reek + "' -o '" + reekGeometry + "' --quiet > /dev/null") == 0);
-    CHECK(Run(resmrTool + " add-properties '" + reekGeometry + "' '" + reek +
-              "' > /dev/null 2>&1") == 0);
+    CHECK(Run(resmrTool + " build '" + reek + "' -o '" + reekGeometry + "' --quiet > /dev/null") == 0);
+    CHECK(Run(resmrTool + " add-properties '" + reekGeometry + "' '" + reek + "' > /dev/null 2>&1") == 0);
     const EclipseGrid reekGrid = ReadEclipseGrid(reek);
     const EclipseResults reekResults(reek, reekGrid);
     const MultiresolutionFile geometry(reekGeometry);
     const PropertyFile properties(reekProperties);
-    CHECK(CheckTables(geometry, properties, reekGrid, reekResults) ==
-          static_cast<int>(properties.Tables().size()));
+    CHECK(CheckTables(geometry, properties, reekGrid, reekResults) == static_cast<int>(properties.Tables().size()));
     std::remove(reekProperties.c_str());
     GrowingRun(resmrTool, reek, reekGeometry, temp, reekGrid, reekResults);
     std::remove(reekProperties.c_str());
@@ -374,8 +347,7 @@ int main(int argc, char** argv)
 
   // The deck's arrays (PORO, PERMX, ...) replace the INIT arrays of the same name, the
   // other tables stay; the geometry still does not change.
-  CHECK(
-    Run(resmrTool + " add-properties '" + geometryPath + "' '" + deck + "' > /dev/null 2>&1") == 0);
+  CHECK(Run(resmrTool + " add-properties '" + geometryPath + "' '" + deck + "' > /dev/null 2>&1") == 0);
   CHECK(Slurp(geometryPath) == before);
   {
     const MultiresolutionFile geometry(geometryPath);
@@ -387,38 +359,33 @@ int main(int argc, char** argv)
 
   // Another geometry (the same grid cut into other regions) is refused by name.
   const std::string otherPath = temp + "/spe9-cmax.resmr";
-  CHECK(Run(resmrTool + " build '" + egrid + "' -o '" + otherPath +
-            "' --cmax 64 --quiet > /dev/null") == 0);
+  CHECK(Run(resmrTool + " build '" + egrid + "' -o '" + otherPath + "' --cmax 64 --quiet > /dev/null") == 0);
   {
     const MultiresolutionFile other(otherPath);
     const PropertyFile properties(propertyPath);
-    resmr_testing::ExpectError<FileFormatError>("other geometry",
-      [&] { properties.CheckGeometry(other); },
-      { propertyPath, "another geometry" });
+    resmr_testing::ExpectError<FileFormatError>(
+      "other geometry", [&] { properties.CheckGeometry(other); }, { propertyPath, "another geometry" });
   }
-  CHECK(Run(resmrTool + " add-properties '" + otherPath + "' '" + egrid + "' -o '" + propertyPath +
-            "' 2>/dev/null") != 0);
+  CHECK(
+    Run(resmrTool + " add-properties '" + otherPath + "' '" + egrid + "' -o '" + propertyPath + "' 2>/dev/null") != 0);
   CHECK(Slurp(otherPath).size() > 0);
 
   // Damaged property files are refused with the file and the place named.
   const std::string bytes = Slurp(propertyPath);
   const std::string damaged = temp + "/damaged.resmrp";
-  const auto writeBytes = [&](const std::string& content)
-  {
+  const auto writeBytes = [&](const std::string& content) {
     std::ofstream out(damaged, std::ios::binary | std::ios::trunc);
     out.write(content.data(), static_cast<std::streamsize>(content.size()));
   };
   writeBytes(bytes.substr(0, bytes.size() - 10));
-  resmr_testing::ExpectError<FileFormatError>(
-    "truncated", [&] { PropertyFile f(damaged); }, { damaged, "truncated" });
+  resmr_testing::ExpectError<FileFormatError>("truncated", [&] { PropertyFile f(damaged); }, { damaged, "truncated" });
   std::string flipped = bytes;
   flipped[200] ^= 0x5a; // inside the first table's first chunk
   writeBytes(flipped);
   {
     const PropertyFile f(damaged);
     resmr_testing::ExpectError<FileFormatError>("flipped chunk",
-      [&]
-      {
+      [&] {
         for (std::size_t t = 0; t < f.Tables().size(); ++t)
         {
           for (int64_t k = 0; k < 15; ++k)

@@ -52,9 +52,8 @@ double Distance(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, c
 {
   const glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
   const glm::dvec3 q = p - glm::dot(p - a, n) * n;
-  const bool inside = glm::dot(glm::cross(b - a, q - a), n) >= 0 &&
-                      glm::dot(glm::cross(c - b, q - b), n) >= 0 &&
-                      glm::dot(glm::cross(a - c, q - c), n) >= 0;
+  const bool inside = glm::dot(glm::cross(b - a, q - a), n) >= 0 && glm::dot(glm::cross(c - b, q - b), n) >= 0 &&
+    glm::dot(glm::cross(a - c, q - c), n) >= 0;
   if (inside)
   {
     return std::fabs(glm::dot(p - a, n));
@@ -145,8 +144,7 @@ Measured CheckRegion(const RegionMesh& mesh, double maxError, const std::string&
   CHECK(input.size() <= 2 * mesh.side.quads.size());
 
   std::set<uint32_t> used, kept;
-  glm::dvec3 low(std::numeric_limits<double>::infinity()),
-    high(-std::numeric_limits<double>::infinity());
+  glm::dvec3 low(std::numeric_limits<double>::infinity()), high(-std::numeric_limits<double>::infinity());
   for (const auto& t : input)
   {
     for (uint32_t v : t)
@@ -221,8 +219,7 @@ Measured CheckRegion(const RegionMesh& mesh, double maxError, const std::string&
     distinct.insert(sorted);
     const glm::dvec3 n = NormalOf(mesh, t);
     const glm::dvec3 a = At(mesh, t[0]), b = At(mesh, t[1]), c = At(mesh, t[2]);
-    const double longest =
-      std::max({ glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c) });
+    const double longest = std::max({ glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c) });
     if (!(glm::length(n) > (original.count(Rotated(t)) ? 1e-12 : 0.999e-6) * longest))
     {
       ++thin;
@@ -234,9 +231,8 @@ Measured CheckRegion(const RegionMesh& mesh, double maxError, const std::string&
     for (uint32_t v : t)
     {
       const auto& around = incident[v];
-      const bool agrees = std::any_of(around.begin(),
-        around.end(),
-        [&](uint32_t s) { return glm::dot(n, NormalOf(mesh, input[s])) > 0; });
+      const bool agrees = std::any_of(
+        around.begin(), around.end(), [&](uint32_t s) { return glm::dot(n, NormalOf(mesh, input[s])) > 0; });
       turned += !agrees;
     }
   }
@@ -273,14 +269,8 @@ Measured CheckRegion(const RegionMesh& mesh, double maxError, const std::string&
   CHECK(m.removed == 0 || stats.largestError >= m.farthest * (1 - 1e-6) - tolerance);
   if (m.farthest > reach * (1 + 1e-9) || lost || turned || thin)
   {
-    std::fprintf(stderr,
-      "%s: farthest %g (error %g), %lld locked lost, %lld turned, %lld thin\n",
-      label.c_str(),
-      m.farthest,
-      maxError,
-      static_cast<long long>(lost),
-      static_cast<long long>(turned),
-      static_cast<long long>(thin));
+    std::fprintf(stderr, "%s: farthest %g (error %g), %lld locked lost, %lld turned, %lld thin\n", label.c_str(),
+      m.farthest, maxError, static_cast<long long>(lost), static_cast<long long>(turned), static_cast<long long>(thin));
   }
   return m;
 }
@@ -311,8 +301,7 @@ RegionMesh Block(int nx, int ny, int layers, double bend, double slope)
   {
     for (int i = 0; i < nx; ++i)
     {
-      const uint32_t n = static_cast<uint32_t>(j * (nx + 1) + i),
-                     row = static_cast<uint32_t>(nx + 1);
+      const uint32_t n = static_cast<uint32_t>(j * (nx + 1) + i), row = static_cast<uint32_t>(nx + 1);
       mesh.corners.push_back({ n, n + 1, n + row + 1, n + row });
     }
   }
@@ -360,22 +349,16 @@ void TestHandBuilt()
   const auto start = std::chrono::steady_clock::now();
   SideSimplificationStats stats;
   const Triangles simplified = SimplifySideSurface(large, 0.5, &stats);
-  const double seconds =
-    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("large block: %lld -> %lld side triangles in %.3f s (largest error %.3g)\n",
-    static_cast<long long>(stats.inputTriangles),
-    static_cast<long long>(stats.outputTriangles),
-    seconds,
+    static_cast<long long>(stats.inputTriangles), static_cast<long long>(stats.outputTriangles), seconds,
     stats.largestError);
   CHECK(stats.inputTriangles == 100000 && !simplified.empty());
   CHECK(stats.outputTriangles < stats.inputTriangles / 4);
 }
 
 /// Every region of a synthetic hierarchy; returns input and output triangles by level.
-std::map<int, Measured> CheckHierarchy(const SyntheticParameters& p,
-  int64_t cmax,
-  bool exact,
-  const std::string& name)
+std::map<int, Measured> CheckHierarchy(const SyntheticParameters& p, int64_t cmax, bool exact, const std::string& name)
 {
   const std::string path = TempPath(name + ".resmr");
   HierarchyOptions options;
@@ -397,8 +380,7 @@ std::map<int, Measured> CheckHierarchy(const SyntheticParameters& p,
     {
       ExtractSurfaces(mesh);
     }
-    const std::string label =
-      name + " level " + std::to_string(r.level) + " region " + std::to_string(r.index);
+    const std::string label = name + " level " + std::to_string(r.level) + " region " + std::to_string(r.index);
     const auto start = std::chrono::steady_clock::now();
     SimplifySideSurface(mesh, r.error + lattice);
     const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
@@ -418,15 +400,9 @@ std::map<int, Measured> CheckHierarchy(const SyntheticParameters& p,
   for (const auto& e : levels)
   {
     const Measured& l = e.second;
-    std::printf(
-      "%s level %d%s: side triangles %lld -> %lld (%.1f%% fewer), farthest removed vertex %.3g\n",
-      name.c_str(),
-      e.first,
-      e.first == report.leafLevel ? " (leaves)" : "",
-      static_cast<long long>(l.input),
-      static_cast<long long>(l.output),
-      100.0 * (1.0 - double(l.output) / double(l.input)),
-      l.farthest);
+    std::printf("%s level %d%s: side triangles %lld -> %lld (%.1f%% fewer), farthest removed vertex %.3g\n",
+      name.c_str(), e.first, e.first == report.leafLevel ? " (leaves)" : "", static_cast<long long>(l.input),
+      static_cast<long long>(l.output), 100.0 * (1.0 - double(l.output) / double(l.input)), l.farthest);
   }
   std::printf("%s: slowest region %.3f s\n", name.c_str(), slowest);
   std::remove(path.c_str());
@@ -459,8 +435,7 @@ void TestHierarchies()
 bool Closed(const RegionMesh& mesh)
 {
   std::map<std::pair<std::array<double, 3>, std::array<double, 3>>, int> balance;
-  const auto at = [&](uint32_t v)
-  {
+  const auto at = [&](uint32_t v) {
     const double* p = &mesh.positions[static_cast<std::size_t>(v) * 3];
     return std::array<double, 3>{ p[0], p[1], p[2] };
   };
@@ -499,14 +474,11 @@ void TestSealedPinchOuts()
     mesh.active[c * 3 + 1] = 0;
   }
   ComputeOpenSides(mesh);
-  const auto extract = [&](double thickness, uint8_t cutOfSecond)
-  {
+  const auto extract = [&](double thickness, uint8_t cutOfSecond) {
     mesh.sealedPinchThickness = thickness;
     mesh.cutEdges = { 0, cutOfSecond };
     ExtractSurfaces(mesh);
-    return std::array<std::size_t, 3>{
-      mesh.top.quads.size(), mesh.bottom.quads.size(), mesh.side.quads.size()
-    };
+    return std::array<std::size_t, 3>{ mesh.top.quads.size(), mesh.bottom.quads.size(), mesh.side.quads.size() };
   };
   // Unsealed: both active cells of a column show their top and bottom, and 3 open sides each.
   CHECK((extract(0, 0) == std::array<std::size_t, 3>{ 4, 4, 12 }));

@@ -69,17 +69,11 @@ std::string Slurp(const std::string& path)
 /// resmr synth writes for that model, on a geometry built from the spec; leaves the geometry
 /// and both property files in `temp` (synth.resmr, files.resmrp, spec.resmrp). Returns the
 /// tables a generator pass gave.
-uint64_t CompareWithFiles(const std::string& resmrTool,
-  const std::string& temp,
-  int64_t ni,
-  int64_t nj,
-  int64_t nk,
-  uint64_t seed,
-  int steps)
+uint64_t CompareWithFiles(
+  const std::string& resmrTool, const std::string& temp, int64_t ni, int64_t nj, int64_t nk, uint64_t seed, int steps)
 {
-  const std::string spec = "synth:" + std::to_string(ni) + "x" + std::to_string(nj) + "x" +
-                           std::to_string(nk) + ":" + std::to_string(seed) + ":" +
-                           std::to_string(steps);
+  const std::string spec = "synth:" + std::to_string(ni) + "x" + std::to_string(nj) + "x" + std::to_string(nk) + ":" +
+    std::to_string(seed) + ":" + std::to_string(steps);
   const std::string egrid = temp + "/synth.EGRID", geometryPath = temp + "/synth.resmr";
   const std::string fromFiles = temp + "/files.resmrp", fromSpec = temp + "/spec.resmrp";
   const std::string report = temp + "/report.json";
@@ -87,9 +81,9 @@ uint64_t CompareWithFiles(const std::string& resmrTool,
   {
     std::remove(path.c_str());
   }
-  CHECK(Run(resmrTool + " synth " + std::to_string(ni) + " " + std::to_string(nj) + " " +
-            std::to_string(nk) + " --seed " + std::to_string(seed) + " --steps " +
-            std::to_string(steps) + " -o '" + egrid + "' --quiet > /dev/null") == 0);
+  CHECK(
+    Run(resmrTool + " synth " + std::to_string(ni) + " " + std::to_string(nj) + " " + std::to_string(nk) + " --seed " +
+      std::to_string(seed) + " --steps " + std::to_string(steps) + " -o '" + egrid + "' --quiet > /dev/null") == 0);
   // The geometry from the generator, as for models no EGRID can hold (the steps change no cell).
   CHECK(Run(resmrTool + " build " + spec + " -o '" + geometryPath + "' --quiet > /dev/null") == 0);
   const std::string addProperties = resmrTool + " add-properties '" + geometryPath + "' ";
@@ -103,15 +97,14 @@ uint64_t CompareWithFiles(const std::string& resmrTool,
   const std::size_t tables = 10 + 3 * static_cast<std::size_t>(steps);
   CHECK(files.Tables().size() == tables);
   CHECK(generated.Tables().size() == tables);
-  for (const char* name :
-    { "PORV", "DEPTH", "DX", "DY", "DZ", "PORO", "PERMX", "PERMY", "PERMZ", "NTG" })
+  for (const char* name : { "PORV", "DEPTH", "DX", "DY", "DZ", "PORO", "PERMX", "PERMY", "PERMZ", "NTG" })
   {
     CHECK(generated.Find(name, -1) >= 0);
   }
   for (int32_t step = 0; step < steps; ++step)
   {
-    CHECK(generated.Find("PRESSURE", step) >= 0 && generated.Find("SWAT", step) >= 0 &&
-          generated.Find("SOIL", step) >= 0);
+    CHECK(
+      generated.Find("PRESSURE", step) >= 0 && generated.Find("SWAT", step) >= 0 && generated.Find("SOIL", step) >= 0);
   }
   // As many tables a pass as their packed tables fit in one whole array.
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
@@ -134,8 +127,7 @@ uint64_t CompareWithFiles(const std::string& resmrTool,
     const PropertyTable& got = generated.Tables()[static_cast<std::size_t>(found)];
     CHECK(got.reportNumber == expected.reportNumber && got.days == expected.days);
     CHECK(SameValue(got.minimum, expected.minimum) && SameValue(got.maximum, expected.maximum));
-    int64_t differ =
-      Differences(generated.ReadPacked(static_cast<std::size_t>(found)), files.ReadPacked(t));
+    int64_t differ = Differences(generated.ReadPacked(static_cast<std::size_t>(found)), files.ReadPacked(t));
     for (int64_t k = 0; k < nk; ++k)
     {
       const std::vector<float> layer = files.ReadLayer(t, k);
@@ -148,33 +140,22 @@ uint64_t CompareWithFiles(const std::string& resmrTool,
     }
     if (differ)
     {
-      std::fprintf(stderr,
-        "%s step %d: %lld values differ\n",
-        expected.name.c_str(),
-        expected.step,
+      std::fprintf(stderr, "%s step %d: %lld values differ\n", expected.name.c_str(), expected.step,
         static_cast<long long>(differ));
     }
     wrong += differ;
   }
   CHECK(wrong == 0);
   CHECK(finite > values / 4); // real values compared, not NaN with NaN
-  const PropertyTable& poro =
-    generated.Tables()[static_cast<std::size_t>(generated.Find("PORO", -1))];
+  const PropertyTable& poro = generated.Tables()[static_cast<std::size_t>(generated.Find("PORO", -1))];
   CHECK(poro.minimum > 0 && poro.maximum > poro.minimum && poro.maximum < 1);
   const int lastStep = generated.Find("SWAT", steps - 1);
-  CHECK(lastStep >= 0 &&
-        generated.Tables()[static_cast<std::size_t>(lastStep)].reportNumber == steps &&
-        generated.Tables()[static_cast<std::size_t>(lastStep)].days == 3650);
-  std::printf("%s: %zu tables in %ld generator passes (%llu a pass); %lld layer values (%lld with "
-              "a value) and "
+  CHECK(lastStep >= 0 && generated.Tables()[static_cast<std::size_t>(lastStep)].reportNumber == steps &&
+    generated.Tables()[static_cast<std::size_t>(lastStep)].days == 3650);
+  std::printf("%s: %zu tables in %ld generator passes (%llu a pass); %lld layer values (%lld with a value) and "
               "the packed tables (%llu slots each) equal the files'\n",
-    spec.c_str(),
-    tables,
-    passes,
-    static_cast<unsigned long long>(group),
-    static_cast<long long>(values),
-    static_cast<long long>(finite),
-    static_cast<unsigned long long>(slots));
+    spec.c_str(), tables, passes, static_cast<unsigned long long>(group), static_cast<long long>(values),
+    static_cast<long long>(finite), static_cast<unsigned long long>(slots));
   std::remove(report.c_str());
   return group;
 }
@@ -187,18 +168,9 @@ void TestSpecParser()
   CHECK(seeded.nx == 2000 && seeded.ny == 1500 && seeded.nz == 100 && seeded.seed == ~uint64_t(0));
   const SyntheticParameters stepped = ParseSyntheticSpec("synth:4x3x2:7:12");
   CHECK(stepped.seed == 7 && stepped.steps == 12);
-  CHECK(IsSyntheticSpec("synth:4x3x2") && !IsSyntheticSpec("model.EGRID") &&
-        !IsSyntheticSpec("SYNTH:4x3x2"));
-  for (const char* bad : { "synth:",
-         "synth:40x30",
-         "synth:40x30x",
-         "synth:40x30x5:",
-         "synth:40x30x5x",
-         "synth:40x30x5:1:2:3",
-         "synth:40x30x5:-1",
-         "synth: 40x30x5",
-         "synth:40x30x5:1 ",
-         "model.EGRID" })
+  CHECK(IsSyntheticSpec("synth:4x3x2") && !IsSyntheticSpec("model.EGRID") && !IsSyntheticSpec("SYNTH:4x3x2"));
+  for (const char* bad : { "synth:", "synth:40x30", "synth:40x30x", "synth:40x30x5:", "synth:40x30x5x",
+         "synth:40x30x5:1:2:3", "synth:40x30x5:-1", "synth: 40x30x5", "synth:40x30x5:1 ", "model.EGRID" })
   {
     resmr_testing::ExpectError<std::invalid_argument>(
       bad, [&] { ParseSyntheticSpec(bad); }, { bad, "synth:NIxNJxNK[:SEED[:STEPS]]" });
@@ -206,9 +178,8 @@ void TestSpecParser()
   // Well formed, but not a model the generator makes: the spec and the parameter named.
   resmr_testing::ExpectError<std::invalid_argument>(
     "zero layers", [&] { ParseSyntheticSpec("synth:40x30x0"); }, { "synth:40x30x0", "dimensions" });
-  resmr_testing::ExpectError<std::invalid_argument>("too many steps",
-    [&] { ParseSyntheticSpec("synth:40x30x5:1:10001"); },
-    { "synth:40x30x5:1:10001", "steps" });
+  resmr_testing::ExpectError<std::invalid_argument>(
+    "too many steps", [&] { ParseSyntheticSpec("synth:40x30x5:1:10001"); }, { "synth:40x30x5:1:10001", "steps" });
 }
 } // namespace
 
@@ -233,7 +204,7 @@ int main(int argc, char** argv)
 
   // Again without steps into the same file: the INIT's tables replaced, the steps kept.
   CHECK(Run(resmrTool + " add-properties '" + geometryPath + "' synth:40x30x5:7 -o '" + fromSpec +
-            "' 2>/dev/null >/dev/null") == 0);
+          "' 2>/dev/null >/dev/null") == 0);
   {
     const PropertyFile generated(fromSpec);
     CHECK(generated.Tables().size() == 10 + 3 * 3);
@@ -244,8 +215,7 @@ int main(int argc, char** argv)
   std::remove(refused.c_str());
   for (const char* bad : { "synth:40x30x6:7", "synth:40x30x5:8", "synth:40x30" })
   {
-    CHECK(Run(resmrTool + " add-properties '" + geometryPath + "' " + bad + " -o '" + refused +
-              "' 2>/dev/null") == 1);
+    CHECK(Run(resmrTool + " add-properties '" + geometryPath + "' " + bad + " -o '" + refused + "' 2>/dev/null") == 1);
     CHECK(!Exists(refused));
   }
 
@@ -263,20 +233,17 @@ int main(int argc, char** argv)
       "ended early", [&] { writer.EndTable(early); }, { "ONES", "after 1 of its 5 layers" });
     resmr_testing::ExpectError<std::invalid_argument>(
       "unknown handle", [&] { writer.AddLayer(early + 1, layer.data()); }, { "no open table" });
-    resmr_testing::ExpectError<std::invalid_argument>(
-      "left open", [&] { writer.Commit(); }, { "ONES", "never ended" });
+    resmr_testing::ExpectError<std::invalid_argument>("left open", [&] { writer.Commit(); }, { "ONES", "never ended" });
     for (int64_t k = 1; k < dims[2]; ++k)
     {
       writer.AddLayer(early, layer.data());
     }
-    resmr_testing::ExpectError<std::invalid_argument>("too many layers",
-      [&] { writer.AddLayer(early, layer.data()); },
-      { "ONES", "more than its 5 layers" });
+    resmr_testing::ExpectError<std::invalid_argument>(
+      "too many layers", [&] { writer.AddLayer(early, layer.data()); }, { "ONES", "more than its 5 layers" });
     writer.EndTable(early);
     writer.Commit();
     const PropertyFile ones(refused);
-    CHECK(ones.Tables().size() == 1 && ones.Tables()[0].minimum == 1.0f &&
-          ones.Tables()[0].maximum == 1.0f);
+    CHECK(ones.Tables().size() == 1 && ones.Tables()[0].minimum == 1.0f && ones.Tables()[0].maximum == 1.0f);
   }
 
   for (const std::string& path : { fromFiles, fromSpec, refused, geometryPath })

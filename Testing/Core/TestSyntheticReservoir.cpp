@@ -70,9 +70,8 @@ uint64_t Fnv1a(const std::string& bytes, uint64_t hash = 1469598103934665603ull)
 /// ECLIPSE corner order: all >= 0 for a cell that is neither inverted nor folded.
 void TetrahedronVolumes(const double c[8][3], double volumes[6])
 {
-  static const int tets[6][4] = {
-    { 0, 1, 3, 7 }, { 0, 3, 2, 7 }, { 0, 2, 6, 7 }, { 0, 6, 4, 7 }, { 0, 4, 5, 7 }, { 0, 5, 1, 7 }
-  };
+  static const int tets[6][4] = { { 0, 1, 3, 7 }, { 0, 3, 2, 7 }, { 0, 2, 6, 7 }, { 0, 6, 4, 7 }, { 0, 4, 5, 7 },
+    { 0, 5, 1, 7 } };
   for (int t = 0; t < 6; ++t)
   {
     const double* a = c[tets[t][0]];
@@ -84,10 +83,10 @@ void TetrahedronVolumes(const double c[8][3], double volumes[6])
         e[v][d] = c[tets[t][v + 1]][d] - a[d];
       }
     }
-    volumes[t] = (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-                   e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-                   e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
-                 6.0;
+    volumes[t] =
+      (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+        e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
+      6.0;
   }
 }
 
@@ -123,8 +122,7 @@ void TestValidityAndGeology()
   CHECK(grid.deck.dims[0] == 72 && grid.deck.dims[1] == 56 && grid.deck.dims[2] == 18);
   CHECK(grid.activeCells == stats.active);
   const std::vector<double> coord = grid.deck.coord;
-  const resmr::CornerPointGeometry geometry =
-    resmr::CornerPointGeometry::FromDeck(grid.deck, false);
+  const resmr::CornerPointGeometry geometry = resmr::CornerPointGeometry::FromDeck(grid.deck, false);
   const int64_t nx = 72, ny = 56, nz = 18;
 
   // Every cell: no tetrahedron of negative volume (non-negative volume, one orientation);
@@ -171,8 +169,8 @@ void TestValidityAndGeology()
   CHECK(zeroThickness > 0);
   CHECK(zeroActive == 0);
   const double meanThickness = thicknessSum / static_cast<double>(thicknessCount);
-  const double spread = std::sqrt(
-    thicknessSquares / static_cast<double>(thicknessCount) - meanThickness * meanThickness);
+  const double spread =
+    std::sqrt(thicknessSquares / static_cast<double>(thicknessCount) - meanThickness * meanThickness);
   CHECK(spread > 0.2 * meanThickness);
 
   // Requested fractions (defaults: outside 0.25, pinched 0.05, water 0.2).
@@ -180,13 +178,8 @@ void TestValidityAndGeology()
   const double outside = static_cast<double>(stats.outside) / static_cast<double>(stats.cells);
   const double pinched = static_cast<double>(stats.pinched) / inside;
   const double water = static_cast<double>(stats.water) / inside;
-  std::printf(
-    "72x56x18: active %lld, outside %.3f, pinched %.3f, water %.3f, fault faces %lld of %lld\n",
-    static_cast<long long>(stats.active),
-    outside,
-    pinched,
-    water,
-    static_cast<long long>(stats.faultFaces),
+  std::printf("72x56x18: active %lld, outside %.3f, pinched %.3f, water %.3f, fault faces %lld of %lld\n",
+    static_cast<long long>(stats.active), outside, pinched, water, static_cast<long long>(stats.faultFaces),
     static_cast<long long>(stats.lateralFaces));
   CHECK(std::fabs(outside - 0.25) < 0.01);
   CHECK(pinched > 0.6 * 0.05 && pinched < 1.4 * 0.05);
@@ -228,17 +221,13 @@ void TestValidityAndGeology()
         if (j + 1 < ny)
         {
           geometry.CellCorners(i, j + 1, k, b);
-          faultFaces +=
-            (a[2][2] != b[0][2] || a[3][2] != b[1][2] || a[6][2] != b[4][2] || a[7][2] != b[5][2])
-              ? 1
-              : 0;
+          faultFaces += (a[2][2] != b[0][2] || a[3][2] != b[1][2] || a[6][2] != b[4][2] || a[7][2] != b[5][2]) ? 1 : 0;
         }
       }
     }
   }
   CHECK(faultFaces == stats.faultFaces);
-  const double faultFraction =
-    static_cast<double>(faultFaces) / static_cast<double>(stats.lateralFaces);
+  const double faultFraction = static_cast<double>(faultFaces) / static_cast<double>(stats.lateralFaces);
   CHECK(faultFraction > 0.01 && faultFraction < 0.2);
   CHECK(faultColumnsI.size() >= 10);
 
@@ -303,16 +292,10 @@ void TestValidityAndGeology()
     for (std::size_t c = 0; c < swat.size(); ++c)
     {
       flooded += !std::isnan(swat[c]) && swat[c] > 0.5 ? 1 : 0;
-      if (!std::isnan(swat[c]) &&
-          (swat[c] < 0 || swat[c] > 1 || pressure[c] < 50 || pressure[c] > 500))
+      if (!std::isnan(swat[c]) && (swat[c] < 0 || swat[c] > 1 || pressure[c] < 50 || pressure[c] > 500))
       {
         ++resmr_testing::Failures;
-        std::fprintf(stderr,
-          "step %zu cell %zu: SWAT %g PRESSURE %g out of range\n",
-          s,
-          c,
-          swat[c],
-          pressure[c]);
+        std::fprintf(stderr, "step %zu cell %zu: SWAT %g PRESSURE %g out of range\n", s, c, swat[c], pressure[c]);
         break;
       }
     }
@@ -350,15 +333,11 @@ void TestFaultsAndFractionsFollowKnobs()
   const resmr::SyntheticStatistics& s = stream.Statistics();
   const double inside = static_cast<double>(s.cells - s.outside);
   std::printf("120x90x12, 12 faults: outside %.3f pinched %.3f water %.3f fault faces %.3f\n",
-    static_cast<double>(s.outside) / static_cast<double>(s.cells),
-    static_cast<double>(s.pinched) / inside,
-    static_cast<double>(s.water) / inside,
-    static_cast<double>(s.faultFaces) / static_cast<double>(s.lateralFaces));
+    static_cast<double>(s.outside) / static_cast<double>(s.cells), static_cast<double>(s.pinched) / inside,
+    static_cast<double>(s.water) / inside, static_cast<double>(s.faultFaces) / static_cast<double>(s.lateralFaces));
   CHECK(std::fabs(static_cast<double>(s.outside) / static_cast<double>(s.cells) - 0.5) < 0.01);
-  CHECK(static_cast<double>(s.pinched) / inside > 0.6 * 0.15 &&
-        static_cast<double>(s.pinched) / inside < 1.4 * 0.15);
-  CHECK(static_cast<double>(s.water) / inside > 0.75 * 0.4 &&
-        static_cast<double>(s.water) / inside < 1.25 * 0.4);
+  CHECK(static_cast<double>(s.pinched) / inside > 0.6 * 0.15 && static_cast<double>(s.pinched) / inside < 1.4 * 0.15);
+  CHECK(static_cast<double>(s.water) / inside > 0.75 * 0.4 && static_cast<double>(s.water) / inside < 1.25 * 0.4);
   CHECK(s.faultFaces > 0);
   CHECK(layer.k == 11);
 }
@@ -383,8 +362,7 @@ void TestDeterminismAndGrdecl()
   }
   // The same bits on every machine: this hash was taken when the generator was written; a
   // change of the generator's output must update it knowingly.
-  std::printf("30x20x6 seed 7, 2 steps: EGRID+INIT+UNRST hash %016llx\n",
-    static_cast<unsigned long long>(hash));
+  std::printf("30x20x6 seed 7, 2 steps: EGRID+INIT+UNRST hash %016llx\n", static_cast<unsigned long long>(hash));
   CHECK(hash == 0xc8f30ebbd3351979ull);
   parameters.seed = 8;
   const Written other = WriteModel(parameters, "OTHER");
@@ -407,15 +385,12 @@ void TestDeterminismAndGrdecl()
   }
   CHECK(differing == 0);
   const resmr::CellArray* actnum = deck.FindArray("ACTNUM");
-  CHECK(
-    actnum && std::count(actnum->values.begin(), actnum->values.end(), 1.0) == grid.activeCells);
+  CHECK(actnum && std::count(actnum->values.begin(), actnum->values.end(), 1.0) == grid.activeCells);
   CHECK(deck.FindArray("PORO") && deck.FindArray("PERMX") && deck.FindArray("NTG"));
-  CHECK(ReadBytes(deckPath) ==
-        [&]
-        {
-          resmr::WriteSyntheticGrdecl(model, Directory + "/SAME2.GRDECL");
-          return ReadBytes(Directory + "/SAME2.GRDECL");
-        }());
+  CHECK(ReadBytes(deckPath) == [&] {
+    resmr::WriteSyntheticGrdecl(model, Directory + "/SAME2.GRDECL");
+    return ReadBytes(Directory + "/SAME2.GRDECL");
+  }());
 }
 
 void TestBadArguments()
@@ -424,16 +399,14 @@ void TestBadArguments()
   auto invalid = [](resmr::SyntheticParameters p) { resmr::SyntheticReservoir model(p); };
   resmr::SyntheticParameters p;
   p.nx = 0;
-  ExpectError<std::invalid_argument>(
-    "zero dims", [&] { invalid(p); }, { "at least 1", "0 x 100 x 20" });
+  ExpectError<std::invalid_argument>("zero dims", [&] { invalid(p); }, { "at least 1", "0 x 100 x 20" });
   p = {};
   p.nz = 2000000;
   ExpectError<std::invalid_argument>("huge nz", [&] { invalid(p); }, { "at most 1000000" });
   p = {};
   p.nx = 20000;
   p.ny = 20000;
-  ExpectError<std::invalid_argument>(
-    "huge columns", [&] { invalid(p); }, { "100 million columns" });
+  ExpectError<std::invalid_argument>("huge columns", [&] { invalid(p); }, { "100 million columns" });
   p = {};
   p.waterFraction = 1.5;
   ExpectError<std::invalid_argument>("water", [&] { invalid(p); }, { "water fraction" });
@@ -447,8 +420,7 @@ void TestBadArguments()
   p.ny = 1000;
   p.nz = 269;
   const resmr::SyntheticReservoir big(p);
-  ExpectError<resmr::InputError>("EGRID limit",
-    [&] { resmr::WriteSyntheticEclipse(big, Directory + "/BIG.EGRID"); },
+  ExpectError<resmr::InputError>("EGRID limit", [&] { resmr::WriteSyntheticEclipse(big, Directory + "/BIG.EGRID"); },
     { "BIG.EGRID", "268,435,455", "269000000", "synth:1000x1000x269:1" });
   CHECK(CountFiles("BIG*") == 0);
 
@@ -458,11 +430,9 @@ void TestBadArguments()
   p.nz = 4;
   const resmr::SyntheticReservoir small(p);
   ExpectError<resmr::InputError>("unwritable folder",
-    [&] { resmr::WriteSyntheticEclipse(small, Directory + "/no/such/X.EGRID"); },
-    { "X.EGRID", "cannot create" });
+    [&] { resmr::WriteSyntheticEclipse(small, Directory + "/no/such/X.EGRID"); }, { "X.EGRID", "cannot create" });
   ExpectError<resmr::InputError>("steps in GRDECL",
-    [&]
-    {
+    [&] {
       resmr::SyntheticParameters stepped = p;
       stepped.steps = 2;
       resmr::WriteSyntheticGrdecl(resmr::SyntheticReservoir(stepped), Directory + "/STEPS.GRDECL");
@@ -488,12 +458,9 @@ void TestBadArguments()
   std::signal(SIGXFSZ, SIG_IGN);
   setrlimit(RLIMIT_FSIZE, &limited);
   ExpectError<resmr::InputError>("disk full",
-    [&] { resmr::WriteSyntheticEclipse(resmr::SyntheticReservoir(medium), target); },
-    { "FULL.EGRID", "write failed" });
+    [&] { resmr::WriteSyntheticEclipse(resmr::SyntheticReservoir(medium), target); }, { "FULL.EGRID", "write failed" });
   ExpectError<resmr::InputError>("disk full GRDECL",
-    [&] {
-      resmr::WriteSyntheticGrdecl(resmr::SyntheticReservoir(noSteps), Directory + "/FULL.GRDECL");
-    },
+    [&] { resmr::WriteSyntheticGrdecl(resmr::SyntheticReservoir(noSteps), Directory + "/FULL.GRDECL"); },
     { "FULL.GRDECL", "write failed" });
   setrlimit(RLIMIT_FSIZE, &saved);
   CHECK(ReadBytes(target) == "older model");

@@ -54,8 +54,8 @@ void TestMatrices()
   CHECK(Transpose(t) == a);
   // a * a^T: dot products of a's rows.
   const Matrix4 aat = Multiply(a, t);
-  CHECK(aat[0] == 30 && aat[1] == 70 && aat[4] == 70 && aat[5] == 174 &&
-        aat[15] == 13 * 13 + 14 * 14 + 15 * 15 + 16 * 16);
+  CHECK(
+    aat[0] == 30 && aat[1] == 70 && aat[4] == 70 && aat[5] == 174 && aat[15] == 13 * 13 + 14 * 14 + 15 * 15 + 16 * 16);
   CHECK(Multiply(a, IdentityMatrix()) == a && Multiply(IdentityMatrix(), a) == a);
   // Order matters: shear then translate differs from translate then shear.
   const Matrix4 shear{ 1, 2, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
@@ -70,8 +70,7 @@ void TestMatrices()
   const Matrix4 turn{ 0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
   CHECK(Invert(turn, inverse) && SameMatrix(inverse, Transpose(turn)));
   const Matrix4 general{ 2, 1, 0, 3, 1, 3, 1, 0, 0, 1, 4, 1, 1, 0, 1, 5 };
-  CHECK(
-    Invert(general, inverse) && SameMatrix(Multiply(general, inverse), IdentityMatrix(), 1e-14));
+  CHECK(Invert(general, inverse) && SameMatrix(Multiply(general, inverse), IdentityMatrix(), 1e-14));
   Matrix4 untouched = IdentityMatrix();
   CHECK(!Invert(a, untouched) && untouched == IdentityMatrix()); // a's rows are dependent
 
@@ -95,10 +94,8 @@ void TestMatrices()
   CHECK(sheared[4] == 2 && sheared[1] == 0);
 
   // Normal matrices: a scale's is its inverse; a shear's inverse transpose, column-major.
-  const std::array<float, 9> scaled =
-    NormalMatrix({ 2, 0, 0, 7, 0, 4, 0, 7, 0, 0, 1, 7, 0, 0, 0, 1 });
-  CHECK(scaled[0] == 0.5f && scaled[4] == 0.25f && scaled[8] == 1.f && scaled[1] == 0 &&
-        scaled[3] == 0);
+  const std::array<float, 9> scaled = NormalMatrix({ 2, 0, 0, 7, 0, 4, 0, 7, 0, 0, 1, 7, 0, 0, 0, 1 });
+  CHECK(scaled[0] == 0.5f && scaled[4] == 0.25f && scaled[8] == 1.f && scaled[1] == 0 && scaled[3] == 0);
   const std::array<float, 9> normal = NormalMatrix(shear);
   const std::array<float, 9> expected{ 1, -2, 0, 0, 1, 0, 0, 0, 1 }; // shear by 2
   CHECK(normal == expected);
@@ -137,9 +134,7 @@ void TestCameraToView()
   // a quarter of the height, which is half of the half-height.
   const double n = 1, f = 100;
   camera = CameraState();
-  camera.worldToClip = {
-    1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -(f + n) / (f - n), -2 * f * n / (f - n), 0, 0, -1, 0
-  };
+  camera.worldToClip = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -(f + n) / (f - n), -2 * f * n / (f - n), 0, 0, -1, 0 };
   camera.viewAngleDegrees = 90;
   camera.viewportHeight = 800;
   camera.nearClip = n;
@@ -161,8 +156,7 @@ void TestUploadPlan()
 {
   CHECK(UploadBudgetMs(0) == 10);
   CHECK(Near(UploadBudgetMs(20), 5));
-  CHECK(
-    UploadBytesPerFrame == 8u << 20 && TableBytesPerFrame == 4u << 20 && PieceBytes == 1u << 20);
+  CHECK(UploadBytesPerFrame == 8u << 20 && TableBytesPerFrame == 4u << 20 && PieceBytes == 1u << 20);
 
   // Table slabs: 1 MB slices, 4 MB a frame.
   const std::size_t mb = std::size_t(1) << 20;
@@ -188,7 +182,7 @@ void TestUploadPlan()
   DrawPieceCursor pairs(buffers, 170); // two triangles (168 bytes) a piece
   CHECK(!pairs.Done());
   CHECK(pairs.Next().first == 0 && pairs.Next().end == 6 && pairs.Next().lowVertex == 0 &&
-        pairs.Next().highVertex == 5 && pairs.Next().bytes == 168);
+    pairs.Next().highVertex == 5 && pairs.Next().bytes == 168);
   CHECK(pairs.Advance() == 168 && !pairs.Done());
   CHECK(pairs.Next().first == 6 && pairs.Next().end == 12 && pairs.Next().lowVertex == 6);
   CHECK(pairs.Advance() == 168 && pairs.Done());
@@ -234,14 +228,11 @@ void TestControllerInputs()
 
 void TestResidency()
 {
-  CHECK(
-    MainMemoryShare(1024) == std::size_t(512) << 20 && GpuShare(1024) == std::size_t(512) << 20);
+  CHECK(MainMemoryShare(1024) == std::size_t(512) << 20 && GpuShare(1024) == std::size_t(512) << 20);
   CHECK(MainMemoryShare(16) + GpuShare(16) == std::size_t(16) << 20);
 
   // Copies not wanted go, in the mirror's order, until the piece fits.
-  const std::vector<std::pair<std::size_t, std::size_t>> mirrored{
-    { 1, 100 }, { 2, 200 }, { 3, 300 }, { 4, 50 }
-  };
+  const std::vector<std::pair<std::size_t, std::size_t>> mirrored{ { 1, 100 }, { 2, 200 }, { 3, 300 }, { 4, 50 } };
   CHECK((CopiesToRelease(mirrored, { 2, 4 }, 650, 100, 500) == std::vector<std::size_t>{ 1, 3 }));
   CHECK((CopiesToRelease(mirrored, { 2, 4 }, 650, 100, 700) == std::vector<std::size_t>{ 1 }));
   CHECK(CopiesToRelease(mirrored, { 2, 4 }, 650, 100, 750).empty());
@@ -324,8 +315,7 @@ void TestPropertyRequests()
   const std::string spec = "synth:6x5x3:7:2";
   const std::string geometry = Temp + "/synth.resmr", properties = Temp + "/synth.resmrp";
   CHECK(Run(Tool + " build " + spec + " -o '" + geometry + "' --quiet > /dev/null") == 0);
-  CHECK(Run(Tool + " add-properties '" + geometry + "' " + spec + " -o '" + properties +
-            "' > /dev/null 2>&1") == 0);
+  CHECK(Run(Tool + " add-properties '" + geometry + "' " + spec + " -o '" + properties + "' > /dev/null 2>&1") == 0);
   const PropertyFile file(properties);
   PropertyRequest request = RequestFor(&file, "PORO", 1, -1);
   CHECK(request.wanted && request.step == -1 && request.name == "PORO" && request.layer == -1);

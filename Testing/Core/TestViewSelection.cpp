@@ -50,13 +50,10 @@ int Run(const std::string& command)
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-std::string Build(const std::string& input,
-  const std::string& name,
-  const std::string& options = "")
+std::string Build(const std::string& input, const std::string& name, const std::string& options = "")
 {
   const std::string out = Temp + "/" + name + ".resmr";
-  CHECK(
-    Run(Tool + " build '" + input + "' -o '" + out + "' --quiet " + options + " > /dev/null") == 0);
+  CHECK(Run(Tool + " build '" + input + "' -o '" + out + "' --quiet " + options + " > /dev/null") == 0);
   return out;
 }
 
@@ -88,52 +85,18 @@ Mat LookAt(const Vec& eye, const Vec& target, const Vec& up)
 {
   const Vec f = Normalise({ target[0] - eye[0], target[1] - eye[1], target[2] - eye[2] });
   const Vec s = Normalise(CrossProduct(f, up)), u = CrossProduct(s, f);
-  const auto dot = [](const Vec& a, const Vec& b)
-  { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
-  return { s[0],
-    s[1],
-    s[2],
-    -dot(s, eye),
-    u[0],
-    u[1],
-    u[2],
-    -dot(u, eye),
-    -f[0],
-    -f[1],
-    -f[2],
-    dot(f, eye),
-    0,
-    0,
-    0,
+  const auto dot = [](const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  return { s[0], s[1], s[2], -dot(s, eye), u[0], u[1], u[2], -dot(u, eye), -f[0], -f[1], -f[2], dot(f, eye), 0, 0, 0,
     1 };
 }
 
 /// A perspective camera (viewport 1000 pixels high, square).
-ViewParameters Perspective(const Vec& eye,
-  const Vec& target,
-  const Vec& up,
-  double fovyDegrees,
-  double nearPlane,
-  double farPlane,
-  double tolerance)
+ViewParameters Perspective(const Vec& eye, const Vec& target, const Vec& up, double fovyDegrees, double nearPlane,
+  double farPlane, double tolerance)
 {
   const double t = 1 / std::tan(fovyDegrees * M_PI / 360);
-  const Mat projection{ t,
-    0,
-    0,
-    0,
-    0,
-    t,
-    0,
-    0,
-    0,
-    0,
-    (farPlane + nearPlane) / (nearPlane - farPlane),
-    2 * farPlane * nearPlane / (nearPlane - farPlane),
-    0,
-    0,
-    -1,
-    0 };
+  const Mat projection{ t, 0, 0, 0, 0, t, 0, 0, 0, 0, (farPlane + nearPlane) / (nearPlane - farPlane),
+    2 * farPlane * nearPlane / (nearPlane - farPlane), 0, 0, -1, 0 };
   ViewParameters view;
   view.worldToClip = Multiply(projection, LookAt(eye, target, up));
   view.eye = eye;
@@ -228,9 +191,7 @@ bool BoxOutside(const RegionRecord& record, const Mat& m)
     int out = 0;
     for (int c = 0; c < 8; ++c)
     {
-      const double p[4] = {
-        (c & 1) ? b[3] : b[0], (c & 2) ? b[4] : b[1], -((c & 4) ? b[2] : b[5]), 1
-      };
+      const double p[4] = { (c & 1) ? b[3] : b[0], (c & 2) ? b[4] : b[1], -((c & 4) ? b[2] : b[5]), 1 };
       double clip[4] = { 0, 0, 0, 0 };
       for (int r = 0; r < 4; ++r)
         for (int k = 0; k < 4; ++k)
@@ -247,15 +208,11 @@ bool BoxOutside(const RegionRecord& record, const Mat& m)
 /// Crack-freeness of a drawn set: no drawn region next to an ancestor or descendant, no drawn
 /// triangle with another's vertex at the midpoint of one of its edges (T-junction), the
 /// partner of a drawn region never split further, and (full view) every leaf covered once.
-void CheckConformity(const Model& model,
-  const ViewSelection& selection,
-  bool fullView,
-  const std::function<bool(std::size_t)>& resident,
-  const char* label)
+void CheckConformity(const Model& model, const ViewSelection& selection, bool fullView,
+  const std::function<bool(std::size_t)>& resident, const char* label)
 {
   const auto& header = model.file->Header();
-  const DiamondHierarchy tree(
-    header.box[0], header.box[1], header.box[2], header.box[3], header.leafLevel);
+  const DiamondHierarchy tree(header.box[0], header.box[1], header.box[2], header.box[3], header.leafLevel);
   const std::vector<std::size_t> drawn = DrawnSet(selection);
   const std::set<std::size_t> drawnSet(drawn.begin(), drawn.end());
   int failures = 0;
@@ -281,8 +238,7 @@ void CheckConformity(const Model& model,
       const auto& b = corners[(e + 1) % 3];
       if (vertices.count({ (a[0] + b[0]) / 2, (a[1] + b[1]) / 2 }))
       {
-        std::fprintf(
-          stderr, "%s: T-junction on region (%d, %lld)\n", label, rec.level, (long long)rec.index);
+        std::fprintf(stderr, "%s: T-junction on region (%d, %lld)\n", label, rec.level, (long long)rec.index);
         ++failures;
       }
     }
@@ -301,8 +257,7 @@ void CheckConformity(const Model& model,
       if (fullView)
       {
         bool covered = drawnSet.count(partner) != 0;
-        for (int64_t p = model.Parent(partner); p >= 0;
-             p = model.Parent(static_cast<std::size_t>(p)))
+        for (int64_t p = model.Parent(partner); p >= 0; p = model.Parent(static_cast<std::size_t>(p)))
           covered = covered || drawnSet.count(static_cast<std::size_t>(p));
         failures += !covered;
       }
@@ -320,8 +275,7 @@ void CheckConformity(const Model& model,
     }
   }
   if (failures)
-    std::fprintf(
-      stderr, "%s: %d conformity failures among %zu drawn\n", label, failures, drawn.size());
+    std::fprintf(stderr, "%s: %d conformity failures among %zu drawn\n", label, failures, drawn.size());
   CHECK(failures == 0);
 }
 
@@ -341,12 +295,8 @@ void TestExtremes(const Model& model)
   std::vector<std::size_t> roots = model.selector->Roots();
   std::sort(roots.begin(), roots.end());
   CHECK(DrawnSet(coarsest) == roots);
-  std::printf("  %s: %zu regions, leaf level %d, finest cut %zu, roots %zu\n",
-    model.path.c_str(),
-    regions.size(),
-    model.file->Header().leafLevel,
-    finest.drawn.size(),
-    roots.size());
+  std::printf("  %s: %zu regions, leaf level %d, finest cut %zu, roots %zu\n", model.path.c_str(), regions.size(),
+    model.file->Header().leafLevel, finest.drawn.size(), roots.size());
   // Parallel: projected error = e * pixelsPerUnit, so the cut is SelectByError(tol / ppu).
   view.parallel = true;
   view.direction = { 0, 0, -1 };
@@ -381,13 +331,12 @@ void TestConformity(const Model& model)
     std::vector<uint8_t> resident(count);
     const double fraction = (trial % 5) / 4.0;
     for (std::size_t r = 0; r < count; ++r)
-      resident[r] = model.file->Regions()[r].level == 0 ||
-                    std::uniform_real_distribution<double>(0, 1)(random) < fraction;
+      resident[r] =
+        model.file->Regions()[r].level == 0 || std::uniform_real_distribution<double>(0, 1)(random) < fraction;
     const auto isResident = [&](std::size_t r) { return resident[r] != 0; };
     const double angle = trial * 0.7;
     const Vec eye{ model.centre[0] + 1.5 * model.radius * std::cos(angle),
-      model.centre[1] + 1.5 * model.radius * std::sin(angle),
-      model.centre[2] + model.radius * (0.2 + trial % 3) };
+      model.centre[1] + 1.5 * model.radius * std::sin(angle), model.centre[2] + model.radius * (0.2 + trial % 3) };
     // Full view (no culling), then a narrow frustum through the same eye.
     ViewParameters view;
     view.worldToClip = Everything(1e-9);
@@ -397,12 +346,9 @@ void TestConformity(const Model& model)
     const auto full = model.selector->Select(view, isResident);
     CheckConformity(model, full, true, isResident, "full view");
     mostDrawn = std::max(mostDrawn, full.drawn.size());
-    const Vec target{
-      model.centre[0] + 0.3 * model.radius * std::cos(3 * angle), model.centre[1], model.centre[2]
-    };
+    const Vec target{ model.centre[0] + 0.3 * model.radius * std::cos(3 * angle), model.centre[1], model.centre[2] };
     const auto narrow = model.selector->Select(
-      Perspective(eye, target, { 0, 0, 1 }, 12, 1, 10 * model.radius, view.tolerancePixels),
-      isResident);
+      Perspective(eye, target, { 0, 0, 1 }, 12, 1, 10 * model.radius, view.tolerancePixels), isResident);
     CheckConformity(model, narrow, false, isResident, "narrow frustum");
     views += 2;
   }
@@ -421,22 +367,19 @@ void TestToleranceInterval(const Model& model)
     std::vector<uint8_t> resident(count);
     const double fraction = trial % 3 == 0 ? 1.0 : 0.6;
     for (std::size_t r = 0; r < count; ++r)
-      resident[r] = model.file->Regions()[r].level == 0 ||
-                    std::uniform_real_distribution<double>(0, 1)(random) < fraction;
+      resident[r] =
+        model.file->Regions()[r].level == 0 || std::uniform_real_distribution<double>(0, 1)(random) < fraction;
     const auto isResident = [&](std::size_t r) { return resident[r] != 0; };
     const double angle = trial * 0.9;
     const Vec eye{ model.centre[0] + 1.3 * model.radius * std::cos(angle),
-      model.centre[1] + 1.3 * model.radius * std::sin(angle),
-      model.centre[2] + model.radius * 0.4 };
-    ViewParameters view =
-      Perspective(eye, model.centre, { 0, 0, 1 }, 40, 1e-3 * model.radius, 10 * model.radius, 1);
+      model.centre[1] + 1.3 * model.radius * std::sin(angle), model.centre[2] + model.radius * 0.4 };
+    ViewParameters view = Perspective(eye, model.centre, { 0, 0, 1 }, 40, 1e-3 * model.radius, 10 * model.radius, 1);
     view.pixelsPerUnit = 1000;
     view.tolerancePixels = std::pow(2.0, trial % 8);
     const auto selection = model.selector->Select(view, isResident);
     const double below = selection.refineBelowPixels, at = selection.coarsenAtPixels;
     CHECK(below <= view.tolerancePixels && view.tolerancePixels < at);
-    const auto cutAt = [&](double tolerance)
-    {
+    const auto cutAt = [&](double tolerance) {
       ViewParameters other = view;
       other.tolerancePixels = tolerance;
       return DrawnSet(model.selector->Select(other, isResident));
@@ -455,8 +398,7 @@ void TestToleranceInterval(const Model& model)
       ++coarsened;
     }
   }
-  std::printf(
-    "  tolerance interval: %d views could refine, %d could coarsen\n", refined, coarsened);
+  std::printf("  tolerance interval: %d views could refine, %d could coarsen\n", refined, coarsened);
   CHECK(refined >= 6 && coarsened >= 6);
 }
 
@@ -465,19 +407,16 @@ void TestFrustum(const Model& model)
   const Vec above{ model.centre[0], model.centre[1], model.high[2] + model.radius };
   // Looking up, away from the model: nothing.
   const auto away = model.selector->Select(
-    Perspective(
-      above, { above[0], above[1], above[2] + 1 }, { 0, 1, 0 }, 60, 1, 10 * model.radius, 1),
-    AllResident);
+    Perspective(above, { above[0], above[1], above[2] + 1 }, { 0, 1, 0 }, 60, 1, 10 * model.radius, 1), AllResident);
   CHECK(away.drawn.empty() && away.wanted.empty());
   // Everything in sight, then a narrow frustum at a corner.
   const Vec eye{ model.centre[0], model.centre[1], model.high[2] + 3 * model.radius };
-  const auto wide = model.selector->Select(
-    Perspective(eye, model.centre, { 0, 1, 0 }, 90, 1, 10 * model.radius, 1e-9), AllResident);
+  const auto wide =
+    model.selector->Select(Perspective(eye, model.centre, { 0, 1, 0 }, 90, 1, 10 * model.radius, 1e-9), AllResident);
   CHECK(DrawnSet(wide) == SelectByError(*model.file, 0));
   const auto& b = model.file->Regions()[model.Leaves()[0]].bounds;
   const Vec target{ (b[0] + b[3]) / 2, (b[1] + b[4]) / 2, -(b[2] + b[5]) / 2 };
-  const ViewParameters narrowView =
-    Perspective(eye, target, { 0, 1, 0 }, 8, 1, 10 * model.radius, 1e-9);
+  const ViewParameters narrowView = Perspective(eye, target, { 0, 1, 0 }, 8, 1, 10 * model.radius, 1e-9);
   const auto narrow = model.selector->Select(narrowView, AllResident);
   CHECK(!narrow.drawn.empty() && narrow.drawn.size() < wide.drawn.size());
   const std::vector<std::size_t> drawn = DrawnSet(narrow);
@@ -492,10 +431,8 @@ void TestFrustum(const Model& model)
   }
   for (std::size_t r : drawn)
     CHECK(!BoxOutside(model.file->Regions()[r], narrowView.worldToClip));
-  std::printf("  frustum: wide %zu drawn, narrow %zu drawn, %zu finest regions culled\n",
-    wide.drawn.size(),
-    narrow.drawn.size(),
-    culled);
+  std::printf("  frustum: wide %zu drawn, narrow %zu drawn, %zu finest regions culled\n", wide.drawn.size(),
+    narrow.drawn.size(), culled);
 }
 
 void TestNormalCones(const Model& model)
@@ -505,8 +442,7 @@ void TestNormalCones(const Model& model)
   for (int parallel = 0; parallel < 2; ++parallel)
   {
     const Vec eye{ model.centre[0], model.centre[1], model.high[2] + 4 * model.radius };
-    ViewParameters view =
-      Perspective(eye, model.centre, { 0, 1, 0 }, 60, 1, 10 * model.radius, 1e-9);
+    ViewParameters view = Perspective(eye, model.centre, { 0, 1, 0 }, 60, 1, 10 * model.radius, 1e-9);
     view.parallel = parallel == 1;
     const auto selection = model.selector->Select(view, AllResident);
     for (const auto& d : selection.drawn)
@@ -535,8 +471,8 @@ void TestNormalCones(const Model& model)
   }
   // From below, the other way round.
   const Vec below{ model.centre[0], model.centre[1], model.low[2] - 4 * model.radius };
-  const auto fromBelow = model.selector->Select(
-    Perspective(below, model.centre, { 0, 1, 0 }, 60, 1, 10 * model.radius, 1e-9), AllResident);
+  const auto fromBelow =
+    model.selector->Select(Perspective(below, model.centre, { 0, 1, 0 }, 60, 1, 10 * model.radius, 1e-9), AllResident);
   int topsCulled = 0;
   for (const auto& d : fromBelow.drawn)
   {
@@ -548,11 +484,8 @@ void TestNormalCones(const Model& model)
     }
   }
   CHECK(topsShown > 0 && bottomsCulled > 0 && topsCulled > 0);
-  std::printf(
-    "  normal cones: from above %d tops shown, %d bottoms culled; from below %d tops culled\n",
-    topsShown,
-    bottomsCulled,
-    topsCulled);
+  std::printf("  normal cones: from above %d tops shown, %d bottoms culled; from below %d tops culled\n", topsShown,
+    bottomsCulled, topsCulled);
 }
 
 void TestFallback(const Model& model)
@@ -560,8 +493,7 @@ void TestFallback(const Model& model)
   const auto& roots = model.selector->Roots();
   const auto onlyRoots = [&](std::size_t r) { return model.file->Regions()[r].level == 0; };
   const Vec eye{ model.centre[0], model.centre[1], model.high[2] + model.radius };
-  const ViewParameters view =
-    Perspective(eye, model.centre, { 0, 1, 0 }, 90, 1, 10 * model.radius, 0.5);
+  const ViewParameters view = Perspective(eye, model.centre, { 0, 1, 0 }, 90, 1, 10 * model.radius, 0.5);
   const auto selection = model.selector->Select(view, onlyRoots);
   std::vector<std::size_t> sortedRoots(roots.begin(), roots.end());
   std::sort(sortedRoots.begin(), sortedRoots.end());
@@ -588,8 +520,7 @@ void TestFallback(const Model& model)
   int frames = 0;
   for (; frames < 20; ++frames)
   {
-    const auto frame =
-      model.selector->Select(view, [&](std::size_t r) { return loaded.count(r) != 0; });
+    const auto frame = model.selector->Select(view, [&](std::size_t r) { return loaded.count(r) != 0; });
     if (frame.substituted == 0)
     {
       CHECK(DrawnSet(frame) == DrawnSet(ideal));
@@ -599,10 +530,8 @@ void TestFallback(const Model& model)
       loaded.insert(r);
   }
   CHECK(frames <= 2);
-  std::printf("  fallback: roots drawn for %zu wanted, ideal cut %zu after %d frames\n",
-    selection.wanted.size(),
-    ideal.drawn.size(),
-    frames);
+  std::printf("  fallback: roots drawn for %zu wanted, ideal cut %zu after %d frames\n", selection.wanted.size(),
+    ideal.drawn.size(), frames);
 }
 
 /// Back faces may be culled only from outside the model, with the near plane clear of it.
@@ -618,13 +547,8 @@ void TestBackFaces(const Model& model)
   view.parallel = true;
   CHECK(!model.selector->Select(view, AllResident).backFacesHidden);
   const Vec inside{ model.centre[0], model.centre[1], model.centre[2] };
-  view = Perspective(inside,
-    { model.centre[0] + 1, model.centre[1], model.centre[2] },
-    { 0, 0, 1 },
-    30,
-    1e-3,
-    10 * model.radius,
-    1);
+  view = Perspective(
+    inside, { model.centre[0] + 1, model.centre[1], model.centre[2] }, { 0, 0, 1 }, 30, 1e-3, 10 * model.radius, 1);
   view.nearDistance = 1e-3;
   CHECK(!model.selector->Select(view, AllResident).backFacesHidden);
   // Just above the top of the box: inside by less than the margin is still inside.
@@ -663,18 +587,16 @@ void TestDrawBuffers(const std::string& path, int expectedHandedness)
   std::vector<std::vector<uint8_t>> active;
   for (int64_t k = 0; k < dims[2]; ++k)
     active.push_back(file.ReadActiveLayer(k));
-  const auto isActive = [&](int64_t i, int64_t j, int64_t k)
-  {
+  const auto isActive = [&](int64_t i, int64_t j, int64_t k) {
     return i >= 0 && j >= 0 && k >= 0 && i < dims[0] && j < dims[1] && k < dims[2] &&
-           active[static_cast<std::size_t>(k)][static_cast<std::size_t>(i + dims[0] * j)] != 0;
+      active[static_cast<std::size_t>(k)][static_cast<std::size_t>(i + dims[0] * j)] != 0;
   };
   const auto& o = file.Header().latticeOrigin;
   const std::array<double, 3> origin{ o[0], o[1], -o[2] };
   // Generic barycentric weights: an interior point that never falls on a cell boundary.
   const double w[3] = { 1.0 / 3 + std::sqrt(2.0) * 1e-3, 1.0 / 3 + std::sqrt(3.0) * 1e-3, 0 };
   const double w2 = 1 - w[0] - w[1];
-  std::size_t regions = 0, triangles = 0, bad = 0, spanning = 0, sideBad = 0, inwardTopBottom = 0,
-              inwardSides = 0;
+  std::size_t regions = 0, triangles = 0, bad = 0, spanning = 0, sideBad = 0, inwardTopBottom = 0, inwardSides = 0;
   double largestError = 0;
   for (std::size_t r = 0; r < file.Regions().size(); ++r)
   {
@@ -685,10 +607,8 @@ void TestDrawBuffers(const std::string& path, int expectedHandedness)
     const RegionDrawBuffers buffers = PrepareRegionDrawBuffers(mesh, origin, handedness);
     const std::size_t vertexCount = buffers.vertices.size() / 6;
     CHECK(buffers.vertices.size() % 6 == 0 && buffers.indices.size() % 3 == 0);
-    CHECK(
-      buffers.topIndices + buffers.bottomIndices + buffers.sideIndices == buffers.indices.size());
-    CHECK(buffers.topIndices == 6 * mesh.top.quads.size() &&
-          buffers.bottomIndices == 6 * mesh.bottom.quads.size());
+    CHECK(buffers.topIndices + buffers.bottomIndices + buffers.sideIndices == buffers.indices.size());
+    CHECK(buffers.topIndices == 6 * mesh.top.quads.size() && buffers.bottomIndices == 6 * mesh.bottom.quads.size());
     CHECK(buffers.sideIndices == 3 * mesh.sideTriangles.size());
     std::set<uint32_t> topUsed, bottomUsed;
     for (const auto& q : mesh.top.quads)
@@ -708,10 +628,8 @@ void TestDrawBuffers(const std::string& path, int expectedHandedness)
     if (!mesh.top.quads.empty())
     {
       const double* p = &mesh.positions[mesh.top.quads[0][0] * 3];
-      largestError = std::max({ largestError,
-        std::fabs(buffers.vertices[0] + origin[0] - p[0]),
-        std::fabs(buffers.vertices[1] + origin[1] - p[1]),
-        std::fabs(buffers.vertices[2] + origin[2] + p[2]) });
+      largestError = std::max({ largestError, std::fabs(buffers.vertices[0] + origin[0] - p[0]),
+        std::fabs(buffers.vertices[1] + origin[1] - p[1]), std::fabs(buffers.vertices[2] + origin[2] + p[2]) });
     }
     // The region's columns by cell (i, j).
     std::map<std::pair<int64_t, int64_t>, std::size_t> columns;
@@ -734,11 +652,8 @@ void TestDrawBuffers(const std::string& path, int expectedHandedness)
         const float* a = &buffers.vertices[buffers.indices[t] * 6];
         const float* b = &buffers.vertices[buffers.indices[t + 1] * 6];
         const float* c = &buffers.vertices[buffers.indices[t + 2] * 6];
-        const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] },
-                     v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
-        const double n[3] = {
-          u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]
-        };
+        const double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] }, v[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+        const double n[3] = { u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0] };
         const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         double outward[3] = { 0, 0, 0 };
         if (t < buffers.topIndices)
@@ -754,16 +669,14 @@ void TestDrawBuffers(const std::string& path, int expectedHandedness)
             for (int x = 0; x < 3; ++x)
               cellCoord[x] += buffers.vertices[buffers.indices[t + w] * 6 + 3 + x] / 3;
           const uint32_t k = static_cast<uint32_t>(std::floor(cellCoord[2]));
-          const auto column =
-            columns.find({ int64_t(std::floor(cellCoord[0])), int64_t(std::floor(cellCoord[1])) });
+          const auto column = columns.find({ int64_t(std::floor(cellCoord[0])), int64_t(std::floor(cellCoord[1])) });
           if (column != columns.end())
           {
             for (uint32_t corner : mesh.corners[column->second])
               for (uint32_t level : { k, k + 1 })
                 for (int x = 0; x < 3; ++x)
                 {
-                  const double p =
-                    mesh.positions[(corner * layers + level) * 3 + x]; // (x, y, depth)
+                  const double p = mesh.positions[(corner * layers + level) * 3 + x]; // (x, y, depth)
                   outward[x] -= ((x == 2 ? -p : p) - origin[x]) / 8;
                 }
             for (int x = 0; x < 3; ++x)
@@ -802,8 +715,7 @@ void TestDrawBuffers(const std::string& path, int expectedHandedness)
           for (int v = 0; v < 3; ++v)
           {
             const double c = buffers.vertices[buffers.indices[t + v] * 6 + 3 + a];
-            half =
-              half && std::fabs(c - std::floor(c) - 0.5) < 1e-6 && std::fabs(c - point[a]) < 1e-6;
+            half = half && std::fabs(c - std::floor(c) - 0.5) < 1e-6 && std::fabs(c - point[a]) < 1e-6;
           }
           if (half)
             axis = a;
@@ -823,8 +735,7 @@ void TestDrawBuffers(const std::string& path, int expectedHandedness)
           // low or high side; the cell's edge lying there must be open.
           const auto& tv = mesh.topology;
           const std::size_t side = (t - buffers.topIndices - buffers.bottomIndices) / 3;
-          const uint32_t node =
-            mesh.sideTriangles[side][0] / static_cast<uint32_t>(mesh.layers + 1);
+          const uint32_t node = mesh.sideTriangles[side][0] / static_cast<uint32_t>(mesh.layers + 1);
           const double plane = tv[node][axis];
           ok = plane == double(axis == 0 ? i : j) || plane == double(axis == 0 ? i : j) + 1;
           const auto& q = mesh.corners[column->second];
@@ -841,21 +752,13 @@ void TestDrawBuffers(const std::string& path, int expectedHandedness)
         ++sideBad;
       if (!ok && bad < 4)
       {
-        const int part = t < buffers.topIndices                           ? 0
-                         : t < buffers.topIndices + buffers.bottomIndices ? 1
-                                                                          : 2;
+        const int part = t < buffers.topIndices ? 0 : t < buffers.topIndices + buffers.bottomIndices ? 1 : 2;
         std::fprintf(stderr,
-          "    misplaced %s triangle in region %zu at (%.3f %.3f %.3f): active %d above %d below "
-          "%d\n",
-          part == 0   ? "top"
-          : part == 1 ? "bottom"
-                      : "side",
-          r,
-          point[0],
-          point[1],
-          point[2],
-          int(isActive(i, j, k)),
-          int(isActive(i, j, k - 1)),
+          "    misplaced %s triangle in region %zu at (%.3f %.3f %.3f): active %d above %d below %d\n",
+          part == 0     ? "top"
+            : part == 1 ? "bottom"
+                        : "side",
+          r, point[0], point[1], point[2], int(isActive(i, j, k)), int(isActive(i, j, k - 1)),
           int(isActive(i, j, k + 1)));
         if (part == 2)
           for (int v = 0; v < 3; ++v)
@@ -867,18 +770,9 @@ void TestDrawBuffers(const std::string& path, int expectedHandedness)
       bad += !ok;
     }
   }
-  std::printf("  draw buffers %s: handedness %+d, %zu leaf regions, %zu triangles, %zu misplaced, "
-              "%zu side triangles "
+  std::printf("  draw buffers %s: handedness %+d, %zu leaf regions, %zu triangles, %zu misplaced, %zu side triangles "
               "across a pillar, position error %.3g; facing inward: %zu top/bottom, %zu side\n",
-    path.c_str(),
-    handedness,
-    regions,
-    triangles,
-    bad,
-    spanning,
-    largestError,
-    inwardTopBottom,
-    inwardSides);
+    path.c_str(), handedness, regions, triangles, bad, spanning, largestError, inwardTopBottom, inwardSides);
   // A few faces of warped cells (and simplified side triangles across a pillar, measured
   // against one cell) point past 90 degrees from their cell's centre: 2 in a thousand at most.
   CHECK(inwardTopBottom * 1000 <= triangles && inwardSides * 500 <= triangles);
@@ -909,20 +803,16 @@ void TestCoarseSides(const std::string& path)
   std::size_t exact = 0, coarse = 0;
   for (std::size_t r = 0; r < file.Regions().size(); ++r)
   {
-    const RegionDrawBuffers buffers =
-      LoadRegionDrawBuffers(file, r, { o[0], o[1], -o[2] }, handedness);
+    const RegionDrawBuffers buffers = LoadRegionDrawBuffers(file, r, { o[0], o[1], -o[2] }, handedness);
     RegionMesh mesh = file.ReadRegion(r);
     const std::size_t simplified = mesh.sideTriangles.size();
     UseOriginalSideFaces(mesh);
     CHECK(buffers.sideIndices == 3 * mesh.sideTriangles.size());
     CHECK(buffers.coarseSideIndices == 3 * simplified);
-    CHECK(buffers.topIndices + buffers.bottomIndices + buffers.sideIndices +
-            buffers.coarseSideIndices ==
-          buffers.indices.size());
+    CHECK(buffers.topIndices + buffers.bottomIndices + buffers.sideIndices + buffers.coarseSideIndices ==
+      buffers.indices.size());
     const std::size_t vertexCount = buffers.vertices.size() / 6;
-    for (std::size_t i = buffers.indices.size() - buffers.coarseSideIndices;
-         i < buffers.indices.size();
-         ++i)
+    for (std::size_t i = buffers.indices.size() - buffers.coarseSideIndices; i < buffers.indices.size(); ++i)
       CHECK(buffers.indices[i] < vertexCount);
     if (file.Regions()[r].level < file.Header().leafLevel)
     {
@@ -930,10 +820,7 @@ void TestCoarseSides(const std::string& path)
       coarse += buffers.coarseSideIndices;
     }
   }
-  std::printf("%s: coarse levels' sides %zu triangles exact, %zu simplified\n",
-    path.c_str(),
-    exact / 3,
-    coarse / 3);
+  std::printf("%s: coarse levels' sides %zu triangles exact, %zu simplified\n", path.c_str(), exact / 3, coarse / 3);
   CHECK(coarse > 0 && coarse < exact);
 }
 
@@ -946,28 +833,24 @@ void TestDrawPieces(const std::string& path)
   const MultiresolutionFile file(path);
   const int handedness = TopologyHandedness(file);
   const auto& o = file.Header().latticeOrigin;
-  for (const std::size_t limit :
-    { std::size_t(4) << 10, std::size_t(64) << 10, std::size_t(1) << 20 })
+  for (const std::size_t limit : { std::size_t(4) << 10, std::size_t(64) << 10, std::size_t(1) << 20 })
   {
     std::size_t pieces = 0, copied = 0, bytes = 0;
     for (std::size_t r = 0; r < file.Regions().size(); ++r)
     {
-      const RegionDrawBuffers buffers =
-        LoadRegionDrawBuffers(file, r, { o[0], o[1], -o[2] }, handedness);
+      const RegionDrawBuffers buffers = LoadRegionDrawBuffers(file, r, { o[0], o[1], -o[2] }, handedness);
       bytes += buffers.Bytes();
       for (std::size_t first = 0; first < buffers.indices.size();)
       {
         const DrawPiece piece = NextDrawPiece(buffers, first, limit);
         CHECK(piece.first == first && piece.end > first && piece.end <= buffers.indices.size());
         CHECK((piece.end - first) % 3 == 0);
-        CHECK(piece.bytes ==
-              (std::size_t(piece.highVertex - piece.lowVertex) + 1) * 24 + (piece.end - first) * 4);
+        CHECK(piece.bytes == (std::size_t(piece.highVertex - piece.lowVertex) + 1) * 24 + (piece.end - first) * 4);
         CHECK(piece.bytes <= limit || piece.end - first == 3);
         bool inside = true;
         for (std::size_t n = first; n < piece.end; ++n)
         {
-          inside = inside && buffers.indices[n] >= piece.lowVertex &&
-                   buffers.indices[n] <= piece.highVertex;
+          inside = inside && buffers.indices[n] >= piece.lowVertex && buffers.indices[n] <= piece.highVertex;
         }
         CHECK(inside);
         if (piece.end < buffers.indices.size())
@@ -981,12 +864,8 @@ void TestDrawPieces(const std::string& path)
         first = piece.end;
       }
     }
-    std::printf("%s: pieces of at most %zu bytes: %zu, copying %zu bytes of %zu\n",
-      path.c_str(),
-      limit,
-      pieces,
-      copied,
-      bytes);
+    std::printf(
+      "%s: pieces of at most %zu bytes: %zu, copying %zu bytes of %zu\n", path.c_str(), limit, pieces, copied, bytes);
     CHECK(limit < (std::size_t(64) << 10) ? copied <= bytes + bytes / 4 : copied == bytes);
   }
 }
@@ -1023,17 +902,12 @@ void TestCache(const std::string& path)
     CHECK(sum == cache.ResidentBytes());
     const auto& o = file->Header().latticeOrigin;
     CHECK(cache.Origin() == (std::array<double, 3>{ o[0], o[1], -o[2] }));
-    const auto expected =
-      LoadRegionDrawBuffers(*file, leaves[0], cache.Origin(), TopologyHandedness(*file));
+    const auto expected = LoadRegionDrawBuffers(*file, leaves[0], cache.Origin(), TopologyHandedness(*file));
     CHECK(cache.Get(leaves[0]) && cache.Get(leaves[0])->vertices == expected.vertices &&
-          cache.Get(leaves[0])->indices == expected.indices);
+      cache.Get(leaves[0])->indices == expected.indices);
     CHECK(cache.LastError().empty());
-    std::printf("  cache: %zu leaves (%zu bytes) + %zu roots (%zu bytes) loaded in %.3f s\n",
-      leaves.size(),
-      leafBytes,
-      roots.size(),
-      rootBytes,
-      seconds);
+    std::printf("  cache: %zu leaves (%zu bytes) + %zu roots (%zu bytes) loaded in %.3f s\n", leaves.size(), leafBytes,
+      roots.size(), rootBytes, seconds);
   }
   {
     // A core kept busy by an ordinary thread: the idle loader gets almost nothing there, and
@@ -1050,14 +924,12 @@ void TestCache(const std::string& path)
     const bool isolated = pinned && sched_setaffinity(0, sizeof(one), &one) == 0;
 #endif
     std::atomic<bool> spin{ true }, spinning{ false };
-    std::thread spinner(
-      [&]
-      {
-        volatile uint64_t n = 0;
-        spinning = true;
-        while (spin.load(std::memory_order_relaxed))
-          n = n + 1;
-      });
+    std::thread spinner([&] {
+      volatile uint64_t n = 0;
+      spinning = true;
+      while (spin.load(std::memory_order_relaxed))
+        n = n + 1;
+    });
     while (!spinning)
       std::this_thread::yield();
     const auto start = steady_clock::now();
@@ -1069,8 +941,7 @@ void TestCache(const std::string& path)
       CHECK(cache.WaitIdle(seconds(30)));
       cache.Request(leaves);
       loaded = cache.WaitIdle(seconds(30));
-      loaded = loaded && cache.ResidentCount() == roots.size() + leaves.size() &&
-               cache.LastError().empty();
+      loaded = loaded && cache.ResidentCount() == roots.size() + leaves.size() && cache.LastError().empty();
       rescues = cache.StandbyRescues();
     }
     const double took = duration<double>(steady_clock::now() - start).count();
@@ -1081,8 +952,7 @@ void TestCache(const std::string& path)
       sched_setaffinity(0, sizeof(saved), &saved);
 #endif
     CHECK(loaded);
-    std::printf("  cache on a core kept busy: all loaded in %.2f s, standby rescues %llu\n",
-      took,
+    std::printf("  cache on a core kept busy: all loaded in %.2f s, standby rescues %llu\n", took,
       static_cast<unsigned long long>(rescues));
 #ifdef __linux__
     CHECK(!isolated || rescues > 0);
@@ -1102,7 +972,7 @@ void TestCache(const std::string& path)
     // The hash and normal tables come from the loader too, equal to the file's.
     const auto tables = cache.Tables();
     CHECK(tables && tables->hash.offsets == file->ReadHash().offsets &&
-          tables->normals == file->ReadModelArray(ModelChunk::CellNormals));
+      tables->normals == file->ReadModelArray(ModelChunk::CellNormals));
     CHECK(cache.ResidentCount() == roots.size() + n);
     for (std::size_t i = 0; i < leaves.size(); ++i)
       CHECK(cache.IsResident(leaves[i]) == (i < n));
@@ -1118,16 +988,13 @@ void TestCache(const std::string& path)
     // Budget below the roots: roots only.
     RegionCache tiny(file, nullptr, 1);
     tiny.Request(leaves);
-    CHECK(tiny.WaitIdle(seconds(10)) && tiny.ResidentCount() == roots.size() &&
-          tiny.ResidentBytes() == rootBytes);
+    CHECK(tiny.WaitIdle(seconds(10)) && tiny.ResidentCount() == roots.size() && tiny.ResidentBytes() == rootBytes);
   }
   {
     // LRU: A, B, C fill the budget; D evicts A (the least recently requested); after B is
     // requested again and the budget is cut to what is resident, E evicts C.
     std::vector<std::size_t> bySize = leaves;
-    std::sort(bySize.begin(),
-      bySize.end(),
-      [&](std::size_t a, std::size_t b) { return sizes[a] > sizes[b]; });
+    std::sort(bySize.begin(), bySize.end(), [&](std::size_t a, std::size_t b) { return sizes[a] > sizes[b]; });
     const std::size_t A = bySize[0], B = bySize[1], C = bySize[2], D = bySize[3], E = bySize[4];
     RegionCache cache(file, nullptr, rootBytes + sizes[A] + sizes[B] + sizes[C]);
     CHECK(cache.WaitIdle(seconds(10)));
@@ -1140,16 +1007,14 @@ void TestCache(const std::string& path)
     }
     cache.Request({ D });
     CHECK(cache.WaitIdle(seconds(10)));
-    CHECK(
-      !cache.IsResident(A) && cache.IsResident(B) && cache.IsResident(C) && cache.IsResident(D));
+    CHECK(!cache.IsResident(A) && cache.IsResident(B) && cache.IsResident(C) && cache.IsResident(D));
     CHECK(cache.Generation() == generation + 2);
     cache.Request({ B });
     CHECK(cache.WaitIdle(seconds(10)));
     cache.SetBudget(cache.ResidentBytes());
     cache.Request({ E });
     CHECK(cache.WaitIdle(seconds(10)));
-    CHECK(
-      !cache.IsResident(C) && cache.IsResident(B) && cache.IsResident(D) && cache.IsResident(E));
+    CHECK(!cache.IsResident(C) && cache.IsResident(B) && cache.IsResident(D) && cache.IsResident(E));
     CHECK(cache.ResidentBytes() <= cache.Budget());
   }
   {
@@ -1166,8 +1031,7 @@ void TestCache(const std::string& path)
       loaded = cache.ResidentCount();
     }
     const double ms = duration<double, std::milli>(steady_clock::now() - start).count();
-    std::printf(
-      "  cache destroyed after %.1f ms with %zu of %zu regions loaded\n", ms, loaded, all.size());
+    std::printf("  cache destroyed after %.1f ms with %zu of %zu regions loaded\n", ms, loaded, all.size());
     CHECK(ms < 500);
   }
 }
@@ -1197,8 +1061,8 @@ void TestDamagedChunk(const std::string& path)
   const std::string error = cache.LastError();
   std::printf("  damaged chunk: %s\n", error.c_str());
   CHECK(error.find("damaged.resmr") != std::string::npos);
-  CHECK(error.find("level " + std::to_string(record.level) + ", index " +
-                   std::to_string(record.index)) != std::string::npos);
+  CHECK(error.find("level " + std::to_string(record.level) + ", index " + std::to_string(record.index)) !=
+    std::string::npos);
   CHECK(!cache.IsResident(victim) && !cache.Pending());
   CHECK(cache.ResidentCount() == model.selector->Roots().size() + model.Leaves().size() - 1);
 }
@@ -1226,33 +1090,27 @@ void TestProperties()
   const auto first = cache.Property();
   CHECK(first && first->name == "PRESSURE" && first->step == 0);
   CHECK(
-    first && Same(first->values,
-               properties->ReadPacked(static_cast<std::size_t>(properties->Find("PRESSURE", 0)))));
+    first && Same(first->values, properties->ReadPacked(static_cast<std::size_t>(properties->Find("PRESSURE", 0)))));
   cache.RequestProperty("PRESSURE", 1);
   const auto meanwhile = cache.Property(); // the previous table or the new one, never none
   CHECK(meanwhile && meanwhile->name == "PRESSURE");
   CHECK(cache.WaitIdle(seconds(10)));
   const auto second = cache.Property();
   CHECK(second && second->step == 1 &&
-        Same(second->values,
-          properties->ReadPacked(static_cast<std::size_t>(properties->Find("PRESSURE", 1)))));
+    Same(second->values, properties->ReadPacked(static_cast<std::size_t>(properties->Find("PRESSURE", 1)))));
   CHECK(first->step == 0); // the old table is untouched for whoever still holds it
   // A layer's 2D table for the single-layer view.
   cache.RequestProperty("PRESSURE", 1, 2);
   CHECK(cache.WaitIdle(seconds(10)));
   const auto layer = cache.Property();
   const auto& dims = file->Header().dims;
-  CHECK(layer && layer->layer == 2 && layer->step == 1 &&
-        layer->values.size() == std::size_t(dims[0] * dims[1]) &&
-        Same(layer->values,
-          properties->ReadLayer(static_cast<std::size_t>(properties->Find("PRESSURE", 1)), 2)));
+  CHECK(layer && layer->layer == 2 && layer->step == 1 && layer->values.size() == std::size_t(dims[0] * dims[1]) &&
+    Same(layer->values, properties->ReadLayer(static_cast<std::size_t>(properties->Find("PRESSURE", 1)), 2)));
   cache.RequestProperty("NOSUCH", 3);
   CHECK(cache.WaitIdle(seconds(10)));
   CHECK(cache.Property() == nullptr);
-  CHECK(cache.LastError().find("NOSUCH") != std::string::npos &&
-        cache.LastError().find("3") != std::string::npos);
-  std::printf("  properties: PRESSURE steps 0 and 1 (%zu slots); missing: %s\n",
-    second ? second->values.size() : 0,
+  CHECK(cache.LastError().find("NOSUCH") != std::string::npos && cache.LastError().find("3") != std::string::npos);
+  std::printf("  properties: PRESSURE steps 0 and 1 (%zu slots); missing: %s\n", second ? second->values.size() : 0,
     cache.LastError().c_str());
 }
 /// Single-layer buffers (Sec. 4.1, 6.1) of every leaf region for the first, a middle and the
@@ -1278,10 +1136,8 @@ void TestLayerBuffers(const std::string& path)
   for (const int64_t k : { int64_t(0), dims[2] / 2, dims[2] - 1 })
   {
     const std::vector<uint8_t> active = file.ReadActiveLayer(k);
-    const auto isActive = [&](int64_t i, int64_t j)
-    {
-      return i >= 0 && j >= 0 && i < dims[0] && j < dims[1] &&
-             active[std::size_t(i + dims[0] * j)] != 0;
+    const auto isActive = [&](int64_t i, int64_t j) {
+      return i >= 0 && j >= 0 && i < dims[0] && j < dims[1] && active[std::size_t(i + dims[0] * j)] != 0;
     };
     std::vector<int> tops(std::size_t(dims[0] * dims[1]), 0), bottoms(tops.size(), 0);
     std::set<std::tuple<int64_t, int64_t, int, int>> sides; // i, j, axis, low (0) or high (1) side
@@ -1289,19 +1145,16 @@ void TestLayerBuffers(const std::string& path)
     for (std::size_t r : leaves)
     {
       const RegionMesh mesh = file.ReadRegion(r);
-      const RegionDrawBuffers buffers =
-        PrepareLayerDrawBuffers(mesh, int32_t(k), origin, handedness);
+      const RegionDrawBuffers buffers = PrepareLayerDrawBuffers(mesh, int32_t(k), origin, handedness);
       RegionSurface top, bottom, side;
       ExtractLayerSurfaces(mesh, int32_t(k), top, bottom, side);
       CHECK(buffers.layer == k && buffers.sideIndices == 6 * side.quads.size());
-      CHECK(buffers.topIndices == 6 * top.quads.size() &&
-            buffers.bottomIndices == 6 * bottom.quads.size());
+      CHECK(buffers.topIndices == 6 * top.quads.size() && buffers.bottomIndices == 6 * bottom.quads.size());
       // Top and bottom vertices sit half a layer in; side vertices on the layer's interfaces.
       for (std::size_t t = 0; t < buffers.indices.size(); ++t)
       {
         const float ck = buffers.vertices[buffers.indices[t] * 6 + 5];
-        outside += t < buffers.topIndices + buffers.bottomIndices ? ck != float(k + 0.5)
-                                                                  : ck < k || ck > k + 1;
+        outside += t < buffers.topIndices + buffers.bottomIndices ? ck != float(k + 0.5) : ck < k || ck > k + 1;
       }
       for (std::size_t t = 0; t < buffers.indices.size(); t += 3)
       {
@@ -1340,8 +1193,7 @@ void TestLayerBuffers(const std::string& path)
       {
         const std::size_t c = std::size_t(i + dims[0] * j);
         cells += isActive(i, j);
-        wrongTop +=
-          isActive(i, j) ? (tops[c] != 2) + (bottoms[c] != 2) : (tops[c] != 0) + (bottoms[c] != 0);
+        wrongTop += isActive(i, j) ? (tops[c] != 2) + (bottoms[c] != 2) : (tops[c] != 0) + (bottoms[c] != 0);
         if (!isActive(i, j))
           continue;
         const int64_t across[4][2] = { { i - 1, j }, { i + 1, j }, { i, j - 1 }, { i, j + 1 } };
@@ -1352,19 +1204,10 @@ void TestLayerBuffers(const std::string& path)
           faultSides += isActive(across[n][0], across[n][1]) && drawn;
         }
       }
-    std::printf("  layer %lld of %s: %zu active cells, %zu triangles, %zu misplaced, %zu cells "
-                "without exactly one "
-                "top and bottom, %zu open sides missing, %zu sides against an active cell "
-                "(faults), %zu vertices off the layer\n",
-      static_cast<long long>(k + 1),
-      path.c_str(),
-      cells,
-      triangles,
-      bad,
-      wrongTop,
-      missingSides,
-      faultSides,
-      outside);
+    std::printf(
+      "  layer %lld of %s: %zu active cells, %zu triangles, %zu misplaced, %zu cells without exactly one "
+      "top and bottom, %zu open sides missing, %zu sides against an active cell (faults), %zu vertices off the layer\n",
+      static_cast<long long>(k + 1), path.c_str(), cells, triangles, bad, wrongTop, missingSides, faultSides, outside);
     CHECK(cells > 0 && bad == 0 && wrongTop == 0 && missingSides == 0 && outside == 0);
   }
 }
@@ -1400,8 +1243,8 @@ void TestLayerCache(const std::string& path)
   {
     const auto buffers = cache.Get(r);
     const auto expected = LoadRegionDrawBuffers(*file, r, cache.Origin(), handedness, k);
-    CHECK(buffers && buffers == cache.Get(r, k) && buffers->layer == k &&
-          buffers->vertices == expected.vertices && buffers->indices == expected.indices);
+    CHECK(buffers && buffers == cache.Get(r, k) && buffers->layer == k && buffers->vertices == expected.vertices &&
+      buffers->indices == expected.indices);
   }
   CHECK(!cache.IsResident(leaves[0])); // nothing of the layer asked for yet but its roots
   const auto loadStart = steady_clock::now();
@@ -1428,15 +1271,9 @@ void TestLayerCache(const std::string& path)
   CHECK(cache.LastError().empty());
   // Back to the whole model: everything it wanted is still there.
   CHECK(cache.SetLayer(-1) && !cache.Pending() && cache.IsResident(leaves[0]));
-  std::printf("  layer cache %s: switch to layer %d in %.3f ms, its %zu leaves loaded in %.1f ms, "
-              "%zu bytes held over "
+  std::printf("  layer cache %s: switch to layer %d in %.3f ms, its %zu leaves loaded in %.1f ms, %zu bytes held over "
               "3 layers and the whole model\n",
-    path.c_str(),
-    k + 1,
-    switchMs,
-    leaves.size(),
-    loadMs,
-    held);
+    path.c_str(), k + 1, switchMs, leaves.size(), loadMs, held);
   CHECK(switchMs < 50);
 
   // A budget for the roots and the larger of the two sets of leaves (the whole model's, the
@@ -1453,8 +1290,7 @@ void TestLayerCache(const std::string& path)
   RegionCache small(file, nullptr, budget);
   small.Request(leaves);
   CHECK(small.WaitIdle(seconds(10)));
-  CHECK(
-    std::all_of(leaves.begin(), leaves.end(), [&](std::size_t r) { return small.IsResident(r); }));
+  CHECK(std::all_of(leaves.begin(), leaves.end(), [&](std::size_t r) { return small.IsResident(r); }));
   CHECK(small.SetLayer(k));
   small.Request(leaves);
   CHECK(small.WaitIdle(seconds(30)));
@@ -1464,24 +1300,17 @@ void TestLayerCache(const std::string& path)
     wholeLeft += small.Get(r, -1) != nullptr;
     layerLeaves += small.Get(r, k) != nullptr;
   }
-  std::printf("  layer cache under %zu bytes: %zu of %zu whole-model leaves left, %zu layer "
-              "leaves, %zu bytes "
+  std::printf("  layer cache under %zu bytes: %zu of %zu whole-model leaves left, %zu layer leaves, %zu bytes "
               "resident\n",
-    budget,
-    wholeLeft,
-    leaves.size(),
-    layerLeaves,
-    small.ResidentBytes());
-  CHECK(
-    layerLeaves == leaves.size() && wholeLeft < leaves.size() && small.ResidentBytes() <= budget);
+    budget, wholeLeft, leaves.size(), layerLeaves, small.ResidentBytes());
+  CHECK(layerLeaves == leaves.size() && wholeLeft < leaves.size() && small.ResidentBytes() <= budget);
 }
 
 /// The controller against a modelled renderer whose frame costs fixed + work / tolerance^2
 /// seconds (triangles fall as the square of the tolerance).
 void TestFrameRateController()
 {
-  const auto run = [](double fixed, double work, double startPixels, int frames, double& worst)
-  {
+  const auto run = [](double fixed, double work, double startPixels, int frames, double& worst) {
     FrameRateController controller;
     controller.SetTargetFramesPerSecond(10);
     controller.Reset(startPixels);
@@ -1504,10 +1333,8 @@ void TestFrameRateController()
   const double band = FrameRateController::HighFraction * 0.1;
   const double settled = run(0.03, 0.5, 1, 200, worst);
   const double settledSeconds = 0.03 + 0.5 / (settled * settled);
-  std::printf("  controller: settled at %.2f px (%.3f s a frame), slowest frame after 20 %.3f s\n",
-    settled,
-    settledSeconds,
-    worst);
+  std::printf("  controller: settled at %.2f px (%.3f s a frame), slowest frame after 20 %.3f s\n", settled,
+    settledSeconds, worst);
   CHECK(worst <= band && settledSeconds >= FrameRateController::LowFraction * 0.1);
   // A view far heavier than the old 256 px cap allowed (a low flight over kilometre errors):
   // the tolerance keeps rising until the target holds.
@@ -1515,8 +1342,7 @@ void TestFrameRateController()
   std::printf("  controller, heavy view: %.0f px, slowest frame after 20 %.3f s\n", heavy, worst);
   CHECK(heavy > 256 && heavy <= FrameRateController::MaximumPixels && worst <= band);
   // Back to a light view from the heaviest tolerance: down to the minimum within 100 frames.
-  CHECK(run(0.01, 1e-6, FrameRateController::MaximumPixels, 100, worst) ==
-        FrameRateController::MinimumPixels);
+  CHECK(run(0.01, 1e-6, FrameRateController::MaximumPixels, 100, worst) == FrameRateController::MinimumPixels);
   // A renderer slower than the target at any tolerance: the tolerance stops at the maximum.
   CHECK(run(0.2, 1, 1, 100, worst) == FrameRateController::MaximumPixels);
 
@@ -1541,15 +1367,13 @@ void TestFrameRateController()
   // Steps act on the cut. A view whose diamonds' projected errors are 1, 2, 4, ... 4096 px,
   // each split adding as many triangles as all coarser ones: only the tolerance's power of
   // two matters. A frame costs 40 ms plus 1 ms per 4,000 triangles.
-  const auto triangles = [](double pixels)
-  {
+  const auto triangles = [](double pixels) {
     double count = 1000;
     for (double error = 4096; error >= 1; error /= 2)
       count += error > pixels ? count : 0;
     return std::min(count, 1e9);
   };
-  const auto range = [](double pixels)
-  {
+  const auto range = [](double pixels) {
     CutRange same;
     same.refineBelow = 0;
     same.coarsenAt = std::numeric_limits<double>::infinity();
@@ -1569,18 +1393,15 @@ void TestFrameRateController()
   steps.SetTargetFramesPerSecond(10);
   steps.Reset(FrameRateController::MaximumPixels);
   int fastFrames = 0;
-  while (triangles(steps.Tolerance()) == triangles(FrameRateController::MaximumPixels) &&
-         fastFrames < 50)
+  while (triangles(steps.Tolerance()) == triangles(FrameRateController::MaximumPixels) && fastFrames < 50)
   {
     const double before = steps.Tolerance();
     steps.Update(seconds(steps.Tolerance()), true, range(steps.Tolerance()));
     CHECK(steps.Tolerance() >= FrameRateController::MaxRefineStep * before);
     ++fastFrames;
   }
-  std::printf("  controller, cut range: %d fast frames from %.0f px to %.0f px\n",
-    fastFrames,
-    FrameRateController::MaximumPixels,
-    steps.Tolerance());
+  std::printf("  controller, cut range: %d fast frames from %.0f px to %.0f px\n", fastFrames,
+    FrameRateController::MaximumPixels, steps.Tolerance());
   CHECK(fastFrames <= 3);
   // Too fine: a slow frame's step passes the nearest split diamond, so it merges.
   steps.Reset(1.5);
@@ -1603,10 +1424,7 @@ void TestFrameRateController()
       }
       steps.Update(s, true, range(steps.Tolerance()));
     }
-    std::printf("  controller, cut range from %.1f px: frames %.3f-%.3f s after 20\n",
-      start,
-      fastest,
-      slowest);
+    std::printf("  controller, cut range from %.1f px: frames %.3f-%.3f s after 20\n", start, fastest, slowest);
     CHECK(slowest <= FrameRateController::HighFraction * 0.1);
     CHECK(fastest >= 0.5 * FrameRateController::LowFraction * 0.1);
   }
@@ -1668,59 +1486,48 @@ int main(int argc, char** argv)
   Temp = argv[3];
   mkdir(Temp.c_str(), 0755);
   const auto start = std::chrono::steady_clock::now();
-  const std::string reek =
-    Build(Data + "/reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID", "reek");
-  const std::string reek64 =
-    Build(Data + "/reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID", "reek64", "--cmax 64");
+  const std::string reek = Build(Data + "/reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID", "reek");
+  const std::string reek64 = Build(Data + "/reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID", "reek64", "--cmax 64");
   const std::string brugge = Build(Data + "/brugge/Real0/BRUGGE_0000.EGRID", "brugge");
   const std::string synth = Build("synth:96x80x10:5", "synth", "--cmax 96");
-  const std::string left =
-    Build(Data + "/format_variants/xtgeo_etc/sixcells_lefthanded_hdr1.grdecl", "left");
-  const std::string right =
-    Build(Data + "/format_variants/xtgeo_etc/sixcells2_rhand_hdr1.grdecl", "right");
+  const std::string left = Build(Data + "/format_variants/xtgeo_etc/sixcells_lefthanded_hdr1.grdecl", "left");
+  const std::string right = Build(Data + "/format_variants/xtgeo_etc/sixcells2_rhand_hdr1.grdecl", "right");
   std::vector<std::unique_ptr<Model>> models;
   for (const auto& path : { reek64, brugge, synth })
     models.emplace_back(new Model(path));
   const bool ok = resmr_testing::RunNamedTests({
     { "Extremes",
-      [&]
-      {
+      [&] {
         for (const auto& m : models)
           TestExtremes(*m);
       } },
     { "Conformity",
-      [&]
-      {
+      [&] {
         for (const auto& m : models)
           TestConformity(*m);
       } },
     { "ToleranceInterval",
-      [&]
-      {
+      [&] {
         for (const auto& m : models)
           TestToleranceInterval(*m);
       } },
     { "Frustum",
-      [&]
-      {
+      [&] {
         for (const auto& m : models)
           TestFrustum(*m);
       } },
     { "NormalCones",
-      [&]
-      {
+      [&] {
         for (const auto& m : models)
           TestNormalCones(*m);
       } },
     { "Fallback",
-      [&]
-      {
+      [&] {
         for (const auto& m : models)
           TestFallback(*m);
       } },
     { "BackFaces",
-      [&]
-      {
+      [&] {
         for (const auto& m : models)
           TestBackFaces(*m);
       } },
@@ -1728,8 +1535,7 @@ int main(int argc, char** argv)
     { "FrameRateController", [&] { TestFrameRateController(); } },
     { "UploadPacer", [&] { TestUploadPacer(); } },
     { "DrawBuffers",
-      [&]
-      {
+      [&] {
         TestDrawBuffers(reek, 0);
         TestDrawBuffers(brugge, 0);
         TestDrawBuffers(synth, 0);
@@ -1740,8 +1546,7 @@ int main(int argc, char** argv)
         TestDrawBuffers(right, r);
       } },
     { "CoarseSides",
-      [&]
-      {
+      [&] {
         TestCoarseSides(reek);
         TestCoarseSides(synth);
         TestDrawPieces(reek);
@@ -1751,16 +1556,14 @@ int main(int argc, char** argv)
     { "DamagedChunk", [&] { TestDamagedChunk(reek); } },
     { "Properties", [&] { TestProperties(); } },
     { "LayerBuffers",
-      [&]
-      {
+      [&] {
         TestLayerBuffers(reek);
         TestLayerBuffers(brugge);
         TestLayerBuffers(synth);
       } },
     { "LayerCache", [&] { TestLayerCache(reek64); } },
   });
-  std::printf("total %.2f s\n",
-    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  std::printf("total %.2f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   if (!ok)
   {
     std::fprintf(stderr, "%d checks failed\n", resmr_testing::Failures);

@@ -21,12 +21,11 @@
 // file: INIT, UNRST, binary GRDECL), so real files are seeds as they are.
 //
 // Per input: every part is sniffed (LooksLike*), opened as an EclipseKeywordFile (and, for
-// parts 1.., indexed up to the last whole record as results files are) and every record read
-// (numeric ones as double, float and int32_t, character ones as strings, MESS ones must be
-// refused); then ReadEclipseGrid on part 0 (maxCells 1 << 20), grid invariants checked,
-// EclipseResults built and every static array and every dynamic array of every step read (double,
-// float, int32_t); last the corner-point geometry of the grid is built as the reader does
-// (FromDeck, BuildSharedCorners).
+// parts 1.., indexed up to the last whole record as results files are) and every record read (numeric ones as double,
+// float and int32_t, character ones as strings, MESS ones must be refused); then ReadEclipseGrid on part 0 (maxCells 1
+// << 20), grid invariants checked, EclipseResults built and every static array and every dynamic array of every step
+// read (double, float, int32_t); last the corner-point geometry of the grid is built as the reader does (FromDeck,
+// BuildSharedCorners).
 //
 // Expected outcomes: results, or a resmr::InputError (or another std::exception) for bad
 // input. Anything else -- a crash, a sanitizer report, a hang or a runaway allocation -- is
@@ -102,7 +101,7 @@ public:
     const std::string path = this->Directory + "/" + name;
     std::FILE* file = std::fopen(path.c_str(), "wb");
     if (!file || (!data.empty() && std::fwrite(data.data(), 1, data.size(), file) != data.size()) ||
-        std::fclose(file) != 0)
+      std::fclose(file) != 0)
     {
       std::perror(path.c_str());
       std::abort();
@@ -126,8 +125,7 @@ std::string LastOutcome; // what the last input did, for the replay log
 /// The bytes of the fixed grid (see the input layout above).
 const std::string& FixedGrid()
 {
-  static const std::string bytes = []
-  {
+  static const std::string bytes = [] {
     const char* tmp = std::getenv("TMPDIR");
     std::string directory = std::string(tmp && *tmp ? tmp : "/tmp") + "/resmr-fuzz-grid-XXXXXX";
     if (!mkdtemp(directory.data()))
@@ -139,8 +137,8 @@ const std::string& FixedGrid()
     parameters.nx = 6;
     parameters.ny = 5;
     parameters.nz = 3;
-    const resmr::SyntheticOutput written = resmr::WriteSyntheticEclipse(
-      resmr::SyntheticReservoir(parameters), directory + "/FIXED.EGRID");
+    const resmr::SyntheticOutput written =
+      resmr::WriteSyntheticEclipse(resmr::SyntheticReservoir(parameters), directory + "/FIXED.EGRID");
     std::string grid;
     resmr_fuzz::ReadWholeFile(directory + "/FIXED.EGRID", grid);
     for (const std::string& path : written.files)
@@ -247,16 +245,15 @@ std::string ReadEveryRecord(const std::string& path, std::string_view contents, 
   }
   try
   {
-    const resmr::EclipseKeywordFile file(path,
-      results ? resmr::KeywordFileIndexing::UpToLastWholeRecord
-              : resmr::KeywordFileIndexing::WholeFile);
+    const resmr::EclipseKeywordFile file(
+      path, results ? resmr::KeywordFileIndexing::UpToLastWholeRecord : resmr::KeywordFileIndexing::WholeFile);
     // A lenient index stops exactly where its last whole record ends.
     const int64_t lastEnd = file.Records().empty() ? 0 : file.Records().back().endOffset;
     if (file.StoppedAt() >= 0 && (file.StoppedAt() != lastEnd || file.StoppedAt() >= file.Size()))
     {
       BrokenInvariant(path + ": index stopped at byte " + std::to_string(file.StoppedAt()) +
-                      ", its last whole record ends at " + std::to_string(lastEnd) +
-                      ", the file has " + std::to_string(file.Size()) + " bytes");
+        ", its last whole record ends at " + std::to_string(lastEnd) + ", the file has " + std::to_string(file.Size()) +
+        " bytes");
     }
     std::vector<double> numbers;
     std::vector<float> floats;
@@ -264,29 +261,25 @@ std::string ReadEveryRecord(const std::string& path, std::string_view contents, 
     for (const resmr::EclipseRecord& record : file.Records())
     {
       ++records;
-      if (record.count < 0 || record.dataOffset < record.headerOffset ||
-          record.endOffset < record.dataOffset || record.endOffset > file.Size())
+      if (record.count < 0 || record.dataOffset < record.headerOffset || record.endOffset < record.dataOffset ||
+        record.endOffset > file.Size())
       {
-        BrokenInvariant(path + ": record " + record.name + " has count " +
-                        std::to_string(record.count) + ", offsets " +
-                        std::to_string(record.headerOffset) + "/" +
-                        std::to_string(record.dataOffset) + "/" + std::to_string(record.endOffset) +
-                        " in a file of " + std::to_string(file.Size()) + " bytes");
+        BrokenInvariant(path + ": record " + record.name + " has count " + std::to_string(record.count) + ", offsets " +
+          std::to_string(record.headerOffset) + "/" + std::to_string(record.dataOffset) + "/" +
+          std::to_string(record.endOffset) + " in a file of " + std::to_string(file.Size()) + " bytes");
       }
       // Formatted numbers are one blank-separated token each (finding 04).
       std::size_t longest = 0;
       if (file.IsFormatted() && record.IsNumeric())
       {
-        const int64_t tokens =
-          CountTokens(contents.substr(static_cast<std::size_t>(record.dataOffset),
-                        static_cast<std::size_t>(record.endOffset - record.dataOffset)),
-            longest);
+        const int64_t tokens = CountTokens(contents.substr(static_cast<std::size_t>(record.dataOffset),
+                                             static_cast<std::size_t>(record.endOffset - record.dataOffset)),
+          longest);
         if (tokens != record.count)
         {
           BrokenInvariant(path + ": formatted record " + record.name + " indexed with count " +
-                          std::to_string(record.count) + " but its data holds " +
-                          std::to_string(tokens) + " tokens (longest " + std::to_string(longest) +
-                          " characters)");
+            std::to_string(record.count) + " but its data holds " + std::to_string(tokens) + " tokens (longest " +
+            std::to_string(longest) + " characters)");
         }
       }
       if (file.Find(record.name) == nullptr)
@@ -302,9 +295,8 @@ std::string ReadEveryRecord(const std::string& path, std::string_view contents, 
           // (finding 05: a valid number's first 257 characters parse too).
           if (longest > 257)
           {
-            BrokenInvariant(path + ": formatted record " + record.name +
-                            " read although a value is " + std::to_string(longest) +
-                            " characters long");
+            BrokenInvariant(path + ": formatted record " + record.name + " read although a value is " +
+              std::to_string(longest) + " characters long");
           }
           floats.assign(static_cast<std::size_t>(record.count), 0.0f);
           file.Read(record, floats.data());
@@ -316,9 +308,8 @@ std::string ReadEveryRecord(const std::string& path, std::string_view contents, 
           const std::vector<std::string> strings = file.ReadStrings(record);
           if (strings.size() != static_cast<std::size_t>(record.count))
           {
-            BrokenInvariant(path + ": ReadStrings(" + record.name + ") gave " +
-                            std::to_string(strings.size()) + " strings for count " +
-                            std::to_string(record.count));
+            BrokenInvariant(path + ": ReadStrings(" + record.name + ") gave " + std::to_string(strings.size()) +
+              " strings for count " + std::to_string(record.count));
           }
         }
         else
@@ -356,42 +347,39 @@ void CheckGrid(const resmr::EclipseGrid& grid)
   const auto& d = grid.deck.dims;
   if (d[0] <= 0 || d[1] <= 0 || d[2] <= 0 || d[0] * d[1] * d[2] > MaxCells)
   {
-    BrokenInvariant("grid dims " + std::to_string(d[0]) + " x " + std::to_string(d[1]) + " x " +
-                    std::to_string(d[2]) + " (maxCells " + std::to_string(MaxCells) + ")");
+    BrokenInvariant("grid dims " + std::to_string(d[0]) + " x " + std::to_string(d[1]) + " x " + std::to_string(d[2]) +
+      " (maxCells " + std::to_string(MaxCells) + ")");
   }
   const auto n = static_cast<std::size_t>(grid.deck.CellCount());
   if (grid.deck.coord.size() != static_cast<std::size_t>(6 * (d[0] + 1) * (d[1] + 1)))
   {
-    BrokenInvariant("COORD has " + std::to_string(grid.deck.coord.size()) + " values for " +
-                    std::to_string(d[0]) + " x " + std::to_string(d[1]) + " x " +
-                    std::to_string(d[2]));
+    BrokenInvariant("COORD has " + std::to_string(grid.deck.coord.size()) + " values for " + std::to_string(d[0]) +
+      " x " + std::to_string(d[1]) + " x " + std::to_string(d[2]));
   }
   const std::size_t depths = grid.deck.zcorn.size() + grid.deck.zcornSingle.size();
   if (depths != 8 * n || (!grid.deck.zcorn.empty() && !grid.deck.zcornSingle.empty()))
   {
-    BrokenInvariant(
-      "ZCORN has " + std::to_string(depths) + " values for " + std::to_string(n) +
-      " cells (double and single precision copies: " + std::to_string(grid.deck.zcorn.size()) +
-      ", " + std::to_string(grid.deck.zcornSingle.size()) + ")");
+    BrokenInvariant("ZCORN has " + std::to_string(depths) + " values for " + std::to_string(n) +
+      " cells (double and single precision copies: " + std::to_string(grid.deck.zcorn.size()) + ", " +
+      std::to_string(grid.deck.zcornSingle.size()) + ")");
   }
   if (grid.actnum.size() != n)
   {
-    BrokenInvariant("actnum has " + std::to_string(grid.actnum.size()) + " values for " +
-                    std::to_string(n) + " cells");
+    BrokenInvariant("actnum has " + std::to_string(grid.actnum.size()) + " values for " + std::to_string(n) + " cells");
   }
   for (const resmr::CellArray& array : grid.deck.arrays)
   {
     if (array.values.size() != n)
     {
-      BrokenInvariant("array " + array.name + " has " + std::to_string(array.values.size()) +
-                      " values for " + std::to_string(n) + " cells");
+      BrokenInvariant("array " + array.name + " has " + std::to_string(array.values.size()) + " values for " +
+        std::to_string(n) + " cells");
     }
   }
   if (grid.activeCells < 0 || grid.activeCells > grid.deck.CellCount() || grid.fractureCells < 0 ||
-      grid.fractureCells > grid.deck.CellCount())
+    grid.fractureCells > grid.deck.CellCount())
   {
-    BrokenInvariant("active " + std::to_string(grid.activeCells) + ", fracture " +
-                    std::to_string(grid.fractureCells) + " of " + std::to_string(n) + " cells");
+    BrokenInvariant("active " + std::to_string(grid.activeCells) + ", fracture " + std::to_string(grid.fractureCells) +
+      " of " + std::to_string(n) + " cells");
   }
 }
 
@@ -405,9 +393,8 @@ std::string ReadEveryResult(const resmr::EclipseResults& results, int64_t cells)
   std::vector<float> floats(n);
   for (const resmr::EclipseResultArray& array : results.StaticArrays())
   {
-    if (!results.ReadStatic(array.name, values.data(), -1.0) ||
-        !results.ReadStatic(array.name, floats.data(), -1.0f) ||
-        !results.ReadStatic(array.name, integers.data(), int32_t(-1)))
+    if (!results.ReadStatic(array.name, values.data(), -1.0) || !results.ReadStatic(array.name, floats.data(), -1.0f) ||
+      !results.ReadStatic(array.name, integers.data(), int32_t(-1)))
     {
       BrokenInvariant("ReadStatic(" + array.name + ") misses a listed static array");
     }
@@ -418,26 +405,23 @@ std::string ReadEveryResult(const resmr::EclipseResults& results, int64_t cells)
     const resmr::EclipseReportStep& info = results.Steps()[step];
     if (info.names.size() != info.records.size())
     {
-      BrokenInvariant("step " + std::to_string(step) + " has " + std::to_string(info.names.size()) +
-                      " names and " + std::to_string(info.records.size()) + " records");
+      BrokenInvariant("step " + std::to_string(step) + " has " + std::to_string(info.names.size()) + " names and " +
+        std::to_string(info.records.size()) + " records");
     }
     for (const resmr::EclipseResultArray& array : results.DynamicArrays())
     {
-      const bool listed =
-        std::find(info.names.begin(), info.names.end(), array.name) != info.names.end();
+      const bool listed = std::find(info.names.begin(), info.names.end(), array.name) != info.names.end();
       const bool got = results.ReadDynamic(step, array.name, values.data(), -1.0);
       if (got != listed || results.ReadDynamic(step, array.name, floats.data(), -1.0f) != got ||
-          results.ReadDynamic(step, array.name, integers.data(), int32_t(-1)) != got)
+        results.ReadDynamic(step, array.name, integers.data(), int32_t(-1)) != got)
       {
         BrokenInvariant("ReadDynamic(" + std::to_string(step) + ", " + array.name + ") returned " +
-                        (got ? "true" : "false") + " for a" + (listed ? " listed" : "n unlisted") +
-                        " array");
+          (got ? "true" : "false") + " for a" + (listed ? " listed" : "n unlisted") + " array");
       }
       read += got;
     }
     // Out of range: false, not a crash.
-    if (results.ReadDynamic(
-          results.Steps().size(), info.names.empty() ? "" : info.names[0], values.data(), 0.0))
+    if (results.ReadDynamic(results.Steps().size(), info.names.empty() ? "" : info.names[0], values.data(), 0.0))
     {
       BrokenInvariant("ReadDynamic accepted a step past the end");
     }
@@ -446,19 +430,18 @@ std::string ReadEveryResult(const resmr::EclipseResults& results, int64_t cells)
   {
     if (skipped.offset < 0 || skipped.reason.empty())
     {
-      BrokenInvariant(skipped.file + ": step left out at byte " + std::to_string(skipped.offset) +
-                      " with reason '" + skipped.reason + "'");
+      BrokenInvariant(skipped.file + ": step left out at byte " + std::to_string(skipped.offset) + " with reason '" +
+        skipped.reason + "'");
     }
   }
   if (results.Warnings().size() < results.SkippedSteps().size())
   {
     BrokenInvariant("a step was left out without a warning");
   }
-  return std::to_string(results.StaticArrays().size()) + " static, " +
-         std::to_string(results.Steps().size()) + " steps, " +
-         std::to_string(results.DynamicArrays().size()) + " dynamic names, " +
-         std::to_string(read) + " arrays read, " + std::to_string(results.SkippedSteps().size()) +
-         " steps left out, " + std::to_string(results.Warnings().size()) + " warnings";
+  return std::to_string(results.StaticArrays().size()) + " static, " + std::to_string(results.Steps().size()) +
+    " steps, " + std::to_string(results.DynamicArrays().size()) + " dynamic names, " + std::to_string(read) +
+    " arrays read, " + std::to_string(results.SkippedSteps().size()) + " steps left out, " +
+    std::to_string(results.Warnings().size()) + " warnings";
 }
 } // namespace
 
@@ -466,8 +449,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
 {
   InputFiles& files = TheInputFiles();
   files.Clear();
-  const std::vector<std::string_view> parts =
-    SplitInput(std::string_view(reinterpret_cast<const char*>(data), size));
+  const std::vector<std::string_view> parts = SplitInput(std::string_view(reinterpret_cast<const char*>(data), size));
   std::string gridPath;
   std::string outcome;
   for (std::size_t p = 0; p < parts.size(); ++p)
@@ -476,22 +458,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
     {
       continue; // a missing companion
     }
-    const std::string_view part =
-      p == 0 && parts.size() > 1 && parts[0].empty() ? FixedGrid() : parts[p];
+    const std::string_view part = p == 0 && parts.size() > 1 && parts[0].empty() ? FixedGrid() : parts[p];
     const std::string& path = files.Write(PartName(p, parts.size(), StartsFormatted(part)), part);
     if (p == 0)
     {
       gridPath = path;
     }
-    outcome += (outcome.empty() ? "" : "; ") + path.substr(path.rfind('/') + 1) + ": " +
-               ReadEveryRecord(path, part, p > 0);
+    outcome +=
+      (outcome.empty() ? "" : "; ") + path.substr(path.rfind('/') + 1) + ": " + ReadEveryRecord(path, part, p > 0);
   }
   try
   {
     resmr::EclipseGrid grid = resmr::ReadEclipseGrid(gridPath, MaxCells);
     CheckGrid(grid);
-    outcome += "; grid " + std::to_string(grid.deck.CellCount()) + " cells, " +
-               std::to_string(grid.activeCells) + " active";
+    outcome +=
+      "; grid " + std::to_string(grid.deck.CellCount()) + " cells, " + std::to_string(grid.activeCells) + " active";
     const resmr::EclipseResults results(gridPath, grid);
     outcome += "; " + ReadEveryResult(results, grid.deck.CellCount());
     resmr::CornerPointGeometry geometry = resmr::CornerPointGeometry::FromDeck(grid.deck, true);
@@ -501,8 +482,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
     {
       if (id < 0 || static_cast<std::size_t>(id) >= points)
       {
-        BrokenInvariant("BuildSharedCorners: corner point id " + std::to_string(id) +
-                        " outside [0, " + std::to_string(points) + ")");
+        BrokenInvariant(
+          "BuildSharedCorners: corner point id " + std::to_string(id) + " outside [0, " + std::to_string(points) + ")");
       }
     }
     outcome += "; geometry " + std::to_string(points) + " shared points";
@@ -588,12 +569,8 @@ int main(int argc, char** argv)
 {
   resmr_fuzz::LimitAddressSpace(4);
   long count = 0;
-  return resmr_fuzz::ReplayMain("FuzzEclipseOutputReplay",
-    argc,
-    argv,
-    count,
-    [&](const std::string& path, const std::string& contents)
-    {
+  return resmr_fuzz::ReplayMain(
+    "FuzzEclipseOutputReplay", argc, argv, count, [&](const std::string& path, const std::string& contents) {
       RunInput(path, contents, count);
       // A grid with companions beside it is also replayed as a set, as run_fuzz.sh seeds it.
       std::string set;

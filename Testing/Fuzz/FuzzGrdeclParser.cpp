@@ -123,12 +123,11 @@ void CheckDeck(const resmr::CornerPointModel& deck)
   {
     if (array.values.size() != n)
     {
-      BrokenInvariant("array " + array.name + " has " + std::to_string(array.values.size()) +
-                      " values for " + std::to_string(n) + " cells");
+      BrokenInvariant("array " + array.name + " has " + std::to_string(array.values.size()) + " values for " +
+        std::to_string(n) + " cells");
     }
   }
-  if (!deck.coord.empty() &&
-      deck.coord.size() != static_cast<std::size_t>(6 * (d[0] + 1) * (d[1] + 1)))
+  if (!deck.coord.empty() && deck.coord.size() != static_cast<std::size_t>(6 * (d[0] + 1) * (d[1] + 1)))
   {
     BrokenInvariant("COORD has " + std::to_string(deck.coord.size()) + " values");
   }
@@ -141,9 +140,8 @@ void CheckDeck(const resmr::CornerPointModel& deck)
   {
     if (!vectors[axis]->empty() && vectors[axis]->size() != static_cast<std::size_t>(d[axis]))
     {
-      BrokenInvariant(std::string("D") + "XYZ"[axis] + "V has " +
-                      std::to_string(vectors[axis]->size()) + " values for " +
-                      std::to_string(d[axis]) + " cells along the axis");
+      BrokenInvariant(std::string("D") + "XYZ"[axis] + "V has " + std::to_string(vectors[axis]->size()) +
+        " values for " + std::to_string(d[axis]) + " cells along the axis");
     }
   }
   for (const resmr::Fault& fault : deck.faults)
@@ -155,9 +153,8 @@ void CheckDeck(const resmr::CornerPointModel& deck)
         const int32_t lo = face.box[2 * axis], hi = face.box[2 * axis + 1];
         if (lo < 0 || lo > hi || hi >= d[axis])
         {
-          BrokenInvariant("fault " + fault.name + " box " + std::to_string(lo) + "-" +
-                          std::to_string(hi) + " is outside the grid along axis " +
-                          std::to_string(axis));
+          BrokenInvariant("fault " + fault.name + " box " + std::to_string(lo) + "-" + std::to_string(hi) +
+            " is outside the grid along axis " + std::to_string(axis));
         }
       }
       if (face.face < resmr::FaultFace::IMinus || face.face > resmr::FaultFace::KPlus)
@@ -169,8 +166,7 @@ void CheckDeck(const resmr::CornerPointModel& deck)
 }
 
 /// What the reader does with fault faces: the corners of every cell in each box (capped).
-void VisitFaultCells(const resmr::CornerPointModel& deck,
-  const resmr::CornerPointGeometry& geometry)
+void VisitFaultCells(const resmr::CornerPointModel& deck, const resmr::CornerPointGeometry& geometry)
 {
   int64_t budget = 100000;
   double corners[8][3];
@@ -220,12 +216,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
     {
       if (id < 0 || static_cast<std::size_t>(id) >= points)
       {
-        BrokenInvariant("BuildSharedCorners: corner point id " + std::to_string(id) +
-                        " outside [0, " + std::to_string(points) + ")");
+        BrokenInvariant(
+          "BuildSharedCorners: corner point id " + std::to_string(id) + " outside [0, " + std::to_string(points) + ")");
       }
     }
-    RESMR_FUZZ_OUTCOME("parsed, " + std::to_string(geometry.CellCount()) + " cells, " +
-                       std::to_string(points) + " shared points");
+    RESMR_FUZZ_OUTCOME(
+      "parsed, " + std::to_string(geometry.CellCount()) + " cells, " + std::to_string(points) + " shared points");
   }
   catch (const resmr::InputError& error)
   {
@@ -257,10 +253,7 @@ void RunOne(const std::string& path, const std::string& contents, long& count)
 int main(int argc, char** argv)
 {
   long count = 0;
-  return resmr_fuzz::ReplayMain("FuzzGrdeclParserReplay",
-    argc,
-    argv,
-    count,
+  return resmr_fuzz::ReplayMain("FuzzGrdeclParserReplay", argc, argv, count,
     [&](const std::string& path, const std::string& contents) { RunOne(path, contents, count); });
 }
 #endif

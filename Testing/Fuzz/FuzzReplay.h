@@ -39,8 +39,7 @@ namespace resmr_fuzz
 /// downstream.
 inline bool InvariantsChecked()
 {
-  static const bool checked = []
-  {
+  static const bool checked = [] {
     const char* value = std::getenv("RESMR_FUZZ_NO_INVARIANTS");
     return !(value && *value && std::strcmp(value, "0") != 0);
   }();
@@ -136,9 +135,8 @@ public:
   const std::string& Write(const std::vector<uint8_t>& bytes)
   {
     std::FILE* file = std::fopen(this->Path.c_str(), "wb");
-    if (!file ||
-        (!bytes.empty() && std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) ||
-        std::fclose(file) != 0)
+    if (!file || (!bytes.empty() && std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) ||
+      std::fclose(file) != 0)
     {
       std::perror(this->Path.c_str());
       std::abort();

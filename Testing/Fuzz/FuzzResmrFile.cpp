@@ -3,8 +3,7 @@
 // layer, the perfect spatial hash and its cell and normal tables).
 //
 // libFuzzer build (see run_fuzz.sh):
-//   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I Core Core/*.cpp FuzzResmrFile.cpp
-//   -llzo2
+//   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I Core Core/*.cpp FuzzResmrFile.cpp -llzo2
 // Standalone replay build (ctest FuzzResmrFile.SeedCorpus): compile with
 // -DRESMR_FUZZ_STANDALONE; the executable runs the target over every file (or every file in
 // every directory) named on its command line; `--unpack IN OUT` writes a valid file with its
@@ -54,25 +53,22 @@ constexpr bool MustBeValid = false;
 }
 
 /// What the viewer relies on in a decoded region (MultiresolutionFile.h, RegionMesh.h).
-void CheckRegion(const resmr::MultiresolutionFile& file,
-  const resmr::RegionRecord& record,
-  const resmr::RegionMesh& mesh)
+void CheckRegion(
+  const resmr::MultiresolutionFile& file, const resmr::RegionRecord& record, const resmr::RegionMesh& mesh)
 {
   if (!resmr_fuzz::InvariantsChecked())
   {
     return;
   }
   const auto& header = file.Header();
-  const std::string region =
-    "region (" + std::to_string(record.level) + ", " + std::to_string(record.index) + ")";
-  if (mesh.layers != header.dims[2] || mesh.ColumnCount() != record.columns ||
-      mesh.VertexCount() != record.vertices)
+  const std::string region = "region (" + std::to_string(record.level) + ", " + std::to_string(record.index) + ")";
+  if (mesh.layers != header.dims[2] || mesh.ColumnCount() != record.columns || mesh.VertexCount() != record.vertices)
   {
     BrokenInvariant(region + ": layers, columns or vertices disagree with the header or index");
   }
   if (mesh.positions.size() != static_cast<std::size_t>(mesh.VertexCount()) * 3 ||
-      mesh.active.size() != static_cast<std::size_t>(mesh.ColumnCount() * mesh.layers) ||
-      mesh.openSides.size() != mesh.active.size() || mesh.cutEdges.size() != mesh.corners.size())
+    mesh.active.size() != static_cast<std::size_t>(mesh.ColumnCount() * mesh.layers) ||
+    mesh.openSides.size() != mesh.active.size() || mesh.cutEdges.size() != mesh.corners.size())
   {
     BrokenInvariant(region + ": array sizes disagree");
   }
@@ -129,16 +125,15 @@ void CheckHeader(const resmr::MultiresolutionFile& file)
   const auto& h = file.Header();
   for (int a = 0; a < 3; ++a)
   {
-    if (!(h.latticeStep[a] > 0) || !std::isfinite(h.latticeStep[a]) ||
-        !std::isfinite(h.latticeOrigin[a]) || h.dims[a] <= 0)
+    if (!(h.latticeStep[a] > 0) || !std::isfinite(h.latticeStep[a]) || !std::isfinite(h.latticeOrigin[a]) ||
+      h.dims[a] <= 0)
     {
       BrokenInvariant("opened with lattice step " + std::to_string(h.latticeStep[a]) + ", origin " +
-                      std::to_string(h.latticeOrigin[a]) + " or dimension " +
-                      std::to_string(h.dims[a]) + " on axis " + std::to_string(a));
+        std::to_string(h.latticeOrigin[a]) + " or dimension " + std::to_string(h.dims[a]) + " on axis " +
+        std::to_string(a));
     }
   }
-  if (!(h.box[0] < h.box[2]) || !(h.box[1] < h.box[3]) ||
-      !std::isfinite(h.box[0] + h.box[1] + h.box[2] + h.box[3]))
+  if (!(h.box[0] < h.box[2]) || !(h.box[1] < h.box[3]) || !std::isfinite(h.box[0] + h.box[1] + h.box[2] + h.box[3]))
   {
     BrokenInvariant("opened with an empty or infinite hierarchy box");
   }
@@ -149,8 +144,8 @@ void CheckHeader(const resmr::MultiresolutionFile& file)
   }
   if (deepest != h.leafLevel)
   {
-    BrokenInvariant("opened with leaf level " + std::to_string(h.leafLevel) +
-                    ", deepest region at " + std::to_string(deepest));
+    BrokenInvariant(
+      "opened with leaf level " + std::to_string(h.leafLevel) + ", deepest region at " + std::to_string(deepest));
   }
 }
 
@@ -158,8 +153,7 @@ void CheckHeader(const resmr::MultiresolutionFile& file)
 int ReadEverything(const resmr::MultiresolutionFile& file, std::string& firstError)
 {
   int refused = 0;
-  const auto refuse = [&](const std::exception& error)
-  {
+  const auto refuse = [&](const std::exception& error) {
     if (refused++ == 0)
     {
       firstError = error.what();
@@ -188,10 +182,9 @@ int ReadEverything(const resmr::MultiresolutionFile& file, std::string& firstErr
     {
       const auto flags = file.ReadActiveLayer(k);
       if (resmr_fuzz::InvariantsChecked() &&
-          static_cast<int64_t>(flags.size()) != file.Header().dims[0] * file.Header().dims[1])
+        static_cast<int64_t>(flags.size()) != file.Header().dims[0] * file.Header().dims[1])
       {
-        BrokenInvariant("active flags of layer " + std::to_string(k) + ": " +
-                        std::to_string(flags.size()) + " cells");
+        BrokenInvariant("active flags of layer " + std::to_string(k) + ": " + std::to_string(flags.size()) + " cells");
       }
     }
     catch (const resmr::FileFormatError& error)
@@ -228,9 +221,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
     {
       BrokenInvariant("a valid seed refused: " + firstError);
     }
-    RESMR_FUZZ_OUTCOME("opened, " + std::to_string(file.Regions().size()) + " regions, " +
-                       std::to_string(refused) + " parts refused" +
-                       (refused ? ", first: " + firstError : std::string()));
+    RESMR_FUZZ_OUTCOME("opened, " + std::to_string(file.Regions().size()) + " regions, " + std::to_string(refused) +
+      " parts refused" + (refused ? ", first: " + firstError : std::string()));
   }
   catch (const std::bad_alloc&)
   {
@@ -253,12 +245,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
 #ifdef RESMR_FUZZ_STANDALONE
 int main(int argc, char** argv)
 {
-  return resmr_fuzz::ResmrReplayMain("FuzzResmrFileReplay",
-    argc,
-    argv,
-    resmr_fuzz::ResmrLayout(),
-    MustBeValid,
-    LastOutcome,
-    LLVMFuzzerTestOneInput);
+  return resmr_fuzz::ResmrReplayMain(
+    "FuzzResmrFileReplay", argc, argv, resmr_fuzz::ResmrLayout(), MustBeValid, LastOutcome, LLVMFuzzerTestOneInput);
 }
 #endif

@@ -34,11 +34,9 @@ struct FileLayout
   std::function<uint64_t(const std::vector<uint8_t>& file)> indexBytes;
   /// Byte positions, inside an index of `size` bytes, of every 20-byte chunk reference
   /// (offset u64, stored u32, raw u32, crc u32).
-  std::function<std::vector<std::size_t>(const std::vector<uint8_t>& file, uint64_t size)>
-    references;
+  std::function<std::vector<std::size_t>(const std::vector<uint8_t>& file, uint64_t size)> references;
   /// Called with the repaired index before the header CRC is written (the .resmr geometry id).
-  std::function<void(std::vector<uint8_t>& file, const std::vector<uint8_t>& index)>
-    beforeHeaderCrc;
+  std::function<void(std::vector<uint8_t>& file, const std::vector<uint8_t>& index)> beforeHeaderCrc;
 };
 
 template<typename T>
@@ -64,10 +62,7 @@ void Store(std::vector<uint8_t>& bytes, std::size_t at, const T& value)
 /// Where the index lies: the trailer's offset and size when they fit the file exactly (so a
 /// mutated count in the header still meets the index it disagrees with), else the end of the
 /// file less the trailer and the size the header's counts call for. False if neither fits.
-inline bool LocateIndex(const std::vector<uint8_t>& file,
-  const FileLayout& layout,
-  uint64_t& offset,
-  uint64_t& size)
+inline bool LocateIndex(const std::vector<uint8_t>& file, const FileLayout& layout, uint64_t& offset, uint64_t& size)
 {
   if (file.size() < layout.headerBytes + resmr::IndexTrailerBytes)
   {
@@ -91,10 +86,7 @@ inline bool LocateIndex(const std::vector<uint8_t>& file,
 
 /// Whether the `stored` bytes at `offset` are an LZO stream of `raw` bytes (a packed chunk
 /// that happens to be as long as its contents, not an unpacked one).
-inline bool Decompresses(const std::vector<uint8_t>& file,
-  uint64_t offset,
-  uint32_t stored,
-  uint32_t raw)
+inline bool Decompresses(const std::vector<uint8_t>& file, uint64_t offset, uint32_t stored, uint32_t raw)
 {
   resmr::ChunkRef ref;
   ref.offset = offset;
@@ -115,10 +107,7 @@ inline bool Decompresses(const std::vector<uint8_t>& file,
 /// The mutated file with every checksum right again (see above). Inputs too short or without
 /// a place for the index get only their header CRC (when they have a header). With `pack`
 /// false, no chunk is taken for unpacked (only CRCs are recomputed).
-inline std::vector<uint8_t> Repair(const uint8_t* data,
-  std::size_t size,
-  const FileLayout& layout,
-  bool pack = true)
+inline std::vector<uint8_t> Repair(const uint8_t* data, std::size_t size, const FileLayout& layout, bool pack = true)
 {
   std::vector<uint8_t> file(data, data + size);
   uint64_t indexOffset = 0, indexSize = 0;
@@ -162,16 +151,14 @@ inline std::vector<uint8_t> Repair(const uint8_t* data,
   }
   if (file.size() >= layout.headerBytes)
   {
-    Store<uint32_t>(
-      file, layout.headerBytes - 4, resmr::Crc32(file.data(), layout.headerBytes - 4));
+    Store<uint32_t>(file, layout.headerBytes - 4, resmr::Crc32(file.data(), layout.headerBytes - 4));
   }
   return file;
 }
 
 /// A valid file with every chunk stored raw (stored = raw = its decompressed size), appended
 /// after the data part; the form the repair packs again. Throws for a file that is not valid.
-inline std::vector<uint8_t> UnpackChunks(const std::vector<uint8_t>& valid,
-  const FileLayout& layout)
+inline std::vector<uint8_t> UnpackChunks(const std::vector<uint8_t>& valid, const FileLayout& layout)
 {
   std::vector<uint8_t> file = valid;
   uint64_t indexOffset = 0, indexSize = 0;
@@ -208,28 +195,20 @@ inline std::vector<uint8_t> UnpackChunks(const std::vector<uint8_t>& valid,
 /// the reference).
 inline FileLayout ResmrLayout()
 {
-  constexpr std::size_t Header = 256, Record = 192, ModelRecord = 32, RegionsAt = 128,
-                        ModelAt = 136, IdAt = 176;
+  constexpr std::size_t Header = 256, Record = 192, ModelRecord = 32, RegionsAt = 128, ModelAt = 136, IdAt = 176;
   FileLayout layout;
   layout.headerBytes = Header;
   std::memcpy(layout.trailerMagic, "RESMRIDX", 8);
-  layout.indexBytes = [=](const std::vector<uint8_t>& file) -> uint64_t
-  {
+  layout.indexBytes = [=](const std::vector<uint8_t>& file) -> uint64_t {
     const uint64_t regions = Load<uint64_t>(file, RegionsAt), model = Load<uint64_t>(file, ModelAt);
-    return regions < (uint64_t(1) << 32) && model < (uint64_t(1) << 32)
-             ? regions * Record + model * ModelRecord
-             : 0;
+    return regions < (uint64_t(1) << 32) && model < (uint64_t(1) << 32) ? regions * Record + model * ModelRecord : 0;
   };
   // Records that fit in the index, as many as the header's counts say.
-  const auto counts =
-    [=](const std::vector<uint8_t>& file, uint64_t size, uint64_t& regions, uint64_t& model)
-  {
+  const auto counts = [=](const std::vector<uint8_t>& file, uint64_t size, uint64_t& regions, uint64_t& model) {
     regions = std::min<uint64_t>(Load<uint64_t>(file, RegionsAt), size / Record);
-    model =
-      std::min<uint64_t>(Load<uint64_t>(file, ModelAt), (size - regions * Record) / ModelRecord);
+    model = std::min<uint64_t>(Load<uint64_t>(file, ModelAt), (size - regions * Record) / ModelRecord);
   };
-  layout.references = [=](const std::vector<uint8_t>& file, uint64_t size)
-  {
+  layout.references = [=](const std::vector<uint8_t>& file, uint64_t size) {
     uint64_t regions = 0, model = 0;
     counts(file, size, regions, model);
     std::vector<std::size_t> at;
@@ -246,8 +225,7 @@ inline FileLayout ResmrLayout()
     }
     return at;
   };
-  layout.beforeHeaderCrc = [=](std::vector<uint8_t>& file, const std::vector<uint8_t>& index)
-  {
+  layout.beforeHeaderCrc = [=](std::vector<uint8_t>& file, const std::vector<uint8_t>& index) {
     uint64_t regions = 0, model = 0;
     counts(file, index.size(), regions, model);
     resmr::GeometryDigest digest;
@@ -288,17 +266,14 @@ inline FileLayout ResmrpLayout()
   FileLayout layout;
   layout.headerBytes = Header;
   std::memcpy(layout.trailerMagic, "RESMRPIX", 8);
-  const auto tableBytes = [=](const std::vector<uint8_t>& file) -> uint64_t
-  {
+  const auto tableBytes = [=](const std::vector<uint8_t>& file) -> uint64_t {
     const int64_t layers = Load<int64_t>(file, LayersAt);
-    return layers > 0 && layers <= (int64_t(1) << 24)
-             ? TableHead + 20 * (static_cast<uint64_t>(layers) + 1)
-             : 0;
+    return layers > 0 && layers <= (int64_t(1) << 24) ? TableHead + 20 * (static_cast<uint64_t>(layers) + 1) : 0;
   };
-  layout.indexBytes = [=](const std::vector<uint8_t>& file) -> uint64_t
-  { return Load<uint32_t>(file, TablesAt) * tableBytes(file); };
-  layout.references = [=](const std::vector<uint8_t>& file, uint64_t size)
-  {
+  layout.indexBytes = [=](const std::vector<uint8_t>& file) -> uint64_t {
+    return Load<uint32_t>(file, TablesAt) * tableBytes(file);
+  };
+  layout.references = [=](const std::vector<uint8_t>& file, uint64_t size) {
     std::vector<std::size_t> at;
     const uint64_t bytes = tableBytes(file);
     if (bytes == 0)
@@ -321,13 +296,8 @@ inline FileLayout ResmrpLayout()
 /// The standalone main of a .resmr/.resmrp target: `--unpack IN OUT` writes IN with its chunks
 /// stored uncompressed (how the unpacked seeds are made); otherwise every file named is
 /// replayed through `test`, which must accept it whole when its name starts with "valid".
-inline int ResmrReplayMain(const char* tool,
-  int argc,
-  char** argv,
-  const FileLayout& layout,
-  bool& mustBeValid,
-  std::string& lastOutcome,
-  int (*test)(const uint8_t*, std::size_t))
+inline int ResmrReplayMain(const char* tool, int argc, char** argv, const FileLayout& layout, bool& mustBeValid,
+  std::string& lastOutcome, int (*test)(const uint8_t*, std::size_t))
 {
   LimitAddressSpace(2);
   if (argc == 4 && std::string(argv[1]) == "--unpack")
@@ -338,27 +308,21 @@ inline int ResmrReplayMain(const char* tool,
       std::fprintf(stderr, "cannot read %s\n", argv[2]);
       return 1;
     }
-    const auto unpacked =
-      UnpackChunks(std::vector<uint8_t>(contents.begin(), contents.end()), layout);
+    const auto unpacked = UnpackChunks(std::vector<uint8_t>(contents.begin(), contents.end()), layout);
     std::FILE* out = std::fopen(argv[3], "wb");
     const bool ok = out && std::fwrite(unpacked.data(), 1, unpacked.size(), out) == unpacked.size();
     return out && std::fclose(out) == 0 && ok ? 0 : 1;
   }
   long count = 0;
-  return ReplayMain(tool,
-    argc,
-    argv,
-    count,
-    [&](const std::string& path, const std::string& contents)
-    {
-      std::printf("%s (%zu bytes): ", path.c_str(), contents.size());
-      std::fflush(stdout); // the name is out before a crash
-      lastOutcome.clear();
-      mustBeValid = path.substr(path.find_last_of('/') + 1).rfind("valid", 0) == 0;
-      test(reinterpret_cast<const uint8_t*>(contents.data()), contents.size());
-      std::printf("%s\n", lastOutcome.substr(0, 400).c_str());
-      ++count;
-    });
+  return ReplayMain(tool, argc, argv, count, [&](const std::string& path, const std::string& contents) {
+    std::printf("%s (%zu bytes): ", path.c_str(), contents.size());
+    std::fflush(stdout); // the name is out before a crash
+    lastOutcome.clear();
+    mustBeValid = path.substr(path.find_last_of('/') + 1).rfind("valid", 0) == 0;
+    test(reinterpret_cast<const uint8_t*>(contents.data()), contents.size());
+    std::printf("%s\n", lastOutcome.substr(0, 400).c_str());
+    ++count;
+  });
 }
 
 } // namespace resmr_fuzz

@@ -2,8 +2,7 @@
 // (ReadPacked and ReadLayer of every layer of every table).
 //
 // libFuzzer build (see run_fuzz.sh):
-//   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I Core Core/*.cpp FuzzResmrpFile.cpp
-//   -llzo2
+//   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I Core Core/*.cpp FuzzResmrpFile.cpp -llzo2
 // Standalone replay build (ctest FuzzResmrpFile.SeedCorpus): compile with
 // -DRESMR_FUZZ_STANDALONE; the executable runs the target over every file (or every file in
 // every directory) named on its command line; `--unpack IN OUT` writes a valid file with its
@@ -59,13 +58,12 @@ void CheckIndex(const resmr::PropertyFile& file, const std::vector<uint8_t>& byt
     return;
   }
   const auto& dims = file.Dimensions();
-  const uint64_t indexSize =
-    resmr_fuzz::Load<uint64_t>(bytes, bytes.size() - resmr::IndexTrailerBytes + 8);
+  const uint64_t indexSize = resmr_fuzz::Load<uint64_t>(bytes, bytes.size() - resmr::IndexTrailerBytes + 8);
   const uint64_t perTable = 56 + 20 * (static_cast<uint64_t>(dims[2]) + 1);
   if (indexSize != file.Tables().size() * perTable)
   {
-    BrokenInvariant("opened with " + std::to_string(file.Tables().size()) +
-                    " tables in an index of " + std::to_string(indexSize) + " bytes");
+    BrokenInvariant("opened with " + std::to_string(file.Tables().size()) + " tables in an index of " +
+      std::to_string(indexSize) + " bytes");
   }
   for (const auto& table : file.Tables())
   {
@@ -76,17 +74,14 @@ void CheckIndex(const resmr::PropertyFile& file, const std::vector<uint8_t>& byt
     }
     if (!sized)
     {
-      BrokenInvariant(
-        "opened with table " + table.name + " of chunks the wrong size for its values");
+      BrokenInvariant("opened with table " + table.name + " of chunks the wrong size for its values");
     }
   }
 }
 
 /// Reads every table, packed and by layers; returns the number of parts refused.
-int ReadEverything(const resmr::PropertyFile& file,
-  const std::array<int64_t, 3>& dims,
-  uint64_t slots,
-  std::string& firstError)
+int ReadEverything(
+  const resmr::PropertyFile& file, const std::array<int64_t, 3>& dims, uint64_t slots, std::string& firstError)
 {
   int refused = 0;
   for (std::size_t t = 0; t < file.Tables().size(); ++t)
@@ -94,8 +89,7 @@ int ReadEverything(const resmr::PropertyFile& file,
     const auto& table = file.Tables()[t];
     if (resmr_fuzz::InvariantsChecked() && table.layers.size() != static_cast<std::size_t>(dims[2]))
     {
-      BrokenInvariant(
-        "table " + std::to_string(t) + " has " + std::to_string(table.layers.size()) + " layers");
+      BrokenInvariant("table " + std::to_string(t) + " has " + std::to_string(table.layers.size()) + " layers");
     }
     for (int64_t k = -1; k < dims[2]; ++k)
     {
@@ -106,8 +100,7 @@ int ReadEverything(const resmr::PropertyFile& file,
         if (resmr_fuzz::InvariantsChecked() && values.size() != expected)
         {
           BrokenInvariant("table " + std::to_string(t) + " part " + std::to_string(k) + ": " +
-                          std::to_string(values.size()) + " values for " +
-                          std::to_string(expected));
+            std::to_string(values.size()) + " values for " + std::to_string(expected));
         }
       }
       catch (const resmr::FileFormatError& error)
@@ -142,9 +135,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
     {
       BrokenInvariant("a valid seed refused: " + firstError);
     }
-    RESMR_FUZZ_OUTCOME("opened, " + std::to_string(file.Tables().size()) + " tables, " +
-                       std::to_string(refused) + " parts refused" +
-                       (refused ? ", first: " + firstError : std::string()));
+    RESMR_FUZZ_OUTCOME("opened, " + std::to_string(file.Tables().size()) + " tables, " + std::to_string(refused) +
+      " parts refused" + (refused ? ", first: " + firstError : std::string()));
   }
   catch (const std::bad_alloc&)
   {
@@ -167,12 +159,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size)
 #ifdef RESMR_FUZZ_STANDALONE
 int main(int argc, char** argv)
 {
-  return resmr_fuzz::ResmrReplayMain("FuzzResmrpFileReplay",
-    argc,
-    argv,
-    resmr_fuzz::ResmrpLayout(),
-    MustBeValid,
-    LastOutcome,
-    LLVMFuzzerTestOneInput);
+  return resmr_fuzz::ResmrReplayMain(
+    "FuzzResmrpFileReplay", argc, argv, resmr_fuzz::ResmrpLayout(), MustBeValid, LastOutcome, LLVMFuzzerTestOneInput);
 }
 #endif
