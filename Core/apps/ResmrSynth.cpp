@@ -77,6 +77,38 @@ bool EndsWithNoCase(const std::string& text, const std::string& suffix)
   }
   return true;
 }
+/// The JSON line `resmr synth` prints: what was written and the model's measured geology.
+void PrintReport(const resmr::SyntheticParameters& parameters, const resmr::SyntheticReservoir& model,
+  const resmr::SyntheticOutput& written, double seconds)
+{
+  struct rusage usage;
+  getrusage(RUSAGE_SELF, &usage);
+  const resmr::SyntheticStatistics& s = written.statistics;
+  const double inside = static_cast<double>(s.cells - s.outside);
+  std::string files;
+  for (const std::string& file : written.files)
+  {
+    files += (files.empty() ? "\"" : ", \"") + file + "\"";
+  }
+  std::printf("{\"files\": [%s], \"dims\": [%lld, %lld, %lld], \"seed\": %llu, \"cells\": %lld, "
+              "\"active\": %lld, \"outside_cells\": %lld, \"pinched_cells\": %lld, \"water_cells\": %lld, "
+              "\"inactive_fraction\": %.6f, \"outside_fraction\": %.6f, \"pinched_fraction\": %.6f, "
+              "\"water_fraction\": %.6f, \"fault_face_fraction\": %.6f, \"oil_water_contact\": %.3f, "
+              "\"steps\": %d, \"bytes\": %lld, \"seconds\": %.3f, \"cells_per_minute\": %.0f, "
+              "\"peak_rss_mb\": %.1f}\n",
+    files.c_str(), static_cast<long long>(parameters.nx), static_cast<long long>(parameters.ny),
+    static_cast<long long>(parameters.nz), static_cast<unsigned long long>(parameters.seed),
+    static_cast<long long>(s.cells), static_cast<long long>(s.active), static_cast<long long>(s.outside),
+    static_cast<long long>(s.pinched), static_cast<long long>(s.water),
+    1.0 - static_cast<double>(s.active) / static_cast<double>(s.cells),
+    static_cast<double>(s.outside) / static_cast<double>(s.cells),
+    inside > 0 ? static_cast<double>(s.pinched) / inside : 0.0,
+    inside > 0 ? static_cast<double>(s.water) / inside : 0.0,
+    s.lateralFaces > 0 ? static_cast<double>(s.faultFaces) / static_cast<double>(s.lateralFaces) : 0.0,
+    std::isfinite(model.OilWaterContact()) ? model.OilWaterContact() : -1.0, parameters.steps,
+    static_cast<long long>(written.bytes), seconds, seconds > 0 ? static_cast<double>(s.cells) / seconds * 60 : 0.0,
+    usage.ru_maxrss / 1024.0);
+}
 } // namespace
 
 int SynthCommand(int argc, char** argv)
@@ -199,33 +231,7 @@ int SynthCommand(int argc, char** argv)
       std::fprintf(stderr, "resmr: note: removed %s, left from an older model (no steps asked)\n", removed.c_str());
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    struct rusage usage;
-    getrusage(RUSAGE_SELF, &usage);
-    const resmr::SyntheticStatistics& s = written.statistics;
-    const double inside = static_cast<double>(s.cells - s.outside);
-    std::string files;
-    for (const std::string& file : written.files)
-    {
-      files += (files.empty() ? "\"" : ", \"") + file + "\"";
-    }
-    std::printf("{\"files\": [%s], \"dims\": [%lld, %lld, %lld], \"seed\": %llu, \"cells\": %lld, "
-                "\"active\": %lld, \"outside_cells\": %lld, \"pinched_cells\": %lld, \"water_cells\": %lld, "
-                "\"inactive_fraction\": %.6f, \"outside_fraction\": %.6f, \"pinched_fraction\": %.6f, "
-                "\"water_fraction\": %.6f, \"fault_face_fraction\": %.6f, \"oil_water_contact\": %.3f, "
-                "\"steps\": %d, \"bytes\": %lld, \"seconds\": %.3f, \"cells_per_minute\": %.0f, "
-                "\"peak_rss_mb\": %.1f}\n",
-      files.c_str(), static_cast<long long>(parameters.nx), static_cast<long long>(parameters.ny),
-      static_cast<long long>(parameters.nz), static_cast<unsigned long long>(parameters.seed),
-      static_cast<long long>(s.cells), static_cast<long long>(s.active), static_cast<long long>(s.outside),
-      static_cast<long long>(s.pinched), static_cast<long long>(s.water),
-      1.0 - static_cast<double>(s.active) / static_cast<double>(s.cells),
-      static_cast<double>(s.outside) / static_cast<double>(s.cells),
-      inside > 0 ? static_cast<double>(s.pinched) / inside : 0.0,
-      inside > 0 ? static_cast<double>(s.water) / inside : 0.0,
-      s.lateralFaces > 0 ? static_cast<double>(s.faultFaces) / static_cast<double>(s.lateralFaces) : 0.0,
-      std::isfinite(model.OilWaterContact()) ? model.OilWaterContact() : -1.0, parameters.steps,
-      static_cast<long long>(written.bytes), seconds, seconds > 0 ? static_cast<double>(s.cells) / seconds * 60 : 0.0,
-      usage.ru_maxrss / 1024.0);
+    PrintReport(parameters, model, written, seconds);
     return 0;
   }
   catch (const std::exception& error)
