@@ -65,9 +65,17 @@ mkdir -p "${build}" "${work}/corpus" "${work}/artifacts"
 fuzzer="${build}/${target}"
 echo "== building ${fuzzer}"
 # -fno-sanitize-recover: a UBSan report is a crash with an artifact, not a line in the log.
+# Core's stages are folders, each on the include path (as Core/CMakeLists.txt does).
+stages=(common eclipse synthetic simplify hierarchy format view)
+includes=()
+sources=()
+for stage in "${stages[@]}"; do
+  includes+=(-I "${repo}/Core/${stage}")
+  sources+=("${repo}/Core/${stage}"/*.cpp)
+done
 "${cxx}" -std=c++17 -g -O1 -fno-omit-frame-pointer \
   -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-  -I "${repo}/Core" "${repo}"/Core/*.cpp "${here}/${target}.cpp" -o "${fuzzer}" -llzo2
+  "${includes[@]}" "${sources[@]}" "${here}/${target}.cpp" -o "${fuzzer}" -llzo2
 
 # ---------------------------------------------------------------- corpus
 find "${seeds}" -maxdepth 1 -type f -exec cp -n {} "${work}/corpus/" \;

@@ -19,7 +19,7 @@ memory (/proc/self/status: VmRSS, and RssAnon, which leaves out pages of the mem
 .resmr and .resmrp that the kernel keeps as a cache and may drop at any time).
 
 Checks:
-- ResidentMB <= budget + OVERHEAD_MB on every frame. The region cache (Core/RegionCache.h)
+- ResidentMB <= budget + OVERHEAD_MB on every frame. The region cache (Core/view/RegionCache.h)
   makes a region resident only if its total then fits its half, after evicting the least
   recently requested regions that neither are roots nor are wanted by the newest frame; the
   roots load whatever the budget, so its bound is max(half, roots' bytes), and the roots
