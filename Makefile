@@ -1,5 +1,5 @@
 # Two entry points (see README): `make demo` and `make test`. Both install what is missing
-# (Debian 12 packages), configure and build, then run.
+# (the Debian packages of this release, 12 or 13), configure and build, then run.
 SHELL := /bin/bash
 BUILD_DIR ?= build
 PLUGIN_DIR := $(BUILD_DIR)/lib/paraview-plugins/ReservoirMultiresolution
@@ -11,10 +11,17 @@ DEMO_OUTPUT ?= demo-output
 XVFB := xvfb-run -a -s '-screen 0 1280x1024x24 -noreset'
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-# ParaView 5.11 SDK and the -dev packages its CMake config needs; build tools; the test
-# oracle (OPM) and a virtual display for headless rendering.
+# The Debian release picks the package list: 12 (bookworm) has ParaView 5.11 built with Qt 5,
+# 13 (trixie) ParaView 5.13 built with Qt 6; releases after 13 get 13's list.
+DEBIAN_RELEASE ?= $(shell . /etc/os-release 2>/dev/null; \
+  case "$$VERSION_ID:$$VERSION_CODENAME" in (12:*|*:bookworm) echo 12 ;; (*) echo 13 ;; esac)
+
+# The ParaView SDK and the -dev packages its CMake config needs; build tools; the test oracle
+# (OPM) and a virtual display for headless rendering.
 PACKAGES := paraview paraview-dev python3-paraview python3-numpy xvfb xauth \
-  cmake ninja-build g++ liblzo2-dev libglm-dev \
+  cmake ninja-build g++ liblzo2-dev libglm-dev python3-opm-common
+ifeq ($(DEBIAN_RELEASE),12)
+PACKAGES += \
   qtbase5-dev libqt5svg5-dev qttools5-dev libqt5x11extras5-dev qtxmlpatterns5-dev-tools \
   libqt5opengl5-dev libutfcpp-dev libhdf5-dev libnetcdf-dev libgdal-dev libboost-dev \
   libopenmpi-dev openmpi-bin python3-mpi4py libtheora-dev libavcodec-dev libavformat-dev libavutil-dev \
@@ -22,7 +29,16 @@ PACKAGES := paraview paraview-dev python3-paraview python3-numpy xvfb xauth \
   libpng-dev libtiff-dev libfreetype-dev libexpat1-dev zlib1g-dev libx11-dev libxt-dev \
   python3-dev libgl-dev libdouble-conversion-dev libjsoncpp-dev libpugixml-dev libfmt-dev \
   libcgns-dev libprotobuf-dev protobuf-compiler libogg-dev libsqlite3-dev libproj-dev \
-  nlohmann-json3-dev python3-opm-common
+  nlohmann-json3-dev
+else
+# What ParaView 5.13's and VTK 9.3's find-package lists ask for on Debian 13.
+PACKAGES += \
+  qt6-base-dev qt6-5compat-dev qt6-tools-dev qt6-svg-dev \
+  libboost-dev libexpat1-dev libeigen3-dev libfreetype-dev libgl2ps-dev libglew-dev libhdf5-dev \
+  libjpeg-dev liblz4-dev liblzma-dev libxml2-dev libopenmpi-dev openmpi-bin libnetcdf-dev \
+  libgl-dev libopengl-dev libglx-dev libpng-dev libtiff-dev libtheora-dev libx11-dev libxt-dev \
+  libxcursor-dev zlib1g-dev libdouble-conversion-dev python3-mpi4py libutfcpp-dev python3-dev
+endif
 
 .PHONY: all deps configure build demo test clean
 

@@ -4,6 +4,7 @@
 // past findings without libFuzzer.
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>

@@ -196,8 +196,14 @@ check_tools("Reek", reek_path, reek_warnings)
 spe9_folder = os.path.join(DATA, "spe9/opm-data_deck")
 spe9_source = os.path.join(spe9_folder, "SPE9_CP.DATA")
 spe9_includes = {name: os.path.join(spe9_folder, name) for name in ("SPE9.GRDECL", "PERMVALUES.DATA")}
+# SPE9's deck gives no FIPNUM, and OPM 2024.10 (Debian 13) refuses a COPYREG from an array the
+# deck does not give (OPM 2022.10 copies the default 1): FIPNUM is given first, in two regions,
+# so that the copy moves values that differ.
+SPE9_FIPNUM = ("REGIONS", "EQUALS\n 'FIPNUM' 1 /\n 'FIPNUM' 3 1 12 1 25 1 15 /\n/\n", [])
 spe9_blocks = [(section, block.replace(" 11 40 1 64 1 14 ", " 11 24 1 25 1 15 "), warnings)
                for section, block, warnings in GRID_EDITS] + [marker(24 * 25 * 15)]
+spe9_blocks.insert(next(i for i, (_, block, _) in enumerate(spe9_blocks) if block.startswith("COPYREG")),
+                   SPE9_FIPNUM)
 spe9_path, spe9_expected = copy_deck(
     spe9_source, "spe9", spe9_includes, spe9_blocks, extra_sections=("EDIT", "REGIONS"))
 spe9_reader = check_against_opm(

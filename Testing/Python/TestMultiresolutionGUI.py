@@ -60,7 +60,8 @@ trace = os.path.join(temp, "trace.log")
 if os.path.exists(trace):
     os.remove(trace)
 environment = dict(os.environ, PV_PLUGIN_PATH=os.path.dirname(args.plugin))
-gui = subprocess.Popen([paraview, "--dr", f"--script={setup}", "-l", f"{trace},TRACE"], env=environment,
+# --log=FILE,VERBOSITY in one argument: ParaView 5.13 reads a separate "-l" value as a data file.
+gui = subprocess.Popen([paraview, "--dr", f"--script={setup}", f"--log={trace},TRACE"], env=environment,
                        stdout=open(os.path.join(temp, "paraview.log"), "w"), stderr=subprocess.STDOUT)
 
 FRAME = re.compile(r"multiresolution surface: (\d+) regions, (\d+) triangles at ([\d.]+) px")
