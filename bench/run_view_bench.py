@@ -24,7 +24,9 @@ parser = argparse.ArgumentParser()
 parser.add_argument("--plugin", required=True)
 parser.add_argument("--resmr", required=True)
 parser.add_argument("--scratch", required=True)
-parser.add_argument("--data", default="/work/shared/data")
+parser.add_argument("--data", default=os.environ.get("RESMR_DATA_DIR") or os.path.join(
+    os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "data"),
+    help="the shared data folder (default: RESMR_DATA_DIR, else ../shared/data beside the checkout)")
 parser.add_argument("--models", nargs="+", required=True)
 parser.add_argument("--fps", type=float, default=10)
 parser.add_argument("--frames", type=int, default=300)
