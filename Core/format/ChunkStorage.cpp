@@ -141,6 +141,28 @@ void CloseDescriptor(int& descriptor)
   }
 }
 
+const uint8_t* MapOwnFile(const std::string& path, uint64_t minimumBytes, const char (&magic)[8], const std::string& kind,
+  const std::string& extension, uint64_t& size, int& descriptor)
+{
+  const uint8_t* data = MapReadOnlyFile(path, size, &descriptor);
+  std::string problem;
+  if (size < minimumBytes)
+  {
+    problem = std::to_string(size) + " bytes, too short for a " + kind + " file (truncated?)";
+  }
+  else if (std::memcmp(data, magic, 8) != 0)
+  {
+    problem = "not a " + kind + " (" + extension + ") file (bad magic at byte 0)";
+  }
+  if (!problem.empty())
+  {
+    UnmapFile(data, size);
+    CloseDescriptor(descriptor);
+    throw FileFormatError(path + ": " + problem);
+  }
+  return data;
+}
+
 void UnmapFile(const uint8_t* data, uint64_t size)
 {
   if (data)

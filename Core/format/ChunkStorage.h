@@ -41,6 +41,11 @@ std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const C
 /// for CheckMappedSize.
 const uint8_t* MapReadOnlyFile(const std::string& path, uint64_t& size, int* keep = nullptr);
 void UnmapFile(const uint8_t* data, uint64_t size);
+/// Maps one of this project's files as MapReadOnlyFile does (kept open, for CheckMappedSize)
+/// and checks that it holds at least `minimumBytes` and starts with `magic`; throws
+/// FileFormatError naming the file and the `kind` of file (e.g. "property", ".resmrp").
+const uint8_t* MapOwnFile(const std::string& path, uint64_t minimumBytes, const char (&magic)[8], const std::string& kind,
+  const std::string& extension, uint64_t& size, int& descriptor);
 void CloseDescriptor(int& descriptor);
 /// Throws FileFormatError naming the file if the open file is now shorter than the
 /// `size` bytes mapped: reading a page past its end would kill the process (SIGBUS). Called

@@ -901,20 +901,10 @@ void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader 
 MultiresolutionFile::MultiresolutionFile(const std::string& path)
   : FilePath(path)
 {
-  this->Data = MapReadOnlyFile(path, this->Size, &this->Descriptor);
-  if (this->Size < HeaderBytes + IndexTrailerBytes)
-  {
-    UnmapFile(this->Data, this->Size);
-    CloseDescriptor(this->Descriptor);
-    throw FileFormatError(
-      path + ": " + std::to_string(this->Size) + " bytes, too short for a multiresolution file (truncated?)");
-  }
+  this->Data = MapOwnFile(path, HeaderBytes + IndexTrailerBytes, HeaderMagic, "multiresolution", ".resmr", this->Size,
+    this->Descriptor);
   try
   {
-    if (std::memcmp(this->Data, HeaderMagic, 8) != 0)
-    {
-      throw FileFormatError(path + ": not a multiresolution (.resmr) file (bad magic at byte 0)");
-    }
     ByteReader head(this->Data, HeaderBytes, path + ": header");
     uint8_t magic[8];
     head.GetBytes(magic, 8);

@@ -138,20 +138,9 @@ std::string TableName(const PropertyTable& t)
 PropertyFile::PropertyFile(const std::string& path)
   : FilePath(path)
 {
-  this->Data = MapReadOnlyFile(path, this->Size, &this->Descriptor);
-  if (this->Size < HeaderBytes + IndexTrailerBytes)
-  {
-    UnmapFile(this->Data, this->Size);
-    CloseDescriptor(this->Descriptor);
-    throw FileFormatError(
-      path + ": " + std::to_string(this->Size) + " bytes, too short for a property file (truncated?)");
-  }
+  this->Data = MapOwnFile(path, HeaderBytes + IndexTrailerBytes, Magic, "property", ".resmrp", this->Size, this->Descriptor);
   try
   {
-    if (std::memcmp(this->Data, Magic, 8) != 0)
-    {
-      throw FileFormatError(path + ": not a property (.resmrp) file (bad magic at byte 0)");
-    }
     uint32_t crc;
     std::memcpy(&crc, this->Data + HeaderBytes - 4, 4);
     if (Crc32(this->Data, HeaderBytes - 4) != crc)

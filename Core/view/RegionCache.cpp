@@ -632,9 +632,15 @@ bool RegionCache::Pending() const
 
 bool RegionCache::WaitIdle(std::chrono::milliseconds timeout) const
 {
+  return this->WaitWhile(timeout, &RegionCache::PendingLocked);
+}
+
+bool RegionCache::WaitWhile(std::chrono::milliseconds timeout, bool (RegionCache::*busy)() const) const
+{
   std::unique_lock<std::mutex> lock(this->Lock);
   const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (this->PendingLocked())
+  // Each load ends with Idle notified, so every mesh that arrives wakes this wait.
+  while ((this->*busy)())
   {
     this->RescueIfStarvedLocked();
     const auto now = std::chrono::steady_clock::now();
@@ -662,21 +668,7 @@ bool RegionCache::RootsMissing() const
 
 bool RegionCache::WaitForRoots(std::chrono::milliseconds timeout) const
 {
-  std::unique_lock<std::mutex> lock(this->Lock);
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  // Each load ends with Idle notified, so every root that arrives wakes this wait.
-  while (this->RootsMissingLocked())
-  {
-    this->RescueIfStarvedLocked();
-    const auto now = std::chrono::steady_clock::now();
-    if (now >= deadline)
-    {
-      return false;
-    }
-    const std::chrono::steady_clock::duration slice = this->StarvationWindow / 2;
-    this->Idle.wait_for(lock, std::min<std::chrono::steady_clock::duration>(deadline - now, slice));
-  }
-  return true;
+  return this->WaitWhile(timeout, &RegionCache::RootsMissingLocked);
 }
 
 void RegionCache::SetStarvationWindow(std::chrono::milliseconds window)

@@ -229,6 +229,8 @@ private:
   int64_t NextRegionLocked();
   bool PendingLocked() const;
   bool RootsMissingLocked() const;
+  /// Waits (the lock released) while `busy` holds, at most `timeout`; false on timeout.
+  bool WaitWhile(std::chrono::milliseconds timeout, bool (RegionCache::*busy)() const) const;
   /// Neither loaded nor failed (it may be being read). Lock held.
   bool MissingLocked(Key key) const;
   /// The current layer's roots are pinned. Lock held.
