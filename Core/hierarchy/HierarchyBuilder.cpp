@@ -5,6 +5,7 @@
 #include "ColumnCollapse.h"
 #include "ColumnMesh.h"
 #include "DiamondHierarchy.h"
+#include "DiskUse.h"
 #include "HashMix.h"
 #include "LeafPartition.h"
 #include "MemoryBudget.h"
@@ -582,9 +583,11 @@ private:
   using Leaf = std::pair<int64_t, std::vector<int64_t>>;
   /// Scratch bytes a vertex of a column mesh costs while a region is built.
   static constexpr int64_t VertexBytes = 24 + 80 + 40;
-  int PrepareScratch(MultiresolutionHeader& header, HierarchyReport& report);
+  int PrepareScratch(MultiresolutionHeader& header, HierarchyReport& report, bool& partitioned);
   void Resume(int finished, const MultiresolutionHeader& header);
   void PartitionInput();
+  void ReopenPartition();
+  void CheckFreeDisk() const;
   std::vector<Leaf> PlanLeaves(MultiresolutionHeader& header, HierarchyReport& report);
   void BuildLeaves(const std::vector<Leaf>& leaves, int leafLevel, HierarchyReport& report);
   std::vector<std::size_t> Share(std::size_t count) const;
@@ -635,6 +638,8 @@ private:
   std::string Scratch;
   std::mutex ProgressLock;
   std::unique_ptr<LeafPartition> Partition;
+  uint64_t PartitionChunkBytes = 0; ///< rank 0's chunk file once the partition pass is done
+  std::unique_ptr<DiskMeter> Meter; ///< rank 0's
   DiamondHierarchy Tree;
   MultiresolutionHeader Header;
   std::unique_ptr<ChunkFile> Chunks;
@@ -798,6 +803,7 @@ void Builder::WriteBuildManifest(const MultiresolutionHeader& header, const Hier
   {
     out.Put(m);
   }
+  out.Put(this->PartitionChunkBytes);
   out.Save(this->Scratch + "/build.manifest");
 }
 
@@ -832,6 +838,7 @@ bool Builder::ReadBuildManifest(MultiresolutionHeader& header, HierarchyReport& 
     {
       this->ActiveLayers.push_back(in.Get<ModelChunk>());
     }
+    this->PartitionChunkBytes = in.Get<uint64_t>();
   }
   catch (const std::runtime_error&)
   {
@@ -1274,9 +1281,10 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
   this->Chunks->AddModelArray(ModelChunk::CellNormals, slotNormals.data(), slotNormals.size() * 4, model);
 }
 
-/// Creates the scratch folder, or finds in it the last level every rank finished (-1: none,
-/// start over) and clears what an unfinished level left.
-int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& report)
+/// Creates the scratch folder, or finds in it the last level every rank finished (-1: none)
+/// and clears what an unfinished level left. `partitioned`: no level is finished but the
+/// partition pass is, so the build resumes with the leaves.
+int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& report, bool& partitioned)
 {
   const bool lead = this->Options.rank == 0;
   if (mkdir(this->Scratch.c_str(), 0755) != 0 && errno != EEXIST)
@@ -1284,8 +1292,10 @@ int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& repo
     throw std::runtime_error(this->Scratch + ": cannot create the scratch folder: " + std::strerror(errno));
   }
   int finished = -1;
+  partitioned = false;
   if (this->ReadBuildManifest(header, report))
   {
+    partitioned = Exists(this->Scratch + "/tiles/partition.state");
     for (int level = header.leafLevel; level >= 0; --level)
     {
       bool all = true;
@@ -1300,11 +1310,23 @@ int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& repo
       finished = level;
     }
   }
+  if (finished < 0 && !partitioned && this->Options.checkDisk)
+  {
+    try
+    {
+      this->CheckFreeDisk(); // every rank: they see the same disks, so all refuse or none
+    }
+    catch (const std::runtime_error&)
+    {
+      rmdir(this->Scratch.c_str()); // the folder just made, if nothing else is in it
+      throw;
+    }
+  }
   this->Barrier();
   if (lead)
   {
     // Start over, or clear what the unfinished level left (other ranks wait below).
-    if (finished < 0)
+    if (finished < 0 && !partitioned)
     {
       RemoveTree(this->Scratch);
       if (mkdir(this->Scratch.c_str(), 0755) != 0 && errno != EEXIST)
@@ -1319,6 +1341,41 @@ int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& repo
   }
   this->Barrier();
   return finished;
+}
+
+/// Refuses a build the disks cannot hold (BuildDiskNeed), before any work, with what it needs.
+void Builder::CheckFreeDisk() const
+{
+  const BuildDiskNeed need(this->CellCount);
+  const uint64_t scratchFree = FreeDiskBytes(this->Scratch), outputFree = FreeDiskBytes(this->Output);
+  const bool shared = SameFilesystem(this->Scratch, this->Output);
+  const auto gb = [](uint64_t bytes) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.1f GB", double(bytes) / 1e9);
+    return std::string(text);
+  };
+  const std::string what = std::to_string(this->CellCount) + " cells need about " + gb(need.scratch) +
+    " of scratch and " + gb(need.file) + " for the file (" + std::to_string(need.ScratchBytesPerCell) + " and " +
+    std::to_string(need.FileBytesPerCell) + " bytes a cell)";
+  std::string problem;
+  if (shared && scratchFree < need.scratch + need.file)
+  {
+    problem = this->Scratch + " and " + this->Output + " share a disk with " + gb(scratchFree) + " free";
+  }
+  else if (!shared && scratchFree < need.scratch)
+  {
+    problem = "the scratch folder " + this->Scratch + " has " + gb(scratchFree) + " free";
+  }
+  else if (!shared && outputFree < need.file)
+  {
+    problem = "the output " + this->Output + " has " + gb(outputFree) + " free";
+  }
+  if (!problem.empty())
+  {
+    throw std::runtime_error("not enough free disk: " + what + "; " + problem +
+      ". Put the scratch folder on a disk with room (--scratch DIR), or free some space (--no-disk-check "
+      "starts anyway; a build stopped by a full disk keeps its finished work and resumes)");
+  }
 }
 
 /// Reloads the levels a killed build finished and reopens this rank's chunk file at the
@@ -1373,11 +1430,23 @@ void Builder::PartitionInput()
         this->ActiveLayers.push_back(chunk);
       }));
     this->Partition->SaveState();
+    this->PartitionChunkBytes = this->Chunks->Sync();
   });
   if (!lead)
   {
     this->Partition.reset(new LeafPartition(this->Scratch + "/tiles"));
   }
+}
+
+/// The partition pass of a killed build, reopened from its tiles; rank 0 takes the tiles over
+/// (removed once the leaves are built) and its chunk file is cut back to the active flags.
+void Builder::ReopenPartition()
+{
+  const bool lead = this->Options.rank == 0;
+  this->Chunks.reset(
+    new ChunkFile(this->ChunkPath(this->Options.rank), lead ? static_cast<int64_t>(this->PartitionChunkBytes) : 0));
+  this->Partition.reset(new LeafPartition(this->Scratch + "/tiles"));
+  this->Partition->SetRemoveOnDestroy(lead);
 }
 
 /// The hierarchy over the pillars' extent, its leaf level chosen for Cmax columns a leaf, and
@@ -1573,6 +1642,10 @@ void Builder::WriteFile(MultiresolutionHeader& header, HierarchyReport& report)
     AssembleMultiresolutionFile(this->Output, header, paths, regions, modelParts);
     struct stat info;
     report.fileBytes = stat(this->Output.c_str(), &info) == 0 ? static_cast<uint64_t>(info.st_size) : 0;
+    // The file is whole beside the scratch it was made from: the build's last peak.
+    this->Meter->Sample(uint64_t(info.st_blocks) * 512);
+    report.peakScratchBytes = this->Meter->PeakScratchBytes();
+    report.peakDiskBytes = this->Meter->PeakTotalBytes();
   });
 }
 
@@ -1584,7 +1657,12 @@ HierarchyReport Builder::Run()
   report.cells = dims[0] * dims[1] * dims[2];
   this->CellCount = report.cells;
   MultiresolutionHeader header;
-  int finished = this->PrepareScratch(header, report);
+  bool partitioned = false;
+  if (this->Options.rank == 0)
+  {
+    this->Meter.reset(new DiskMeter(this->Scratch, this->Output));
+  }
+  int finished = this->PrepareScratch(header, report, partitioned);
   bool keepScratch = false;
   try
   {
@@ -1595,10 +1673,19 @@ HierarchyReport Builder::Run()
     }
     else
     {
-      this->PartitionInput();
-      report.partitionSeconds = Seconds() - start;
+      if (partitioned)
+      {
+        report.resumedFromPartition = true;
+        this->ReopenPartition();
+      }
+      else
+      {
+        this->PartitionInput();
+        report.partitionSeconds = Seconds() - start;
+      }
       report.activeCells = this->Partition->ActiveCells();
       const std::vector<Leaf> leaves = this->PlanLeaves(header, report);
+      keepScratch = true; // the partition is finished: a failure from here keeps it
       this->BuildLeaves(leaves, header.leafLevel, report);
       finished = header.leafLevel;
     }
@@ -1610,6 +1697,10 @@ HierarchyReport Builder::Run()
   catch (const std::exception& error)
   {
     this->Chunks.reset();
+    if (this->Partition)
+    {
+      this->Partition->SetRemoveOnDestroy(!keepScratch && this->Options.rank == 0);
+    }
     this->Partition.reset();
     if (!keepScratch)
     {
@@ -1619,10 +1710,11 @@ HierarchyReport Builder::Run()
       }
       throw;
     }
-    throw std::runtime_error(std::string(error.what()) + " (finished levels are kept in " + this->Scratch +
+    throw std::runtime_error(std::string(error.what()) + " (the finished work is kept in " + this->Scratch +
       ": run the same build again to resume)");
   }
   this->Chunks.reset();
+  this->Meter.reset();
   this->Barrier();
   if (this->Options.rank == 0)
   {

@@ -56,6 +56,9 @@ struct HierarchyOptions
   /// Continue a build killed in the same scratch folder (same input and options) from its
   /// last finished level; false: start over.
   bool resume = true;
+  /// Refuse to start when the disks of the scratch folder and the output have less free
+  /// space than the build needs (see BuildDiskNeed).
+  bool checkDisk = true;
   /// MPI (through ParaView's controller, vtkBuildMultiresolutionHierarchy): this process's
   /// rank among `ranks`, which share the scratch folder and split the leaves and each
   /// level's diamonds. `barrier` must return once every rank has called it (required when
@@ -71,10 +74,28 @@ struct HierarchyReport
   int leafLevel = 0;
   int64_t regions = 0, nonEmptyRegions = 0;
   int threadsUsed = 0;
-  int resumedFromLevel = -1; ///< the last finished level a resumed build started from, or -1
+  int resumedFromLevel = -1;         ///< the last finished level a resumed build started from, or -1
+  bool resumedFromPartition = false; ///< a resumed build reused the partition pass and redid the leaves
   uint64_t hashedCells = 0, hashSlots = 0, hashOffsets = 0; ///< perfect hash (Sec. 5.4)
   uint64_t fileBytes = 0;
+  /// Peak bytes of the scratch folder, and of the scratch folder with the file being written.
+  uint64_t peakScratchBytes = 0, peakDiskBytes = 0;
   double partitionSeconds = 0, leafSeconds = 0, simplifySeconds = 0, totalSeconds = 0;
+};
+
+/// Disk a build of `cells` cells needs at its peak: the scratch folder (tiles, region meshes
+/// with their quadrics, chunks) and the file, a bound with some margin over what the build
+/// benchmark measures (docs/benchmarks.md).
+struct BuildDiskNeed
+{
+  static constexpr uint64_t ScratchBytesPerCell = 150;
+  static constexpr uint64_t FileBytesPerCell = 16;
+  uint64_t scratch = 0, file = 0;
+  explicit BuildDiskNeed(int64_t cells)
+    : scratch(uint64_t(cells) * ScratchBytesPerCell)
+    , file(uint64_t(cells) * FileBytesPerCell)
+  {
+  }
 };
 
 /// Phase name and fraction of the whole build done (0..1).

@@ -40,6 +40,10 @@ public:
   explicit LeafPartition(const std::string& folder);
   /// Writes what the constructor learnt (columns, extent, tiles) for LeafPartition(folder).
   void SaveState() const;
+  /// Whether the destructor removes the tiles and the state: by default the writer does and
+  /// a reader does not; a failed build keeps them to resume, and a resumed build's rank 0
+  /// takes them over to remove them once the leaves are built.
+  void SetRemoveOnDestroy(bool remove) { this->Owner = remove; }
   ~LeafPartition();
   LeafPartition(const LeafPartition&) = delete;
   LeafPartition& operator=(const LeafPartition&) = delete;
