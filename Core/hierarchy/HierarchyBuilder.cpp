@@ -1356,7 +1356,7 @@ void Builder::CheckFreeDisk() const
   };
   const std::string what = std::to_string(this->CellCount) + " cells need about " + gb(need.scratch) +
     " of scratch and " + gb(need.file) + " for the file (" + std::to_string(need.ScratchBytesPerCell) + " and " +
-    std::to_string(need.FileBytesPerCell) + " bytes a cell)";
+    std::to_string(need.FileBytesPerCell) + " bytes a cell, and a few hundred MB)";
   std::string problem;
   if (shared && scratchFree < need.scratch + need.file)
   {

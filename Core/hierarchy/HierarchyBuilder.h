@@ -85,15 +85,16 @@ struct HierarchyReport
 
 /// Disk a build of `cells` cells needs at its peak: the scratch folder (tiles, region meshes
 /// with their quadrics, chunks) and the file, a bound with some margin over what the build
-/// benchmark measures (docs/benchmarks.md).
+/// benchmark measures (docs/benchmarks.md); small models cost more a cell, hence the fixed
+/// parts.
 struct BuildDiskNeed
 {
-  static constexpr uint64_t ScratchBytesPerCell = 150;
-  static constexpr uint64_t FileBytesPerCell = 16;
+  static constexpr uint64_t ScratchBytesPerCell = 150, ScratchFixedBytes = uint64_t(256) << 20;
+  static constexpr uint64_t FileBytesPerCell = 16, FileFixedBytes = uint64_t(64) << 20;
   uint64_t scratch = 0, file = 0;
   explicit BuildDiskNeed(int64_t cells)
-    : scratch(uint64_t(cells) * ScratchBytesPerCell)
-    , file(uint64_t(cells) * FileBytesPerCell)
+    : scratch(uint64_t(cells) * ScratchBytesPerCell + ScratchFixedBytes)
+    , file(uint64_t(cells) * FileBytesPerCell + FileFixedBytes)
   {
   }
 };
