@@ -70,6 +70,12 @@ if [ ! -x "$root/usr/bin/apt-get" ] || [ -d "$root/debootstrap" ]; then
   debootstrap --variant=minbase trixie "$root" "$mirror"
 fi
 
+# The chroot's / a mount point of its own: tests make private mount namespaces there (unshare -m
+# sets the propagation of /, which must be a mount point).
+if ! mountpoint -q "$root"; then
+  mount --bind "$root" "$root"
+  mounts+=("$root")
+fi
 mount_in /proc -t proc proc
 mount_in /sys -t sysfs sysfs
 mount_in /dev --bind /dev

@@ -5,7 +5,8 @@ keeps what it finished, resumes when there is room, and writes the file an unint
 writes.
 
 The full disks are small tmpfs filesystems mounted in a private mount namespace (unshare -m),
-grown after the failure (mount -o remount,size=...) for the resumed run.
+grown after the failure (mount -o remount,size=...) for the resumed run, to more than the
+free-disk check asks of a build that starts over.
 
 usage: TestBuildDiskFull.py RESMR TEMP
 """
@@ -100,7 +101,7 @@ for step in range(1, 20):
     script = (f"'{resmr}' build {model} -o '{out}' {flags} --quiet --no-disk-check > '{temp}/first.json' "
               f"2> '{temp}/first.err'; echo $? > '{temp}/first.rc'; "
               f"ls -A '{out}.scratch' > '{temp}/kept.txt' 2>/dev/null; "
-              f"mount -o remount,size={peak * 2} '{disk}' && "
+              f"mount -o remount,size={peak * 2 + (1 << 30)} '{disk}' && "
               f"'{resmr}' build {model} -o '{out}' {flags} --quiet > '{temp}/second.json' 2> '{temp}/second.err' && "
               f"'{resmr}' info --regions '{out}' > '{temp}/info.json'")
     run = in_namespace(size, script)
