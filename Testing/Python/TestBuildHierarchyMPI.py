@@ -11,6 +11,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 
 from paraview import simple
 from vtkmodules.vtkParallelCore import vtkMultiProcessController
@@ -19,6 +20,11 @@ parser = argparse.ArgumentParser()
 parser.add_argument("--plugin", required=True)
 parser.add_argument("--temp", required=True)
 parser.add_argument("--resmr", required=True)
+parser.add_argument("--model", default="synth:90x70x12:5",
+                    help="the input both builds read (the test's is small; bigger ones check the scale)")
+parser.add_argument("--cmax", type=int, default=64)
+parser.add_argument("--threads", type=int, default=1, help="worker threads of each rank")
+parser.add_argument("--single-threads", type=int, default=0, help="worker threads of the one process (0: --threads)")
 args = parser.parse_args()
 
 controller = vtkMultiProcessController.GetGlobalController()
@@ -31,7 +37,7 @@ os.makedirs(args.temp, exist_ok=True)
 controller.Barrier()
 simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
 
-model = "synth:90x70x12:5"
+model = args.model
 parallel = os.path.join(args.temp, "two-ranks.resmr")
 single = os.path.join(args.temp, "one-process.resmr")
 if rank == 0:
@@ -40,7 +46,8 @@ if rank == 0:
             os.remove(path)
 controller.Barrier()
 
-build = simple.BuildMultiresolutionHierarchy(Input=model, FileName=parallel, Cmax=64, Threads=1)
+started = time.time()
+build = simple.BuildMultiresolutionHierarchy(Input=model, FileName=parallel, Cmax=args.cmax, Threads=args.threads)
 build.UpdatePipeline()
 build.UpdatePropertyInformation()
 error = build.GetPropertyValue("LastError")
@@ -48,11 +55,14 @@ if error:
     print(f"FAIL: rank {rank}: {error}")
     sys.exit(1)
 controller.Barrier()
+parallel_seconds = time.time() - started
 
 failed = False
 if rank == 0:
-    subprocess.run([args.resmr, "build", model, "-o", single, "--cmax", "64", "--threads", "1", "--quiet"],
-                   check=True, stdout=subprocess.DEVNULL)
+    started = time.time()
+    subprocess.run([args.resmr, "build", model, "-o", single, "--cmax", str(args.cmax), "--threads",
+                    str(args.single_threads or args.threads), "--quiet"], check=True, stdout=subprocess.DEVNULL)
+    print(f"two ranks: {parallel_seconds:.1f} s; one process: {time.time() - started:.1f} s")
 
     def info(path):
         text = subprocess.run([args.resmr, "info", "--regions", path], check=True, capture_output=True,
@@ -72,13 +82,16 @@ if rank == 0:
         differ = [x for x, y in zip(a["region_list"], b["region_list"]) if x != y]
         print(f"FAIL: {len(differ)} region records differ, first: {differ[:2]}")
         failed = True
-    # The parallel file is a real one: chunks of both ranks, readable end to end.
-    level = simple.ExtractMultiresolutionLevel(FileName=parallel, Level=a["leaf_level"])
-    level.UpdatePipeline()
-    cells = level.GetDataInformation().GetNumberOfCells()
-    if cells != 90 * 70 * 12 - 0 and cells <= 0:
-        print(f"FAIL: finest level of the two-rank file has {cells} cells")
-        failed = True
+    # The parallel file is a real one: chunks of both ranks, readable end to end (the finest
+    # level of a small model; a big one's would not fit in memory, and its chunks' CRCs are
+    # compared above).
+    if a["cells"] <= 10_000_000:
+        level = simple.ExtractMultiresolutionLevel(FileName=parallel, Level=a["leaf_level"])
+        level.UpdatePipeline()
+        cells = level.GetDataInformation().GetNumberOfCells()
+        if cells <= 0:
+            print(f"FAIL: finest level of the two-rank file has {cells} cells")
+            failed = True
     if not failed:
         print(f"MPI build equivalent: {len(regions)} regions, {a['leaf_level'] + 1} levels, "
               f"{a['hash']['cells']} hashed cells, geometry {a['geometry_id']}")
