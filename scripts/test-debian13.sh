@@ -9,7 +9,7 @@
 # reused after; it must lie outside the repository. The test data comes from $RESMR_DATA_DIR,
 # else ../shared/data beside the repository, mounted read-only as ../shared/data beside the
 # clone. $DEBIAN_MIRROR picks the mirror (default http://deb.debian.org/debian).
-# The log of the last run is CHROOT_DIR/work/test-debian13.log; the exit status is make's.
+# The log of the last run is CHROOT_DIR/srv/test-debian13.log; the exit status is make's.
 set -euo pipefail
 
 if [ "$(id -u)" != 0 ]; then
@@ -82,7 +82,9 @@ mount_in /dev --bind /dev
 mount_in /dev/pts --bind /dev/pts
 # OpenMPI's shared-memory transport needs a tmpfs at /dev/shm; the chroot gets its own.
 mount_in /dev/shm -t tmpfs -o mode=1777 tmpfs
-mount_in /work/shared/data --bind -o ro "$data"
+# Inside the chroot the clone is /srv/ReservoirMultiresolution, the data beside it in
+# /srv/shared/data, where the build looks for it (../shared/data).
+mount_in /srv/shared/data --bind -o ro "$data"
 cp -L /etc/resolv.conf "$root/etc/resolv.conf"
 
 in_root() { chroot "$root" /usr/bin/env -i HOME=/root TERM="${TERM:-dumb}" LANG=C.UTF-8 \
@@ -95,7 +97,7 @@ if [ -n "$missing" ]; then
   in_root env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends $missing
 fi
 
-clone="$root/work/ReservoirMultiresolution"
+clone="$root/srv/ReservoirMultiresolution"
 rm -rf --one-file-system "$clone"
 git clone --quiet --no-checkout "$repo" "$clone"
 git -C "$clone" checkout --quiet --detach "$head"
@@ -103,15 +105,15 @@ echo "test-debian13: testing $(git -C "$clone" log -1 --format='%h %s') in $root
 
 # The packages first (network needed), then the suite in a network namespace of its own: its
 # Xvfb display, pvserver port and MPI sockets cannot meet those of tests run on the host.
-log="$root/work/test-debian13.log"
+log="$root/srv/test-debian13.log"
 start=$(date +%s)
 status=0
 {
-  in_root sh -c 'cd /work/ReservoirMultiresolution && make deps' &&
+  in_root sh -c 'cd /srv/ReservoirMultiresolution && make deps' &&
   unshare --net sh -c 'ip link set lo up && exec "$@"' sh \
     chroot "$root" /usr/bin/env -i HOME=/root LANG=C.UTF-8 CI=true \
     PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
-    nice -n 10 sh -c 'cd /work/ReservoirMultiresolution && make test'
+    nice -n 10 sh -c 'cd /srv/ReservoirMultiresolution && make test'
 } 2>&1 | tee "$log" || status=$?
 elapsed=$(( $(date +%s) - start ))
 
