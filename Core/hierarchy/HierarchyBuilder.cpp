@@ -1,6 +1,8 @@
 // Out-of-core, multi-threaded build of the diamond hierarchy, paper Sec. 4.2 (with 4.3 and 6.2).
 #include "HierarchyBuilder.h"
 
+#include "BuildJournal.h"
+#include "BuildSchedule.h"
 #include "ByteStream.h"
 #include "ColumnCollapse.h"
 #include "ColumnMesh.h"
@@ -52,67 +54,148 @@ std::string RegionPath(const std::string& folder, int level, int64_t index)
 }
 
 template<typename T>
-void PutVector(std::FILE* file, const std::vector<T>& values, bool& ok)
+void PutVector(ByteWriter& out, const std::vector<T>& values)
 {
-  const uint64_t count = values.size();
-  ok = ok && std::fwrite(&count, sizeof(count), 1, file) == 1;
-  ok = ok && (count == 0 || std::fwrite(values.data(), sizeof(T), values.size(), file) == values.size());
+  out.Put(static_cast<uint64_t>(values.size()));
+  out.PutBytes(values.data(), values.size() * sizeof(T));
 }
 
 template<typename T>
-void GetVector(std::FILE* file, std::vector<T>& values, bool& ok)
+void GetVector(ByteReader& in, std::vector<T>& values)
 {
-  uint64_t count = 0;
-  ok = ok && std::fread(&count, sizeof(count), 1, file) == 1 && count < (uint64_t(1) << 40);
-  if (ok)
+  const uint64_t count = std::min<uint64_t>(in.Get<uint64_t>(), in.Left() / sizeof(T) + 1);
+  const uint8_t* bytes = in.Skip(static_cast<std::size_t>(count * sizeof(T)));
+  values.resize(static_cast<std::size_t>(count));
+  if (count > 0)
   {
-    values.resize(count);
-    ok = count == 0 || std::fread(values.data(), sizeof(T), values.size(), file) == values.size();
+    std::memcpy(values.data(), bytes, static_cast<std::size_t>(count * sizeof(T)));
   }
 }
 
-void SaveRegion(const std::string& path, const ScratchRegion& region)
+/// Scratch files are LZO-compressed in pieces (chunks hold at most MaxChunkBytes), written
+/// under a temporary name, synced and renamed: a scratch file is there whole or not at all.
+void SaveCompressed(const std::string& path, const std::vector<uint8_t>& raw)
 {
-  std::FILE* file = std::fopen(path.c_str(), "wb");
+  constexpr std::size_t piece = std::size_t(1) << 30;
+  const std::string temporary = path + ".part";
+  std::FILE* file = std::fopen(temporary.c_str(), "wb");
   if (!file)
   {
     throw std::runtime_error(path + ": cannot create scratch file: " + std::strerror(errno));
   }
-  bool ok = std::fwrite(&region.mesh.layers, sizeof(int32_t), 1, file) == 1;
-  PutVector(file, region.mesh.positions, ok);
-  PutVector(file, region.mesh.quadrics, ok);
-  PutVector(file, region.mesh.topology, ok);
-  PutVector(file, region.mesh.corners, ok);
-  PutVector(file, region.mesh.activeCells, ok);
-  PutVector(file, region.mesh.origin, ok);
-  PutVector(file, region.cutEdges, ok);
-  PutVector(file, region.openSides, ok);
-  ok = (std::fclose(file) == 0) && ok;
-  if (!ok)
+  const uint64_t size = raw.size();
+  bool ok = std::fwrite(&size, sizeof(size), 1, file) == 1;
+  for (std::size_t at = 0; ok && at < raw.size(); at += piece)
   {
-    unlink(path.c_str());
+    const std::vector<uint8_t> part(raw.begin() + static_cast<std::ptrdiff_t>(at),
+      raw.begin() + static_cast<std::ptrdiff_t>(std::min(raw.size(), at + piece)));
+    const std::vector<uint8_t> stored = CompressChunk(part);
+    const uint32_t head[3] = { static_cast<uint32_t>(stored.size()), static_cast<uint32_t>(part.size()),
+      Crc32(stored.data(), stored.size()) };
+    ok = std::fwrite(head, sizeof(head), 1, file) == 1 &&
+      std::fwrite(stored.data(), 1, stored.size(), file) == stored.size();
+  }
+  ok = (std::fflush(file) == 0) && (fsync(fileno(file)) == 0) && ok;
+  ok = (std::fclose(file) == 0) && ok;
+  if (!ok || std::rename(temporary.c_str(), path.c_str()) != 0)
+  {
+    unlink(temporary.c_str());
     throw std::runtime_error(path + ": scratch write failed (disk full?)");
   }
 }
 
-bool LoadRegion(const std::string& path, ScratchRegion& region)
+/// False if the file is absent; throws naming it if it is damaged.
+bool LoadCompressed(const std::string& path, std::vector<uint8_t>& raw)
 {
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (!file)
   {
+    return false;
+  }
+  std::vector<uint8_t> stored;
+  uint8_t block[65536];
+  std::size_t got = 0;
+  while ((got = std::fread(block, 1, sizeof(block), file)) > 0)
+  {
+    stored.insert(stored.end(), block, block + got);
+  }
+  std::fclose(file);
+  uint64_t size = 0;
+  bool ok = stored.size() >= sizeof(size);
+  if (ok)
+  {
+    std::memcpy(&size, stored.data(), sizeof(size));
+  }
+  raw.clear();
+  std::size_t at = sizeof(size);
+  while (ok && raw.size() < size)
+  {
+    uint32_t head[3];
+    ok = at + sizeof(head) <= stored.size();
+    if (!ok)
+    {
+      break;
+    }
+    std::memcpy(head, stored.data() + at, sizeof(head));
+    ChunkRef ref;
+    ref.offset = at + sizeof(head);
+    ref.stored = head[0];
+    ref.raw = head[1];
+    ref.crc = head[2];
+    try
+    {
+      const std::vector<uint8_t> part = DecompressChunk(stored.data(), stored.size(), ref, path);
+      raw.insert(raw.end(), part.begin(), part.end());
+    }
+    catch (const std::exception&)
+    {
+      ok = false;
+    }
+    at = ref.offset + ref.stored;
+  }
+  if (!ok || raw.size() != size || at != stored.size())
+  {
+    throw std::runtime_error(path + ": scratch file is truncated or corrupt");
+  }
+  return true;
+}
+
+void SaveRegion(const std::string& path, const ScratchRegion& region)
+{
+  ByteWriter out;
+  out.Put(region.mesh.layers);
+  PutVector(out, region.mesh.positions);
+  PutVector(out, region.mesh.quadrics);
+  PutVector(out, region.mesh.topology);
+  PutVector(out, region.mesh.corners);
+  PutVector(out, region.mesh.activeCells);
+  PutVector(out, region.mesh.origin);
+  PutVector(out, region.cutEdges);
+  PutVector(out, region.openSides);
+  SaveCompressed(path, out.Bytes);
+}
+
+bool LoadRegion(const std::string& path, ScratchRegion& region)
+{
+  std::vector<uint8_t> raw;
+  if (!LoadCompressed(path, raw))
+  {
     return false; // an empty region saves nothing
   }
-  bool ok = std::fread(&region.mesh.layers, sizeof(int32_t), 1, file) == 1;
-  GetVector(file, region.mesh.positions, ok);
-  GetVector(file, region.mesh.quadrics, ok);
-  GetVector(file, region.mesh.topology, ok);
-  GetVector(file, region.mesh.corners, ok);
-  GetVector(file, region.mesh.activeCells, ok);
-  GetVector(file, region.mesh.origin, ok);
-  GetVector(file, region.cutEdges, ok);
-  GetVector(file, region.openSides, ok);
-  std::fclose(file);
-  if (!ok)
+  try
+  {
+    ByteReader in(raw.data(), raw.size(), path);
+    region.mesh.layers = in.Get<int32_t>();
+    GetVector(in, region.mesh.positions);
+    GetVector(in, region.mesh.quadrics);
+    GetVector(in, region.mesh.topology);
+    GetVector(in, region.mesh.corners);
+    GetVector(in, region.mesh.activeCells);
+    GetVector(in, region.mesh.origin);
+    GetVector(in, region.cutEdges);
+    GetVector(in, region.openSides);
+  }
+  catch (const std::exception&)
   {
     throw std::runtime_error(path + ": scratch file is truncated or corrupt");
   }
@@ -601,12 +684,27 @@ private:
       this->Progress(phase, fraction);
     }
   }
-  void BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns);
-  void BuildDiamond(const DiamondHierarchy::Diamond& diamond);
+  /// A finished region on its way to the chunk file.
+  struct Emitted
+  {
+    RegionMesh mesh;
+    RegionRecord record;
+    std::array<double, 6> box{};
+  };
+  void BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns, std::vector<Emitted>& out);
+  void BuildDiamond(const DiamondHierarchy::Diamond& diamond, std::vector<Emitted>& out);
   std::vector<ScratchRegion> LoadChildren(const DiamondHierarchy::Diamond& diamond) const;
   void SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const ColumnMesh& mesh,
-    const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides);
-  void Emit(int level, int64_t index, const ScratchRegion& region, bool keepScratch);
+    const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides, std::vector<Emitted>& out);
+  /// Saves the region's scratch file (for the level above) and encodes it.
+  void Prepare(int level, int64_t index, const ScratchRegion& region, bool keepScratch, std::vector<Emitted>& out);
+  /// Appends a task's regions to the chunk file and records them; with `task` (a one-process
+  /// build), also in the journal.
+  void Commit(std::vector<Emitted>& out, const BuildSchedule::Task* task);
+  /// A leaf's box of columns with its halo: i0, i1, j0, j1.
+  std::array<int64_t, 4> LeafBox(const std::vector<int64_t>& columns) const;
+  void BuildDepthFirst(const std::vector<Leaf>& leaves, HierarchyReport& report);
+  std::vector<uint8_t> ReadJournal(const BuildSchedule& schedule, HierarchyReport& report);
   int ThreadsFor(int64_t bytesPerTask) const;
   void Barrier()
   {
@@ -644,7 +742,8 @@ private:
   MultiresolutionHeader Header;
   std::unique_ptr<ChunkFile> Chunks;
   std::vector<ModelChunk> ActiveLayers; ///< rank 0's
-  std::mutex RecordLock;
+  std::mutex RecordLock, CommitLock;
+  std::unique_ptr<BuildJournal> Journal; ///< one-process builds
   std::map<std::pair<int, int64_t>, RegionRecord> Records;
   std::map<std::pair<int, int64_t>, int> Parts; ///< the rank whose chunk file holds a region
   std::map<std::pair<int, int64_t>, std::array<double, 6>> OwnBoxes;
@@ -706,26 +805,62 @@ void Builder::Collective(const std::function<void()>& work)
   }
 }
 
-void Builder::Emit(int level, int64_t index, const ScratchRegion& region, bool keepScratch)
+void Builder::Prepare(
+  int level, int64_t index, const ScratchRegion& region, bool keepScratch, std::vector<Emitted>& out)
 {
   if (keepScratch)
   {
     SaveRegion(RegionPath(this->Scratch, level, index), region);
   }
-  RegionRecord record;
-  record.level = level;
-  record.index = index;
+  Emitted emitted;
+  emitted.record.level = level;
+  emitted.record.index = index;
   const double ownError = QuadricDistance(region.mesh);
-  record.ownError = static_cast<float>(ownError);
+  emitted.record.ownError = static_cast<float>(ownError);
   // The file rounds positions to its lattice after simplification: allow one step more.
   const auto& step = this->Header.latticeStep;
-  const RegionMesh mesh = ToRegionMesh(region, this->Header, level == this->Header.leafLevel ? 0.f : record.ownError,
+  emitted.mesh = ToRegionMesh(region, this->Header, level == this->Header.leafLevel ? 0.f : emitted.record.ownError,
     ownError + std::sqrt(step[0] * step[0] + step[1] * step[1] + step[2] * step[2]));
-  this->Chunks->AddRegion(mesh, this->Header, record);
+  emitted.box = BoxOf(region.mesh.positions);
+  out.push_back(std::move(emitted));
+}
+
+void Builder::Commit(std::vector<Emitted>& out, const BuildSchedule::Task* task)
+{
+  // One task's chunks lie together and its journal record follows them, so a resumed build
+  // cuts the chunk file back to the end of its last recorded task.
+  std::unique_lock<std::mutex> commit(this->CommitLock, std::defer_lock);
+  if (task)
+  {
+    commit.lock();
+  }
+  for (Emitted& emitted : out)
+  {
+    this->Chunks->AddRegion(emitted.mesh, this->Header, emitted.record);
+    emitted.mesh = RegionMesh();
+  }
+  if (task)
+  {
+    ByteWriter record;
+    record.Put(static_cast<int32_t>(task->level));
+    record.Put(task->first);
+    record.Put(this->Chunks->Sync());
+    record.Put(static_cast<uint64_t>(out.size()));
+    for (const Emitted& emitted : out)
+    {
+      record.Put(emitted.record);
+      record.Put(emitted.box);
+    }
+    this->Journal->Append(record.Bytes);
+  }
   std::lock_guard<std::mutex> guard(this->RecordLock);
-  this->Records[{ level, index }] = record;
-  this->Parts[{ level, index }] = this->Options.rank;
-  this->OwnBoxes[{ level, index }] = BoxOf(region.mesh.positions);
+  for (const Emitted& emitted : out)
+  {
+    const std::pair<int, int64_t> key{ emitted.record.level, emitted.record.index };
+    this->Records[key] = emitted.record;
+    this->Parts[key] = this->Options.rank;
+    this->OwnBoxes[key] = emitted.box;
+  }
 }
 
 void Builder::SaveLevel(int level)
@@ -847,10 +982,10 @@ bool Builder::ReadBuildManifest(MultiresolutionHeader& header, HierarchyReport& 
   return true;
 }
 
-void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
+std::array<int64_t, 4> Builder::LeafBox(const std::vector<int64_t>& columns) const
 {
   const auto& dims = this->Partition->Dims();
-  const int64_t nx = dims[0], ny = dims[1], nz = dims[2];
+  const int64_t nx = dims[0], ny = dims[1];
   int64_t i0 = nx, i1 = 0, j0 = ny, j1 = 0;
   for (int64_t column : columns)
   {
@@ -862,10 +997,15 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
   }
   // One column of halo all round: the nodes and quadrics of the leaf's border come out as in
   // the whole model, and edges shared with the halo are the leaf's cut edges.
-  i0 = std::max<int64_t>(i0 - 1, 0);
-  j0 = std::max<int64_t>(j0 - 1, 0);
-  i1 = std::min(i1 + 1, nx);
-  j1 = std::min(j1 + 1, ny);
+  return { std::max<int64_t>(i0 - 1, 0), std::min(i1 + 1, nx), std::max<int64_t>(j0 - 1, 0), std::min(j1 + 1, ny) };
+}
+
+void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns, std::vector<Emitted>& out)
+{
+  const auto& dims = this->Partition->Dims();
+  const int64_t nx = dims[0], nz = dims[2];
+  const auto box = this->LeafBox(columns);
+  const int64_t i0 = box[0], i1 = box[1], j0 = box[2], j1 = box[3];
   const int64_t w = i1 - i0, h = j1 - j0;
   std::vector<uint8_t> selected(static_cast<std::size_t>(w * h), 0);
   const auto& hasActive = this->Partition->ColumnHasActive();
@@ -935,7 +1075,7 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
         }
       }
     }
-    normals.Save(this->NormalsPath(leaf));
+    SaveCompressed(this->NormalsPath(leaf), normals.Bytes);
   }
   const ColumnMesh halo = ColumnMesh::FromCells({ w, h, nz }, corners, active, 0, w, 0, h, &selected);
   std::vector<uint8_t> keep(static_cast<std::size_t>(halo.ColumnSlots()), 0);
@@ -976,7 +1116,7 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns)
     o[0] += static_cast<int32_t>(i0);
     o[1] += static_cast<int32_t>(j0);
   }
-  this->Emit(this->Tree.LeafLevel(), leaf, region, this->Tree.LeafLevel() > 0);
+  this->Prepare(this->Tree.LeafLevel(), leaf, region, this->Tree.LeafLevel() > 0, out);
   this->WorkDone += static_cast<int64_t>(columns.size());
   this->Report(this->Phase, this->WorkStart + this->WorkSpan * static_cast<double>(this->WorkDone) / this->WorkTotal);
 }
@@ -1008,7 +1148,7 @@ std::vector<ScratchRegion> Builder::LoadChildren(const DiamondHierarchy::Diamond
 /// Splits the simplified diamond along its hypotenuse by column centre and emits each
 /// triangle's region with the edges cut towards the other triangle and other diamonds.
 void Builder::SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const ColumnMesh& mesh,
-  const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides)
+  const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides, std::vector<Emitted>& out)
 {
   const int32_t slots = mesh.ColumnSlots();
   const int32_t layers = mesh.Layers();
@@ -1069,11 +1209,11 @@ void Builder::SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const Colum
       region.cutEdges.push_back(cut);
     }
     const int64_t index = which == 1 ? diamond.first : diamond.second;
-    this->Emit(diamond.level, index, region, diamond.level > 0);
+    this->Prepare(diamond.level, index, region, diamond.level > 0, out);
   }
 }
 
-void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond)
+void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond, std::vector<Emitted>& out)
 {
   const std::vector<ScratchRegion> children = this->LoadChildren(diamond);
   if (children.empty())
@@ -1094,7 +1234,7 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond)
   }
   // Cut edges left are on the diamond's boundary, where columns are locked and unchanged.
   UpdateOpenSides(mesh, childCut, openSides);
-  this->SplitAndEmit(diamond, mesh, childCut, openSides);
+  this->SplitAndEmit(diamond, mesh, childCut, openSides, out);
   this->WorkDone += inputColumns;
   this->Report(this->Phase, this->WorkStart + this->WorkSpan * static_cast<double>(this->WorkDone) / this->WorkTotal);
 }
@@ -1252,11 +1392,12 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
     {
       continue;
     }
-    ManifestIn in;
-    if (!in.Load(this->NormalsPath(entry.first.second)))
+    std::vector<uint8_t> raw;
+    if (!LoadCompressed(this->NormalsPath(entry.first.second), raw))
     {
       throw std::runtime_error(this->NormalsPath(entry.first.second) + ": missing scratch file of cell normals");
     }
+    ByteReader in(raw.data(), raw.size(), this->NormalsPath(entry.first.second));
     const uint64_t count = in.Get<uint64_t>();
     for (uint64_t c = 0; c < count; ++c)
     {
@@ -1443,8 +1584,11 @@ void Builder::PartitionInput()
 void Builder::ReopenPartition()
 {
   const bool lead = this->Options.rank == 0;
-  this->Chunks.reset(
-    new ChunkFile(this->ChunkPath(this->Options.rank), lead ? static_cast<int64_t>(this->PartitionChunkBytes) : 0));
+  if (this->Options.ranks > 1) // one process: ReadJournal reopens it at the end of its last task
+  {
+    this->Chunks.reset(
+      new ChunkFile(this->ChunkPath(this->Options.rank), lead ? static_cast<int64_t>(this->PartitionChunkBytes) : 0));
+  }
   this->Partition.reset(new LeafPartition(this->Scratch + "/tiles"));
   this->Partition->SetRemoveOnDestroy(lead);
 }
@@ -1528,7 +1672,9 @@ void Builder::BuildLeaves(const std::vector<Leaf>& leaves, int leafLevel, Hierar
   this->Collective([&] {
     ParallelFor(static_cast<int64_t>(mine.size()), leafThreads, [&](int64_t n) {
       const auto& leaf = leaves[mine[static_cast<std::size_t>(n)]];
-      this->BuildLeaf(leaf.first, leaf.second);
+      std::vector<Emitted> out;
+      this->BuildLeaf(leaf.first, leaf.second, out);
+      this->Commit(out, nullptr);
     });
     this->SaveLevel(leafLevel);
   });
@@ -1589,8 +1735,11 @@ void Builder::SimplifyLevels(int finished, HierarchyReport& report)
     }
     const std::vector<std::size_t> mine = this->Share(busy.size());
     this->Collective([&] {
-      ParallelFor(static_cast<int64_t>(mine.size()), diamondThreads,
-        [&](int64_t n) { this->BuildDiamond(busy[mine[static_cast<std::size_t>(n)]]); });
+      ParallelFor(static_cast<int64_t>(mine.size()), diamondThreads, [&](int64_t n) {
+        std::vector<Emitted> out;
+        this->BuildDiamond(busy[mine[static_cast<std::size_t>(n)]], out);
+        this->Commit(out, nullptr);
+      });
       this->SaveLevel(level);
     });
     this->LoadLevel(level);
@@ -1606,6 +1755,115 @@ void Builder::SimplifyLevels(int finished, HierarchyReport& report)
     }
   }
   report.simplifySeconds = Seconds() - simplifyStart;
+}
+
+/// The tasks a killed one-process build finished, from its journal: their regions are
+/// recorded again, the chunk file is cut back to the end of the last one, and the children
+/// of finished diamonds are removed (a kill may have come between the two).
+std::vector<uint8_t> Builder::ReadJournal(const BuildSchedule& schedule, HierarchyReport& report)
+{
+  const auto& tasks = schedule.Tasks();
+  std::map<std::pair<int, int64_t>, int32_t> index;
+  for (std::size_t t = 0; t < tasks.size(); ++t)
+  {
+    index[{ tasks[t].level, tasks[t].first }] = static_cast<int32_t>(t);
+  }
+  const std::string path = this->Scratch + "/build.journal";
+  std::vector<std::vector<uint8_t>> records;
+  this->Journal.reset(new BuildJournal(path, records));
+  std::vector<uint8_t> done(tasks.size(), 0);
+  uint64_t chunkEnd = this->PartitionChunkBytes;
+  for (const auto& bytes : records)
+  {
+    ByteReader in(bytes.data(), bytes.size(), path);
+    const int level = in.Get<int32_t>();
+    const int64_t first = in.Get<int64_t>();
+    const auto found = index.find({ level, first });
+    if (found == index.end() || done[static_cast<std::size_t>(found->second)])
+    {
+      throw std::runtime_error(path + ": records a task this build does not have (build with --fresh)");
+    }
+    done[static_cast<std::size_t>(found->second)] = 1;
+    chunkEnd = std::max(chunkEnd, in.Get<uint64_t>());
+    const uint64_t count = in.Get<uint64_t>();
+    std::vector<Emitted> regions(std::min<uint64_t>(count, 2));
+    for (auto& emitted : regions)
+    {
+      emitted.record = in.Get<RegionRecord>();
+      emitted.box = in.Get<std::array<double, 6>>();
+      const std::pair<int, int64_t> key{ emitted.record.level, emitted.record.index };
+      this->Records[key] = emitted.record;
+      this->Parts[key] = 0;
+      this->OwnBoxes[key] = emitted.box;
+    }
+    ++report.resumedTasks;
+  }
+  this->Chunks.reset();
+  this->Chunks.reset(new ChunkFile(this->ChunkPath(0), static_cast<int64_t>(chunkEnd)));
+  for (std::size_t t = 0; t < tasks.size(); ++t)
+  {
+    for (int64_t child : done[t] ? BuildSchedule::Children(tasks[t]) : std::vector<int64_t>())
+    {
+      unlink(RegionPath(this->Scratch, tasks[t].level + 1, child).c_str());
+    }
+  }
+  return done;
+}
+
+/// One process (ours): leaves and diamonds as one schedule, depth first (BuildSchedule), so
+/// that only regions made but not yet merged lie in scratch; each finished task goes to the
+/// journal, and the same build run again skips them.
+void Builder::BuildDepthFirst(const std::vector<Leaf>& leaves, HierarchyReport& report)
+{
+  const int64_t nz = this->Source.Dims()[2];
+  const int64_t cmax = this->Options.cmax;
+  std::vector<int64_t> triangles;
+  for (const Leaf& leaf : leaves)
+  {
+    triangles.push_back(leaf.first);
+  }
+  const BuildSchedule schedule(this->Tree, triangles);
+  const auto& tasks = schedule.Tasks();
+  report.tasks = static_cast<int64_t>(tasks.size());
+  const std::vector<uint8_t> done = this->ReadJournal(schedule, report);
+  // Work: leaf columns once, then the columns merged at each level (about halving).
+  this->WorkDone = 0;
+  this->WorkTotal = std::max<int64_t>(1, 3 * report.columns);
+  this->WorkStart = 0.1;
+  this->WorkSpan = 0.85;
+  this->Phase = "hierarchy";
+  const int64_t leafTask = (cmax * 2) * (nz + 1) * VertexBytes * 2 + cmax * 2 * nz * 40;
+  const int64_t diamondTask = 4 * cmax * (nz + 1) * VertexBytes * 3;
+  const int threads = this->ThreadsFor(std::max(leafTask, diamondTask));
+  report.threadsUsed = threads;
+  std::atomic<int64_t> leafMicros{ 0 }, diamondMicros{ 0 };
+  const double start = Seconds();
+  schedule.Run(threads, done, [&](int32_t t) {
+    const BuildSchedule::Task& task = tasks[static_cast<std::size_t>(t)];
+    const double begin = Seconds();
+    std::vector<Emitted> out;
+    if (task.leaf)
+    {
+      const Leaf& leaf = leaves[static_cast<std::size_t>(task.leafIndex)];
+      this->BuildLeaf(leaf.first, leaf.second, out);
+      this->Commit(out, &task);
+      leafMicros += static_cast<int64_t>(1e6 * (Seconds() - begin));
+      return;
+    }
+    this->BuildDiamond({ task.level, task.first, task.second }, out);
+    this->Commit(out, &task);
+    for (int64_t child : BuildSchedule::Children(task))
+    {
+      unlink(RegionPath(this->Scratch, task.level + 1, child).c_str());
+    }
+    diamondMicros += static_cast<int64_t>(1e6 * (Seconds() - begin));
+  });
+  // The phases interleave: the wall time is shared out by the time the tasks of each took.
+  const double wall = Seconds() - start, busy = std::max<double>(1, double(leafMicros + diamondMicros));
+  report.leafSeconds = wall * double(leafMicros) / busy;
+  report.simplifySeconds = wall * double(diamondMicros) / busy;
+  this->Journal.reset();
+  this->Partition.reset();
 }
 
 /// Rank 0: errors and bounds, the property side, then the file from every rank's chunks.
@@ -1670,6 +1928,8 @@ HierarchyReport Builder::Run()
     {
       report.resumedFromLevel = finished;
       this->Resume(finished, header);
+      keepScratch = true;
+      this->SimplifyLevels(finished, report);
     }
     else
     {
@@ -1686,12 +1946,17 @@ HierarchyReport Builder::Run()
       report.activeCells = this->Partition->ActiveCells();
       const std::vector<Leaf> leaves = this->PlanLeaves(header, report);
       keepScratch = true; // the partition is finished: a failure from here keeps it
-      this->BuildLeaves(leaves, header.leafLevel, report);
-      finished = header.leafLevel;
+      if (this->Options.ranks == 1)
+      {
+        this->BuildDepthFirst(leaves, report);
+      }
+      else
+      {
+        this->BuildLeaves(leaves, header.leafLevel, report);
+        this->SimplifyLevels(header.leafLevel, report);
+      }
     }
-    keepScratch = true;
     report.leafLevel = header.leafLevel;
-    this->SimplifyLevels(finished, report);
     this->WriteFile(header, report);
   }
   catch (const std::exception& error)

@@ -75,7 +75,9 @@ struct HierarchyReport
   int64_t regions = 0, nonEmptyRegions = 0;
   int threadsUsed = 0;
   int resumedFromLevel = -1;         ///< the last finished level a resumed build started from, or -1
-  bool resumedFromPartition = false; ///< a resumed build reused the partition pass and redid the leaves
+  bool resumedFromPartition = false; ///< a resumed build reused the partition pass
+  int64_t tasks = 0;                 ///< leaves and diamonds a one-process build runs (BuildSchedule)
+  int64_t resumedTasks = 0;          ///< of those, the ones a resumed build found finished
   uint64_t hashedCells = 0, hashSlots = 0, hashOffsets = 0; ///< perfect hash (Sec. 5.4)
   uint64_t fileBytes = 0;
   /// Peak bytes of the scratch folder, and of the scratch folder with the file being written.

@@ -5,6 +5,7 @@
 // read as none, unknown ones refused).
 #include "CoreTesting.h"
 
+#include "BuildSchedule.h"
 #include "ColumnMesh.h"
 #include "CornerPointGeometry.h"
 #include "DiamondHierarchy.h"
@@ -17,6 +18,7 @@
 #include "SyntheticReservoir.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -767,6 +769,118 @@ void TestMapAxesInFile()
   rmdir(TempPath("map-spool").c_str());
 }
 
+void TestBuildSchedule()
+{
+  // A tree whose leaf level has 2048 triangles, about 70% of them holding columns.
+  const DiamondHierarchy tree(0, 0, 300, 200, 10);
+  std::mt19937_64 random(5);
+  std::vector<int64_t> leaves;
+  for (int64_t t = 0; t < DiamondHierarchy::TriangleCount(10); ++t)
+  {
+    if (random() % 10 < 7)
+    {
+      leaves.push_back(t);
+    }
+  }
+  std::shuffle(leaves.begin(), leaves.end(), random);
+  const BuildSchedule schedule(tree, leaves);
+  const auto& tasks = schedule.Tasks();
+  // Every leaf once; every task after those it depends on; every triangle above a built one
+  // in exactly one diamond task.
+  std::set<int64_t> leafSeen;
+  std::map<std::pair<int, int64_t>, int> triangles;
+  for (std::size_t t = 0; t < tasks.size(); ++t)
+  {
+    const auto& task = tasks[t];
+    CHECK(task.leaf == (task.level == 10));
+    if (task.leaf)
+    {
+      CHECK(leaves[static_cast<std::size_t>(task.leafIndex)] == task.first);
+      CHECK(leafSeen.insert(task.first).second);
+    }
+    for (int64_t triangle : { task.first, task.second })
+    {
+      if (triangle >= 0)
+      {
+        ++triangles[{ task.level, triangle }];
+      }
+    }
+    for (int32_t d : task.dependsOn)
+    {
+      CHECK(d >= 0 && static_cast<std::size_t>(d) < t);
+    }
+  }
+  CHECK(leafSeen.size() == leaves.size());
+  for (int level = 0; level < 10; ++level)
+  {
+    for (int64_t t = 0; t < DiamondHierarchy::TriangleCount(level); ++t)
+    {
+      const int shift = 10 - level;
+      const bool built = std::any_of(leaves.begin(), leaves.end(), [&](int64_t leaf) { return (leaf >> shift) == t; });
+      const int count = triangles[{ level, t }];
+      CHECK(!built || count == 1);
+    }
+  }
+  // Depth first: run in order, regions made but not yet merged stay few (level by level, a
+  // whole level of them waits).
+  std::vector<int32_t> consumersLeft(tasks.size(), 0);
+  for (const auto& task : tasks)
+  {
+    for (int32_t d : task.dependsOn)
+    {
+      ++consumersLeft[static_cast<std::size_t>(d)];
+    }
+  }
+  int64_t waiting = 0, most = 0;
+  for (const auto& task : tasks)
+  {
+    for (int32_t d : task.dependsOn)
+    {
+      waiting -= --consumersLeft[static_cast<std::size_t>(d)] == 0 ? 1 : 0;
+    }
+    ++waiting;
+    most = std::max(most, waiting);
+  }
+  std::printf("schedule: %zu tasks, %zu leaves, at most %lld made and not yet merged\n", tasks.size(), leaves.size(),
+    static_cast<long long>(most));
+  CHECK(most <= static_cast<int64_t>(leaves.size()) / 8);
+
+  // Run on 3 threads: each task once, after its dependencies; tasks marked done are skipped.
+  std::vector<uint8_t> done(tasks.size(), 0);
+  for (std::size_t t = 0; t < tasks.size() / 3; ++t)
+  {
+    done[t] = 1;
+  }
+  std::vector<std::atomic<int>> runs(tasks.size());
+  std::atomic<int> misordered{ 0 };
+  schedule.Run(3, done, [&](int32_t t) {
+    for (int32_t d : tasks[static_cast<std::size_t>(t)].dependsOn)
+    {
+      misordered += done[static_cast<std::size_t>(d)] || runs[static_cast<std::size_t>(d)] == 1 ? 0 : 1;
+    }
+    ++runs[static_cast<std::size_t>(t)];
+  });
+  CHECK(misordered == 0);
+  for (std::size_t t = 0; t < tasks.size(); ++t)
+  {
+    CHECK(runs[t] == (done[t] ? 0 : 1));
+  }
+  // A failing task stops the run and its error comes out.
+  std::atomic<int> after{ 0 };
+  resmr_testing::ExpectError<std::runtime_error>("failing task",
+    [&] {
+      schedule.Run(2, std::vector<uint8_t>(tasks.size(), 0), [&](int32_t t) {
+        if (t == 40)
+        {
+          throw std::runtime_error("task 40 failed");
+        }
+        after += t > 40 ? 1 : 0;
+      });
+    },
+    { "task 40 failed" });
+  CHECK(after < static_cast<int>(tasks.size()) - 41);
+}
+
 void TestFailedBuildLeavesNothing()
 {
   // An existing file of the output's name survives a failed build untouched.
@@ -792,6 +906,7 @@ void TestFailedBuildLeavesNothing()
 int main()
 {
   TestDiamondTree();
+  TestBuildSchedule();
   TestHierarchyFile();
   TestMapAxesInFile();
   TestFailedBuildLeavesNothing();

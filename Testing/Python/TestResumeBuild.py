@@ -1,6 +1,5 @@
-"""A build killed with SIGKILL after some levels resumes from its last finished level and
-writes the file an uninterrupted build writes (issue 6: "a killed build resumes from the last
-finished level").
+"""A build killed with SIGKILL part-way resumes from the tasks its journal records (leaves and
+diamonds) and writes the file an uninterrupted build writes; --fresh starts over.
 
 usage: TestResumeBuild.py RESMR TEMP
 """
@@ -8,6 +7,7 @@ import json
 import os
 import shutil
 import signal
+import struct
 import subprocess
 import sys
 import time
@@ -19,30 +19,51 @@ model = "synth:160x120x24:3"
 killed = os.path.join(temp, "killed.resmr")
 whole = os.path.join(temp, "whole.resmr")
 scratch = killed + ".scratch"
+journal = os.path.join(scratch, "build.journal")
 arguments = ["--cmax", "64", "--threads", "1", "--quiet"]
 failures = []
 
-# Kill it once a level above the leaves has finished (its manifest is in place).
+
+def recorded_tasks():
+    """Whole records in the build journal (magic, size, CRC-32, then the record)."""
+    try:
+        data = open(journal, "rb").read()
+    except FileNotFoundError:
+        return 0
+    count, at = 0, 0
+    while at + 12 <= len(data):
+        magic, size, _ = struct.unpack_from("<III", data, at)
+        if magic != 0x4C4E524A or at + 12 + size > len(data):
+            break
+        count, at = count + 1, at + 12 + size
+    return count
+
+
+def info(path):
+    return json.loads(subprocess.run([resmr, "info", "--regions", path], check=True, capture_output=True,
+                                     text=True).stdout)
+
+
+# The uninterrupted build, and how many tasks it runs.
+result = subprocess.run([resmr, "build", model, "-o", whole] + arguments, check=True, capture_output=True, text=True)
+tasks = json.loads(result.stdout)["tasks"]
+print(f"{tasks} tasks")
+
+# Kill it once a third of its tasks are recorded.
 process = subprocess.Popen([resmr, "build", model, "-o", killed] + arguments, stdout=subprocess.DEVNULL)
 deadline = time.time() + 300
-leaf = None
 stopped_at = None
 while time.time() < deadline and process.poll() is None:
-    if os.path.isdir(scratch):
-        levels = sorted(int(name.split("-")[1].split(".")[0]) for name in os.listdir(scratch)
-                        if name.startswith("level-") and name.endswith(".rank-0"))
-        if levels and leaf is None:
-            leaf = levels[-1]
-        if leaf is not None and len(levels) >= 3:
-            process.send_signal(signal.SIGKILL)
-            process.wait()
-            stopped_at = levels[0]
-            break
-    time.sleep(0.02)
-if stopped_at is None:
-    failures.append(f"the build was not caught between levels (exit {process.poll()}); make the model bigger")
+    if recorded_tasks() >= tasks // 3:
+        process.send_signal(signal.SIGKILL)
+        process.wait()
+        stopped_at = recorded_tasks()
+        break
+    time.sleep(0.005)
+if stopped_at is None or stopped_at >= tasks:
+    failures.append(f"the build was not caught part-way (exit {process.poll()}); make the model bigger")
 else:
-    print(f"killed after level {stopped_at} finished (leaf level {leaf})")
+    print(f"killed with {stopped_at} of {tasks} tasks recorded")
     if os.path.exists(killed):
         failures.append("a killed build left a file under the final name")
     # Run again: it must resume, not start over.
@@ -51,20 +72,12 @@ else:
         failures.append(f"resumed build failed: {result.stderr}")
     else:
         report = json.loads(result.stdout)
-        resumed = report["resumed_from_level"]
-        print(f"resumed from level {resumed}")
-        if resumed < 0 or resumed > stopped_at:
-            failures.append(f"resumed from level {resumed}, expected {stopped_at} or a later-finished level")
+        print(f"resumed with {report['resumed_tasks']} tasks done")
+        if not report["resumed_partition"] or report["resumed_tasks"] < stopped_at:
+            failures.append(f"resumed {report['resumed_tasks']} tasks and partition {report['resumed_partition']}, "
+                            f"expected the partition and at least {stopped_at} tasks")
         if os.path.exists(scratch):
             failures.append("the scratch folder is left after a successful build")
-
-    # Same file as an uninterrupted build.
-    subprocess.run([resmr, "build", model, "-o", whole] + arguments, check=True, stdout=subprocess.DEVNULL)
-
-    def info(path):
-        return json.loads(subprocess.run([resmr, "info", "--regions", path], check=True, capture_output=True,
-                                         text=True).stdout)
-
     if not failures:
         a, b = info(killed), info(whole)
         for key in ("levels", "hash", "geometry_id", "region_list"):
@@ -73,14 +86,14 @@ else:
 
     # --fresh ignores a scratch folder and starts over.
     process = subprocess.Popen([resmr, "build", model, "-o", killed] + arguments, stdout=subprocess.DEVNULL)
-    while process.poll() is None and not (os.path.isdir(scratch) and any(
-            n.startswith("level-") for n in os.listdir(scratch))):
-        time.sleep(0.02)
+    while process.poll() is None and recorded_tasks() < 3:
+        time.sleep(0.005)
     process.send_signal(signal.SIGKILL)
     process.wait()
     result = subprocess.run([resmr, "build", model, "-o", killed, "--fresh"] + arguments, capture_output=True,
                             text=True)
-    if result.returncode != 0 or json.loads(result.stdout)["resumed_from_level"] != -1:
+    if result.returncode != 0 or json.loads(result.stdout)["resumed_tasks"] != 0 or \
+            json.loads(result.stdout)["resumed_partition"]:
         failures.append("--fresh did not start over")
 
 for failure in failures:
