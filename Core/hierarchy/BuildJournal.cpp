@@ -83,10 +83,10 @@ void BuildJournal::Append(const std::vector<uint8_t>& record)
     if (written <= 0)
     {
       const std::string reason = std::strerror(errno);
-      // A torn record would be cut on the next open; cut it now so later appends follow whole ones.
-      if (ftruncate(this->Descriptor, static_cast<off_t>(this->Size)) != 0)
-      {
-      }
+      // Cut the torn record now, so that later appends follow whole ones (the next open cuts it
+      // anyway if this fails too).
+      const int cut = ftruncate(this->Descriptor, static_cast<off_t>(this->Size));
+      static_cast<void>(cut);
       throw std::runtime_error(this->Path + ": build journal write failed (disk full?): " + reason);
     }
     done += static_cast<std::size_t>(written);

@@ -94,7 +94,13 @@ if code != 0:
 expected = info(whole) if code == 0 else None
 peak = report["peak_disk_bytes"]
 phases = set()
+partition_partway = False
 flags = " ".join(arguments)
+
+
+def kept_tasks(kept):
+    return "build.journal" in kept
+
 for step in range(1, 20):
     size = max(1 << 20, (peak * step // 20) & ~4095)
     out = f"{disk}/m.resmr"
@@ -115,25 +121,30 @@ for step in range(1, 20):
                         f"{open(temp + '/second.err').read()}")
         continue
     second = json.load(open(f"{temp}/second.json"))
-    phase = ("simplify" if second["resumed_from_level"] >= 0 else
-             "leaves" if second["resumed_partition"] else "partition")
+    phase = ("partition" if not second["resumed_partition"] else
+             "writing" if second["resumed_tasks"] == second["tasks"] else "hierarchy")
     phases.add(phase)
-    print(f"{size / 1e6:.1f} MB: stopped in the {phase} phase ({len(kept)} scratch files kept): "
+    partway = phase == "partition" and second["resumed_layers"] > 0
+    partition_partway = partition_partway or partway
+    print(f"{size / 1e6:.1f} MB: stopped in the {phase} phase ({len(kept)} scratch files kept, "
+          f"{second['resumed_layers']} layers and {second['resumed_tasks']} of {second['tasks']} tasks resumed): "
           f"{first_error.splitlines()[-1][:160]}")
     if "No space left" not in first_error and "disk full" not in first_error:
         failures.append(f"{size} B: the error does not say the disk is full: {first_error}")
-    if phase != "partition" and "kept" not in first_error:
+    if (phase != "partition" or partway) and "kept" not in first_error:
         failures.append(f"{size} B: the error does not say the finished work is kept: {first_error}")
-    if phase == "partition" and kept:
-        failures.append(f"{size} B: a build stopped in its first pass left {kept}")
+    if phase == "hierarchy" and second["resumed_tasks"] == 0 and kept_tasks(kept):
+        failures.append(f"{size} B: tasks were recorded but none resumed")
     if expected is not None:
         resumed = json.load(open(f"{temp}/info.json"))
         for key in ("levels", "hash", "geometry_id", "region_list"):
             if resumed[key] != expected[key]:
                 failures.append(f"{size} B ({phase}): {key} differs from the uninterrupted build")
-for phase in ("partition", "leaves", "simplify"):
+for phase in ("partition", "hierarchy", "writing"):
     if phase not in phases:
         failures.append(f"no disk size stopped the build in its {phase} phase (sizes tried up to the peak)")
+if not partition_partway:
+    failures.append("no build stopped in its partition pass resumed part-way through it")
 
 for failure in failures:
     print("FAIL: " + failure)
