@@ -353,7 +353,7 @@ LeafPartition::LeafPartition(
   const std::size_t tiles = static_cast<std::size_t>(this->TilesX * this->TilesY);
   this->Readers.assign(tiles, 0);
   this->Removed.assign(tiles, 0);
-  const bool resume = this->TakeCheckpoint(source);
+  const bool resume = this->TakeCheckpoint();
   if (!resume)
   {
     this->StartBounds();
@@ -405,12 +405,13 @@ void LeafPartition::StartBounds()
 
 /// Adopts the unfinished checkpoint in the folder if it is of this grid and its tile files
 /// still hold its blocks; false to start over.
-bool LeafPartition::TakeCheckpoint(LayerSource& source)
+bool LeafPartition::TakeCheckpoint()
 {
   State state;
   std::string why;
   if (!LoadState(this->StatePath(), state, why) || state.complete || state.dims != this->Dimensions ||
-    state.tile != this->Tile || state.coord != source.Coord())
+    state.tile != this->Tile || state.coord.size() != this->CoordValues.size() ||
+    std::memcmp(state.coord.data(), this->CoordValues.data(), state.coord.size() * sizeof(double)) != 0)
   {
     return false;
   }
@@ -962,7 +963,7 @@ void LeafPartition::ReadTile(int64_t ti, int64_t tj, int64_t i0, int64_t i1, int
   }
   if (descriptor < 0)
   {
-    throw std::runtime_error(path + ": the partition tile is gone (its leaves were built and it was removed)");
+    throw std::runtime_error(path + ": the partition tile is gone (released once its leaves were built, or removed)");
   }
   std::vector<uint32_t> layers[2], residuals; // this layer's cells and the one above's
   layers[0].resize(static_cast<std::size_t>(tw * th * 8));

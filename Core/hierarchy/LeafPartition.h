@@ -124,7 +124,7 @@ private:
   std::string TilePath(int64_t ti, int64_t tj) const;
   std::string StatePath() const { return this->Folder + "/partition.state"; }
   void StartBounds();
-  bool TakeCheckpoint(LayerSource& source);
+  bool TakeCheckpoint();
   void OpenTiles(bool resume);
   void SkipLayers(LayerSource& source, std::vector<std::vector<uint32_t>>& above);
   void StreamLayers(LayerSource& source, const PartitionHooks& hooks, std::vector<std::vector<uint32_t>>& above);
