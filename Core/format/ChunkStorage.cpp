@@ -171,10 +171,12 @@ void UnmapFile(const uint8_t* data, uint64_t size)
   }
 }
 
+/// Eight bytes a step through eight tables ("slicing by 8"): the same CRC as one byte a step
+/// with the first table, faster, as the builder checks every scratch block it reads.
 uint32_t Crc32(const void* data, std::size_t size, uint32_t crc)
 {
-  static const auto table = [] {
-    std::array<uint32_t, 256> t{};
+  static const auto tables = [] {
+    std::array<std::array<uint32_t, 256>, 8> t{};
     for (uint32_t i = 0; i < 256; ++i)
     {
       uint32_t c = i;
@@ -182,15 +184,31 @@ uint32_t Crc32(const void* data, std::size_t size, uint32_t crc)
       {
         c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
       }
-      t[i] = c;
+      t[0][i] = c;
+    }
+    for (uint32_t i = 0; i < 256; ++i)
+    {
+      for (int s = 1; s < 8; ++s)
+      {
+        t[s][i] = (t[s - 1][i] >> 8) ^ t[0][t[s - 1][i] & 0xFF];
+      }
     }
     return t;
   }();
   crc = ~crc;
   const auto* bytes = static_cast<const uint8_t*>(data);
-  for (std::size_t i = 0; i < size; ++i)
+  for (; size >= 8; size -= 8, bytes += 8)
   {
-    crc = table[(crc ^ bytes[i]) & 0xFF] ^ (crc >> 8);
+    uint32_t low, high;
+    std::memcpy(&low, bytes, 4); // little-endian, as every format here is
+    std::memcpy(&high, bytes + 4, 4);
+    low ^= crc;
+    crc = tables[7][low & 0xFF] ^ tables[6][(low >> 8) & 0xFF] ^ tables[5][(low >> 16) & 0xFF] ^ tables[4][low >> 24] ^
+      tables[3][high & 0xFF] ^ tables[2][(high >> 8) & 0xFF] ^ tables[1][(high >> 16) & 0xFF] ^ tables[0][high >> 24];
+  }
+  for (; size > 0; --size, ++bytes)
+  {
+    crc = tables[0][(crc ^ *bytes) & 0xFF] ^ (crc >> 8);
   }
   return ~crc;
 }

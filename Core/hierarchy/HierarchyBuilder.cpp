@@ -1556,20 +1556,21 @@ void Builder::PartitionInput()
       return;
     }
     std::vector<uint8_t> bits;
-    this->Partition.reset(new LeafPartition(
-      this->Source, this->Scratch + "/tiles", tile, [this](double f) { this->Report("partition", 0.1 * f); },
-      [&](int64_t k, const std::vector<uint8_t>& active) {
-        bits.assign((active.size() + 7) / 8, 0);
-        for (std::size_t c = 0; c < active.size(); ++c)
-        {
-          bits[c >> 3] |= static_cast<uint8_t>((active[c] ? 1 : 0) << (c & 7));
-        }
-        ModelChunk chunk;
-        chunk.kind = ModelChunk::ActiveLayer;
-        chunk.part = static_cast<uint32_t>(k);
-        chunk.chunk = this->Chunks->Put(bits, "active flags of layer " + std::to_string(k + 1));
-        this->ActiveLayers.push_back(chunk);
-      }));
+    PartitionHooks hooks;
+    hooks.progress = [this](double f) { this->Report("partition", 0.1 * f); };
+    hooks.onLayer = [&](int64_t k, const std::vector<uint8_t>& active) {
+      bits.assign((active.size() + 7) / 8, 0);
+      for (std::size_t c = 0; c < active.size(); ++c)
+      {
+        bits[c >> 3] |= static_cast<uint8_t>((active[c] ? 1 : 0) << (c & 7));
+      }
+      ModelChunk chunk;
+      chunk.kind = ModelChunk::ActiveLayer;
+      chunk.part = static_cast<uint32_t>(k);
+      chunk.chunk = this->Chunks->Put(bits, "active flags of layer " + std::to_string(k + 1));
+      this->ActiveLayers.push_back(chunk);
+    };
+    this->Partition.reset(new LeafPartition(this->Source, this->Scratch + "/tiles", tile, hooks));
     this->Partition->SaveState();
     this->PartitionChunkBytes = this->Chunks->Sync();
   });
