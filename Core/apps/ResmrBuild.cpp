@@ -32,7 +32,8 @@ const char* BuildUsage =
   "  --memory SIZE memory budget, e.g. 4G or 512M (default: half the available memory)\n"
   "  --scratch DIR scratch folder (default OUT.resmr.scratch, removed at the end; a build\n"
   "                killed or stopped by a full disk, run again with the same arguments, resumes\n"
-  "                from its last finished level, or from its partition pass)\n"
+  "                from what it finished: the partition pass's last checkpoint and every leaf\n"
+  "                and diamond it recorded)\n"
   "  --fresh       ignore a killed build's scratch folder and start over\n"
   "  --no-disk-check  start even when the disks hold less free space than the build needs\n"
   "  Prints a progress bar on stderr and a JSON report on stdout.\n";
@@ -192,8 +193,8 @@ int BuildCommand(int argc, char** argv)
       "{\"input\": \"%s\", \"output\": \"%s\", \"cells\": %lld, \"active_cells\": %lld, \"columns\": %lld, "
       "\"leaf_level\": %d, \"regions\": %lld, \"threads\": %d, \"file_bytes\": %llu, \"bytes_per_cell\": %.3f, "
       "\"partition_s\": %.2f, \"leaves_s\": %.2f, \"simplify_s\": %.2f, \"total_s\": %.2f, "
-      "\"cells_per_s\": %.0f, \"peak_rss_mb\": %.1f, \"resumed_from_level\": %d, \"resumed_partition\": %s, \"tasks\": "
-      "%lld, \"resumed_tasks\": %lld, "
+      "\"cells_per_s\": %.0f, \"peak_rss_mb\": %.1f, \"resumed_from_level\": %d, \"resumed_partition\": %s, "
+      "\"resumed_layers\": %lld, \"tasks\": %lld, \"resumed_tasks\": %lld, "
       "\"hashed_cells\": %llu, \"hash_slots\": %llu, \"hash_offsets\": %llu, \"peak_scratch_bytes\": %llu, "
       "\"peak_disk_bytes\": %llu}\n",
       input.c_str(), output.c_str(), static_cast<long long>(report.cells), static_cast<long long>(report.activeCells),
@@ -202,10 +203,10 @@ int BuildCommand(int argc, char** argv)
       double(report.fileBytes) / double(report.cells), report.partitionSeconds, report.leafSeconds,
       report.simplifySeconds, report.totalSeconds, double(report.cells) / std::max(report.totalSeconds, 1e-9),
       usage.ru_maxrss / 1024.0, report.resumedFromLevel, report.resumedFromPartition ? "true" : "false",
-      static_cast<long long>(report.tasks), static_cast<long long>(report.resumedTasks),
-      static_cast<unsigned long long>(report.hashedCells), static_cast<unsigned long long>(report.hashSlots),
-      static_cast<unsigned long long>(report.hashOffsets), static_cast<unsigned long long>(report.peakScratchBytes),
-      static_cast<unsigned long long>(report.peakDiskBytes));
+      static_cast<long long>(report.resumedLayers), static_cast<long long>(report.tasks),
+      static_cast<long long>(report.resumedTasks), static_cast<unsigned long long>(report.hashedCells),
+      static_cast<unsigned long long>(report.hashSlots), static_cast<unsigned long long>(report.hashOffsets),
+      static_cast<unsigned long long>(report.peakScratchBytes), static_cast<unsigned long long>(report.peakDiskBytes));
     return 0;
   }
   catch (const std::exception& error)

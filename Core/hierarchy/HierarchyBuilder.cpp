@@ -668,7 +668,7 @@ private:
   static constexpr int64_t VertexBytes = 24 + 80 + 40;
   int PrepareScratch(MultiresolutionHeader& header, HierarchyReport& report, bool& partitioned);
   void Resume(int finished, const MultiresolutionHeader& header);
-  void PartitionInput();
+  void PartitionInput(HierarchyReport& report);
   void ReopenPartition();
   void CheckFreeDisk() const;
   std::vector<Leaf> PlanLeaves(MultiresolutionHeader& header, HierarchyReport& report);
@@ -1434,9 +1434,14 @@ int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& repo
   }
   int finished = -1;
   partitioned = false;
+  bool complete = false;
+  const bool checkpoint = LeafPartition::HasCheckpoint(this->Scratch + "/tiles", &complete);
+  // A partition pass stopped part-way resumes from its checkpoint (LeafPartition checks that
+  // it is of the same input); the rest of the build starts over from it.
+  const bool partial = this->Options.resume && checkpoint && !complete;
   if (this->ReadBuildManifest(header, report))
   {
-    partitioned = Exists(this->Scratch + "/tiles/partition.state");
+    partitioned = checkpoint && complete;
     for (int level = header.leafLevel; level >= 0; --level)
     {
       bool all = true;
@@ -1451,7 +1456,7 @@ int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& repo
       finished = level;
     }
   }
-  if (finished < 0 && !partitioned && this->Options.checkDisk)
+  if (finished < 0 && !partitioned && !partial && this->Options.checkDisk)
   {
     try
     {
@@ -1467,7 +1472,7 @@ int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& repo
   if (lead)
   {
     // Start over, or clear what the unfinished level left (other ranks wait below).
-    if (finished < 0 && !partitioned)
+    if (finished < 0 && !partitioned && !partial)
     {
       RemoveTree(this->Scratch);
       if (mkdir(this->Scratch.c_str(), 0755) != 0 && errno != EEXIST)
@@ -1487,7 +1492,7 @@ int Builder::PrepareScratch(MultiresolutionHeader& header, HierarchyReport& repo
 /// Refuses a build the disks cannot hold (BuildDiskNeed), before any work, with what it needs.
 void Builder::CheckFreeDisk() const
 {
-  const BuildDiskNeed need(this->CellCount);
+  const BuildDiskNeed need(this->Source.Dims(), this->Options.ranks);
   const uint64_t scratchFree = FreeDiskBytes(this->Scratch), outputFree = FreeDiskBytes(this->Output);
   const bool shared = SameFilesystem(this->Scratch, this->Output);
   const auto gb = [](uint64_t bytes) {
@@ -1496,8 +1501,12 @@ void Builder::CheckFreeDisk() const
     return std::string(text);
   };
   const std::string what = std::to_string(this->CellCount) + " cells need about " + gb(need.scratch) +
-    " of scratch and " + gb(need.file) + " for the file (" + std::to_string(need.ScratchBytesPerCell) + " and " +
-    std::to_string(need.FileBytesPerCell) + " bytes a cell, and a few hundred MB)";
+    " of scratch and " + gb(need.file) + " for the file (" + std::to_string(need.FileBytesPerCell) +
+    " bytes a cell for the file, " +
+    (this->Options.ranks > 1 ? std::to_string(need.LevelScratchBytesPerCell) + " for the scratch of MPI ranks"
+                             : std::to_string(need.ScratchBytesPerCell) + " and " +
+          std::to_string(need.ScratchBytesPerColumn) + " a column for the scratch") +
+    ", and a few hundred MB)";
   std::string problem;
   if (shared && scratchFree < need.scratch + need.file)
   {
@@ -1541,11 +1550,10 @@ void Builder::Resume(int finished, const MultiresolutionHeader& header)
 /// The streaming pass (Sec. 4.2 and 7, "partitioning"): rank 0 reads the input once, layer by
 /// layer, into scratch tiles and stores each layer's active flags; the other ranks open its
 /// tiles.
-void Builder::PartitionInput()
+void Builder::PartitionInput(HierarchyReport& report)
 {
   const bool lead = this->Options.rank == 0;
   const auto dims = this->Source.Dims();
-  this->Chunks.reset(new ChunkFile(this->ChunkPath(this->Options.rank)));
   // Tiles of about 64 x 64 columns, fewer and bigger for very wide grids (at most ~1000
   // files).
   const int64_t tile =
@@ -1553,12 +1561,18 @@ void Builder::PartitionInput()
   this->Collective([&] {
     if (!lead)
     {
+      this->Chunks.reset(new ChunkFile(this->ChunkPath(this->Options.rank)));
       return;
     }
+    this->ActiveLayers.clear(); // onResume gives back those of a pass stopped part-way
     std::vector<uint8_t> bits;
     PartitionHooks hooks;
     hooks.progress = [this](double f) { this->Report("partition", 0.1 * f); };
     hooks.onLayer = [&](int64_t k, const std::vector<uint8_t>& active) {
+      if (!this->Chunks) // a pass that starts over (one that resumes has it from onResume)
+      {
+        this->Chunks.reset(new ChunkFile(this->ChunkPath(0)));
+      }
       bits.assign((active.size() + 7) / 8, 0);
       for (std::size_t c = 0; c < active.size(); ++c)
       {
@@ -1569,6 +1583,35 @@ void Builder::PartitionInput()
       chunk.part = static_cast<uint32_t>(k);
       chunk.chunk = this->Chunks->Put(bits, "active flags of layer " + std::to_string(k + 1));
       this->ActiveLayers.push_back(chunk);
+    };
+    // A checkpoint keeps the layers' active flags in the chunk file (synced) and their list.
+    hooks.checkpointNote = [this] {
+      ByteWriter note;
+      note.Put(this->Chunks ? this->Chunks->Sync() : uint64_t(0));
+      note.Put(static_cast<uint64_t>(this->ActiveLayers.size()));
+      for (const ModelChunk& chunk : this->ActiveLayers)
+      {
+        note.Put(chunk);
+      }
+      return note.Bytes;
+    };
+    hooks.onResume = [&](int64_t layers, const std::vector<uint8_t>& note) {
+      ByteReader in(note.data(), note.size(), this->Scratch + "/tiles: partition checkpoint");
+      in.Get<uint64_t>();
+      const uint64_t count = in.Get<uint64_t>();
+      this->ActiveLayers.clear();
+      for (uint64_t k = 0; k < count && static_cast<int64_t>(k) < layers; ++k)
+      {
+        this->ActiveLayers.push_back(in.Get<ModelChunk>());
+      }
+      if (static_cast<int64_t>(this->ActiveLayers.size()) != layers)
+      {
+        throw std::runtime_error(this->Scratch + "/tiles: the partition checkpoint lacks layers' active flags");
+      }
+      // The flags of the layers done, and none of those to stream again.
+      const ChunkRef last = layers > 0 ? this->ActiveLayers.back().chunk : ChunkRef();
+      this->Chunks.reset(new ChunkFile(this->ChunkPath(0), static_cast<int64_t>(last.offset + last.stored)));
+      report.resumedLayers = layers;
     };
     this->Partition.reset(new LeafPartition(this->Source, this->Scratch + "/tiles", tile, hooks));
     this->Partition->SaveState();
@@ -1827,6 +1870,15 @@ void Builder::BuildDepthFirst(const std::vector<Leaf>& leaves, HierarchyReport& 
   const auto& tasks = schedule.Tasks();
   report.tasks = static_cast<int64_t>(tasks.size());
   const std::vector<uint8_t> done = this->ReadJournal(schedule, report);
+  // A tile of the partition is freed once no leaf still to build reads it.
+  for (std::size_t t = 0; t < tasks.size(); ++t)
+  {
+    if (tasks[t].leaf && !done[t])
+    {
+      const auto box = this->LeafBox(leaves[static_cast<std::size_t>(tasks[t].leafIndex)].second);
+      this->Partition->Retain(box[0], box[1], box[2], box[3]);
+    }
+  }
   // Work: leaf columns once, then the columns merged at each level (about halving).
   this->WorkDone = 0;
   this->WorkTotal = std::max<int64_t>(1, 3 * report.columns);
@@ -1848,6 +1900,8 @@ void Builder::BuildDepthFirst(const std::vector<Leaf>& leaves, HierarchyReport& 
       const Leaf& leaf = leaves[static_cast<std::size_t>(task.leafIndex)];
       this->BuildLeaf(leaf.first, leaf.second, out);
       this->Commit(out, &task);
+      const auto box = this->LeafBox(leaf.second);
+      this->Partition->Release(box[0], box[1], box[2], box[3]);
       leafMicros += static_cast<int64_t>(1e6 * (Seconds() - begin));
       return;
     }
@@ -1864,6 +1918,9 @@ void Builder::BuildDepthFirst(const std::vector<Leaf>& leaves, HierarchyReport& 
   report.leafSeconds = wall * double(leafMicros) / busy;
   report.simplifySeconds = wall * double(diamondMicros) / busy;
   this->Journal.reset();
+  // Every tile is freed; the partition's state stays until the file is written, for a build
+  // that stops after this and resumes (its leaves are planned from it).
+  this->Partition->SetRemoveOnDestroy(false);
   this->Partition.reset();
 }
 
@@ -1941,7 +1998,7 @@ HierarchyReport Builder::Run()
       }
       else
       {
-        this->PartitionInput();
+        this->PartitionInput(report);
         report.partitionSeconds = Seconds() - start;
       }
       report.activeCells = this->Partition->ActiveCells();
@@ -1963,6 +2020,9 @@ HierarchyReport Builder::Run()
   catch (const std::exception& error)
   {
     this->Chunks.reset();
+    // A partition pass stopped part-way keeps its last checkpoint.
+    bool complete = false;
+    keepScratch = keepScratch || LeafPartition::HasCheckpoint(this->Scratch + "/tiles", &complete);
     if (this->Partition)
     {
       this->Partition->SetRemoveOnDestroy(!keepScratch && this->Options.rank == 0);

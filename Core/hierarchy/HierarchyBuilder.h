@@ -33,6 +33,7 @@
 
 #include "LayerSource.h"
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -75,7 +76,8 @@ struct HierarchyReport
   int64_t regions = 0, nonEmptyRegions = 0;
   int threadsUsed = 0;
   int resumedFromLevel = -1;         ///< the last finished level a resumed build started from, or -1
-  bool resumedFromPartition = false; ///< a resumed build reused the partition pass
+  bool resumedFromPartition = false; ///< a resumed build reused the finished partition pass
+  int64_t resumedLayers = 0;         ///< layers a partition pass stopped part-way had done
   int64_t tasks = 0;                 ///< leaves and diamonds a one-process build runs (BuildSchedule)
   int64_t resumedTasks = 0;          ///< of those, the ones a resumed build found finished
   uint64_t hashedCells = 0, hashSlots = 0, hashOffsets = 0; ///< perfect hash (Sec. 5.4)
@@ -85,18 +87,25 @@ struct HierarchyReport
   double partitionSeconds = 0, leafSeconds = 0, simplifySeconds = 0, totalSeconds = 0;
 };
 
-/// Disk a build of `cells` cells needs at its peak: the scratch folder (tiles, region meshes
-/// with their quadrics, chunks) and the file, a bound with some margin over what the build
-/// benchmark measures (docs/benchmarks.md); small models cost more a cell, hence the fixed
-/// parts.
+/// Disk a build needs at its peak: the scratch folder and the file, a bound with some margin
+/// over what the build benchmark measures (docs/benchmarks.md). One process builds depth
+/// first: compressed partition tiles, the regions waiting to be merged and the chunks; region
+/// meshes carry every interface of every column, so thin models cost more a cell, hence the
+/// part a column. MPI ranks build level by level, with two levels of region meshes and their
+/// quadrics in scratch. Small models cost more a cell, hence the fixed parts.
 struct BuildDiskNeed
 {
-  static constexpr uint64_t ScratchBytesPerCell = 150, ScratchFixedBytes = uint64_t(256) << 20;
+  static constexpr uint64_t ScratchBytesPerCell = 24, ScratchBytesPerColumn = 64;
+  static constexpr uint64_t LevelScratchBytesPerCell = 150; ///< MPI ranks, level by level
+  static constexpr uint64_t ScratchFixedBytes = uint64_t(256) << 20;
   static constexpr uint64_t FileBytesPerCell = 16, FileFixedBytes = uint64_t(64) << 20;
   uint64_t scratch = 0, file = 0;
-  explicit BuildDiskNeed(int64_t cells)
-    : scratch(uint64_t(cells) * ScratchBytesPerCell + ScratchFixedBytes)
-    , file(uint64_t(cells) * FileBytesPerCell + FileFixedBytes)
+  BuildDiskNeed(const std::array<int64_t, 3>& dims, int ranks)
+    : scratch((ranks > 1 ? uint64_t(dims[0] * dims[1] * dims[2]) * LevelScratchBytesPerCell
+                         : uint64_t(dims[0] * dims[1] * dims[2]) * ScratchBytesPerCell +
+                    uint64_t(dims[0] * dims[1]) * ScratchBytesPerColumn) +
+        ScratchFixedBytes)
+    , file(uint64_t(dims[0] * dims[1] * dims[2]) * FileBytesPerCell + FileFixedBytes)
   {
   }
 };

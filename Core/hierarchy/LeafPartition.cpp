@@ -311,10 +311,6 @@ public:
   bool Ok = true;
 };
 
-uint32_t LayerCrc(const std::vector<float>& zcorn, const std::vector<uint8_t>& active)
-{
-  return Crc32(active.data(), active.size(), Crc32(zcorn.data(), zcorn.size() * sizeof(float)));
-}
 } // namespace
 
 /// A checkpoint as the state file holds it.
@@ -324,8 +320,6 @@ struct LeafPartition::State
   std::array<int64_t, 3> dims{};
   int64_t tile = 0, layers = 0, activeCount = 0;
   std::array<double, 6> bounds{};
-  uint32_t lastLayerCrc = 0;
-  std::vector<double> coord;
   std::vector<uint8_t> anyActive;
   std::vector<std::vector<Block>> blocks;
   std::vector<uint8_t> note;
@@ -359,6 +353,7 @@ LeafPartition::LeafPartition(
     this->StartBounds();
     this->Blocks.assign(tiles, {});
     unlink(this->StatePath().c_str()); // a stale state must never describe the new tiles
+    this->SaveCoord();
   }
   std::vector<std::vector<uint32_t>> above(tiles);
   try
@@ -409,9 +404,11 @@ bool LeafPartition::TakeCheckpoint()
 {
   State state;
   std::string why;
+  std::vector<double> coord;
   if (!LoadState(this->StatePath(), state, why) || state.complete || state.dims != this->Dimensions ||
-    state.tile != this->Tile || state.coord.size() != this->CoordValues.size() ||
-    std::memcmp(state.coord.data(), this->CoordValues.data(), state.coord.size() * sizeof(double)) != 0)
+    state.tile != this->Tile || !LoadCoord(this->Folder, state.dims, coord, why) ||
+    coord.size() != this->CoordValues.size() ||
+    std::memcmp(coord.data(), this->CoordValues.data(), coord.size() * sizeof(double)) != 0)
   {
     return false;
   }
@@ -434,7 +431,6 @@ bool LeafPartition::TakeCheckpoint()
   this->AnyActive = std::move(state.anyActive);
   this->Blocks = std::move(state.blocks);
   this->Note = std::move(state.note);
-  this->LastLayerCrc = state.lastLayerCrc;
   return true;
 }
 
@@ -468,6 +464,7 @@ void LeafPartition::SkipLayers(LayerSource& source, std::vector<std::vector<uint
   const int64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
   std::vector<float> zcorn;
   std::vector<uint8_t> active;
+  std::vector<uint32_t> cells;
   for (int64_t k = 0; k < this->LayersDone; ++k)
   {
     if (!source.Next(zcorn, active) || static_cast<int64_t>(zcorn.size()) != 8 * nx * ny ||
@@ -476,39 +473,71 @@ void LeafPartition::SkipLayers(LayerSource& source, std::vector<std::vector<uint
       throw std::runtime_error(
         source.Name() + ": layer " + std::to_string(k + 1) + " is missing or has the wrong size");
     }
-  }
-  if (this->LayersDone == 0)
-  {
-    return;
-  }
-  if (LayerCrc(zcorn, active) != this->LastLayerCrc)
-  {
-    throw std::runtime_error(source.Name() + ": layer " + std::to_string(this->LayersDone) +
-      " differs from the one the partition checkpoint in " + this->Folder + " was made from; start the build over");
-  }
-  std::vector<uint32_t> cells;
-  for (int64_t tj = 0; tj < this->TilesY; ++tj)
-  {
-    for (int64_t ti = 0; ti < this->TilesX; ++ti)
+    if (k + 2 < this->LayersDone)
     {
-      const int64_t i0 = ti * this->Tile, j0 = tj * this->Tile;
-      const int64_t w = std::min(this->Tile, nx - i0), h = std::min(this->Tile, ny - j0);
-      GatherTile(zcorn, nx, ny, i0, j0, w, h, cells);
-      KeepBottoms(cells, above[static_cast<std::size_t>(tj * this->TilesX + ti)]);
+      continue;
+    }
+    // The last layer done must encode to the blocks the tiles hold (the one before it gives
+    // the prediction).
+    for (int64_t tj = 0; tj < this->TilesY; ++tj)
+    {
+      for (int64_t ti = 0; ti < this->TilesX; ++ti)
+      {
+        const std::size_t t = static_cast<std::size_t>(tj * this->TilesX + ti);
+        if (k + 1 == this->LayersDone)
+        {
+          uint32_t planes = 0;
+          const std::vector<uint8_t> stored = this->EncodeTile(k, ti, tj, zcorn, active, above, cells, planes);
+          if (Crc32(stored.data(), stored.size()) != this->Blocks[t][static_cast<std::size_t>(k)].crc)
+          {
+            throw std::runtime_error(source.Name() + ": layer " + std::to_string(k + 1) +
+              " differs from the one the partition checkpoint in " + this->Folder +
+              " was made from; start the build over");
+          }
+        }
+        else
+        {
+          const int64_t i0 = ti * this->Tile, j0 = tj * this->Tile;
+          GatherTile(zcorn, nx, ny, i0, j0, std::min(this->Tile, nx - i0), std::min(this->Tile, ny - j0), cells);
+        }
+        KeepBottoms(cells, above[t]);
+      }
     }
   }
 }
 
-/// The layers from LayersDone on: statistics, tiles, and a checkpoint now and then (unless
-/// asked for after every layer, the time between two at least ten times what the last one
-/// took, so a large COORD costs little).
+/// One tile's block of layer k, compressed (`cells` gets the tile's corners).
+std::vector<uint8_t> LeafPartition::EncodeTile(int64_t k, int64_t ti, int64_t tj, const std::vector<float>& zcorn,
+  const std::vector<uint8_t>& active, const std::vector<std::vector<uint32_t>>& above, std::vector<uint32_t>& cells,
+  uint32_t& planes) const
+{
+  const int64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
+  const std::size_t t = static_cast<std::size_t>(tj * this->TilesX + ti);
+  const int64_t i0 = ti * this->Tile, j0 = tj * this->Tile;
+  const int64_t w = std::min(this->Tile, nx - i0), h = std::min(this->Tile, ny - j0);
+  GatherTile(zcorn, nx, ny, i0, j0, w, h, cells);
+  std::vector<uint8_t> flags(static_cast<std::size_t>(w * h)), raw;
+  std::vector<uint32_t> residuals;
+  for (int64_t j = 0; j < h; ++j)
+  {
+    std::memcpy(&flags[static_cast<std::size_t>(j * w)], &active[static_cast<std::size_t>((j0 + j) * nx + i0)],
+      static_cast<std::size_t>(w));
+  }
+  planes = EncodeBlock(cells.data(), k > 0 ? above[t].data() : nullptr, flags.data(), w, h, residuals, raw);
+  return CompressChunk(raw);
+}
+
+/// The layers from LayersDone on: statistics, tiles, and a checkpoint whenever the tiles have
+/// grown by the checkpoint's own size since the last one (checkpoints cost at most as much
+/// disk traffic as the tiles) or checkpointSeconds have passed.
 void LeafPartition::StreamLayers(
   LayerSource& source, const PartitionHooks& hooks, std::vector<std::vector<uint32_t>>& above)
 {
   const int64_t nx = this->Dimensions[0], ny = this->Dimensions[1], nz = this->Dimensions[2];
   std::vector<float> zcorn;
   std::vector<uint8_t> active;
-  double last = Now(), cost = 0;
+  double last = Now();
+  uint64_t grown = 0, checkpointBytes = 0;
   for (int64_t k = this->LayersDone; k < nz; ++k)
   {
     if (!source.Next(zcorn, active) || static_cast<int64_t>(zcorn.size()) != 8 * nx * ny ||
@@ -521,21 +550,33 @@ void LeafPartition::StreamLayers(
     {
       hooks.onLayer(k, active);
     }
+    try
+    {
+      this->WriteLayer(k, zcorn, active, above);
+    }
+    catch (const std::runtime_error&)
+    {
+      this->CheckpointAfterFailure(hooks);
+      throw;
+    }
     this->AddLayerStatistics(source, k, zcorn, active);
-    this->WriteLayer(k, zcorn, active, above);
     this->LayersDone = k + 1;
+    for (const std::vector<Block>& blocks : this->Blocks)
+    {
+      grown += blocks.back().stored;
+    }
     if (hooks.progress)
     {
       hooks.progress(static_cast<double>(k + 1) / nz);
     }
-    if (k + 1 < nz && Now() - last >= (hooks.checkpointSeconds > 0 ? std::max(hooks.checkpointSeconds, 10 * cost) : 0))
+    if (k + 1 < nz && (grown >= checkpointBytes || Now() - last >= hooks.checkpointSeconds))
     {
-      const double start = Now();
       this->Note = hooks.checkpointNote ? hooks.checkpointNote() : std::vector<uint8_t>();
-      this->LastLayerCrc = LayerCrc(zcorn, active);
       this->SaveState();
+      struct stat info;
+      checkpointBytes = stat(this->StatePath().c_str(), &info) == 0 ? static_cast<uint64_t>(info.st_size) : 0;
+      grown = 0;
       last = Now();
-      cost = last - start;
     }
   }
   if (this->ActiveCount == 0)
@@ -543,9 +584,26 @@ void LeafPartition::StreamLayers(
     this->Bounds[2] = this->Bounds[5] = 0;
   }
   this->Complete = true;
-  this->LastLayerCrc = 0;
   this->Note = hooks.checkpointNote ? hooks.checkpointNote() : std::vector<uint8_t>();
   this->SaveState();
+}
+
+/// A write failed (a full disk, most often): the layers done so far are kept as a checkpoint
+/// if it can be written, else the last one stays.
+void LeafPartition::CheckpointAfterFailure(const PartitionHooks& hooks)
+{
+  if (this->LayersDone == 0)
+  {
+    return;
+  }
+  try
+  {
+    this->Note = hooks.checkpointNote ? hooks.checkpointNote() : std::vector<uint8_t>();
+    this->SaveState();
+  }
+  catch (const std::exception&)
+  {
+  }
 }
 
 /// Active columns, the active cell count and the depth range of the active cells' corners.
@@ -583,26 +641,14 @@ void LeafPartition::AddLayerStatistics(
 void LeafPartition::WriteLayer(int64_t k, const std::vector<float>& zcorn, const std::vector<uint8_t>& active,
   std::vector<std::vector<uint32_t>>& above)
 {
-  const int64_t nx = this->Dimensions[0], ny = this->Dimensions[1];
-  std::vector<uint32_t> cells, residuals;
-  std::vector<uint8_t> flags, raw;
+  std::vector<uint32_t> cells;
   for (int64_t tj = 0; tj < this->TilesY; ++tj)
   {
     for (int64_t ti = 0; ti < this->TilesX; ++ti)
     {
       const std::size_t t = static_cast<std::size_t>(tj * this->TilesX + ti);
-      const int64_t i0 = ti * this->Tile, j0 = tj * this->Tile;
-      const int64_t w = std::min(this->Tile, nx - i0), h = std::min(this->Tile, ny - j0);
-      GatherTile(zcorn, nx, ny, i0, j0, w, h, cells);
-      flags.resize(static_cast<std::size_t>(w * h));
-      for (int64_t j = 0; j < h; ++j)
-      {
-        std::memcpy(&flags[static_cast<std::size_t>(j * w)], &active[static_cast<std::size_t>((j0 + j) * nx + i0)],
-          static_cast<std::size_t>(w));
-      }
       Block block;
-      block.planes = EncodeBlock(cells.data(), k > 0 ? above[t].data() : nullptr, flags.data(), w, h, residuals, raw);
-      const std::vector<uint8_t> stored = CompressChunk(raw);
+      const std::vector<uint8_t> stored = this->EncodeTile(k, ti, tj, zcorn, active, above, cells, block.planes);
       block.offset = this->TileEnd(t);
       block.stored = static_cast<uint32_t>(stored.size());
       block.crc = Crc32(stored.data(), stored.size());
@@ -648,7 +694,59 @@ LeafPartition::~LeafPartition()
     }
   }
   unlink(this->StatePath().c_str());
+  unlink((this->Folder + "/coord.bin").c_str());
   rmdir(this->Folder.c_str());
+}
+
+/// COORD, written once a pass (checkpoints would rewrite it: it is the largest part of the
+/// state), under a temporary name renamed into place, with its CRC-32.
+void LeafPartition::SaveCoord() const
+{
+  const std::string path = this->Folder + "/coord.bin";
+  const std::string temporary = path + ".part";
+  CheckedFile out(std::fopen(temporary.c_str(), "wb"));
+  if (!out.File)
+  {
+    throw std::runtime_error(temporary + ": cannot create: " + std::strerror(errno));
+  }
+  out.Put(static_cast<uint64_t>(this->CoordValues.size()));
+  out.Put(this->CoordValues.data(), this->CoordValues.size() * sizeof(double));
+  const uint32_t crc = out.Crc;
+  out.Put(crc);
+  if (!out.Close() || std::rename(temporary.c_str(), path.c_str()) != 0)
+  {
+    unlink(temporary.c_str());
+    throw std::runtime_error(path + ": write failed (disk full?)");
+  }
+}
+
+/// COORD as SaveCoord wrote it for `dims`; false with the reason in `why`.
+bool LeafPartition::LoadCoord(
+  const std::string& folder, const std::array<int64_t, 3>& dims, std::vector<double>& coord, std::string& why)
+{
+  CheckedFile in(std::fopen((folder + "/coord.bin").c_str(), "rb"));
+  if (!in.File)
+  {
+    why = "coord.bin: cannot open: " + std::string(std::strerror(errno));
+    return false;
+  }
+  const uint64_t count = static_cast<uint64_t>(6 * (dims[0] + 1) * (dims[1] + 1));
+  struct stat info;
+  if (in.Get<uint64_t>() != count || fstat(fileno(in.File), &info) != 0 ||
+    static_cast<uint64_t>(info.st_size) != 12 + 8 * count)
+  {
+    why = "coord.bin: truncated, or not of these dimensions";
+    return false;
+  }
+  coord.resize(count);
+  in.Get(coord.data(), coord.size() * sizeof(double));
+  const uint32_t crc = in.Crc;
+  if (!in.Ok || in.Get<uint32_t>() != crc)
+  {
+    why = "coord.bin: truncated or corrupt";
+    return false;
+  }
+  return true;
 }
 
 /// The state file, whole, then renamed over the last one, so a reader finds the old
@@ -670,9 +768,6 @@ void LeafPartition::SaveState() const
   out.Put(this->LayersDone);
   out.Put(this->ActiveCount);
   out.Put(this->Bounds);
-  out.Put(this->LastLayerCrc);
-  out.Put(static_cast<uint64_t>(this->CoordValues.size()));
-  out.Put(this->CoordValues.data(), this->CoordValues.size() * sizeof(double));
   out.Put(static_cast<uint64_t>(this->AnyActive.size()));
   out.Put(this->AnyActive.data(), this->AnyActive.size());
   out.Put(static_cast<uint64_t>(this->Blocks.size()));
@@ -722,7 +817,6 @@ bool LeafPartition::LoadState(const std::string& path, State& state, std::string
   in.Get(state.layers);
   in.Get(state.activeCount);
   in.Get(state.bounds);
-  in.Get(state.lastLayerCrc);
   state.complete = complete != 0;
   const int64_t nx = state.dims[0], ny = state.dims[1], nz = state.dims[2];
   if (!in.Ok || std::memcmp(magic, StateMagic, sizeof(magic)) != 0 || version != StateVersion || nx <= 0 || ny <= 0 ||
@@ -735,19 +829,16 @@ bool LeafPartition::LoadState(const std::string& path, State& state, std::string
   // The sizes the dimensions imply, checked against the file's before anything is allocated.
   const uint64_t tiles =
     static_cast<uint64_t>(((nx + state.tile - 1) / state.tile) * ((ny + state.tile - 1) / state.tile));
-  const uint64_t coordCount = static_cast<uint64_t>(6 * (nx + 1) * (ny + 1)), columns = static_cast<uint64_t>(nx * ny);
+  const uint64_t columns = static_cast<uint64_t>(nx * ny);
   struct stat info;
   if (fstat(fileno(in.File), &info) != 0 ||
-    double(info.st_size) < 8.0 * double(coordCount) + double(columns) + 20.0 * double(tiles) * double(state.layers))
+    double(info.st_size) < double(columns) + 20.0 * double(tiles) * double(state.layers))
   {
     why = "shorter than its dimensions imply";
     return false;
   }
-  state.coord.resize(coordCount);
   state.anyActive.resize(columns);
-  bool sizes = in.Get<uint64_t>() == state.coord.size();
-  in.Get(state.coord.data(), state.coord.size() * sizeof(double));
-  sizes = sizes && in.Get<uint64_t>() == state.anyActive.size();
+  bool sizes = in.Get<uint64_t>() == state.anyActive.size();
   in.Get(state.anyActive.data(), state.anyActive.size());
   sizes = sizes && in.Get<uint64_t>() == tiles;
   if (!sizes || !in.Ok)
@@ -815,7 +906,10 @@ LeafPartition::LeafPartition(const std::string& folder)
   this->LayersDone = state.layers;
   this->ActiveCount = state.activeCount;
   this->Bounds = state.bounds;
-  this->CoordValues = std::move(state.coord);
+  if (!LoadCoord(folder, state.dims, this->CoordValues, why))
+  {
+    throw std::runtime_error(folder + "/" + why);
+  }
   this->AnyActive = std::move(state.anyActive);
   this->Blocks = std::move(state.blocks);
   this->Note = std::move(state.note);

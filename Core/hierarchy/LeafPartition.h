@@ -12,8 +12,10 @@
 //   held in memory and in `folder`/partition.state; a corrupt or short block throws
 //   std::runtime_error naming the tile file and the layer.
 // - The state file is rewritten atomically (temporary file, then rename) as a checkpoint after
-//   a layer once PartitionHooks::checkpointSeconds have passed since the last one, and after
-//   the last layer, marked complete. A writer that finds an incomplete checkpoint of the same
+//   a layer once the tiles have grown by its own size since the last one or
+//   PartitionHooks::checkpointSeconds have passed, after a write that failed (a full disk)
+//   when it can still be written, and after the last layer, marked complete. COORD is
+//   written once, in `folder`/coord.bin. A writer that finds an incomplete checkpoint of the same
 //   grid and tile size in `folder` resumes after its layers instead of starting over.
 // - ReadBox() gives the cells of [i0, i1) x [j0, j1) in the same layout as the source grid
 //   restricted to the box: corners [k][j][i][8] and active [k][j][i].
@@ -46,8 +48,8 @@ struct PartitionHooks
   std::function<std::vector<uint8_t>()> checkpointNote;
   /// A pass resumed after `layers` layers, with the note of that checkpoint.
   std::function<void(int64_t layers, const std::vector<uint8_t>& note)> onResume;
-  /// Least time between two checkpoints, as each rewrites COORD and the block index; 0: after
-  /// every layer.
+  /// Most time between two checkpoints (they also come whenever the tiles have grown by a
+  /// checkpoint's size); 0: after every layer.
   double checkpointSeconds = 5;
 };
 
@@ -127,6 +129,13 @@ private:
   bool TakeCheckpoint();
   void OpenTiles(bool resume);
   void SkipLayers(LayerSource& source, std::vector<std::vector<uint32_t>>& above);
+  std::vector<uint8_t> EncodeTile(int64_t k, int64_t ti, int64_t tj, const std::vector<float>& zcorn,
+    const std::vector<uint8_t>& active, const std::vector<std::vector<uint32_t>>& above, std::vector<uint32_t>& cells,
+    uint32_t& planes) const;
+  void SaveCoord() const;
+  static bool LoadCoord(
+    const std::string& folder, const std::array<int64_t, 3>& dims, std::vector<double>& coord, std::string& why);
+  void CheckpointAfterFailure(const PartitionHooks& hooks);
   void StreamLayers(LayerSource& source, const PartitionHooks& hooks, std::vector<std::vector<uint32_t>>& above);
   void AddLayerStatistics(
     const LayerSource& source, int64_t k, const std::vector<float>& zcorn, const std::vector<uint8_t>& active);
@@ -145,7 +154,6 @@ private:
   int64_t Tile = 64, TilesX = 0, TilesY = 0;
   int64_t LayersDone = 0;
   bool Complete = false;
-  uint32_t LastLayerCrc = 0; ///< CRC-32 of the last layer streamed, checked by a resumed pass
   std::vector<uint8_t> Note; ///< the caller's bytes of the last checkpoint
   std::string Folder;
   std::vector<std::vector<Block>> Blocks; ///< per tile, one a layer

@@ -230,13 +230,12 @@ void TestResume()
   CHECK(resumed.ColumnHasActive() == whole.ColumnHasActive());
   CHECK(resumed.TileBytes() == whole.TileBytes());
 
-  // Without a checkpoint (the default interval is longer than this pass), a stopped pass
-  // starts over.
+  // Without a checkpoint (stopped in its first layer), a stopped pass starts over.
   PartitionHooks rarely;
   bool called = false;
   rarely.onResume = [&](int64_t, const std::vector<uint8_t>&) { called = true; };
   {
-    FaultySource failing(stopAt);
+    FaultySource failing(0);
     resmr_testing::ExpectError<std::runtime_error>("stopped pass without checkpoint",
       [&] { LeafPartition partition(failing, Temp + "/rarely", TileSize, rarely); }, { "stopped at layer" });
   }

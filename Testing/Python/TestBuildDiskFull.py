@@ -1,8 +1,9 @@
 """Disk of a hierarchy build: the peak scratch the build reports stays within the bound its
 free-disk check assumes (BuildDiskNeed) on a 10M-cell model; a build the disk cannot hold is
 refused before any work, saying what it needs; and a build stopped by a full disk in any phase
-keeps what it finished, resumes when there is room, and writes the file an uninterrupted build
-writes.
+(the partition pass, resumed part-way from its last checkpoint; the leaves and diamonds,
+resumed from the tasks its journal records; the writing of the file) keeps what it finished,
+resumes when there is room, and writes the file an uninterrupted build writes.
 
 The full disks are small tmpfs filesystems mounted in a private mount namespace (unshare -m),
 grown after the failure (mount -o remount,size=...) for the resumed run, to more than the
@@ -20,8 +21,10 @@ resmr, temp = sys.argv[1], sys.argv[2]
 shutil.rmtree(temp, ignore_errors=True)
 os.makedirs(temp)
 failures = []
-# BuildDiskNeed in HierarchyBuilder.h: bytes a cell and fixed bytes of the scratch and the file.
-SCRATCH_BYTES_PER_CELL, SCRATCH_FIXED, FILE_BYTES_PER_CELL, FILE_FIXED = 150, 256 << 20, 16, 64 << 20
+# BuildDiskNeed in HierarchyBuilder.h (one process): bytes a cell, a column and fixed bytes of
+# the scratch, and of the file.
+SCRATCH_BYTES_PER_CELL, SCRATCH_BYTES_PER_COLUMN, SCRATCH_FIXED = 24, 64, 256 << 20
+FILE_BYTES_PER_CELL, FILE_FIXED = 16, 64 << 20
 
 
 def build(model, output, *extra):
@@ -45,7 +48,9 @@ else:
     per_cell = report["peak_scratch_bytes"] / cells
     print(f"10M: peak scratch {report['peak_scratch_bytes'] / 1e6:.0f} MB ({per_cell:.1f} B a cell), "
           f"with the file {report['peak_disk_bytes'] / 1e6:.0f} MB, file {report['file_bytes'] / cells:.1f} B a cell")
-    if not 0 < report["peak_scratch_bytes"] <= SCRATCH_BYTES_PER_CELL * cells + SCRATCH_FIXED:
+    columns = 1000 * 1000
+    if not 0 < report["peak_scratch_bytes"] <= SCRATCH_BYTES_PER_CELL * cells + SCRATCH_BYTES_PER_COLUMN * columns + \
+            SCRATCH_FIXED:
         failures.append(f"peak scratch {per_cell:.1f} B a cell is over the bound the disk check assumes")
     if report["peak_disk_bytes"] < report["peak_scratch_bytes"]:
         failures.append("the peak with the file is below the peak of the scratch alone")
@@ -53,8 +58,8 @@ else:
         failures.append(f"file of {report['file_bytes'] / cells:.1f} B a cell, over {FILE_BYTES_PER_CELL}")
     os.remove(big)
 
-# 2. Refused before any work when the disk cannot hold it (1.26 billion cells need about 190 GB
-# of scratch; the scratch folder is put on a 64 MB filesystem).
+# 2. Refused before any work when the disk cannot hold it (1.26 billion cells need about 50 GB
+# of scratch and file; the scratch folder is put on a 64 MB filesystem).
 unshare = shutil.which("unshare")
 probe = subprocess.run([unshare, "-m", "true"], capture_output=True) if unshare else None
 if probe is None or probe.returncode != 0:
