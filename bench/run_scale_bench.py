@@ -16,12 +16,13 @@ what exists is not built again (--rebuild builds anyway).
 import argparse
 import json
 import os
-import platform
 import re
 import shutil
 import subprocess
 import sys
 import time
+
+import run_build_bench as build_bench
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -51,16 +52,9 @@ out_base = os.path.join(ROOT, "bench", "results", f"scale-{nx}x{ny}x{nz}")
 
 
 def machine():
-    cpu = "unknown"
-    with open("/proc/cpuinfo") as handle:
-        for line in handle:
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    with open("/proc/meminfo") as handle:
-        memory = int(handle.readline().split()[1]) / 1024 / 1024
-    return {"cpu": cpu, "cores": os.cpu_count(), "memory_gib": round(memory, 1), "os": platform.platform(),
-            "free_disk_gb": round(shutil.disk_usage(args.scratch).free / 1e9, 1)}
+    host = build_bench.machine()
+    host["free_disk_gb"] = round(shutil.disk_usage(args.scratch).free / 1e9, 1)
+    return host
 
 
 def timed(command):

@@ -1,6 +1,8 @@
 // Depth-first order of the hierarchy build's tasks (ours; the paper builds level by level).
 #include "BuildSchedule.h"
 
+#include "ThreadGroup.h"
+
 #include <algorithm>
 #include <condition_variable>
 #include <exception>
@@ -192,16 +194,7 @@ void BuildSchedule::Run(int threads, const std::vector<uint8_t>& done, const std
       changed.notify_all();
     }
   };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t)
-  {
-    pool.emplace_back(work);
-  }
-  work();
-  for (auto& thread : pool)
-  {
-    thread.join();
-  }
+  RunOnThreads(threads, work);
   if (failure)
   {
     std::rethrow_exception(failure);

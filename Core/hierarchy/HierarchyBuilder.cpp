@@ -16,6 +16,7 @@
 #include "PerfectSpatialHash.h"
 #include "RegionMesh.h"
 #include "SideSurfaceSimplification.h"
+#include "ThreadGroup.h"
 
 #include <algorithm>
 #include <atomic>
@@ -377,16 +378,7 @@ void ParallelFor(int64_t count, int threads, const std::function<void(int64_t)>&
       }
     }
   };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t)
-  {
-    pool.emplace_back(work);
-  }
-  work();
-  for (auto& thread : pool)
-  {
-    thread.join();
-  }
+  RunOnThreads(threads, work);
   if (failure)
   {
     std::rethrow_exception(failure);
@@ -1350,6 +1342,12 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
 
   // Perfect spatial hash over them (Lefebvre and Hoppe), the cell of each slot.
   std::vector<std::array<uint32_t, 3>> hashed;
+  uint64_t count = 0;
+  for (const auto& word : touched)
+  {
+    count += static_cast<uint64_t>(__builtin_popcountll(word.load(std::memory_order_relaxed)));
+  }
+  hashed.reserve(static_cast<std::size_t>(count)); // exactly: it is the largest array of the build
   for (uint64_t word = 0; word < touched.size(); ++word)
   {
     uint64_t bits = touched[word].load(std::memory_order_relaxed);
@@ -1363,7 +1361,6 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
         static_cast<uint32_t>(n % layer / static_cast<uint64_t>(nx)), static_cast<uint32_t>(n / layer) });
     }
   }
-  std::vector<std::atomic<uint64_t>>().swap(touched);
   const PerfectSpatialHash hash = BuildPerfectSpatialHash(hashed);
   header.hashTableSides = hash.tableSides;
   header.hashOffsetSides = hash.offsetSides;
@@ -1371,21 +1368,27 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
   report.hashedCells = hashed.size();
   report.hashSlots = hash.TableSize();
   report.hashOffsets = static_cast<uint64_t>(hash.offsets.size());
-  const std::size_t slots = static_cast<std::size_t>(hash.TableSize());
-  std::vector<uint64_t> slotCell(slots, ~uint64_t(0));
-  std::vector<std::array<uint16_t, 2>> slotNormals(slots, { 0, 0 });
-  // Cells by column, to gather normals leaf by leaf.
-  std::vector<std::pair<uint64_t, uint64_t>> byColumn(hashed.size()); // (column, k) , slot
-  for (std::size_t c = 0; c < hashed.size(); ++c)
+  std::vector<uint16_t> offsets;
+  for (const auto& o : hash.offsets)
   {
-    const auto& p = hashed[c];
-    const uint64_t slot = hash.Slot(p[0], p[1], p[2]);
-    slotCell[static_cast<std::size_t>(slot)] =
-      p[0] + static_cast<uint64_t>(nx) * (p[1] + static_cast<uint64_t>(ny) * p[2]);
-    byColumn[c] = { (p[0] + static_cast<uint64_t>(nx) * p[1]) * static_cast<uint64_t>(nz) + p[2], slot };
+    offsets.insert(offsets.end(), o.begin(), o.end());
   }
-  std::vector<std::array<uint32_t, 3>>().swap(hashed);
-  std::sort(byColumn.begin(), byColumn.end());
+  this->Chunks->AddModelArray(ModelChunk::HashOffsets, offsets.data(), offsets.size() * 2, model);
+  // Each table is written and freed before the next is made: the largest arrays of the build.
+  const std::size_t slots = static_cast<std::size_t>(hash.TableSize());
+  {
+    std::vector<uint64_t> slotCell(slots, ~uint64_t(0));
+    for (const auto& p : hashed)
+    {
+      slotCell[static_cast<std::size_t>(hash.Slot(p[0], p[1], p[2]))] =
+        p[0] + static_cast<uint64_t>(nx) * (p[1] + static_cast<uint64_t>(ny) * p[2]);
+    }
+    std::vector<std::array<uint32_t, 3>>().swap(hashed);
+    this->Chunks->AddModelArray(ModelChunk::HashCells, slotCell.data(), slotCell.size() * 8, model);
+  }
+  // The normals of the hashed cells (those `touched` flags), leaf by leaf.
+  std::vector<std::array<uint16_t, 2>> slotNormals(slots, { 0, 0 });
+  const uint64_t layer = static_cast<uint64_t>(nx * ny);
   for (const auto& entry : this->Records)
   {
     if (entry.first.first != header.leafLevel || entry.second.columns == 0)
@@ -1398,27 +1401,24 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
       throw std::runtime_error(this->NormalsPath(entry.first.second) + ": missing scratch file of cell normals");
     }
     ByteReader in(raw.data(), raw.size(), this->NormalsPath(entry.first.second));
-    const uint64_t count = in.Get<uint64_t>();
-    for (uint64_t c = 0; c < count; ++c)
+    const uint64_t columns = in.Get<uint64_t>();
+    for (uint64_t c = 0; c < columns; ++c)
     {
       const uint64_t column = static_cast<uint64_t>(in.Get<int64_t>());
       const uint8_t* stack = in.Skip(static_cast<std::size_t>(nz) * 4);
-      auto it = std::lower_bound(
-        byColumn.begin(), byColumn.end(), std::make_pair(column * static_cast<uint64_t>(nz), uint64_t(0)));
-      for (; it != byColumn.end() && it->first / static_cast<uint64_t>(nz) == column; ++it)
+      for (uint64_t k = 0; k < static_cast<uint64_t>(nz) && column < layer; ++k)
       {
-        const uint64_t k = it->first % static_cast<uint64_t>(nz);
-        std::memcpy(slotNormals[static_cast<std::size_t>(it->second)].data(), stack + k * 4, 4);
+        const uint64_t n = column + layer * k;
+        if (touched[n >> 6].load(std::memory_order_relaxed) >> (n & 63) & 1)
+        {
+          const uint64_t slot = hash.Slot(static_cast<uint32_t>(column % static_cast<uint64_t>(nx)),
+            static_cast<uint32_t>(column / static_cast<uint64_t>(nx)), static_cast<uint32_t>(k));
+          std::memcpy(slotNormals[static_cast<std::size_t>(slot)].data(), stack + k * 4, 4);
+        }
       }
     }
   }
-  std::vector<uint16_t> offsets;
-  for (const auto& o : hash.offsets)
-  {
-    offsets.insert(offsets.end(), o.begin(), o.end());
-  }
-  this->Chunks->AddModelArray(ModelChunk::HashOffsets, offsets.data(), offsets.size() * 2, model);
-  this->Chunks->AddModelArray(ModelChunk::HashCells, slotCell.data(), slotCell.size() * 8, model);
+  std::vector<std::atomic<uint64_t>>().swap(touched);
   this->Chunks->AddModelArray(ModelChunk::CellNormals, slotNormals.data(), slotNormals.size() * 4, model);
 }
 
