@@ -27,20 +27,27 @@ SyntheticLayerSource::SyntheticLayerSource(const SyntheticParameters& parameters
 {
   this->Stream.reset(new SyntheticLayerStream(*this->Model));
   this->CoordValues = this->Model->Coord();
+  this->Dimensions = { parameters.nx, parameters.ny, parameters.nz };
 }
 
 SyntheticLayerSource::~SyntheticLayerSource() = default;
 
 std::array<int64_t, 3> SyntheticLayerSource::Dims() const
 {
-  const auto& p = this->Model->Parameters();
-  return { p.nx, p.ny, p.nz };
+  return this->Dimensions;
+}
+
+void SyntheticLayerSource::Finished()
+{
+  this->Stream.reset();
+  this->Model.reset();
+  std::vector<double>().swap(this->CoordValues);
 }
 
 bool SyntheticLayerSource::Next(std::vector<float>& zcorn, std::vector<uint8_t>& active)
 {
   SyntheticLayer layer;
-  if (!this->Stream->Next(layer))
+  if (!this->Stream || !this->Stream->Next(layer))
   {
     return false;
   }

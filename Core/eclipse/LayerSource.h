@@ -39,6 +39,9 @@ public:
   /// What the input left out (deck edits the viewer does not build, missing INCLUDEs ...),
   /// one message a line naming the file and place.
   virtual std::vector<std::string> Warnings() const { return {}; }
+  /// The reader needs no more layers: the source may free what streaming them took. Dims(),
+  /// Name(), Placement() and Warnings() still answer; Coord() and Next() no longer do.
+  virtual void Finished() {}
 };
 
 /// Layers generated on the fly (SyntheticReservoir), never all in memory.
@@ -51,11 +54,14 @@ public:
   const std::vector<double>& Coord() const override { return this->CoordValues; }
   bool Next(std::vector<float>& zcorn, std::vector<uint8_t>& active) override;
   std::string Name() const override { return this->Label; }
+  /// Frees the generator (its per-pillar and per-column fields) and COORD.
+  void Finished() override;
 
 private:
   std::unique_ptr<SyntheticReservoir> Model;
   std::unique_ptr<SyntheticLayerStream> Stream;
   std::vector<double> CoordValues;
+  std::array<int64_t, 3> Dimensions{};
   std::string Label;
 };
 

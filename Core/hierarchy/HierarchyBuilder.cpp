@@ -2002,6 +2002,7 @@ HierarchyReport Builder::Run()
         report.partitionSeconds = Seconds() - start;
       }
       report.activeCells = this->Partition->ActiveCells();
+      this->Source.Finished(); // the tiles hold the model now
       const std::vector<Leaf> leaves = this->PlanLeaves(header, report);
       keepScratch = true; // the partition is finished: a failure from here keeps it
       if (this->Options.ranks == 1)
