@@ -98,6 +98,7 @@ def view(results):
     subprocess.run(command, check=True)
     with open(out + ".json") as handle:
         results["view"] = json.load(handle)
+    results["view_budget_mb"] = args.budget
     save(results)
 
 
@@ -146,7 +147,7 @@ def report(results):
             lines += ["## View (bench/run_view_bench.py, 1280x720, llvmpipe)", "",
                       f"First image {e['first_image_s']:.2f} s; frame times p50 {e['p50_ms']:.0f} ms, "
                       f"p99 {e['p99_ms']:.0f} ms at {e.get('fps', 10)} FPS; resident at most "
-                      f"{e.get('max_resident_mb', 0):.0f} MB (budget {args.budget} MB); process RSS at most "
+                      f"{e.get('max_resident_mb', 0):.0f} MB (budget {results.get('view_budget_mb', args.budget)} MB); process RSS at most "
                       f"{e.get('max_rss_mb', 0):.0f} MB.", ""]
     with open(out_base + ".md", "w") as handle:
         handle.write("\n".join(lines))
