@@ -161,18 +161,25 @@ bool LoadCompressed(const std::string& path, std::vector<uint8_t>& raw)
   return true;
 }
 
+/// Every array of a scratch region, in the order its file holds them.
+template<typename Region, typename Visit>
+void EachArray(Region& region, Visit&& visit)
+{
+  visit(region.mesh.positions);
+  visit(region.mesh.quadrics);
+  visit(region.mesh.topology);
+  visit(region.mesh.corners);
+  visit(region.mesh.activeCells);
+  visit(region.mesh.origin);
+  visit(region.cutEdges);
+  visit(region.openSides);
+}
+
 void SaveRegion(const std::string& path, const ScratchRegion& region)
 {
   ByteWriter out;
   out.Put(region.mesh.layers);
-  PutVector(out, region.mesh.positions);
-  PutVector(out, region.mesh.quadrics);
-  PutVector(out, region.mesh.topology);
-  PutVector(out, region.mesh.corners);
-  PutVector(out, region.mesh.activeCells);
-  PutVector(out, region.mesh.origin);
-  PutVector(out, region.cutEdges);
-  PutVector(out, region.openSides);
+  EachArray(region, [&](const auto& values) { PutVector(out, values); });
   SaveCompressed(path, out.Bytes);
 }
 
@@ -187,14 +194,7 @@ bool LoadRegion(const std::string& path, ScratchRegion& region)
   {
     ByteReader in(raw.data(), raw.size(), path);
     region.mesh.layers = in.Get<int32_t>();
-    GetVector(in, region.mesh.positions);
-    GetVector(in, region.mesh.quadrics);
-    GetVector(in, region.mesh.topology);
-    GetVector(in, region.mesh.corners);
-    GetVector(in, region.mesh.activeCells);
-    GetVector(in, region.mesh.origin);
-    GetVector(in, region.cutEdges);
-    GetVector(in, region.openSides);
+    EachArray(region, [&](auto& values) { GetVector(in, values); });
   }
   catch (const std::exception&)
   {
