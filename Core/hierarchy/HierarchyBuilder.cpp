@@ -1340,32 +1340,36 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
   });
   parts.clear();
 
-  // Perfect spatial hash over them (Lefebvre and Hoppe), the cell of each slot.
-  std::vector<std::array<uint32_t, 3>> hashed;
-  uint64_t count = 0;
-  for (const auto& word : touched)
-  {
-    count += static_cast<uint64_t>(__builtin_popcountll(word.load(std::memory_order_relaxed)));
-  }
-  hashed.reserve(static_cast<std::size_t>(count)); // exactly: it is the largest array of the build
-  for (uint64_t word = 0; word < touched.size(); ++word)
-  {
-    uint64_t bits = touched[word].load(std::memory_order_relaxed);
-    while (bits)
+  // Perfect spatial hash over them (Lefebvre and Hoppe), the cell of each slot. The cell
+  // list is the largest array of the build: made exactly once, freed before the tables.
+  const uint64_t layer = static_cast<uint64_t>(nx * ny);
+  const auto eachTouched = [&](auto&& visit) {
+    for (uint64_t word = 0; word < touched.size(); ++word)
     {
-      const int bit = __builtin_ctzll(bits);
-      bits &= bits - 1;
-      const uint64_t n = word * 64 + static_cast<uint64_t>(bit);
-      const uint64_t layer = static_cast<uint64_t>(nx * ny);
-      hashed.push_back({ static_cast<uint32_t>(n % layer % static_cast<uint64_t>(nx)),
-        static_cast<uint32_t>(n % layer / static_cast<uint64_t>(nx)), static_cast<uint32_t>(n / layer) });
+      for (uint64_t bits = touched[word].load(std::memory_order_relaxed); bits; bits &= bits - 1)
+      {
+        const uint64_t n = word * 64 + static_cast<uint64_t>(__builtin_ctzll(bits));
+        visit(n, std::array<uint32_t, 3>{ static_cast<uint32_t>(n % layer % static_cast<uint64_t>(nx)),
+                   static_cast<uint32_t>(n % layer / static_cast<uint64_t>(nx)), static_cast<uint32_t>(n / layer) });
+      }
     }
+  };
+  PerfectSpatialHash hash;
+  {
+    std::vector<std::array<uint32_t, 3>> hashed;
+    uint64_t count = 0;
+    for (const auto& word : touched)
+    {
+      count += static_cast<uint64_t>(__builtin_popcountll(word.load(std::memory_order_relaxed)));
+    }
+    hashed.reserve(static_cast<std::size_t>(count));
+    eachTouched([&](uint64_t, const std::array<uint32_t, 3>& p) { hashed.push_back(p); });
+    hash = BuildPerfectSpatialHash(hashed);
+    header.hashedCells = hashed.size();
   }
-  const PerfectSpatialHash hash = BuildPerfectSpatialHash(hashed);
   header.hashTableSides = hash.tableSides;
   header.hashOffsetSides = hash.offsetSides;
-  header.hashedCells = hashed.size();
-  report.hashedCells = hashed.size();
+  report.hashedCells = header.hashedCells;
   report.hashSlots = hash.TableSize();
   report.hashOffsets = static_cast<uint64_t>(hash.offsets.size());
   std::vector<uint16_t> offsets;
@@ -1374,21 +1378,17 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
     offsets.insert(offsets.end(), o.begin(), o.end());
   }
   this->Chunks->AddModelArray(ModelChunk::HashOffsets, offsets.data(), offsets.size() * 2, model);
-  // Each table is written and freed before the next is made: the largest arrays of the build.
+  // Each table is written and freed before the next is made.
   const std::size_t slots = static_cast<std::size_t>(hash.TableSize());
   {
     std::vector<uint64_t> slotCell(slots, ~uint64_t(0));
-    for (const auto& p : hashed)
-    {
-      slotCell[static_cast<std::size_t>(hash.Slot(p[0], p[1], p[2]))] =
-        p[0] + static_cast<uint64_t>(nx) * (p[1] + static_cast<uint64_t>(ny) * p[2]);
-    }
-    std::vector<std::array<uint32_t, 3>>().swap(hashed);
+    eachTouched([&](uint64_t n, const std::array<uint32_t, 3>& p) {
+      slotCell[static_cast<std::size_t>(hash.Slot(p[0], p[1], p[2]))] = n;
+    });
     this->Chunks->AddModelArray(ModelChunk::HashCells, slotCell.data(), slotCell.size() * 8, model);
   }
   // The normals of the hashed cells (those `touched` flags), leaf by leaf.
   std::vector<std::array<uint16_t, 2>> slotNormals(slots, { 0, 0 });
-  const uint64_t layer = static_cast<uint64_t>(nx * ny);
   for (const auto& entry : this->Records)
   {
     if (entry.first.first != header.leafLevel || entry.second.columns == 0)

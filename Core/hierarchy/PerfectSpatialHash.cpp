@@ -59,24 +59,65 @@ int LowestBit(uint64_t word)
     std::to_string(uint64_t(c[1]) + 1) + ", " + std::to_string(uint64_t(c[2]) + 1) + ") listed twice");
 }
 
-/// Whether no two cells agree modulo m[a] r[a] on every axis a. With gcd(m[a], r[a]) = 1 that
-/// is (by the Chinese remainder theorem) whether (h0, h1) = (p mod m, p mod r) is injective on
-/// the cells, which LH require: cells agreeing in both share an entry and hence a slot.
-bool Separable(const std::vector<Cell>& cells, const Sides& m, const Sides& r)
+Sides Extent(const std::vector<Cell>& cells);
+
+/// The first cell listed twice, thrown; `n` agrees with an earlier cell in every residue.
+void ThrowIfListedBefore(const std::vector<Cell>& cells, std::size_t n)
 {
-  std::array<uint64_t, 3> product;
+  if (std::find(cells.begin(), cells.begin() + static_cast<std::ptrdiff_t>(n), cells[n]) !=
+    cells.begin() + static_cast<std::ptrdiff_t>(n))
+  {
+    ThrowDuplicate(cells[n]);
+  }
+}
+
+/// Whether no two cells agree modulo `modulus` on every axis. Residues are marked in a bitset
+/// when their space is at most 64 bits a cell (a shell in its box: a bit or two a cell), so
+/// that the largest sets need no per-cell keys; else (sparse sets) keys are sorted. A cell
+/// listed twice throws when it is the collision found; sorting finds every one.
+bool ResiduesDistinct(const std::vector<Cell>& cells, const std::array<uint64_t, 3>& modulus)
+{
+  Cell low{ UINT32_MAX, UINT32_MAX, UINT32_MAX };
+  for (const Cell& c : cells)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      low[a] = std::min(low[a], c[a]);
+    }
+  }
+  const Sides extent = Extent(cells);
+  std::array<uint64_t, 3> span;
+  double space = 1;
   for (int a = 0; a < 3; ++a)
   {
-    product[a] = uint64_t(m[a]) * r[a];
+    span[a] = std::min<uint64_t>(modulus[a], extent[a]);
+    space *= static_cast<double>(span[a]);
+  }
+  const auto residue = [&](const Cell& c, int a) { return (uint64_t(c[a]) - low[a]) % modulus[a]; };
+  if (space <= 64.0 * static_cast<double>(cells.size()) + 4096)
+  {
+    std::vector<uint64_t> seen(static_cast<std::size_t>((static_cast<uint64_t>(space) + 63) / 64), 0);
+    for (std::size_t n = 0; n < cells.size(); ++n)
+    {
+      const uint64_t key = residue(cells[n], 0) + span[0] * (residue(cells[n], 1) + span[1] * residue(cells[n], 2));
+      uint64_t& word = seen[static_cast<std::size_t>(key >> 6)];
+      if (word >> (key & 63) & 1)
+      {
+        ThrowIfListedBefore(cells, n);
+        return false;
+      }
+      word |= uint64_t(1) << (key & 63);
+    }
+    return true;
   }
   std::vector<std::pair<Cell, uint32_t>> keyed(cells.size());
   for (uint32_t n = 0; n < cells.size(); ++n)
   {
     const Cell& c = cells[n];
-    keyed[n] = { { uint32_t(c[0] % product[0]), uint32_t(c[1] % product[1]), uint32_t(c[2] % product[2]) }, n };
+    keyed[n] = { { uint32_t(residue(c, 0)), uint32_t(residue(c, 1)), uint32_t(residue(c, 2)) }, n };
   }
   std::sort(keyed.begin(), keyed.end());
-  bool separable = true;
+  bool distinct = true;
   for (std::size_t n = 1; n < keyed.size(); ++n)
   {
     if (keyed[n].first == keyed[n - 1].first)
@@ -85,10 +126,18 @@ bool Separable(const std::vector<Cell>& cells, const Sides& m, const Sides& r)
       {
         ThrowDuplicate(cells[keyed[n].second]);
       }
-      separable = false; // keep looking: a duplicate elsewhere is the caller's error, not ours
+      distinct = false; // keep looking: a duplicate elsewhere is the caller's error, not ours
     }
   }
-  return separable;
+  return distinct;
+}
+
+/// Whether no two cells agree modulo m[a] r[a] on every axis a. With gcd(m[a], r[a]) = 1 that
+/// is (by the Chinese remainder theorem) whether (h0, h1) = (p mod m, p mod r) is injective on
+/// the cells, which LH require: cells agreeing in both share an entry and hence a slot.
+bool Separable(const std::vector<Cell>& cells, const Sides& m, const Sides& r)
+{
+  return ResiduesDistinct(cells, { uint64_t(m[0]) * r[0], uint64_t(m[1]) * r[1], uint64_t(m[2]) * r[2] });
 }
 
 /// One construction with sides m and r (LH Sec. 4.2): cells grouped by offset entry h1, groups
@@ -508,6 +557,7 @@ PerfectSpatialHash BuildPerfectSpatialHash(const std::vector<Cell>& cells)
     throw std::invalid_argument("perfect spatial hash: " + std::to_string(n) + " cells are too many");
   }
   const Sides extent = Extent(cells);
+  ResiduesDistinct(cells, { extent[0], extent[1], extent[2] }); // throws for a cell listed twice
 
   // Shaped tables first: every table of at most 1.25 |S| slots the shapes below give, smallest
   // first, each with an offset table of |S| / 6 or |S| / 4 entries shaped like the set.
