@@ -31,6 +31,7 @@ pqMultiresolutionReadout pqMultiresolutionReadout::Pull(vtkSMProxy* surface)
   pqMultiresolutionReadout readout;
   surface->UpdatePropertyInformation();
   readout.Tolerance = vtkSMPropertyHelper(surface, "CurrentTolerance").GetAsDouble();
+  readout.RenderScale = vtkSMPropertyHelper(surface, "CurrentRenderScale").GetAsDouble();
   readout.TargetFrameRate = vtkSMPropertyHelper(surface, "TargetFrameRate").GetAsDouble();
   readout.ResidentMB = vtkSMPropertyHelper(surface, "ResidentMB").GetAsDouble();
   readout.BudgetMB = vtkSMPropertyHelper(surface, "MemoryBudgetMB").GetAsInt();

@@ -118,10 +118,11 @@ void pqMultiresolutionReadoutDock::updateReadout()
   auto* data = qobject_cast<pqDataRepresentation*>(chosen);
   pqPipelineSource* input = data ? data->getInput() : nullptr;
   this->Source->setText(input ? input->getSMName() : tr("Multiresolution Surface"));
-  this->Tolerance->setText(
-    tr("%1 px (%2)")
-      .arg(readout.Tolerance, 0, 'f', 2)
-      .arg(readout.TargetFrameRate > 0 ? tr("holding %1 fps").arg(readout.TargetFrameRate) : tr("fixed")));
+  const QString holding = readout.TargetFrameRate <= 0 ? tr("fixed")
+    : readout.RenderScale < 1
+    ? tr("holding %1 fps, drawn at %2% resolution").arg(readout.TargetFrameRate).arg(qRound(100 * readout.RenderScale))
+    : tr("holding %1 fps").arg(readout.TargetFrameRate);
+  this->Tolerance->setText(tr("%1 px (%2)").arg(readout.Tolerance, 0, 'f', 2).arg(holding));
   this->Resident->setText(tr("%1 MB of %2 MB").arg(readout.ResidentMB, 0, 'f', 1).arg(readout.BudgetMB));
   this->Triangles->setText(locale.toString(static_cast<qlonglong>(readout.Triangles)));
   this->Regions->setText(tr("%1 (%2 standing in)").arg(readout.Regions).arg(readout.Substituted));

@@ -103,7 +103,8 @@ void pqMultiresolutionRefreshManager::onRenderEnded()
     // that failed or does not fit the budget would give the same frame forever).
     const bool changed = !own || !previous || previous->Regions != readout.Regions ||
       previous->Triangles != readout.Triangles || previous->Substituted != readout.Substituted;
-    again = again || readout.LoadsPending || (readout.Substituted > 0 && changed);
+    // A moving frame drawn at a reduced resolution: the still frame after it is drawn in full.
+    again = again || readout.LoadsPending || (readout.Substituted > 0 && changed) || readout.RenderScale < 1;
     if (readout.TargetFrameRate > 0)
     {
       // The controller counts the gap between back-to-back frames as frame time: keep it

@@ -9,7 +9,9 @@
 //   ancestors for regions not loaded yet (RegionsSubstituted) and differs from the last, or
 // - a target frame rate is set and the frame-rate controller is still refining: after any
 //   render that was not ours (the still frame after an interaction can afford more detail),
-//   and then while each frame lowers the tolerance.
+//   and then while each frame lowers the tolerance, or
+// - the frame was drawn at a reduced resolution while the camera moved: the next render of
+//   the same camera is the still frame, drawn in full.
 // One single-shot timer per view: renders from anywhere restart it, so requests coalesce,
 // and nothing is scheduled once nothing is loading and the tolerance holds.
 #ifndef pqMultiresolutionRefreshManager_h

@@ -1,6 +1,7 @@
 #include "vtkMultiresolutionSurfaceMapper.h"
 
 #include "vtkMultiresolutionGpuRegions.h"
+#include "vtkMultiresolutionReducedResolution.h"
 #include "vtkMultiresolutionShaderVariants.h"
 #include "vtkMultiresolutionTableTextures.h"
 
@@ -142,6 +143,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   vtkMultiresolutionGpuRegions Regions;
   vtkMultiresolutionTableTextures Tables;
   vtkMultiresolutionShaderVariants Shaders;
+  vtkMultiresolutionReducedResolution Reduced;
   GpuTimer Timer;
 
   // View state and readout.
@@ -152,6 +154,9 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   bool HavePreviousView = false;
   resmr::ViewParameters PreviousView;
   double Tolerance = 1;
+  double RenderScale = 1; ///< the last frame's
+  bool HaveLastClip = false;
+  resmr::Matrix4 LastClip{}; ///< the last frame's model to clip transform
   vtkIdType Triangles = 0;
   int Drawn = 0, Substituted = 0;
   double FrameMs = 0;
@@ -174,6 +179,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
 
   void ReleaseGpu()
   {
+    this->Reduced.ReleaseGraphicsResources(this->Window);
     this->Regions.ReleaseGraphicsResources();
     this->Tables.ForgetAll(this->Window);
   }
@@ -194,6 +200,8 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   double intervalMs = 0;        ///< since the last frame began (0: the first)
   bool afterAllocation = false; ///< the last frame allocated a table texture
   bool bounded = true;          ///< interactive: a bounded upload a frame (no WaitForDetailMs)
+  bool moving = false;          ///< the camera (or the actor) moved since the last frame
+  double scale = 1;             ///< the fraction of the view's width and height drawn
   // What the descriptor names.
   std::string filePath, propertyPath, propertyStamp;
   int32_t step = 0;
@@ -231,6 +239,10 @@ int vtkMultiresolutionSurfaceMapper::FillInputPortInformation(int, vtkInformatio
 double vtkMultiresolutionSurfaceMapper::GetCurrentTolerance() const
 {
   return this->Internal->Tolerance;
+}
+double vtkMultiresolutionSurfaceMapper::GetCurrentRenderScale() const
+{
+  return this->Internal->RenderScale;
 }
 double vtkMultiresolutionSurfaceMapper::GetResidentMB() const
 {
@@ -370,7 +382,14 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   {
     return;
   }
+  // Fill-bound moving frames are drawn at a reduced resolution and stretched onto the view.
+  const bool reduced = frame.scale < 1 && in.Reduced.Begin(frame.window, frame.renderer, frame.scale);
+  frame.scale = reduced ? frame.scale : 1;
   this->DrawRegions(frame);
+  if (reduced)
+  {
+    in.Reduced.End(frame.window);
+  }
   this->FinishFrame(frame);
 }
 
@@ -525,8 +544,14 @@ void vtkMultiresolutionSurfaceMapper::ComputeView(Frame& frame)
   state.viewportHeight = height;
   frame.view = resmr::ViewFromCamera(state, frame.modelToWorld);
   frame.modelToClip = frame.view.worldToClip;
+  frame.moving = in.HaveLastClip && frame.modelToClip != in.LastClip;
+  in.LastClip = frame.modelToClip;
+  in.HaveLastClip = true;
   this->ChooseTolerance();
   frame.view.tolerancePixels = in.Tolerance;
+  // Only interactive moving frames under a target frame rate are drawn reduced: still frames,
+  // screenshots and scripts waiting for detail get every pixel.
+  frame.scale = this->TargetFrameRate > 0 && frame.bounded && frame.moving ? in.Controller.Scale() : 1;
 }
 
 void vtkMultiresolutionSurfaceMapper::ChooseTolerance()
@@ -540,6 +565,7 @@ void vtkMultiresolutionSurfaceMapper::ChooseTolerance()
       in.ControllerRunning = true;
     }
     in.Controller.SetTargetFramesPerSecond(this->TargetFrameRate);
+    in.Controller.SetScaleFloor(this->MovingResolutionFloor);
     in.Tolerance = in.Controller.Tolerance();
   }
   else
@@ -686,6 +712,7 @@ void vtkMultiresolutionSurfaceMapper::SetUniforms(Frame& frame)
   }
   program->SetUniform3f("solidColor", look->GetDiffuseColor());
   program->SetUniformf("gridLineWidth", static_cast<float>(this->GridLineWidth));
+  program->SetUniformf("renderScale", static_cast<float>(frame.scale));
   program->SetUniform3f("gridLineColor", this->GridLineColor);
   program->SetUniformf("ambient", static_cast<float>(look->GetAmbient() + (look->GetLighting() ? 0 : 1)));
   program->SetUniformf("diffuse", static_cast<float>(look->GetLighting() ? look->GetDiffuse() : 0));
@@ -770,6 +797,7 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
   vtkLogF(TRACE, "multiresolution surface: %d regions, %lld triangles at %.2f px", in.Drawn,
     static_cast<long long>(in.Triangles), in.Tolerance);
   in.FrameMs = ElapsedMs(frame.start) + in.Timer.Ms();
+  in.RenderScale = frame.scale;
   if (this->TargetFrameRate > 0)
   {
     const double measuredMs = resmr::MeasuredFrameMs(
@@ -783,7 +811,7 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
       resmr::CutRange same;
       same.refineBelow = frame.selection.refineBelowPixels;
       same.coarsenAt = frame.selection.coarsenAtPixels;
-      in.Controller.Update(measuredMs / 1000, complete, same);
+      in.Controller.Update(measuredMs / 1000, complete, same, frame.moving && frame.bounded);
     }
   }
 }
@@ -794,6 +822,7 @@ void vtkMultiresolutionSurfaceMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ColorMode: " << this->ColorMode << "\n";
   os << indent << "PixelTolerance: " << this->PixelTolerance << "\n";
   os << indent << "TargetFrameRate: " << this->TargetFrameRate << "\n";
+  os << indent << "MovingResolutionFloor: " << this->MovingResolutionFloor << "\n";
   os << indent << "MemoryBudgetMB: " << this->MemoryBudgetMB << "\n";
   os << indent << "GridLines: " << this->GridLines << "\n";
   os << indent << "WaitForDetailMs: " << this->WaitForDetailMs << "\n";

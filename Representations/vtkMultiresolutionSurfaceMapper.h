@@ -61,6 +61,12 @@ public:
   vtkSetClampMacro(TargetFrameRate, double, 0.0, 1000.0);
   vtkGetMacro(TargetFrameRate, double);
 
+  /// While the camera moves and frames miss TargetFrameRate, the surface is first drawn at a
+  /// lower resolution, down to this fraction of the view's width and height, and only then
+  /// coarsened; 1 keeps full resolution. Still frames are always drawn at full resolution.
+  vtkSetClampMacro(MovingResolutionFloor, double, 0.1, 1.0);
+  vtkGetMacro(MovingResolutionFloor, double);
+
   /// Memory budget of resident meshes, MB, CPU and GPU together: the loader keeps at most half
   /// in main memory and the GPU mirrors at most what is resident (the other half). The
   /// model's tables (hash, normals, one property) are outside it: a fixed cost per file.
@@ -90,6 +96,8 @@ public:
   ///@{
   /// Live readout, updated each render.
   double GetCurrentTolerance() const;
+  /// The fraction of the view's width and height the last frame was drawn at (1: full).
+  double GetCurrentRenderScale() const;
   /// Mesh memory now: main memory plus GPU buffers, MB (within MemoryBudgetMB, see there).
   double GetResidentMB() const;
   vtkIdType GetTrianglesDrawn() const;
@@ -125,6 +133,7 @@ private:
   int ColorMode = PropertyColors;
   double PixelTolerance = 1.0;
   double TargetFrameRate = 0.0;
+  double MovingResolutionFloor = 0.5;
   int MemoryBudgetMB = 1024;
   bool GridLines = true;
   double GridLineWidth = 1.0;

@@ -229,6 +229,10 @@ void vtkMultiresolutionSurfaceRepresentation::SetTargetFrameRate(double fps)
 {
   this->Mapper->SetTargetFrameRate(fps);
 }
+void vtkMultiresolutionSurfaceRepresentation::SetMovingResolutionFloor(double fraction)
+{
+  this->Mapper->SetMovingResolutionFloor(fraction);
+}
 void vtkMultiresolutionSurfaceRepresentation::SetMemoryBudgetMB(int megabytes)
 {
   this->Mapper->SetMemoryBudgetMB(megabytes);
@@ -256,6 +260,10 @@ void vtkMultiresolutionSurfaceRepresentation::SetLayer(int layer)
 double vtkMultiresolutionSurfaceRepresentation::GetCurrentTolerance()
 {
   return this->Mapper->GetCurrentTolerance();
+}
+double vtkMultiresolutionSurfaceRepresentation::GetCurrentRenderScale()
+{
+  return this->Mapper->GetCurrentRenderScale();
 }
 double vtkMultiresolutionSurfaceRepresentation::GetResidentMB()
 {

@@ -72,6 +72,7 @@ public:
   void SetColorMode(int mode);
   void SetPixelTolerance(double pixels);
   void SetTargetFrameRate(double fps);
+  void SetMovingResolutionFloor(double fraction);
   void SetMemoryBudgetMB(int megabytes);
   void SetGridLines(bool show);
   void SetGridLineWidth(double pixels);
@@ -79,6 +80,7 @@ public:
   void SetWaitForDetailMs(int milliseconds);
   void SetLayer(int layer);
   double GetCurrentTolerance();
+  double GetCurrentRenderScale();
   double GetResidentMB();
   double GetTrianglesDrawn();
   int GetRegionsDrawn();

@@ -86,6 +86,10 @@ set_property(TEST Multiresolution.Surface APPEND PROPERTY ENVIRONMENT "RESMR_EXE
 # Its single-layer mode (Layer = K) against stock ParaView's layer K (Threshold), pixel by pixel.
 resmr_add_pvpython_test(Multiresolution.Layer TestMultiresolutionLayer.py)
 set_property(TEST Multiresolution.Layer APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+# Moving frames at a reduced resolution, stretched onto the view with their depth; the still
+# frame in full.
+resmr_add_pvpython_test(Multiresolution.MovingResolution TestMultiresolutionMovingResolution.py)
+set_property(TEST Multiresolution.MovingResolution APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
 # Resident memory within the budget over 1,000 frames of an orbit, zoom and low flight on a
 # 10M-cell synthetic model (built once, about 4 minutes on 2 cores, then reused from
 # Temporary/budget); no leak, no error.

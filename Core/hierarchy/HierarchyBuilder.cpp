@@ -1349,8 +1349,9 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
       for (uint64_t bits = touched[word].load(std::memory_order_relaxed); bits; bits &= bits - 1)
       {
         const uint64_t n = word * 64 + static_cast<uint64_t>(__builtin_ctzll(bits));
-        visit(n, std::array<uint32_t, 3>{ static_cast<uint32_t>(n % layer % static_cast<uint64_t>(nx)),
-                   static_cast<uint32_t>(n % layer / static_cast<uint64_t>(nx)), static_cast<uint32_t>(n / layer) });
+        visit(n,
+          std::array<uint32_t, 3>{ static_cast<uint32_t>(n % layer % static_cast<uint64_t>(nx)),
+            static_cast<uint32_t>(n % layer / static_cast<uint64_t>(nx)), static_cast<uint32_t>(n / layer) });
       }
     }
   };

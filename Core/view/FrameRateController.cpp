@@ -10,9 +10,16 @@ namespace resmr
 void FrameRateController::Reset(double tolerancePixels)
 {
   this->Pixels = std::clamp(tolerancePixels, MinimumPixels, MaximumPixels);
+  this->RenderScale = 1;
 }
 
-double FrameRateController::Update(double frameSeconds, bool complete, const CutRange& same)
+void FrameRateController::SetScaleFloor(double floor)
+{
+  this->Floor = std::isfinite(floor) ? std::clamp(floor, 0.05, 1.0) : 1.0;
+  this->RenderScale = std::max(this->RenderScale, this->Floor);
+}
+
+double FrameRateController::Update(double frameSeconds, bool complete, const CutRange& same, bool moving)
 {
   if (!(frameSeconds > 0) || !std::isfinite(frameSeconds))
   {
@@ -21,33 +28,50 @@ double FrameRateController::Update(double frameSeconds, bool complete, const Cut
   // Frame times jitter from frame to frame (loads, uploads, the system), so the tolerance is
   // held in a band below the target, and the slow tail stays inside it.
   const double ratio = frameSeconds / this->TargetSeconds;
-  double factor = 1;
   if (ratio > HighFraction)
   {
-    factor = std::min(4.0, std::sqrt(ratio / AimFraction)); // near or over budget: back off now
+    const double factor = std::min(4.0, std::sqrt(ratio / AimFraction)); // near or over budget: back off now
+    if (moving && this->RenderScale > this->Floor)
+    {
+      // Pixels first: the fill part of a frame goes as the square of the scale.
+      this->RenderScale = std::max(this->Floor, this->RenderScale / factor);
+      return this->Pixels;
+    }
+    return this->Coarsen(factor, same);
   }
-  else if (ratio < LowFraction && complete)
+  if (ratio < LowFraction && complete)
   {
-    factor = std::max(0.8, std::sqrt(ratio / AimFraction)); // headroom: refine a step at a time
+    const double factor = std::max(0.8, std::sqrt(ratio / AimFraction)); // headroom: refine a step at a time
+    const bool finest = same.refineBelow <= 0 || this->Pixels <= MinimumPixels;
+    if (finest && moving && this->RenderScale < 1)
+    {
+      this->RenderScale = std::min({ 1.0, this->RenderScale * MaxScaleStep, this->RenderScale / factor });
+      return this->Pixels;
+    }
+    return this->Refine(factor, same);
   }
-  double from = this->Pixels;
-  if (factor > 1 && same.coarsenAt > from && std::isfinite(same.coarsenAt))
-  {
-    from = same.coarsenAt; // every tolerance below it draws this frame again
-  }
-  else if (factor < 1 && same.refineBelow < from && same.refineBelow > 0)
-  {
-    from = same.refineBelow; // every tolerance above it does
-  }
-  double next = from * factor;
-  if (factor < 1)
-  {
-    // At most a quarter a frame: the range is this view's, and the next may be another (a
-    // cut in a camera path, from a close look where only a far diamond can still split, to
-    // a low flight); refining straight to the far diamond's tolerance would start the flight
-    // far over budget for many frames while the tolerance climbed back.
-    next = std::max(next, this->Pixels * MaxRefineStep);
-  }
+  return this->Pixels;
+}
+
+double FrameRateController::Coarsen(double factor, const CutRange& same)
+{
+  const double from = same.coarsenAt > this->Pixels && std::isfinite(same.coarsenAt)
+    ? same.coarsenAt // every tolerance below it draws this frame again
+    : this->Pixels;
+  this->Pixels = std::clamp(from * factor, MinimumPixels, MaximumPixels);
+  return this->Pixels;
+}
+
+double FrameRateController::Refine(double factor, const CutRange& same)
+{
+  const double from = same.refineBelow < this->Pixels && same.refineBelow > 0
+    ? same.refineBelow // every tolerance above it draws this frame again
+    : this->Pixels;
+  // At most a quarter a frame: the range is this view's, and the next may be another (a cut in
+  // a camera path, from a close look where only a far diamond can still split, to a low
+  // flight); refining straight to the far diamond's tolerance would start the flight far over
+  // budget for many frames while the tolerance climbed back.
+  const double next = std::max(from * factor, this->Pixels * MaxRefineStep);
   this->Pixels = std::clamp(next, MinimumPixels, MaximumPixels);
   return this->Pixels;
 }

@@ -26,6 +26,14 @@
 //   short of thousands of pixels coarsens) took dozens of frames to mean anything again:
 //   dozens of frames too coarse, or too slow. A refining step still lowers the tolerance by
 //   at most MaxRefineStep a frame, since the range is this view's and the next may differ.
+// - Detail is traded last (ours, not the paper's): a slow frame while the camera moves first
+//   lowers the render scale (the fraction of the view's width and height the surface is drawn
+//   at, then stretched to the view), down to ScaleFloor, and only then coarsens the geometry;
+//   with headroom the geometry refines first and the scale comes back only once nothing is
+//   left to refine. A fill-bound frame (a software rasterizer, a laptop, a remote desktop)
+//   costs about its pixel count, which no tolerance lowers: at the roots a 1280x720 frame of
+//   a billion-cell model still took 120 ms on llvmpipe. Still frames (the camera did not
+//   move) neither use nor change the scale: they are drawn at full resolution.
 #pragma once
 
 #include <limits>
@@ -53,17 +61,33 @@ public:
   /// The most one frame lowers the tolerance by, as a factor (see CutRange).
   static constexpr double MaxRefineStep = 0.25;
 
+  /// The default ScaleFloor: half the width and height, a quarter of the pixels, where a
+  /// cell of two pixels and a grid line of one still show.
+  static constexpr double DefaultScaleFloor = 0.5;
+  /// The most one frame raises the scale by, as a factor.
+  static constexpr double MaxScaleStep = 1.25;
+
   void SetTargetFramesPerSecond(double fps) { this->TargetSeconds = fps > 0 ? 1.0 / fps : 0.1; }
+  /// The lowest render scale moving frames may use, in (0, 1]; 1: always full resolution.
+  void SetScaleFloor(double floor);
+  /// The render scale for the next moving frame (1 until a slow moving frame lowers it).
+  double Scale() const { return this->RenderScale; }
   double TargetFramesPerSecond() const { return 1.0 / this->TargetSeconds; }
   void Reset(double tolerancePixels);
   double Tolerance() const { return this->Pixels; }
   /// The tolerance for the next frame, from the time the last one took, whether it drew all
-  /// the detail the tolerance selected, and the tolerances that draw the same cut.
-  double Update(double frameSeconds, bool complete = true, const CutRange& same = CutRange());
+  /// the detail the tolerance selected, the tolerances that draw the same cut, and whether the
+  /// camera moved since the frame before (only moving frames change the scale).
+  double Update(double frameSeconds, bool complete = true, const CutRange& same = CutRange(), bool moving = false);
 
 private:
+  double Coarsen(double factor, const CutRange& same);
+  double Refine(double factor, const CutRange& same);
+
   double TargetSeconds = 0.1;
   double Pixels = 1;
+  double Floor = DefaultScaleFloor;
+  double RenderScale = 1;
 };
 
 } // namespace resmr

@@ -30,7 +30,8 @@ uniform sampler2D colorMap;      // N x 1, RGBA8
 uniform vec2 scalarRange;        // lookup table range (log10 of it with LOG_SCALE)
 uniform vec4 nanColor;
 uniform vec3 solidColor;
-uniform float gridLineWidth;     // pixels
+uniform float gridLineWidth;     // pixels of the view
+uniform float renderScale;       // pixels drawn per pixel of the view, a side (1: full)
 uniform vec3 gridLineColor;
 uniform float ambient;
 uniform float diffuse;
@@ -144,11 +145,14 @@ void main()
   {
     // Distance to the nearest integer of each coordinate, in pixels; the constant axis sits
     // half a cell from any integer with a zero derivative, so it never makes a line.
+    // Drawn at a reduced scale, lines keep their width on the view (at least a drawn pixel)
+    // and fade where cells shrink below the same size on the view.
     vec3 perPixel = max(fwidth(cellCoord), vec3(1e-6));
     vec3 pixels = abs(fract(cellCoord + 0.5) - 0.5) / perPixel;
-    vec3 cellPixels = 1.0 / perPixel;
+    vec3 cellPixels = 1.0 / (perPixel * renderScale);
     vec3 fade = smoothstep(vec3(3.0), vec3(8.0), cellPixels);
-    vec3 line = (1.0 - smoothstep(vec3(0.5 * gridLineWidth - 0.5), vec3(0.5 * gridLineWidth + 0.5), pixels)) * fade;
+    float width = max(gridLineWidth * renderScale, min(gridLineWidth, 1.0));
+    vec3 line = (1.0 - smoothstep(vec3(0.5 * width - 0.5), vec3(0.5 * width + 0.5), pixels)) * fade;
     float strength = max(line.x, max(line.y, line.z));
     color = mix(color, gridLineColor, strength);
   }

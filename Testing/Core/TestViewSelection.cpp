@@ -1346,6 +1346,56 @@ void TestFrameRateController()
   // A renderer slower than the target at any tolerance: the tolerance stops at the maximum.
   CHECK(run(0.2, 1, 1, 100, worst) == FrameRateController::MaximumPixels);
 
+  // Fill-bound (a software rasterizer at the roots of a billion-cell model): a moving frame
+  // costs 10 ms + 120 ms x scale^2 whatever the tolerance. The scale goes first and the
+  // tolerance stays; frames settle inside the band; still frames leave the scale alone.
+  {
+    FrameRateController fill;
+    fill.SetTargetFramesPerSecond(10);
+    fill.Reset(64);
+    const auto cost = [](double scale, double pixels) { return 0.01 + 0.12 * scale * scale + 1e-3 / pixels; };
+    double slowest = 0;
+    for (int f = 0; f < 60; ++f)
+    {
+      const double s = cost(fill.Scale(), fill.Tolerance());
+      if (f >= 5)
+      {
+        slowest = std::max(slowest, s);
+      }
+      fill.Update(s, true, CutRange(), true);
+    }
+    std::printf("  controller, fill-bound: scale %.2f, %.2f px, slowest moving frame after 5 %.3f s\n", fill.Scale(),
+      fill.Tolerance(), slowest);
+    CHECK(fill.Scale() < 1 && fill.Scale() >= FrameRateController::DefaultScaleFloor && slowest <= band);
+    // Still frames (full resolution, slow) coarsen the tolerance as before, never the scale.
+    const double movingScale = fill.Scale();
+    fill.Update(cost(1, fill.Tolerance()), true, CutRange(), false);
+    CHECK(fill.Scale() == movingScale);
+    // Headroom: the geometry refines first; the scale returns only once nothing can split.
+    fill.Reset(8);
+    fill.Update(0.3, true, CutRange(), true);
+    CHECK(fill.Scale() < 1 && fill.Tolerance() == 8);
+    const double lowered = fill.Scale();
+    CutRange splittable;
+    splittable.refineBelow = 4;
+    fill.Update(0.02, true, splittable, true);
+    CHECK(fill.Scale() == lowered && fill.Tolerance() < 8);
+    CutRange finest;
+    finest.refineBelow = 0;
+    for (int f = 0; f < 10; ++f)
+    {
+      fill.Update(0.02, true, finest, true);
+    }
+    CHECK(fill.Scale() == 1);
+    // A floor of 1 (the user's choice): never reduced; the tolerance coarsens at once.
+    FrameRateController full;
+    full.SetTargetFramesPerSecond(10);
+    full.SetScaleFloor(1);
+    full.Reset(8);
+    full.Update(0.3, true, CutRange(), true);
+    CHECK(full.Scale() == 1 && full.Tolerance() > 8);
+  }
+
   // Meshes still loading: frames draw the roots only (fast whatever the tolerance), so they
   // must not refine it; once all is loaded, the frame at the kept tolerance is within the band
   // and refinement resumes from there. Slow incomplete frames still coarsen it.
