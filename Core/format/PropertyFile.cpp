@@ -56,24 +56,30 @@ std::vector<uint8_t> HeaderOf(
   return std::move(head.Bytes);
 }
 
-/// The cell whose value each hash slot holds: its own cell when active, else the nearest
-/// active cell of the same layer (fewest i/j steps; ~0 if the layer has none). Coarse levels'
-/// faces reach over inactive cells (Sec. 4.1 simplifies them with the rest); padding their
-/// slots the way texture atlases pad charts paints them like their surroundings instead of in
-/// the NaN colour. Finest-level faces belong to active cells only, so exact views are unchanged.
-std::vector<uint64_t> NearestActiveSources(const std::vector<uint64_t>& slotCells,
-  const std::vector<std::vector<uint8_t>>& active, const std::array<int64_t, 3>& dims)
+/// Whether cell c of a layer is active, from the layer's flags as bits.
+bool Bit(const std::vector<uint64_t>& bits, uint64_t c)
+{
+  return bits[c >> 6] >> (c & 63) & 1;
+}
+
+/// Replaces the cell of each hash slot by the cell whose value it holds: its own cell when
+/// active, else the nearest active cell of the same layer (fewest i/j steps; ~0 if the layer
+/// has none). Coarse levels' faces reach over inactive cells (Sec. 4.1 simplifies them with
+/// the rest); padding their slots the way texture atlases pad charts paints them like their
+/// surroundings instead of in the NaN colour. Finest-level faces belong to active cells only,
+/// so exact views are unchanged.
+void NearestActiveSources(std::vector<uint64_t>& slotCells, const std::vector<std::vector<uint64_t>>& active,
+  const std::array<int64_t, 3>& dims)
 {
   const uint64_t nx = static_cast<uint64_t>(dims[0]), ny = static_cast<uint64_t>(dims[1]);
   const uint64_t layer = nx * ny;
-  std::vector<uint64_t> sources = slotCells;
-  std::vector<std::vector<std::size_t>> inactiveSlotsByLayer(active.size());
+  std::vector<std::vector<uint32_t>> inactiveSlotsByLayer(active.size());
   for (std::size_t s = 0; s < slotCells.size(); ++s)
   {
     const uint64_t cell = slotCells[s];
-    if (cell != ~uint64_t(0) && !active[cell / layer][cell % layer])
+    if (cell != ~uint64_t(0) && !Bit(active[cell / layer], cell % layer))
     {
-      inactiveSlotsByLayer[cell / layer].push_back(s);
+      inactiveSlotsByLayer[cell / layer].push_back(static_cast<uint32_t>(s));
     }
   }
   std::vector<uint32_t> nearest;
@@ -90,7 +96,7 @@ std::vector<uint64_t> NearestActiveSources(const std::vector<uint64_t>& slotCell
     queue.clear();
     for (uint64_t c = 0; c < layer; ++c)
     {
-      if (active[k][c])
+      if (Bit(active[k], c))
       {
         nearest[c] = static_cast<uint32_t>(c);
         queue.push_back(static_cast<uint32_t>(c));
@@ -111,13 +117,13 @@ std::vector<uint64_t> NearestActiveSources(const std::vector<uint64_t>& slotCell
         }
       }
     }
-    for (std::size_t s : inactiveSlotsByLayer[k])
+    for (uint32_t s : inactiveSlotsByLayer[k])
     {
       const uint32_t source = nearest[slotCells[s] % layer];
-      sources[s] = source == unknown ? ~uint64_t(0) : k * layer + source;
+      slotCells[s] = source == unknown ? ~uint64_t(0) : k * layer + source;
     }
+    std::vector<uint32_t>().swap(inactiveSlotsByLayer[k]);
   }
-  return sources;
 }
 
 /// Index bytes a table takes: name, step, report, days, range, then the packed table's chunk
@@ -138,7 +144,8 @@ std::string TableName(const PropertyTable& t)
 PropertyFile::PropertyFile(const std::string& path)
   : FilePath(path)
 {
-  this->Data = MapOwnFile(path, HeaderBytes + IndexTrailerBytes, Magic, "property", ".resmrp", this->Size, this->Descriptor);
+  this->Data =
+    MapOwnFile(path, HeaderBytes + IndexTrailerBytes, Magic, "property", ".resmrp", this->Size, this->Descriptor);
   try
   {
     uint32_t crc;
@@ -359,6 +366,11 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
   , TableSides(geometry.Header().hashTableSides)
 {
   const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
+  const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
+  if (layer > UINT32_MAX)
+  {
+    throw FileFormatError(geometry.Path() + ": layers of " + std::to_string(layer) + " cells are too large");
+  }
   std::vector<uint64_t> slotCells;
   {
     const auto cells = geometry.ReadModelArray(ModelChunk::HashCells);
@@ -370,7 +382,7 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
     slotCells.resize(cells.size() / 8);
     std::memcpy(slotCells.data(), cells.data(), cells.size());
   }
-  const uint64_t total = static_cast<uint64_t>(this->Dims[0] * this->Dims[1] * this->Dims[2]);
+  const uint64_t total = layer * static_cast<uint64_t>(this->Dims[2]);
   for (uint64_t cell : slotCells)
   {
     if (cell != ~uint64_t(0) && cell >= total)
@@ -379,16 +391,23 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
         geometry.Path() + ": a hash slot names cell " + std::to_string(cell) + " of " + std::to_string(total));
     }
   }
+  // Active flags as bits (a whole model's bytes would be its largest array), a layer each.
   for (int64_t k = 0; k < this->Dims[2]; ++k)
   {
-    this->Active.push_back(geometry.ReadActiveLayer(k));
+    const std::vector<uint8_t> flags = geometry.ReadActiveLayer(k);
+    std::vector<uint64_t> bits((layer + 63) / 64, 0);
+    for (uint64_t c = 0; c < layer && c < flags.size(); ++c)
+    {
+      bits[c >> 6] |= uint64_t(flags[c] != 0) << (c & 63);
+    }
+    this->Active.push_back(std::move(bits));
   }
-  this->SlotSources = NearestActiveSources(slotCells, this->Active, this->Dims);
-  slotCells = std::vector<uint64_t>();
-  // The slots each layer fills (those whose source lies in it), for tables given by layers.
-  const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
+  this->SlotCount = slots;
+  NearestActiveSources(slotCells, this->Active, this->Dims);
+  // The slots each layer fills (those whose source lies in it) with their source's place in
+  // the layer, for tables given by layers.
   this->LayerSlotStart.assign(static_cast<std::size_t>(this->Dims[2]) + 1, 0);
-  for (uint64_t source : this->SlotSources)
+  for (uint64_t source : slotCells)
   {
     if (source != ~uint64_t(0))
     {
@@ -399,13 +418,14 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
   {
     this->LayerSlotStart[k] += this->LayerSlotStart[k - 1];
   }
-  this->SlotsByLayer.resize(this->LayerSlotStart.back());
+  this->LayerSlots.resize(this->LayerSlotStart.back());
   std::vector<uint64_t> next(this->LayerSlotStart.begin(), this->LayerSlotStart.end() - 1);
-  for (uint64_t s = 0; s < this->SlotSources.size(); ++s)
+  for (uint64_t s = 0; s < slotCells.size(); ++s)
   {
-    if (this->SlotSources[s] != ~uint64_t(0))
+    if (slotCells[s] != ~uint64_t(0))
     {
-      this->SlotsByLayer[next[this->SlotSources[s] / layer]++] = s;
+      this->LayerSlots[next[slotCells[s] / layer]++] = { static_cast<uint32_t>(s),
+        static_cast<uint32_t>(slotCells[s] % layer) };
     }
   }
   // The table count is patched in at Commit.
@@ -488,8 +508,8 @@ std::size_t PropertyFileWriter::BeginTable(PropertyTable table)
   opened.high = -opened.low;
   // Slots without a source (empty, or inactive in a layer with no active cell) stay NaN.
   const float none = std::numeric_limits<float>::quiet_NaN();
-  opened.packed.resize(this->SlotSources.size() * 4);
-  for (std::size_t s = 0; s < this->SlotSources.size(); ++s)
+  opened.packed.resize(static_cast<std::size_t>(this->SlotCount) * 4);
+  for (std::size_t s = 0; s < this->SlotCount; ++s)
   {
     std::memcpy(&opened.packed[s * 4], &none, 4);
   }
@@ -525,12 +545,12 @@ void PropertyFileWriter::AddLayer(std::size_t handle, const float* layerValues)
       std::to_string(this->Dims[2]) + " layers");
   }
   const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
-  const std::vector<uint8_t>& active = this->Active[static_cast<std::size_t>(k)];
+  const std::vector<uint64_t>& active = this->Active[static_cast<std::size_t>(k)];
   const float none = std::numeric_limits<float>::quiet_NaN();
   std::vector<uint8_t> raw(static_cast<std::size_t>(layer) * 4);
   for (uint64_t c = 0; c < layer; ++c)
   {
-    const float v = active[c] ? layerValues[c] : none;
+    const float v = Bit(active, c) ? layerValues[c] : none;
     if (!std::isnan(v))
     {
       t.low = std::min(t.low, v);
@@ -542,10 +562,9 @@ void PropertyFileWriter::AddLayer(std::size_t handle, const float* layerValues)
   for (uint64_t at = this->LayerSlotStart[static_cast<std::size_t>(k)];
        at < this->LayerSlotStart[static_cast<std::size_t>(k) + 1]; ++at)
   {
-    const uint64_t s = this->SlotsByLayer[at];
-    const uint64_t c = this->SlotSources[s] % layer;
-    const float v = active[c] ? layerValues[c] : none;
-    std::memcpy(&t.packed[s * 4], &v, 4);
+    const auto [s, c] = this->LayerSlots[at];
+    const float v = Bit(active, c) ? layerValues[c] : none;
+    std::memcpy(&t.packed[std::size_t(s) * 4], &v, 4);
   }
 }
 

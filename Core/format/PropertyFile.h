@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace resmr
@@ -129,10 +130,12 @@ private:
   uint64_t Geometry = 0;
   std::array<int64_t, 3> Dims{};
   std::array<uint32_t, 3> TableSides{};
-  std::vector<uint64_t> SlotSources;        ///< the cell whose value a slot holds (see Add)
-  std::vector<std::vector<uint8_t>> Active; ///< per layer
-  std::vector<uint64_t> LayerSlotStart;     ///< nz + 1: where each layer's slots start below
-  std::vector<uint64_t> SlotsByLayer;       ///< slots with a source, by their source's layer
+  uint64_t SlotCount = 0;                    ///< of the packed tables
+  std::vector<std::vector<uint64_t>> Active; ///< per layer, a bit a cell
+  std::vector<uint64_t> LayerSlotStart;      ///< nz + 1: where each layer's slots start below
+  /// Slots with a source (the cell whose value the slot holds, see Add), by their source's
+  /// layer: (slot, the source's place in its layer).
+  std::vector<std::pair<uint32_t, uint32_t>> LayerSlots;
   std::vector<OpenTable> Open;
   std::vector<PropertyTable> Entries;
 };
