@@ -63,13 +63,7 @@ def show_only(proxy):
     simple.Show(proxy, view)
 
 
-view = simple.CreateRenderView()
-view.ViewSize = [WIDTH, HEIGHT]
-view.OrientationAxesVisibility = 0
-view.Background = [0.0, 0.0, 0.0]
-if hasattr(view, "UseColorPaletteForBackground"):
-    view.UseColorPaletteForBackground = 0
-view.UseFXAA = 0
+view = rt.image_view(WIDTH, HEIGHT)
 view.EnableRenderOnInteraction = 0
 
 failures = []

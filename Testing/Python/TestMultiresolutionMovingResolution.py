@@ -103,13 +103,7 @@ resmr_path = os.path.join(temp, "faulted.resmr")
 if not os.path.exists(resmr_path):
     rt.run_resmr("build", model, "-o", resmr_path, "--quiet")
 
-view = simple.CreateRenderView()
-view.ViewSize = [WIDTH, HEIGHT]
-view.OrientationAxesVisibility = 0
-view.Background = [0.0, 0.0, 0.0]
-if hasattr(view, "UseColorPaletteForBackground"):
-    view.UseColorPaletteForBackground = 0
-view.UseFXAA = 0
+view = rt.image_view(WIDTH, HEIGHT)
 
 reader = simple.OpenDataFile(resmr_path)
 display = simple.Show(reader, view)

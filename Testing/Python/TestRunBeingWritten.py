@@ -162,13 +162,7 @@ def add_properties(size):
     return json.loads(done.stdout)
 
 
-view = simple.CreateRenderView()
-view.ViewSize = [WIDTH, HEIGHT]
-view.OrientationAxesVisibility = 0
-view.Background = [0.0, 0.0, 0.0]
-if hasattr(view, "UseColorPaletteForBackground"):
-    view.UseColorPaletteForBackground = 0
-view.UseFXAA = 0
+view = rt.image_view(WIDTH, HEIGHT)
 lut = simple.GetColorTransferFunction("PRESSURE")
 
 

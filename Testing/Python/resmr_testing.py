@@ -124,6 +124,19 @@ def compare_image(render_view, baseline_dir, name, temp_dir, threshold=0.05, max
                              f"{100 * moved:.2f}% of pixels changed); see {produced}")
 
 
+def image_view(width, height):
+    """A render view for pixel comparisons: black background, no axes, no FXAA."""
+    from paraview import simple
+    view = simple.CreateRenderView()
+    view.ViewSize = [width, height]
+    view.OrientationAxesVisibility = 0
+    view.Background = [0.0, 0.0, 0.0]
+    if hasattr(view, "UseColorPaletteForBackground"):
+        view.UseColorPaletteForBackground = 0
+    view.UseFXAA = 0
+    return view
+
+
 def capture_rgb(view, path, width, height):
     """Saves the view (opaque background) and returns its pixels, (height, width, 3) int64."""
     from paraview import simple
