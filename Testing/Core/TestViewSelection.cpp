@@ -17,6 +17,7 @@
 #include "UploadPacer.h"
 #include "ViewSelection.h"
 
+#include <cerrno>
 #include <sched.h>
 
 #include <algorithm>
@@ -32,6 +33,7 @@
 #include <random>
 #include <set>
 #include <string>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <thread>
 #include <tuple>
@@ -955,7 +957,14 @@ void TestCache(const std::string& path)
     std::printf("  cache on a core kept busy: all loaded in %.2f s, standby rescues %llu\n", took,
       static_cast<unsigned long long>(rescues));
 #ifdef __linux__
-    CHECK(!isolated || rescues > 0);
+    // A spinner at nice 19 weighs 15 to the idle loader's 3, so the loader still gets a sixth of
+    // the core and may never starve: only an ordinary priority makes the core busy enough.
+    errno = 0;
+    const int niceness = getpriority(PRIO_PROCESS, 0);
+    if (errno == 0 && niceness > 10)
+      std::printf("  (run at nice %d: the rescue is not required)\n", niceness);
+    else
+      CHECK(!isolated || rescues > 0);
 #endif
   }
   {
