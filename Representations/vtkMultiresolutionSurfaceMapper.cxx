@@ -636,8 +636,8 @@ vtkShaderProgram* vtkMultiresolutionSurfaceMapper::ReadyProgram(Frame& frame, in
 
 void vtkMultiresolutionSurfaceMapper::StreamTables(Frame& frame)
 {
-  // The hash's offsets and the cells' normals (once a file, when the loader has read them),
-  // then the property table when another is current.
+  // The hash's offsets (once a file, when the loader has read them), then the property table
+  // when another is current, then the cells' normals: colours before per-cell lighting.
   Internals& in = *this->Internal;
   std::size_t budget = resmr::TableBytesPerFrame;
   frame.tablesStart = std::chrono::steady_clock::now();
@@ -648,6 +648,7 @@ void vtkMultiresolutionSurfaceMapper::StreamTables(Frame& frame)
     loaded.reset(); // still the previous property
   }
   in.Tables.StreamProperty(frame.window, loaded, in.File->Header(), budget, !frame.bounded);
+  in.Tables.StreamNormals(frame.window, budget, !frame.bounded);
   frame.tableBytes = resmr::TableBytesPerFrame - budget;
   // The wanted table once on the GPU; until then an earlier time step of the same property
   // and layer stands in (as an ancestor does for a mesh), anything else is drawn in the solid

@@ -144,7 +144,7 @@ vtkMultiresolutionTableTextures::~vtkMultiresolutionTableTextures() = default;
 
 bool vtkMultiresolutionTableTextures::Busy() const
 {
-  return this->OffsetUpload->Busy() || this->PropertyUpload->Busy();
+  return this->OffsetUpload->Busy() || this->NormalUpload->Busy() || this->PropertyUpload->Busy();
 }
 
 void vtkMultiresolutionTableTextures::StreamHash(
@@ -184,14 +184,22 @@ void vtkMultiresolutionTableTextures::StreamHash(
         window, hash.tableSides, 2, VTK_UNSIGNED_SHORT, GL_RG16UI, GL_RG_INTEGER, GL_UNSIGNED_SHORT, 4, up->data(), up);
     }
   }
-  if (this->OffsetUpload->Busy() && this->OffsetUpload->Continue(state, budget, unbounded) &&
-    this->NormalUpload->Continue(state, budget, unbounded))
+  if (this->OffsetUpload->Busy() && this->OffsetUpload->Continue(state, budget, unbounded))
   {
     this->OffsetTexture->ReleaseGraphicsResources(window);
-    this->NormalTexture->ReleaseGraphicsResources(window);
     this->OffsetTexture = this->OffsetUpload->Take();
-    this->NormalTexture = this->NormalUpload->Take();
     this->HashUploaded = true;
+  }
+}
+
+void vtkMultiresolutionTableTextures::StreamNormals(vtkOpenGLRenderWindow* window, std::size_t& budget, bool unbounded)
+{
+  if (this->HashUploaded && this->NormalUpload->Busy() &&
+    this->NormalUpload->Continue(window->GetState(), budget, unbounded))
+  {
+    this->NormalTexture->ReleaseGraphicsResources(window);
+    this->NormalTexture = this->NormalUpload->Take();
+    this->NormalsUploaded = true;
   }
 }
 
@@ -308,7 +316,7 @@ void vtkMultiresolutionTableTextures::Bind(vtkShaderProgram* program, const resm
   const std::array<uint32_t, 3> one{ 1, 1, 1 };
   uniform3i("tableSides", this->HashUploaded ? header.hashTableSides : one);
   uniform3i("offsetSides", this->HashUploaded ? header.hashOffsetSides : one);
-  program->SetUniformi("cellTables", this->HashUploaded ? 1 : 0);
+  program->SetUniformi("cellTables", this->NormalsUploaded ? 1 : 0);
   this->OffsetTexture->Activate();
   program->SetUniformi("hashOffsets", this->OffsetTexture->GetTextureUnit());
   this->NormalTexture->Activate();
@@ -345,6 +353,7 @@ void vtkMultiresolutionTableTextures::CancelUploads(vtkWindow* window)
 void vtkMultiresolutionTableTextures::Forget(vtkWindow* window)
 {
   this->HashUploaded = false;
+  this->NormalsUploaded = false;
   this->Uploaded.reset();
   this->CancelUploads(window);
 }

@@ -3,8 +3,9 @@
 // layer's nx x ny table) and the colour map. The hash and property tables are 3D textures too
 // large to copy in one frame: each is streamed a slab of slices at a time
 // (resmr::SlicesThisFrame) into a texture of its own, which replaces the drawn one only once
-// complete; until then 1-texel stand-ins (no hash: the solid colour) or the previous table
-// (an earlier step of the same property) are drawn. Private to the Multiresolution Surface
+// complete; until then 1-texel stand-ins (no hash: the solid colour; no normals: facet
+// normals) or the previous table (an earlier step of the same property) are drawn. Offsets go
+// first, then the property, then the normals. Private to the Multiresolution Surface
 // mapper; needs the mapper's GL context current.
 #ifndef vtkMultiresolutionTableTextures_h
 #define vtkMultiresolutionTableTextures_h
@@ -39,10 +40,14 @@ public:
   vtkMultiresolutionTableTextures(const vtkMultiresolutionTableTextures&) = delete;
   vtkMultiresolutionTableTextures& operator=(const vtkMultiresolutionTableTextures&) = delete;
 
-  /// Streams the hash's offsets and normals once the loader has read them (`cache.Tables()`),
-  /// spending `budget` bytes (all of it when `unbounded`); a frame that allocates their
+  /// Streams the hash's offsets once the loader has read them (`cache.Tables()`), spending
+  /// `budget` bytes (all of it when `unbounded`); a frame that allocates the offset and normal
   /// textures says so in Allocated().
   void StreamHash(vtkOpenGLRenderWindow* window, const resmr::RegionCache& cache, std::size_t& budget, bool unbounded);
+  /// Streams the cells' normals once the offsets are in, after the property: colours come
+  /// first, per-cell lighting (facet normals until then) next. At a billion cells each table
+  /// is over a GB, streamed a few MB a frame.
+  void StreamNormals(vtkOpenGLRenderWindow* window, std::size_t& budget, bool unbounded);
   /// Streams `loaded` (the requested property table, or null) the same way: a layer's 2D
   /// table at once, a packed table a slab at a time over the texture no longer drawn.
   void StreamProperty(vtkOpenGLRenderWindow* window, const std::shared_ptr<const resmr::PropertyTableData>& loaded,
@@ -50,7 +55,7 @@ public:
   /// Refills the colour map when the lookup table changed.
   void UpdateColorMap(vtkOpenGLRenderWindow* window, vtkScalarsToColors* table);
 
-  /// The hash tables are complete on the GPU (cell lookups can be drawn).
+  /// The hash's offsets are complete on the GPU (cell lookups can be drawn).
   bool HashReady() const { return this->HashUploaded; }
   /// The property table on the GPU (null: none yet).
   const std::shared_ptr<const resmr::PropertyTableData>& UploadedProperty() const { return this->Uploaded; }
@@ -84,7 +89,8 @@ private:
   vtkSmartPointer<vtkTextureObject> PropertyTexture = vtkSmartPointer<vtkTextureObject>::New();
   vtkNew<vtkTextureObject> ColorTexture;
   vtkNew<vtkTextureObject> LayerPropertyTexture; ///< nx x ny R32F: one layer's table
-  bool HashUploaded = false;
+  bool HashUploaded = false;                     ///< the offsets
+  bool NormalsUploaded = false;                  ///< the cells' normals (after the offsets)
   std::shared_ptr<const resmr::PropertyTableData> Uploaded;
   std::unique_ptr<SlabUpload> OffsetUpload, NormalUpload, PropertyUpload;
   /// The property texture drawn before the current one, copied over by the next table.

@@ -23,7 +23,7 @@ uniform ivec3 offsetSides; // r
 uniform usampler3D hashOffsets;  // r0 x r1 x r2, RGB16UI
 uniform usampler3D cellNormals;  // m0 x m1 x m2, RG16UI (top, bottom)
 uniform sampler3D propertyTable; // m0 x m1 x m2, R32F
-uniform int cellTables;          // 0 until the hash and normal tables are loaded
+uniform int cellTables;          // 0 until the normal table is loaded (after the hash and property)
 uniform int layer;               // -1: the whole model; else the one layer drawn (0-based)
 uniform sampler2D layerProperty; // nx x ny, R32F: that layer's table
 uniform sampler2D colorMap;      // N x 1, RGBA8
