@@ -109,8 +109,10 @@ def view(results):
 
 
 def save(results):
+    # The scratch folder is the runner's; a reader of the results sees SCRATCH.
+    text = json.dumps(results, indent=1).replace(os.path.abspath(args.scratch), "SCRATCH")
     with open(out_base + ".json", "w") as handle:
-        json.dump(results, handle, indent=1)
+        handle.write(text)
 
 
 def report(results):
