@@ -2,6 +2,7 @@
 
 #include "MultiresolutionStretchFS.h"
 
+#include "vtkObject.h" // vtkOpenGLError.h's macros need it (VTK 9.3)
 #include "vtkOpenGLError.h"
 #include "vtkOpenGLRenderUtilities.h"
 #include "vtkOpenGLRenderWindow.h"
@@ -159,7 +160,7 @@ void vtkMultiresolutionReducedResolution::End(vtkOpenGLRenderWindow* window)
   glBindTexture(GL_TEXTURE_2D, 0);
   units->Free(depthUnit);
   units->Free(colorUnit);
-  vtkOpenGLCheckErrorMacro("after stretching the reduced multiresolution surface");
+  vtkOpenGLStaticCheckErrorMacro("after stretching the reduced multiresolution surface");
 }
 
 void vtkMultiresolutionReducedResolution::ReleaseGraphicsResources(vtkWindow*)
