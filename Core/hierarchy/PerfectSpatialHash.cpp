@@ -59,8 +59,6 @@ int LowestBit(uint64_t word)
     std::to_string(uint64_t(c[1]) + 1) + ", " + std::to_string(uint64_t(c[2]) + 1) + ") listed twice");
 }
 
-Sides Extent(const std::vector<Cell>& cells);
-
 /// The first cell listed twice, thrown; `n` agrees with an earlier cell in every residue.
 void ThrowIfListedBefore(const std::vector<Cell>& cells, std::size_t n)
 {
@@ -77,20 +75,25 @@ void ThrowIfListedBefore(const std::vector<Cell>& cells, std::size_t n)
 /// listed twice throws when it is the collision found; sorting finds every one.
 bool ResiduesDistinct(const std::vector<Cell>& cells, const std::array<uint64_t, 3>& modulus)
 {
-  Cell low{ UINT32_MAX, UINT32_MAX, UINT32_MAX };
+  if (cells.empty())
+  {
+    return true;
+  }
+  // One pass for the box (this runs once a table shape tried, over every cell).
+  Cell low{ UINT32_MAX, UINT32_MAX, UINT32_MAX }, high{ 0, 0, 0 };
   for (const Cell& c : cells)
   {
     for (int a = 0; a < 3; ++a)
     {
       low[a] = std::min(low[a], c[a]);
+      high[a] = std::max(high[a], c[a]);
     }
   }
-  const Sides extent = Extent(cells);
   std::array<uint64_t, 3> span;
   double space = 1;
   for (int a = 0; a < 3; ++a)
   {
-    span[a] = std::min<uint64_t>(modulus[a], extent[a]);
+    span[a] = std::min<uint64_t>(modulus[a], uint64_t(high[a]) - low[a] + 1);
     space *= static_cast<double>(span[a]);
   }
   const auto residue = [&](const Cell& c, int a) { return (uint64_t(c[a]) - low[a]) % modulus[a]; };
