@@ -23,18 +23,21 @@ public:
     bool logScale = false;
     bool gridLines = false;
     bool specular = false;
+    int lighting = 0;   ///< vtkOpenGLRenderer's lighting complexity (0: unlit)
+    int lightCount = 0; ///< the renderer's lights switched on
   };
 
   /// The fragment shader's source for `painting`: its switches defined after the version line
-  /// VTK puts in.
-  static std::string FragmentSource(const Painting& painting);
+  /// VTK puts in, the renderer's light uniforms (`lightUniforms`, as
+  /// vtkOpenGLRenderer::GetLightingUniforms declares them) and one term a light.
+  static std::string FragmentSource(const Painting& painting, const std::string& lightUniforms);
 
   /// The program for `painting` in `window`'s shader cache, compiled the first time and bound;
   /// null when it does not compile.
-  vtkShaderProgram* Ready(vtkOpenGLRenderWindow* window, const Painting& painting);
+  vtkShaderProgram* Ready(vtkOpenGLRenderWindow* window, const Painting& painting, const char* lightUniforms);
 
 private:
-  std::map<int, std::string> Sources; ///< by the state's switches as bits
+  std::map<long, std::string> Sources; ///< by the state's switches as bits
 };
 
 #endif

@@ -28,6 +28,7 @@
 #include "vtkOpenGLCamera.h"
 #include "vtkOpenGLError.h"
 #include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLRenderer.h"
 #include "vtkOpenGLState.h"
 #include "vtkPolyData.h"
 #include "vtkProperty.h"
@@ -201,6 +202,7 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   bool afterAllocation = false; ///< the last frame allocated a table texture
   bool bounded = true;          ///< interactive: a bounded upload a frame (no WaitForDetailMs)
   bool moving = false;          ///< the camera (or the actor) moved since the last frame
+  bool controlled = false;      ///< drawn at the frame-rate controller's tolerance (moving)
   double scale = 1;             ///< the fraction of the view's width and height drawn
   // What the descriptor names.
   std::string filePath, propertyPath, propertyStamp;
@@ -547,18 +549,23 @@ void vtkMultiresolutionSurfaceMapper::ComputeView(Frame& frame)
   frame.moving = in.HaveLastClip && frame.modelToClip != in.LastClip;
   in.LastClip = frame.modelToClip;
   in.HaveLastClip = true;
-  this->ChooseTolerance();
+  this->ChooseTolerance(frame.moving);
+  frame.controlled = this->TargetFrameRate > 0 && frame.moving;
   frame.view.tolerancePixels = in.Tolerance;
   // Only interactive moving frames under a target frame rate are drawn reduced: still frames,
   // screenshots and scripts waiting for detail get every pixel.
   frame.scale = this->TargetFrameRate > 0 && frame.bounded && frame.moving ? in.Controller.Scale() : 1;
 }
 
-void vtkMultiresolutionSurfaceMapper::ChooseTolerance()
+void vtkMultiresolutionSurfaceMapper::ChooseTolerance(bool moving)
 {
   Internals& in = *this->Internal;
   if (this->TargetFrameRate > 0)
   {
+    // The controller holds the rate while the camera moves, within the quality floor; a still
+    // frame is the user's picture at the user's tolerance, and the controller waits for the
+    // next move where it was.
+    in.Controller.SetMaximumPixels(std::max(this->MaximumPixelTolerance, this->PixelTolerance));
     if (!in.ControllerRunning)
     {
       in.Controller.Reset(resmr::ControllerStartTolerance(this->PixelTolerance));
@@ -566,7 +573,7 @@ void vtkMultiresolutionSurfaceMapper::ChooseTolerance()
     }
     in.Controller.SetTargetFramesPerSecond(this->TargetFrameRate);
     in.Controller.SetScaleFloor(this->MovingResolutionFloor);
-    in.Tolerance = in.Controller.Tolerance();
+    in.Tolerance = moving ? in.Controller.Tolerance() : this->PixelTolerance;
   }
   else
   {
@@ -624,8 +631,18 @@ vtkShaderProgram* vtkMultiresolutionSurfaceMapper::ReadyProgram(Frame& frame, in
   painting.layerView = frame.layer >= 0;
   painting.logScale = colorMode == PropertyColors && table && table->UsingLogScale() != 0;
   painting.gridLines = this->GridLines && colorMode != CellIdColors;
-  painting.specular = look->GetLighting() && look->GetSpecular() > 0;
-  vtkShaderProgram* ready = in.Shaders.Ready(frame.window, painting);
+  // The renderer's lights as stock surfaces use them; an actor with lighting off is unlit.
+  vtkOpenGLRenderer* lights = vtkOpenGLRenderer::SafeDownCast(frame.renderer);
+  painting.lighting = look->GetLighting() && lights ? lights->GetLightingComplexity() : 0;
+  painting.lightCount = painting.lighting > 0 ? lights->GetLightingCount() : 0;
+  painting.lighting = painting.lightCount > 0 ? painting.lighting : 0;
+  painting.specular = painting.lighting > 0 && look->GetSpecular() > 0;
+  vtkShaderProgram* ready =
+    in.Shaders.Ready(frame.window, painting, painting.lighting > 0 ? lights->GetLightingUniforms() : nullptr);
+  if (ready && painting.lighting > 0)
+  {
+    lights->UpdateLightingUniforms(ready);
+  }
   if (!ready && in.Error.empty())
   {
     in.Error = "the multiresolution surface shaders did not compile (see the output window)";
@@ -678,6 +695,24 @@ void vtkMultiresolutionSurfaceMapper::UploadMeshes(Frame& frame)
   frame.selection = in.Selector->Select(frame.view, onGpu);
 }
 
+namespace
+{
+// The actor's material as vtkOpenGLPolyDataMapper passes it: intensities, and colours times
+// their intensities.
+void SetMaterialUniforms(vtkShaderProgram* program, vtkProperty* look, bool parallel)
+{
+  const auto scaled = [](const double* color, double by) {
+    return std::array<float, 3>{ float(color[0] * by), float(color[1] * by), float(color[2] * by) };
+  };
+  program->SetUniform3f("ambientColorUniform", scaled(look->GetAmbientColor(), look->GetAmbient()).data());
+  program->SetUniformf("ambientIntensity", static_cast<float>(look->GetAmbient()));
+  program->SetUniformf("diffuseIntensity", static_cast<float>(look->GetDiffuse()));
+  program->SetUniform3f("specularColorUniform", scaled(look->GetSpecularColor(), look->GetSpecular()).data());
+  program->SetUniformf("specularPower", static_cast<float>(look->GetSpecularPower()));
+  program->SetUniformi("cameraParallel", parallel ? 1 : 0);
+}
+} // namespace
+
 void vtkMultiresolutionSurfaceMapper::SetUniforms(Frame& frame)
 {
   Internals& in = *this->Internal;
@@ -715,10 +750,7 @@ void vtkMultiresolutionSurfaceMapper::SetUniforms(Frame& frame)
   program->SetUniformf("gridLineWidth", static_cast<float>(this->GridLineWidth));
   program->SetUniformf("renderScale", static_cast<float>(frame.scale));
   program->SetUniform3f("gridLineColor", this->GridLineColor);
-  program->SetUniformf("ambient", static_cast<float>(look->GetAmbient() + (look->GetLighting() ? 0 : 1)));
-  program->SetUniformf("diffuse", static_cast<float>(look->GetLighting() ? look->GetDiffuse() : 0));
-  program->SetUniformf("specular", static_cast<float>(look->GetLighting() ? look->GetSpecular() : 0));
-  program->SetUniformf("specularPower", static_cast<float>(std::max(1.0, look->GetSpecularPower())));
+  SetMaterialUniforms(program, look, frame.view.parallel);
 }
 
 void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
@@ -799,7 +831,7 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
     static_cast<long long>(in.Triangles), in.Tolerance);
   in.FrameMs = ElapsedMs(frame.start) + in.Timer.Ms();
   in.RenderScale = frame.scale;
-  if (this->TargetFrameRate > 0)
+  if (frame.controlled)
   {
     const double measuredMs = resmr::MeasuredFrameMs(
       in.FrameMs, frame.rendererMs, frame.intervalMs, this->TargetFrameRate, frame.afterAllocation);
@@ -812,7 +844,7 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
       resmr::CutRange same;
       same.refineBelow = frame.selection.refineBelowPixels;
       same.coarsenAt = frame.selection.coarsenAtPixels;
-      in.Controller.Update(measuredMs / 1000, complete, same, frame.moving && frame.bounded);
+      in.Controller.Update(measuredMs / 1000, complete, same, frame.bounded);
     }
   }
 }
@@ -823,6 +855,7 @@ void vtkMultiresolutionSurfaceMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ColorMode: " << this->ColorMode << "\n";
   os << indent << "PixelTolerance: " << this->PixelTolerance << "\n";
   os << indent << "TargetFrameRate: " << this->TargetFrameRate << "\n";
+  os << indent << "MaximumPixelTolerance: " << this->MaximumPixelTolerance << "\n";
   os << indent << "MovingResolutionFloor: " << this->MovingResolutionFloor << "\n";
   os << indent << "MemoryBudgetMB: " << this->MemoryBudgetMB << "\n";
   os << indent << "GridLines: " << this->GridLines << "\n";

@@ -41,6 +41,9 @@ public:
   /// the descriptor is) or "0" (absent: "0").
   static const char* SourceArrayName() { return "ResMR Source"; }
 
+  /// MaximumPixelTolerance's default (see docs/user-guide.md for the measurements behind it).
+  static constexpr double DefaultMaximumPixelTolerance = 64.0;
+
   enum ColorModes
   {
     SolidColor = 0,
@@ -53,9 +56,17 @@ public:
   vtkSetClampMacro(ColorMode, int, SolidColor, CellIdColors);
   vtkGetMacro(ColorMode, int);
 
-  /// Projected error tolerance in pixels when no frame rate is targeted (0: full detail).
-  vtkSetClampMacro(PixelTolerance, double, 0.0, 1024.0);
+  /// Projected error tolerance in pixels (0: full detail): of every frame when no frame rate is
+  /// targeted, of still frames (the camera stopped) when one is. Any tolerance the frame-rate
+  /// controller chose (GetCurrentTolerance) is accepted, so a frame seen can be drawn again.
+  vtkSetClampMacro(PixelTolerance, double, 0.0, 65536.0);
   vtkGetMacro(PixelTolerance, double);
+
+  /// The quality floor: the coarsest tolerance, in pixels, the frame-rate controller may use
+  /// while the camera moves (never below PixelTolerance); a frame still too slow there is late
+  /// rather than coarser. 65536 lets the controller coarsen as far as it likes.
+  vtkSetClampMacro(MaximumPixelTolerance, double, 0.5, 65536.0);
+  vtkGetMacro(MaximumPixelTolerance, double);
 
   /// Frames per second to hold by adjusting the tolerance (Sec. 6.3); 0: fixed tolerance.
   vtkSetClampMacro(TargetFrameRate, double, 0.0, 1000.0);
@@ -133,6 +144,7 @@ private:
   int ColorMode = PropertyColors;
   double PixelTolerance = 1.0;
   double TargetFrameRate = 0.0;
+  double MaximumPixelTolerance = DefaultMaximumPixelTolerance;
   double MovingResolutionFloor = 0.5;
   int MemoryBudgetMB = 1024;
   bool GridLines = true;
@@ -156,7 +168,7 @@ private:
   void RequestProperty(Frame& frame);
   /// The camera in model coordinates, and the tolerance.
   void ComputeView(Frame& frame);
-  void ChooseTolerance();
+  void ChooseTolerance(bool moving);
   /// Selects, asks the loader for what is missing, and waits where the frame must.
   void SelectRegions(Frame& frame);
   vtkShaderProgram* ReadyProgram(Frame& frame, int colorMode);

@@ -29,8 +29,6 @@ vtkMultiresolutionSurfaceRepresentation::vtkMultiresolutionSurfaceRepresentation
   this->Actor->SetMapper(this->Mapper);
   this->Actor->SetVisibility(0);
   this->Actor->SetPickable(0); // the descriptor has no cells a pick could name
-  this->Actor->GetProperty()->SetAmbient(0.15);
-  this->Actor->GetProperty()->SetDiffuse(0.85);
 }
 
 vtkMultiresolutionSurfaceRepresentation::~vtkMultiresolutionSurfaceRepresentation() = default;
@@ -184,6 +182,14 @@ void vtkMultiresolutionSurfaceRepresentation::SetDiffuseColor(double r, double g
 {
   this->Actor->GetProperty()->SetDiffuseColor(r, g, b);
 }
+void vtkMultiresolutionSurfaceRepresentation::SetAmbientColor(double r, double g, double b)
+{
+  this->Actor->GetProperty()->SetAmbientColor(r, g, b);
+}
+void vtkMultiresolutionSurfaceRepresentation::SetSpecularColor(double r, double g, double b)
+{
+  this->Actor->GetProperty()->SetSpecularColor(r, g, b);
+}
 void vtkMultiresolutionSurfaceRepresentation::SetAmbient(double value)
 {
   this->Actor->GetProperty()->SetAmbient(value);
@@ -228,6 +234,10 @@ void vtkMultiresolutionSurfaceRepresentation::SetPixelTolerance(double pixels)
 void vtkMultiresolutionSurfaceRepresentation::SetTargetFrameRate(double fps)
 {
   this->Mapper->SetTargetFrameRate(fps);
+}
+void vtkMultiresolutionSurfaceRepresentation::SetMaximumPixelTolerance(double pixels)
+{
+  this->Mapper->SetMaximumPixelTolerance(pixels);
 }
 void vtkMultiresolutionSurfaceRepresentation::SetMovingResolutionFloor(double fraction)
 {

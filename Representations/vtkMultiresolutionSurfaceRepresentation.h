@@ -55,6 +55,8 @@ public:
   ///@{
   /// Appearance, forwarded to the actor's property.
   void SetDiffuseColor(double r, double g, double b);
+  void SetAmbientColor(double r, double g, double b);
+  void SetSpecularColor(double r, double g, double b);
   void SetAmbient(double value);
   void SetDiffuse(double value);
   void SetSpecular(double value);
@@ -72,6 +74,7 @@ public:
   void SetColorMode(int mode);
   void SetPixelTolerance(double pixels);
   void SetTargetFrameRate(double fps);
+  void SetMaximumPixelTolerance(double pixels);
   void SetMovingResolutionFloor(double fraction);
   void SetMemoryBudgetMB(int megabytes);
   void SetGridLines(bool show);

@@ -9,8 +9,14 @@ namespace resmr
 
 void FrameRateController::Reset(double tolerancePixels)
 {
-  this->Pixels = std::clamp(tolerancePixels, MinimumPixels, MaximumPixels);
+  this->Pixels = std::clamp(tolerancePixels, MinimumPixels, this->Ceiling);
   this->RenderScale = 1;
+}
+
+void FrameRateController::SetMaximumPixels(double pixels)
+{
+  this->Ceiling = std::isfinite(pixels) ? std::clamp(pixels, MinimumPixels, MaximumPixels) : MaximumPixels;
+  this->Pixels = std::min(this->Pixels, this->Ceiling);
 }
 
 void FrameRateController::SetScaleFloor(double floor)
@@ -58,7 +64,7 @@ double FrameRateController::Coarsen(double factor, const CutRange& same)
   const double from = same.coarsenAt > this->Pixels && std::isfinite(same.coarsenAt)
     ? same.coarsenAt // every tolerance below it draws this frame again
     : this->Pixels;
-  this->Pixels = std::clamp(from * factor, MinimumPixels, MaximumPixels);
+  this->Pixels = std::clamp(from * factor, MinimumPixels, this->Ceiling);
   return this->Pixels;
 }
 
@@ -72,7 +78,7 @@ double FrameRateController::Refine(double factor, const CutRange& same)
   // flight); refining straight to the far diamond's tolerance would start the flight far over
   // budget for many frames while the tolerance climbed back.
   const double next = std::max(from * factor, this->Pixels * MaxRefineStep);
-  this->Pixels = std::clamp(next, MinimumPixels, MaximumPixels);
+  this->Pixels = std::clamp(next, MinimumPixels, this->Ceiling);
   return this->Pixels;
 }
 

@@ -34,6 +34,9 @@
 //   costs about its pixel count, which no tolerance lowers: at the roots a 1280x720 frame of
 //   a billion-cell model still took 120 ms on llvmpipe. Still frames (the camera did not
 //   move) neither use nor change the scale: they are drawn at full resolution.
+// - The quality floor (ours): the tolerance never rises above Ceiling (SetMaximumPixels), the
+//   coarsest picture the user accepts while moving; a frame still too slow there is late
+//   rather than wrong. MaximumPixels as the ceiling lets the controller go as far as it likes.
 #pragma once
 
 #include <limits>
@@ -70,6 +73,9 @@ public:
   void SetTargetFramesPerSecond(double fps) { this->TargetSeconds = fps > 0 ? 1.0 / fps : 0.1; }
   /// The lowest render scale moving frames may use, in (0, 1]; 1: always full resolution.
   void SetScaleFloor(double floor);
+  /// The coarsest tolerance moving frames may use, in [MinimumPixels, MaximumPixels].
+  void SetMaximumPixels(double pixels);
+  double MaximumTolerance() const { return this->Ceiling; }
   /// The render scale for the next moving frame (1 until a slow moving frame lowers it).
   double Scale() const { return this->RenderScale; }
   double TargetFramesPerSecond() const { return 1.0 / this->TargetSeconds; }
@@ -86,6 +92,7 @@ private:
 
   double TargetSeconds = 0.1;
   double Pixels = 1;
+  double Ceiling = MaximumPixels;
   double Floor = DefaultScaleFloor;
   double RenderScale = 1;
 };

@@ -7,11 +7,19 @@
 // shrink below a few pixels. In the single-layer view (layer >= 0) the property comes from
 // that layer's 2D table, indexed by (i, j) without the hash.
 //
+// Lit as VTK lights its surfaces (ours: the renderer's lights and the actor's material, so
+// the surface looks as ParaView's Surface of the full grid): a property's colour is both the
+// ambient and the diffuse colour, as on stock surfaces coloured by an array, and each of the
+// renderer's lights adds a diffuse and a specular term.
+//
 // The mapper compiles one variant per painting mode, with these defined (0 or 1):
 // COLOR_MODE (0: solid colour, 1: property, 2: cell id), LAYER_VIEW (one layer drawn),
-// LOG_SCALE, GRID_LINES, SPECULAR. A software rasterizer (llvmpipe) runs both sides of every
-// branch on a uniform, masked; compiled out, the unused paths cost nothing (a tenth of a
-// full-screen frame there), and GPUs keep fewer registers.
+// LOG_SCALE, GRID_LINES, SPECULAR, and LIGHTING (0: unlit, 1: headlight, 2: directional
+// lights, 3: positional lights, as vtkOpenGLRenderer's lighting complexity), with the
+// renderer's light uniforms declared and one call a light generated at //RESMR::Lights.
+// A software rasterizer (llvmpipe) runs both sides of every branch on a uniform, masked;
+// compiled out, the unused paths cost nothing (a tenth of a full-screen frame there), and
+// GPUs keep fewer registers.
 
 in vec3 cellCoord;
 in vec3 viewPosition;
@@ -33,11 +41,14 @@ uniform vec3 solidColor;
 uniform float gridLineWidth;     // pixels of the view
 uniform float renderScale;       // pixels drawn per pixel of the view, a side (1: full)
 uniform vec3 gridLineColor;
-uniform float ambient;
-uniform float diffuse;
-uniform float specular;
+uniform vec3 ambientColorUniform;  // the actor's ambient colour times its Ambient
+uniform float ambientIntensity;
+uniform float diffuseIntensity;
+uniform vec3 specularColorUniform; // the actor's specular colour times its Specular
 uniform float specularPower;
 uniform mat3 normalToView;
+uniform int cameraParallel;        // 1: parallel projection (the eye looks along -z everywhere)
+//RESMR::LightUniforms
 
 // a mod m for 0 <= a < 2^24: the quotient in float, corrected by one either way (a divide
 // may be a reciprocal and a multiply). Integer division has no vector instruction on CPUs
@@ -67,6 +78,44 @@ vec3 DecodeNormal(uint code)
   n.xy -= t * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
   return normalize(n);
 }
+
+#if LIGHTING > 1
+// One light's diffuse and specular share at this fragment (`toLight` unit, from the fragment).
+void AddLight(vec3 normal, vec3 toEye, vec3 toLight, vec3 lightColor, float attenuation,
+  inout vec3 diffuseSum, inout vec3 specularSum)
+{
+  float df = max(0.0, attenuation * dot(normal, toLight));
+  diffuseSum += df * lightColor;
+#if SPECULAR
+  float sf = sign(df) * attenuation * pow(max(0.0, dot(reflect(-toLight, normal), toEye)), specularPower);
+  specularSum += sf * lightColor;
+#endif
+}
+#endif
+
+#if LIGHTING > 2
+// A light that may be positional: its direction to the fragment, distance fall-off and cone.
+void AddAnyLight(vec3 normal, vec3 toEye, vec3 position, vec3 lightColor, vec3 direction,
+  vec3 lightPosition, vec3 falloff, float coneDegrees, float exponent, int positional,
+  inout vec3 diffuseSum, inout vec3 specularSum)
+{
+  if (positional == 0)
+  {
+    AddLight(normal, toEye, -direction, lightColor, 1.0, diffuseSum, specularSum);
+    return;
+  }
+  vec3 fromLight = position - lightPosition;
+  float distance = length(fromLight);
+  fromLight /= max(distance, 1e-30);
+  float attenuation = 1.0 / (falloff.x + falloff.y * distance + falloff.z * distance * distance);
+  if (coneDegrees <= 90.0)
+  {
+    float along = dot(fromLight, direction);
+    attenuation *= along >= cos(radians(coneDegrees)) ? pow(along, exponent) : 0.0;
+  }
+  AddLight(normal, toEye, -fromLight, lightColor, attenuation, diffuseSum, specularSum);
+}
+#endif
 
 void main()
 {
@@ -118,27 +167,43 @@ void main()
 #endif
 
   // Normal (view space): the original cell's top or bottom face normal (Sec. 5.3), the
-  // facet's own for sides. Lit from the camera (headlight), both sides. A layer's cells are
-  // mostly inside the model, and the normal table is hashed for the external faces' cells
-  // only: a layer lights every face by its geometric normal, per pixel.
+  // facet's own for sides, turned to face the eye (two-sided, as VTK lights a surface whose
+  // back may show). A layer's cells are mostly inside the model, and the normal table is
+  // hashed for the external faces' cells only: a layer lights every face by its geometric
+  // normal, per pixel.
   vec3 facet = normalize(cross(dFdx(viewPosition), dFdy(viewPosition)));
+  facet = (cameraParallel == 1 ? facet.z < 0.0 : dot(facet, viewPosition) > 0.0) ? -facet : facet;
   vec3 normal = facet;
 #if !LAYER_VIEW
   if (faceKind < 2 && cellTables == 1)
   {
     uvec2 codes = texelFetch(cellNormals, slot, 0).xy;
     normal = normalize(normalToView * DecodeNormal(faceKind == 0 ? codes.x : codes.y));
+    normal = dot(normal, facet) < 0.0 ? -normal : normal;
   }
 #endif
-  if (dot(normal, facet) < 0.0 && faceKind == 2)
-  {
-    normal = -normal;
-  }
-  vec3 toEye = normalize(-viewPosition);
-  float lambert = abs(dot(normal, toEye));
-  color = color * (ambient + diffuse * lambert);
+#if COLOR_MODE == 1
+  vec3 ambientPart = ambientIntensity * color; // a property's colour is ambient and diffuse
+#else
+  vec3 ambientPart = ambientColorUniform;
+#endif
+  vec3 diffusePart = diffuseIntensity * color;
+#if LIGHTING == 0
+  color = ambientPart + diffusePart;
+#else
+  vec3 diffuseSum = vec3(0.0);
+  vec3 specularSum = vec3(0.0);
+#if LIGHTING == 1
+  float df = max(0.0, normal.z);
+  diffuseSum = df * lightColor0;
 #if SPECULAR
-  color += vec3(specular * pow(lambert, specularPower));
+  specularSum = pow(df, specularPower) * lightColor0;
+#endif
+#else
+  vec3 toEye = normalize(-viewPosition);
+  //RESMR::Lights
+#endif
+  color = ambientPart + diffusePart * diffuseSum + specularColorUniform * specularSum;
 #endif
 
 #if GRID_LINES

@@ -1354,6 +1354,26 @@ void TestFrameRateController()
   CHECK(run(0.01, 1e-6, FrameRateController::MaximumPixels, 100, worst) == FrameRateController::MinimumPixels);
   // A renderer slower than the target at any tolerance: the tolerance stops at the maximum.
   CHECK(run(0.2, 1, 1, 100, worst) == FrameRateController::MaximumPixels);
+  // The quality floor: under the same slow renderer the tolerance stops at the user's ceiling,
+  // even when it starts above it; raising the ceiling lets it go on.
+  {
+    FrameRateController floor;
+    floor.SetTargetFramesPerSecond(10);
+    floor.SetMaximumPixels(32);
+    floor.Reset(1000);
+    CHECK(floor.Tolerance() == 32);
+    for (int f = 0; f < 100; ++f)
+    {
+      floor.Update(0.2 + 1 / (floor.Tolerance() * floor.Tolerance()), true, CutRange(), f % 2 == 0);
+      CHECK(floor.Tolerance() <= 32);
+    }
+    CHECK(floor.Tolerance() == 32);
+    floor.SetMaximumPixels(FrameRateController::MaximumPixels);
+    floor.Update(0.2, true, CutRange(), false);
+    CHECK(floor.Tolerance() > 32);
+    floor.SetMaximumPixels(8);
+    CHECK(floor.Tolerance() == 8 && floor.MaximumTolerance() == 8);
+  }
 
   // Fill-bound (a software rasterizer at the roots of a billion-cell model): a moving frame
   // costs 10 ms + 120 ms x scale^2 whatever the tolerance. The scale goes first and the
