@@ -89,6 +89,10 @@ set_property(TEST Multiresolution.Layer APPEND PROPERTY ENVIRONMENT "RESMR_EXECU
 # Lit as stock ParaView lights its surfaces: light kit, headlight and material (PSNR).
 resmr_add_pvpython_test(Multiresolution.Lighting TestMultiresolutionLighting.py)
 set_property(TEST Multiresolution.Lighting APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+# The quality floor under slow frames, still frames at the user's tolerance, and moving frames
+# drawn again from their tolerance.
+resmr_add_pvpython_test(Multiresolution.QualityFloor TestMultiresolutionQualityFloor.py)
+set_property(TEST Multiresolution.QualityFloor APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
 # Moving frames at a reduced resolution, stretched onto the view with their depth; the still
 # frame in full.
 resmr_add_pvpython_test(Multiresolution.MovingResolution TestMultiresolutionMovingResolution.py)
