@@ -86,6 +86,9 @@ set_property(TEST Multiresolution.Surface APPEND PROPERTY ENVIRONMENT "RESMR_EXE
 # Its single-layer mode (Layer = K) against stock ParaView's layer K (Threshold), pixel by pixel.
 resmr_add_pvpython_test(Multiresolution.Layer TestMultiresolutionLayer.py)
 set_property(TEST Multiresolution.Layer APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+# Every level and random cuts painted from real values: no pixel in the NaN colour.
+resmr_add_pvpython_test(Multiresolution.EveryLevel TestMultiresolutionEveryLevel.py)
+set_property(TEST Multiresolution.EveryLevel APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
 # Lit as stock ParaView lights its surfaces: light kit, headlight and material (PSNR).
 resmr_add_pvpython_test(Multiresolution.Lighting TestMultiresolutionLighting.py)
 set_property(TEST Multiresolution.Lighting APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")

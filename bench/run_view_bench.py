@@ -9,7 +9,9 @@ a fault line) with the frame-rate controller targeting --fps; per frame the fram
 tolerance, triangles drawn and resident MB (the representation's readout) and the process's
 RSS. With --stock the same path is run on stock ParaView (EGRIDReader + Surface) where the
 model fits. Each model, and stock ParaView on it, runs in a fresh pvpython (--one-process: all in
-this one). Results: bench/results/view.{md,json} and view.png."""
+this one). With --loads 0 2 each model runs idle and again with both cores kept busy. Every
+--quality-every-th frame is drawn again afterwards at its tolerance and at 0 px and compared
+(view_quality.py). Results: bench/results/view.{md,json} and view.png."""
 import argparse
 import json
 import os
@@ -19,6 +21,8 @@ import subprocess
 import time
 
 from paraview import simple
+
+import view_quality
 
 parser = argparse.ArgumentParser()
 parser.add_argument("--plugin", required=True)
@@ -33,6 +37,13 @@ parser.add_argument("--frames", type=int, default=300)
 parser.add_argument("--budget", type=int, default=1024, help="MB")
 parser.add_argument("--moving-floor", type=float, default=0.5,
                     help="the surface's Moving Resolution Floor (1: moving frames always at full resolution)")
+parser.add_argument("--loads", type=int, nargs="+", default=[0],
+                    help="background loads to run each model under: cores kept busy (0: idle)")
+parser.add_argument("--quality-every", type=int, default=10,
+                    help="draw every Nth frame again at its tolerance and at 0 px and compare (0: off)")
+parser.add_argument("--max-tolerance", type=float, default=None,
+                    help="Maximum Pixel Tolerance (the quality floor); default: the representation's")
+parser.add_argument("--busy", type=int, default=0, help=argparse.SUPPRESS)  # one child's load
 parser.add_argument("--stock", action="store_true")
 parser.add_argument("--stock-max-cells", type=float, default=50e6,
                     help="stock ParaView is not run above this (about 330 B a cell: 100M cells need 33 GB)")
@@ -170,9 +181,14 @@ def thread_cpu_ms():
     return totals
 
 
-def run_path(view, display, bounds, readout):
+def run_path(view, display, bounds, readout, samples=None):
+    """Renders the path, one row a frame; with `samples` (a list), every --quality-every-th
+    frame's camera and tolerance are added to it, and the frame 60% along (in the zoom) is kept
+    as drawn in samples' first entry's "drawn" (one read-back, so the path is barely touched)."""
     frames = []
-    for position, focal in camera_path(view, bounds, args.frames):
+    path = camera_path(view, bounds, args.frames)
+    keep = int(0.6 * len(path))
+    for index, (position, focal) in enumerate(path):
         camera = view.GetActiveCamera()
         camera.SetPosition(position)
         camera.SetFocalPoint(focal)
@@ -192,6 +208,11 @@ def run_path(view, display, bounds, readout):
                        substituted=display.GetPropertyValue("RegionsSubstituted"),
                        pending=display.GetPropertyValue("LoadsPending"),
                        render_scale=display.GetPropertyValue("CurrentRenderScale"))
+            if samples is not None and args.quality_every > 0 and index % args.quality_every == 0:
+                samples.append({"frame": index, "position": list(position), "focal": list(focal),
+                                "tolerance": row["tolerance"], "render_scale": row["render_scale"]})
+            if samples is not None and index == keep:
+                row["drawn"] = view_quality.drawn_frame(view)
         frames.append(row)
     return frames
 
@@ -227,7 +248,8 @@ def write_report(results):
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
 
     for e in results["models"]:
-        lines.append(f"| {e['model']} | {e['first_image_s']:.2f} | {e['p50_ms']:.0f} | {e['p99_ms']:.0f} | "
+        load = "" if e.get("load", "idle") == "idle" else f" ({e['load']})"
+        lines.append(f"| {e['model']}{load} | {e['first_image_s']:.2f} | {e['p50_ms']:.0f} | {e['p99_ms']:.0f} | "
                      f"{100 * e['frames_within_target']:.0f}% | {100 * e.get('frames_reduced', 0):.0f}% | "
                      f"{e['max_resident_mb']:.0f} | {e['max_rss_mb']:.0f} | "
                      f"{stock_cell(e, 'stock_first_image_s', 2)} | {stock_cell(e, 'stock_p50_ms', 0)} | "
@@ -260,6 +282,7 @@ def write_report(results):
             cells = [f"{percentile([f[f'cpu_{r}_ms'] for f in e['frames']], 50):.0f}" for r in roles]
             cells += [f"{percentile([f[f'cpu_{r}_ms'] for f in over], 50):.0f}" if over else "-" for r in roles]
             lines.append(f"| {e['model']} | " + " | ".join(cells) + " |")
+    lines += view_quality.report_lines(results["models"])
     with open(args.out + ".md", "w") as out:
         out.write("\n".join(lines) + "\n")
     try:
@@ -361,8 +384,13 @@ def measure_multiresolution(model):
     view.ResetCamera(False)
     simple.Render(view)
     first_image = time.perf_counter() - start
+    if args.max_tolerance is not None:
+        display.MaximumPixelTolerance = args.max_tolerance
     bounds = reader.GetDataInformation().GetBounds()
-    frames = run_path(view, display, bounds, True)
+    samples = []
+    with view_quality.BusyLoad(args.busy):
+        frames = run_path(view, display, bounds, True, samples)
+    kept = next((f for f in frames if "drawn" in f), None)
     times = [f["seconds"] for f in frames]
     target_s = 1 / args.fps
     entry = {"model": model, "first_image_s": first_image, "rss_before_mb": rss_before,
@@ -371,7 +399,8 @@ def measure_multiresolution(model):
              "max_resident_mb": max(f["resident_mb"] for f in frames),
              "max_rss_mb": max(f["rss_mb"] for f in frames), "frames": frames,
              "frames_reduced": sum(1 for f in frames if f.get("render_scale", 1) < 1) / len(frames),
-             "moving_floor": args.moving_floor}
+             "moving_floor": args.moving_floor, "load": f"{args.busy} cores busy" if args.busy else "idle",
+             "max_tolerance": display.MaximumPixelTolerance}
     # Attribution, not the target: frames during which the kernel's reclaim thread ran (it
     # takes 50-60 ms of CPU every ~5.2 s on this VM), and the p99 of the others.
     quiet = [f["seconds"] for f in frames if f["kernel_reclaim_ms"] == 0]
@@ -384,6 +413,28 @@ def measure_multiresolution(model):
           f"resident <= {entry['max_resident_mb']:.0f} MB, RSS <= {entry['max_rss_mb']:.0f} MB; "
           f"{entry['frames_over_target']} frames over target, {entry['frames_over_target_during_reclaim']} of them "
           f"while kdamond ran", flush=True)
+    if samples:
+        folder = os.path.join(args.scratch, "quality", f"{model.replace(':', '_')}-{entry['load'].replace(' ', '_')}")
+        view_quality.measure(view, display, samples, args.budget, folder)
+        entry["quality"] = samples
+        entry.update(view_quality.summary(samples))
+        if kept is not None:
+            # The frame as the user saw it while moving, beside its exact picture (0 px, lit).
+            view_quality.save_png(kept.pop("drawn"), os.path.join(folder, "moving-as-drawn.png"))
+            camera = view.GetActiveCamera()
+            position, focal = camera_path(view, bounds, args.frames)[int(0.6 * args.frames)]
+            camera.SetPosition(position)
+            camera.SetFocalPoint(focal)
+            camera.SetViewUp(0, 0, 1)
+            display.PaintBy = "Property"
+            display.PixelTolerance = 0
+            exact_pixels = view_quality.resmr_testing.capture_rgb(view, os.path.join(folder, "moving-exact.png"),
+                                                               view_quality.WIDTH, view_quality.HEIGHT)
+            entry["moving_example"] = {"frame": int(0.6 * args.frames), "tolerance": kept["tolerance"],
+                                       "render_scale": kept["render_scale"], "folder": folder,
+                                       "covered_pixels": int((exact_pixels.sum(axis=2) > 0).sum())}
+    for f in frames:
+        f.pop("drawn", None)
     simple.Delete(reader)
     simple.Delete(view)
     entry["bounds"] = list(bounds)
@@ -414,7 +465,8 @@ def measure_stock(model, entry):
         view.ResetCamera(False)
         simple.Render(view)
         entry["stock_first_image_s"] = time.perf_counter() - start
-        stock_frames = run_path(view, shown, bounds, False)
+        with view_quality.BusyLoad(args.busy):
+            stock_frames = run_path(view, shown, bounds, False)
         stock_times = [f["seconds"] for f in stock_frames]
         entry["stock_p50_ms"] = 1000 * percentile(stock_times, 50)
         entry["stock_p99_ms"] = 1000 * percentile(stock_times, 99)
@@ -435,7 +487,10 @@ def run_child(part, model, entry=None):
                "--resmr", args.resmr, "--scratch", args.scratch, "--data", args.data, "--models", model,
                "--fps", str(args.fps), "--frames", str(args.frames), "--budget", str(args.budget),
                "--stock-max-cells", str(args.stock_max_cells), "--moving-floor", str(args.moving_floor),
+               "--quality-every", str(args.quality_every), "--busy", str(args.busy),
                "--child", part, "--child-out", out]
+    if args.max_tolerance is not None:
+        command += ["--max-tolerance", str(args.max_tolerance)]
     done = subprocess.run(command + (["--fxaa"] if args.fxaa else []))
     if done.returncode != 0:
         raise SystemExit(f"run_view_bench: measuring {part} on {model} failed (exit {done.returncode}; "
@@ -473,7 +528,8 @@ results["empty_frame_other_fxaa_ms"] = sphere_frame_ms(view, 8, 8)
 print(f"The same with FXAA {'off' if args.fxaa else 'on'}: {results['empty_frame_other_fxaa_ms']:.0f} ms", flush=True)
 simple.Delete(view)
 
-for model in args.models:
+for model, load in [(m, load) for m in args.models for load in args.loads]:
+    args.busy = load
     if args.one_process:
         entry = measure_multiresolution(model)
         if args.stock:

@@ -467,7 +467,10 @@ void RemoveTree(const std::string& path)
 
 /// The cells (natural index) an extracted face of the region may sample through its
 /// interpolated topological coordinates (Sec. 5.2): every cell of the face's box in (i, j,
-/// k) space, on the inner side of a top or bottom face and on both sides of a side face.
+/// k) space, on the inner side of a top or bottom face and on both sides of a side face. A
+/// side triangle is drawn half a cell off along its topological normal's largest axis
+/// (RegionCache's AddSideTriangles), whatever its vertices span on that axis: a simplified
+/// triangle spanning cells there names cells half a cell beyond its box on either side.
 void MarkTouchedCells(
   const RegionMesh& mesh, const std::array<int64_t, 3>& dims, std::vector<std::atomic<uint64_t>>& bits)
 {
@@ -484,10 +487,28 @@ void MarkTouchedCells(
         high[a] = std::max(high[a], t[a]);
       }
     }
+    int offsetAxis = -1;
+    if (kind == 2 && count == 3)
+    {
+      std::array<glm::dvec3, 3> t;
+      for (int v = 0; v < 3; ++v)
+      {
+        const uint32_t node = vertices[v] / interfaces;
+        t[v] = glm::dvec3(mesh.topology[node][0], mesh.topology[node][1], double(vertices[v] % interfaces));
+      }
+      const glm::dvec3 n = glm::cross(t[1] - t[0], t[2] - t[0]);
+      offsetAxis = std::fabs(n.y) > std::fabs(n.x) ? 1 : 0;
+      offsetAxis = std::fabs(n.z) > std::fabs(n[offsetAxis]) ? 2 : offsetAxis;
+    }
     std::array<int64_t, 3> first{}, last{};
     for (int a = 0; a < 3; ++a)
     {
-      if (high[a] - low[a] < 1e-6)
+      if (a == offsetAxis && high[a] - low[a] >= 1e-6)
+      {
+        first[a] = static_cast<int64_t>(std::floor(low[a] - 0.5));
+        last[a] = static_cast<int64_t>(std::floor(high[a] + 0.5));
+      }
+      else if (high[a] - low[a] < 1e-6)
       {
         // Constant coordinate: the cell below a top face, above a bottom face, either side
         // of a side face.

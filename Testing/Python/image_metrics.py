@@ -1,0 +1,111 @@
+"""How far a frame is from the exact one, as users see it, in numpy only (the tests and the
+view benchmark share it). Frames are cell-id images (0: background, else 1 + the cell's
+natural index, `resmr_testing.cell_ids`) of the same camera and size: `got` drawn at some
+tolerance, `exact` at 0 px."""
+import numpy as np
+
+
+def _shifted(image, dy, dx, fill):
+    """`image` moved by (dy, dx) pixels, `fill` where nothing moved in."""
+    out = np.full_like(image, fill)
+    height, width = image.shape
+    out[max(dy, 0):height + min(dy, 0), max(dx, 0):width + min(dx, 0)] = \
+        image[max(-dy, 0):height + min(-dy, 0), max(-dx, 0):width + min(-dx, 0)]
+    return out
+
+
+def cell_agreement(got, exact):
+    """Share of the pixels both cover that name the same cell."""
+    both = (got > 0) & (exact > 0)
+    return float(np.mean(got[both] == exact[both])) if both.any() else 0.0
+
+
+def within_pixels(got, exact, reach=2):
+    """Share of the pixels either covers whose content (a cell, or the background) appears in
+    the other image within `reach` pixels (a square): a cell drawn up to `reach` pixels from
+    where the exact image has it still counts, a cell or a hole the exact image has nowhere
+    near does not."""
+    covered = (got > 0) | (exact > 0)
+    if not covered.any():
+        return 1.0
+    found_got = np.zeros(got.shape, bool)    # got's pixel has its match in exact nearby
+    found_exact = np.zeros(got.shape, bool)  # exact's pixel has its match in got nearby
+    for dy in range(-reach, reach + 1):
+        for dx in range(-reach, reach + 1):
+            found_got |= _shifted(exact, dy, dx, -1) == got
+            found_exact |= _shifted(got, dy, dx, -1) == exact
+    return float(np.mean((found_got & found_exact)[covered]))
+
+
+def _dilate(mask):
+    out = mask.copy()
+    out[1:, :] |= mask[:-1, :]
+    out[:-1, :] |= mask[1:, :]
+    out[:, 1:] |= mask[:, :-1]
+    out[:, :-1] |= mask[:, 1:]
+    return out
+
+
+def see_through_holes(got, exact):
+    """Background pixels of `got` that no background of the exact image reaches through
+    `got`'s background (4-connected): gaps in the surface one sees through, not a silhouette
+    drawn a little inside the exact one. Returns (pixels, deepest: the largest distance in
+    pixels from a hole pixel to the hole's edge)."""
+    open_ = got == 0
+    reached = open_ & (exact == 0)
+    while True:
+        grown = _dilate(reached) & open_
+        if np.array_equal(grown, reached):
+            break
+        reached = grown
+    holes = open_ & ~reached
+    count = int(holes.sum())
+    depth = 0
+    remaining = holes
+    while remaining.any():
+        depth += 1
+        shrunk = remaining.copy()
+        shrunk[1:, :] &= remaining[:-1, :]
+        shrunk[:-1, :] &= remaining[1:, :]
+        shrunk[:, 1:] &= remaining[:, :-1]
+        shrunk[:, :-1] &= remaining[:, 1:]
+        remaining = shrunk
+    return count, depth
+
+
+def silhouette_distance(got, exact, limit=256):
+    """The largest distance, pixels (a square reach, at most `limit`), from a pixel covered in
+    one image and not the other to the nearest pixel covered in the other: how far the
+    outline strays."""
+    a, b = got > 0, exact > 0
+    worst = 0
+    for source, target in ((a & ~b, b), (b & ~a, a)):
+        if not source.any():
+            continue
+        if not target.any():
+            return limit
+        grown, steps = target.copy(), 0
+        while (source & ~grown).any() and steps < limit:
+            steps += 1
+            stepped = _dilate(grown)
+            stepped[1:, 1:] |= grown[:-1, :-1]
+            stepped[1:, :-1] |= grown[:-1, 1:]
+            stepped[:-1, 1:] |= grown[1:, :-1]
+            stepped[:-1, :-1] |= grown[1:, 1:]
+            grown = stepped
+        worst = max(worst, steps)
+    return worst
+
+
+def nan_pixels(rgb, nan_color):
+    """Pixels of an RGB frame (0-255) painted exactly in the lookup table's NaN colour."""
+    target = np.round(np.asarray(nan_color) * 255).astype(np.int64)
+    return int(np.sum(np.all(rgb == target, axis=-1)))
+
+
+def compare(got, exact):
+    """All of the above for one frame: a dict."""
+    holes, deepest = see_through_holes(got, exact)
+    return {"cell_agreement": cell_agreement(got, exact), "within_2px": within_pixels(got, exact, 2),
+            "hole_pixels": holes, "hole_depth_px": deepest,
+            "silhouette_px": silhouette_distance(got, exact)}

@@ -1,0 +1,146 @@
+"""The view benchmark's picture as users see it (run_view_bench.py --quality-every N): every
+Nth frame of the camera path is drawn again, after the timed path, at the tolerance the
+frame-rate controller chose for it and at 0 px, both in the Cell Id colouring, and compared
+(Testing/Python/image_metrics.py): cell agreement, share of pixels within 2 px of the exact
+image, see-through holes, silhouette distance; the same tolerance in the property colouring,
+unlit, counts the pixels in the lookup table's NaN colour. The re-renders wait for every mesh
+(the picture the tolerance stands for, not one still loading) under a budget large enough to
+hold the exact frame. Also a fixed background load (--busy N: N processes spinning at normal
+priority for the length of the timed path), as a workstation running a simulation has."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+from paraview import simple
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Testing", "Python"))
+import image_metrics  # noqa: E402
+import resmr_testing  # noqa: E402
+
+NAN_COLOR = [1.0, 0.0, 1.0]  # no colour map of ParaView's gives pure magenta
+WIDTH, HEIGHT = 1280, 720
+
+
+class BusyLoad:
+    """`cores` processes spinning at normal priority while the block runs."""
+
+    def __init__(self, cores):
+        self.cores, self.processes = cores, []
+
+    def __enter__(self):
+        spin = "while True:\n    pass\n"
+        self.processes = [subprocess.Popen([sys.executable or "python3", "-c", spin]) for _ in range(self.cores)]
+        return self
+
+    def __exit__(self, *exc):
+        for process in self.processes:
+            process.kill()
+            process.wait()
+        return False
+
+
+def drawn_frame(view):
+    """The view's last frame as drawn (no render): (height, width, 3) int64."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
+    grab = vtkWindowToImageFilter()
+    grab.SetInput(view.GetRenderWindow())
+    grab.ShouldRerenderOff()
+    grab.ReadFrontBufferOff()
+    grab.Update()
+    image = grab.GetOutput()
+    width, height, _ = image.GetDimensions()
+    return vtk_to_numpy(image.GetPointData().GetScalars())[:, :3].astype(np.int64).reshape(height, width, 3)
+
+
+def save_png(pixels, path):
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOImage import vtkPNGWriter
+    height, width, _ = pixels.shape
+    image = vtkImageData()
+    image.SetDimensions(width, height, 1)
+    image.GetPointData().SetScalars(numpy_to_vtk(pixels.reshape(-1, 3).astype(np.uint8), deep=1))
+    writer = vtkPNGWriter()
+    writer.SetFileName(path)
+    writer.SetInputData(image)
+    writer.Write()
+
+
+def measure(view, display, samples, budget_mb, folder):
+    """Draws each sample ({frame, position, focal, tolerance}) again at its tolerance and at
+    0 px: the samples with their metrics added."""
+    os.makedirs(folder, exist_ok=True)
+    display.TargetFrameRate = 0
+    display.WaitForDetailMs = 600000
+    display.MemoryBudgetMB = max(budget_mb, 8192)
+    lut = simple.GetColorTransferFunction("PORO")
+    lut.NanColor = NAN_COLOR
+    camera = view.GetActiveCamera()
+
+    def shot(tolerance, paint, name):
+        display.PaintBy = paint
+        display.PixelTolerance = tolerance
+        return resmr_testing.capture_rgb(view, os.path.join(folder, name), WIDTH, HEIGHT)
+
+    for sample in samples:
+        camera.SetPosition(sample["position"])
+        camera.SetFocalPoint(sample["focal"])
+        camera.SetViewUp(0, 0, 1)
+        tag = f"frame{sample['frame']:04d}"
+        exact = resmr_testing.cell_ids(shot(0, "Cell Id", f"{tag}-0px-cellid.png"))
+        got = resmr_testing.cell_ids(shot(sample["tolerance"], "Cell Id", f"{tag}-cellid.png"))
+        sample.update(image_metrics.compare(got, exact))
+        ambient, diffuse = display.Ambient, display.Diffuse
+        display.Ambient, display.Diffuse = 1.0, 0.0
+        sample["nan_pixels"] = image_metrics.nan_pixels(shot(sample["tolerance"], "Property", f"{tag}-poro.png"),
+                                                        NAN_COLOR)
+        display.Ambient, display.Diffuse = ambient, diffuse
+        print(f"  frame {sample['frame']}: {sample['tolerance']:.1f} px, {100 * sample['within_2px']:.1f}% within 2 px, "
+              f"{100 * sample['cell_agreement']:.1f}% same cell, {sample['hole_pixels']} hole px, "
+              f"{sample['nan_pixels']} NaN px, silhouette {sample['silhouette_px']} px", flush=True)
+    return samples
+
+
+def summary(samples):
+    """The figures the report's table shows."""
+    if not samples:
+        return {}
+    within = [s["within_2px"] for s in samples]
+    return {"quality_samples": len(samples),
+            "within_2px_min": min(within), "within_2px_p10": float(np.percentile(within, 10)),
+            "within_2px_p50": float(np.percentile(within, 50)),
+            "frames_within_2px_95": sum(1 for w in within if w >= 0.95) / len(within),
+            "cell_agreement_p50": float(np.percentile([s["cell_agreement"] for s in samples], 50)),
+            "cell_agreement_min": min(s["cell_agreement"] for s in samples),
+            "frames_with_holes": sum(1 for s in samples if s["hole_pixels"] > 0),
+            "hole_pixels_max": max(s["hole_pixels"] for s in samples),
+            "hole_depth_max_px": max(s["hole_depth_px"] for s in samples),
+            "nan_pixels_max": max(s["nan_pixels"] for s in samples),
+            "silhouette_px_max": max(s["silhouette_px"] for s in samples),
+            "sampled_tolerance_p50": float(np.percentile([s["tolerance"] for s in samples], 50)),
+            "sampled_tolerance_p90": float(np.percentile([s["tolerance"] for s in samples], 90))}
+
+
+def report_lines(models):
+    """Markdown: the quality table, one row a model and load."""
+    rows = [e for e in models if e.get("quality_samples")]
+    if not rows:
+        return []
+    lines = ["", "Picture quality of every sampled frame (drawn again at the tolerance the controller chose, and at "
+             "0 px, in the Cell Id colouring): 'within 2 px' is the share of pixels whose cell (or background) the "
+             "exact image has within 2 pixels; holes are background pixels no background of the exact image reaches "
+             "(see-through gaps); NaN pixels are painted in the lookup table's NaN colour.", "",
+             "| model | load | samples | tolerance p50 / p90 px | within 2 px: min / p10 / p50 | frames >= 95% | "
+             "same cell p50 / min | frames with holes | largest hole px (depth) | NaN px max | silhouette px max |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for e in rows:
+        lines.append(
+            f"| {e['model']} | {e.get('load', 'idle')} | {e['quality_samples']} | "
+            f"{e['sampled_tolerance_p50']:.0f} / {e['sampled_tolerance_p90']:.0f} | "
+            f"{100 * e['within_2px_min']:.1f}% / {100 * e['within_2px_p10']:.1f}% / {100 * e['within_2px_p50']:.1f}% | "
+            f"{100 * e['frames_within_2px_95']:.0f}% | {100 * e['cell_agreement_p50']:.1f}% / "
+            f"{100 * e['cell_agreement_min']:.1f}% | {e['frames_with_holes']} | {e['hole_pixels_max']} "
+            f"({e['hole_depth_max_px']}) | {e['nan_pixels_max']} | {e['silhouette_px_max']} |")
+    return lines
