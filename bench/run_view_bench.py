@@ -90,6 +90,9 @@ def prepare(model):
         nx, ny, nz = (int(v) for v in model.split(":")[1].split("x"))
         grid = os.path.join(args.scratch, f"synth_{nx}x{ny}x{nz}.EGRID")
         path = os.path.join(args.scratch, f"synth_{nx}x{ny}x{nz}.resmr")
+        if os.path.exists(path + "p") and not (args.stock and nx * ny * nz <= args.stock_max_cells):
+            # Built already (from the generator or an EGRID): no grid file is needed.
+            return (grid if os.path.exists(grid) else None), path
         if nx * ny * nz > EGRID_MAX_CELLS:
             # Too large for an EGRID: the generator streams straight into the builder and the
             # property file (seed 1, as resmr synth's default).

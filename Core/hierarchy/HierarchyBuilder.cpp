@@ -649,6 +649,36 @@ void LockCutColumns(ColumnMesh& mesh, std::vector<uint8_t>& childCut)
   }
 }
 
+/// Locks every column touching a fault node (ours, not the paper's): a boundary node whose
+/// topological coordinate another node of the mesh shares, the two sides of a fault at one
+/// pillar. The column collapse simplifies each fault block's outline on its own, so the two
+/// traces of a fault that bends (a staircase across I and J, a junction of faults) parted and
+/// opened a gap one sees through. Kept whole, the columns on both sides keep the original
+/// trace and their cells at every level, and the blocks meet as they do in the grid. (Pinning
+/// the fault nodes alone, letting the columns beside them collapse into them, still left
+/// gaps.)
+void LockFaultColumns(ColumnMesh& mesh)
+{
+  std::map<std::array<double, 2>, int> sharing;
+  for (int32_t node = 0; node < mesh.NodeCount(); ++node)
+  {
+    if (mesh.IsNodeAlive(node) && mesh.IsBoundaryNode(node))
+    {
+      ++sharing[mesh.TopologicalCoordinate(node)];
+    }
+  }
+  for (int32_t node = 0; node < mesh.NodeCount(); ++node)
+  {
+    if (mesh.IsNodeAlive(node) && mesh.IsBoundaryNode(node) && sharing[mesh.TopologicalCoordinate(node)] > 1)
+    {
+      for (const int32_t column : mesh.NodeColumns(node))
+      {
+        mesh.SetLocked(column, true);
+      }
+    }
+  }
+}
+
 class Builder
 {
 public:
@@ -1237,6 +1267,7 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond, std::vector
   int64_t inputColumns = 0;
   ColumnMesh mesh = MergeRegions(children, childCut, openSides, inputColumns);
   LockCutColumns(mesh, childCut);
+  LockFaultColumns(mesh);
   const int triangles = diamond.second >= 0 ? 2 : 1;
   const int64_t target = std::min<int64_t>(this->Options.cmax * triangles, (inputColumns + 1) / 2);
   if (mesh.AliveColumns() > target)

@@ -74,7 +74,9 @@ def child(plugin, path, property_name, image, cut):
     result["arrays"] = [data.GetArrayInformation(i).GetName() for i in range(data.GetNumberOfArrays())]
     display.WaitForDetailMs = 20000
     display.GridLines = 0
-    display.DiffuseColor = [1.0, 0.0, 1.0]  # the solid colour: magenta, unlit
+    # The solid colour: magenta, unlit (ambient only), both colours set as the GUI's Solid
+    # Color does (lit as stock surfaces, the ambient term takes AmbientColor).
+    display.DiffuseColor = display.AmbientColor = [1.0, 0.0, 1.0]
     display.Ambient = 1.0
     display.Diffuse = 0.0
     display.Specular = 0.0

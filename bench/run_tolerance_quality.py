@@ -1,0 +1,98 @@
+"""Picture quality against tolerance (the evidence behind MaximumPixelTolerance's default), run
+with pvpython:
+
+  pvpython bench/run_tolerance_quality.py --plugin PLUGIN.so --resmr build/bin/resmr \
+      --scratch bench/scratch/quality [--model 400x300x25] [--tolerances 1 4 16 64 256 65536]
+
+Builds the generated faulted model (the demo's, 3M cells) and draws it at 1280x720 from three
+cameras (an overview, a close look, a low flight along a fault) at each tolerance, waiting for
+every mesh, in the Cell Id colouring, against the exact frame (0 px): the share of pixels
+within 2 px of the exact image, cell agreement, see-through holes, silhouette distance, and
+the triangles drawn (Testing/Python/image_metrics.py). Results: bench/results/tolerance_quality.{md,json}."""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+from paraview import simple
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "Testing", "Python"))
+import image_metrics  # noqa: E402
+import resmr_testing  # noqa: E402
+
+parser = argparse.ArgumentParser()
+parser.add_argument("--plugin", required=True)
+parser.add_argument("--resmr", required=True)
+parser.add_argument("--scratch", required=True)
+parser.add_argument("--model", default="400x300x25")
+parser.add_argument("--tolerances", type=float, nargs="+", default=[1, 4, 16, 32, 64, 128, 256, 65536])
+parser.add_argument("--out", default=os.path.join(HERE, "results", "tolerance_quality"))
+args = parser.parse_args()
+WIDTH, HEIGHT = 1280, 720
+
+os.makedirs(args.scratch, exist_ok=True)
+dims = args.model.split("x")
+grid = os.path.join(args.scratch, f"faulted_{args.model}.EGRID")
+path = os.path.join(args.scratch, f"faulted_{args.model}.resmr")
+if not os.path.exists(path):
+    subprocess.run([args.resmr, "synth", *dims, "-o", grid, "--quiet"], check=True, stdout=subprocess.DEVNULL)
+    subprocess.run([args.resmr, "build", grid, "-o", path, "--quiet"], check=True, stdout=subprocess.DEVNULL)
+
+simple.LoadPlugin(args.plugin, remote=False, ns=globals())
+view = resmr_testing.image_view(WIDTH, HEIGHT)
+reader = simple.OpenDataFile(path)
+display = simple.Show(reader, view)
+display.GridLines = 0
+display.PaintBy = "Cell Id"
+display.MemoryBudgetMB = 8192
+display.WaitForDetailMs = 600000
+simple.Render(view)
+b = reader.GetDataInformation().GetBounds()
+cx, cy, cz = (b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2
+size = max(b[1] - b[0], b[3] - b[2])
+cameras = {"overview": ((cx + 1.2 * size, cy, cz + 0.6 * size), (cx, cy, cz)),
+           "close look": ((cx + 0.3 * size, cy - 0.2 * size, cz + 0.15 * size), (cx, cy, cz)),
+           "low flight": ((b[0] + 0.3 * (b[1] - b[0]), cy - 0.05 * size, b[5] + 0.02 * size),
+                          (b[0] + 0.4 * (b[1] - b[0]), cy, cz))}
+
+
+def draw(camera, tolerance):
+    position, focal = cameras[camera]
+    view.GetActiveCamera().SetPosition(position)
+    view.GetActiveCamera().SetFocalPoint(focal)
+    view.GetActiveCamera().SetViewUp(0, 0, 1)
+    display.PixelTolerance = tolerance
+    ids = resmr_testing.cell_ids(resmr_testing.capture_rgb(view, os.path.join(args.scratch, "frame.png"),
+                                                           WIDTH, HEIGHT))
+    display.UpdatePropertyInformation()
+    return ids, int(display.GetPropertyValue("TrianglesDrawn"))
+
+
+rows = []
+for camera in cameras:
+    exact, exact_triangles = draw(camera, 0)
+    for tolerance in args.tolerances:
+        got, triangles = draw(camera, tolerance)
+        row = {"camera": camera, "tolerance": tolerance, "triangles": triangles, "exact_triangles": exact_triangles}
+        row.update(image_metrics.compare(got, exact))
+        rows.append(row)
+        print(f"{camera} {tolerance:g} px: {100 * row['within_2px']:.1f}% within 2 px, {100 * row['cell_agreement']:.1f}% "
+              f"same cell, {row['hole_pixels']} hole px, silhouette {row['silhouette_px']} px, {triangles} triangles",
+              flush=True)
+
+with open(args.out + ".json", "w") as out:
+    json.dump({"model": f"faulted {args.model}", "size": [WIDTH, HEIGHT], "rows": rows}, out, indent=1)
+lines = [f"# Picture quality against tolerance (generated faulted model {args.model}, {WIDTH}x{HEIGHT}, llvmpipe)", "",
+         "Each frame waits for every mesh its tolerance selects and is compared with the exact frame (0 px) of "
+         "the same camera in the Cell Id colouring: 'within 2 px' is the share of pixels whose cell (or the "
+         "background) the exact frame has within 2 pixels.", "",
+         "| camera | tolerance px | within 2 px | same cell | hole px | silhouette px | triangles (0 px: all) |",
+         "|---|---|---|---|---|---|---|"]
+for row in rows:
+    lines.append(f"| {row['camera']} | {row['tolerance']:g} | {100 * row['within_2px']:.1f}% | "
+                 f"{100 * row['cell_agreement']:.1f}% | {row['hole_pixels']} | {row['silhouette_px']} | "
+                 f"{row['triangles']:,} ({row['exact_triangles']:,}) |")
+with open(args.out + ".md", "w") as out:
+    out.write("\n".join(lines) + "\n")
