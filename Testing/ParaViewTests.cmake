@@ -86,7 +86,7 @@ set_property(TEST Multiresolution.Surface APPEND PROPERTY ENVIRONMENT "RESMR_EXE
 # Its single-layer mode (Layer = K) against stock ParaView's layer K (Threshold), pixel by pixel.
 resmr_add_pvpython_test(Multiresolution.Layer TestMultiresolutionLayer.py)
 set_property(TEST Multiresolution.Layer APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
-# Every level and random cuts painted from real values: no pixel in the NaN colour.
+# Every level and random cuts: no see-through hole, no pixel in the NaN colour.
 resmr_add_pvpython_test(Multiresolution.EveryLevel TestMultiresolutionEveryLevel.py)
 set_property(TEST Multiresolution.EveryLevel APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
 # Lit as stock ParaView lights its surfaces: light kit, headlight and material (PSNR).
