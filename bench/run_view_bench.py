@@ -285,7 +285,7 @@ def write_report(results):
             cells = [f"{percentile([f[f'cpu_{r}_ms'] for f in e['frames']], 50):.0f}" for r in roles]
             cells += [f"{percentile([f[f'cpu_{r}_ms'] for f in over], 50):.0f}" if over else "-" for r in roles]
             lines.append(f"| {e['model']} | " + " | ".join(cells) + " |")
-    lines += view_quality.report_lines(results["models"])
+    lines += view_quality.report_lines(results["models"], os.path.basename(args.out))
     with open(args.out + ".md", "w") as out:
         out.write("\n".join(lines) + "\n")
     try:
@@ -423,7 +423,8 @@ def measure_multiresolution(model):
         entry.update(view_quality.summary(samples))
         if kept is not None:
             # The frame as the user saw it while moving, beside its exact picture (0 px, lit).
-            view_quality.save_png(kept.pop("drawn"), os.path.join(folder, "moving-as-drawn.png"))
+            drawn = kept.pop("drawn")
+            view_quality.save_png(drawn, os.path.join(folder, "moving-as-drawn.png"))
             camera = view.GetActiveCamera()
             position, focal = camera_path(view, bounds, args.frames)[int(0.6 * args.frames)]
             camera.SetPosition(position)
@@ -433,8 +434,10 @@ def measure_multiresolution(model):
             display.PixelTolerance = 0
             exact_pixels = view_quality.resmr_testing.capture_rgb(view, os.path.join(folder, "moving-exact.png"),
                                                                view_quality.WIDTH, view_quality.HEIGHT)
+            view_quality.side_by_side(drawn, exact_pixels, f"{args.out}-{model.replace(':', '_')}-"
+                                      f"{entry['load'].replace(' ', '_')}-moving.png")
             entry["moving_example"] = {"frame": int(0.6 * args.frames), "tolerance": kept["tolerance"],
-                                       "render_scale": kept["render_scale"], "folder": folder,
+                                       "render_scale": kept["render_scale"],
                                        "covered_pixels": int((exact_pixels.sum(axis=2) > 0).sum())}
     for f in frames:
         f.pop("drawn", None)
@@ -490,7 +493,7 @@ def run_child(part, model, entry=None):
                "--resmr", args.resmr, "--scratch", args.scratch, "--data", args.data, "--models", model,
                "--fps", str(args.fps), "--frames", str(args.frames), "--budget", str(args.budget),
                "--stock-max-cells", str(args.stock_max_cells), "--moving-floor", str(args.moving_floor),
-               "--quality-every", str(args.quality_every), "--busy", str(args.busy),
+               "--quality-every", str(args.quality_every), "--busy", str(args.busy), "--out", args.out,
                "--child", part, "--child-out", out]
     if args.max_tolerance is not None:
         command += ["--max-tolerance", str(args.max_tolerance)]

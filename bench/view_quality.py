@@ -8,6 +8,7 @@ unlit, counts the pixels in the lookup table's NaN colour. The re-renders wait f
 hold the exact frame. Also a fixed background load (--busy N: N processes spinning at normal
 priority for the length of the timed path), as a workstation running a simulation has."""
 import os
+import shutil
 import subprocess
 import sys
 
@@ -30,7 +31,8 @@ class BusyLoad:
 
     def __enter__(self):
         spin = "while True:\n    pass\n"
-        self.processes = [subprocess.Popen([sys.executable or "python3", "-c", spin]) for _ in range(self.cores)]
+        python = shutil.which("python3") or "python3"  # pvpython's sys.executable may not exist
+        self.processes = [subprocess.Popen([python, "-c", spin]) for _ in range(self.cores)]
         return self
 
     def __exit__(self, *exc):
@@ -66,6 +68,15 @@ def save_png(pixels, path):
     writer.SetFileName(path)
     writer.SetInputData(image)
     writer.Write()
+
+
+def side_by_side(left, right, path):
+    """Two frames of the same size, halved (2x2 averages), side by side in one PNG."""
+    def half(pixels):
+        height, width = pixels.shape[0] // 2 * 2, pixels.shape[1] // 2 * 2
+        p = pixels[:height, :width].reshape(height // 2, 2, width // 2, 2, 3)
+        return p.mean(axis=(1, 3)).round().astype(np.int64)
+    save_png(np.concatenate([half(left), half(right)], axis=1), path)
 
 
 def measure(view, display, samples, budget_mb, folder):
@@ -123,8 +134,9 @@ def summary(samples):
             "sampled_tolerance_p90": float(np.percentile([s["tolerance"] for s in samples], 90))}
 
 
-def report_lines(models):
-    """Markdown: the quality table, one row a model and load."""
+def report_lines(models, out_name):
+    """Markdown: the quality table, one row a model and load, and each run's moving frame
+    beside its exact frame (`out_name`: the report's file name without extension)."""
     rows = [e for e in models if e.get("quality_samples")]
     if not rows:
         return []
@@ -143,4 +155,12 @@ def report_lines(models):
             f"{100 * e['frames_within_2px_95']:.0f}% | {100 * e['cell_agreement_p50']:.1f}% / "
             f"{100 * e['cell_agreement_min']:.1f}% | {e['frames_with_holes']} | {e['hole_pixels_max']} "
             f"({e['hole_depth_max_px']}) | {e['nan_pixels_max']} | {e['silhouette_px_max']} |")
+    for e in rows:
+        example = e.get("moving_example")
+        if example:
+            image = f"{out_name}-{e['model'].replace(':', '_')}-{e.get('load', 'idle').replace(' ', '_')}-moving.png"
+            lines += ["", f"{e['model']} ({e.get('load', 'idle')}), frame {example['frame']} of the path as drawn while "
+                      f"moving (left: {example['tolerance']:.1f} px, render scale {example['render_scale']:g}) and the "
+                      f"exact frame of its camera (right: 0 px, every mesh loaded), both halved:", "",
+                      f"![moving and exact]({image})"]
     return lines
