@@ -32,6 +32,7 @@ pqMultiresolutionReadout pqMultiresolutionReadout::Pull(vtkSMProxy* surface)
   surface->UpdatePropertyInformation();
   readout.Tolerance = vtkSMPropertyHelper(surface, "CurrentTolerance").GetAsDouble();
   readout.RenderScale = vtkSMPropertyHelper(surface, "CurrentRenderScale").GetAsDouble();
+  readout.Moving = vtkSMPropertyHelper(surface, "CurrentFrameMoving").GetAsInt() != 0;
   readout.TargetFrameRate = vtkSMPropertyHelper(surface, "TargetFrameRate").GetAsDouble();
   readout.ResidentMB = vtkSMPropertyHelper(surface, "ResidentMB").GetAsDouble();
   readout.BudgetMB = vtkSMPropertyHelper(surface, "MemoryBudgetMB").GetAsInt();

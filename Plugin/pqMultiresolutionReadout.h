@@ -12,6 +12,7 @@ struct pqMultiresolutionReadout
   double Tolerance = 0;       ///< px, of the last frame
   double TargetFrameRate = 0; ///< 0: fixed tolerance
   double RenderScale = 1;     ///< of the last frame: below 1 while moving frames are reduced
+  bool Moving = false;        ///< the last frame used the frame-rate controller's tolerance
   double ResidentMB = 0;
   int BudgetMB = 0;
   double Triangles = 0;

@@ -119,6 +119,7 @@ void pqMultiresolutionReadoutDock::updateReadout()
   pqPipelineSource* input = data ? data->getInput() : nullptr;
   this->Source->setText(input ? input->getSMName() : tr("Multiresolution Surface"));
   const QString holding = readout.TargetFrameRate <= 0 ? tr("fixed")
+    : !readout.Moving                                  ? tr("still frame: the set tolerance")
     : readout.RenderScale < 1
     ? tr("holding %1 fps, drawn at %2% resolution").arg(readout.TargetFrameRate).arg(qRound(100 * readout.RenderScale))
     : tr("holding %1 fps").arg(readout.TargetFrameRate);

@@ -155,7 +155,8 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   bool HavePreviousView = false;
   resmr::ViewParameters PreviousView;
   double Tolerance = 1;
-  double RenderScale = 1; ///< the last frame's
+  double RenderScale = 1;  ///< the last frame's
+  bool Controlled = false; ///< the last frame used the controller's tolerance
   bool HaveLastClip = false;
   resmr::Matrix4 LastClip{}; ///< the last frame's model to clip transform
   vtkIdType Triangles = 0;
@@ -245,6 +246,11 @@ double vtkMultiresolutionSurfaceMapper::GetCurrentTolerance() const
 double vtkMultiresolutionSurfaceMapper::GetCurrentRenderScale() const
 {
   return this->Internal->RenderScale;
+}
+
+bool vtkMultiresolutionSurfaceMapper::GetCurrentFrameControlled() const
+{
+  return this->Internal->Controlled;
 }
 double vtkMultiresolutionSurfaceMapper::GetResidentMB() const
 {
@@ -831,6 +837,7 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
     static_cast<long long>(in.Triangles), in.Tolerance);
   in.FrameMs = ElapsedMs(frame.start) + in.Timer.Ms();
   in.RenderScale = frame.scale;
+  in.Controlled = frame.controlled;
   if (frame.controlled)
   {
     const double measuredMs = resmr::MeasuredFrameMs(

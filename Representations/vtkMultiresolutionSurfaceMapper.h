@@ -109,6 +109,9 @@ public:
   double GetCurrentTolerance() const;
   /// The fraction of the view's width and height the last frame was drawn at (1: full).
   double GetCurrentRenderScale() const;
+  /// Whether the last frame was a moving frame at the frame-rate controller's tolerance (a
+  /// still frame uses PixelTolerance).
+  bool GetCurrentFrameControlled() const;
   /// Mesh memory now: main memory plus GPU buffers, MB (within MemoryBudgetMB, see there).
   double GetResidentMB() const;
   vtkIdType GetTrianglesDrawn() const;

@@ -271,6 +271,10 @@ double vtkMultiresolutionSurfaceRepresentation::GetCurrentTolerance()
 {
   return this->Mapper->GetCurrentTolerance();
 }
+int vtkMultiresolutionSurfaceRepresentation::GetCurrentFrameControlled()
+{
+  return this->Mapper->GetCurrentFrameControlled() ? 1 : 0;
+}
 double vtkMultiresolutionSurfaceRepresentation::GetCurrentRenderScale()
 {
   return this->Mapper->GetCurrentRenderScale();

@@ -84,6 +84,7 @@ public:
   void SetLayer(int layer);
   double GetCurrentTolerance();
   double GetCurrentRenderScale();
+  int GetCurrentFrameControlled();
   double GetResidentMB();
   double GetTrianglesDrawn();
   int GetRegionsDrawn();

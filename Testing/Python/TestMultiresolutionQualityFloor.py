@@ -9,7 +9,8 @@ synthetic model:
 - reproducible: a moving frame drawn whole (no region standing in for one still loading) at
   the controller's tolerance T is drawn again, same camera, with Pixel Tolerance = T and no
   target frame rate: the same triangles and regions;
-- Pixel Tolerance accepts any tolerance the controller can choose (up to 65536 px)."""
+- Pixel Tolerance accepts any tolerance the controller can choose (up to 65536 px);
+- the readout (CurrentFrameMoving) says which frames were moving and which still."""
 import os
 
 from paraview import simple
@@ -32,7 +33,8 @@ def check(condition, message):
 def readout(display):
     display.UpdatePropertyInformation()
     return {name: display.GetPropertyValue(name) for name in
-            ("CurrentTolerance", "TrianglesDrawn", "RegionsDrawn", "RegionsSubstituted", "LoadsPending")}
+            ("CurrentTolerance", "TrianglesDrawn", "RegionsDrawn", "RegionsSubstituted", "LoadsPending",
+             "CurrentFrameMoving")}
 
 
 def moving_frames(view, display, frames, degrees=1.5):
@@ -73,10 +75,12 @@ frames = moving_frames(view, display, 40)
 tolerances = [f["CurrentTolerance"] for f in frames]
 check(max(tolerances) <= 16, f"moving frames stay within the 16 px floor: up to {max(tolerances):g} px")
 check(tolerances[-1] == 16, f"slow frames push the tolerance to the floor: last {tolerances[-1]:g} px")
+check(all(f["CurrentFrameMoving"] == 1 for f in frames), "the readout calls every moving frame moving")
 
 simple.Render(view)  # the same camera: a still frame
 still = readout(display)
 check(still["CurrentTolerance"] == 1, f"a still frame uses the user's 1 px: {still['CurrentTolerance']:g} px")
+check(still["CurrentFrameMoving"] == 0, "the readout calls the still frame still")
 resumed = moving_frames(view, display, 1)[0]["CurrentTolerance"]
 check(resumed == 16, f"the next moving frame resumes at the controller's 16 px: {resumed:g} px")
 
