@@ -465,73 +465,139 @@ void RemoveTree(const std::string& path)
   rmdir(path.c_str());
 }
 
+/// Whether triangle (a, b, c) meets the cell [lo, lo + 1]^3 grown by `margin` on every side
+/// (the separating-axis test of Akenine-Moller, "Fast 3D triangle-box overlap testing", 2001).
+bool TriangleMeetsCell(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, const glm::dvec3& lo, double margin)
+{
+  const glm::dvec3 centre = lo + 0.5;
+  const double h = 0.5 + margin;
+  a -= centre;
+  b -= centre;
+  c -= centre;
+  const auto apart = [&](const glm::dvec3& axis) {
+    const double pa = glm::dot(a, axis), pb = glm::dot(b, axis), pc = glm::dot(c, axis);
+    const double r = h * (std::fabs(axis.x) + std::fabs(axis.y) + std::fabs(axis.z));
+    return std::min({ pa, pb, pc }) > r || std::max({ pa, pb, pc }) < -r;
+  };
+  const glm::dvec3 units[3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+  const glm::dvec3 edges[3] = { b - a, c - b, a - c };
+  if (apart(units[0]) || apart(units[1]) || apart(units[2]) || apart(glm::cross(edges[0], edges[1])))
+  {
+    return false;
+  }
+  for (const auto& edge : edges)
+  {
+    for (const auto& unit : units)
+    {
+      if (apart(glm::cross(edge, unit)))
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+/// The triangles a face is drawn as, each moved as the view moves its cell coordinate
+/// (RegionCache): a top quad half a cell down into its cell (k + 0.5), a bottom one half a cell
+/// up, both split q0-q1-q2, q0-q2-q3; a side triangle half a cell along its topological
+/// normal's largest axis, either way (the side depends on the file's handedness). Empty for a
+/// side quad, the exact unit face, whose box is already exact.
+std::vector<std::array<glm::dvec3, 3>> DrawnTriangles(const std::array<glm::dvec3, 4>& t, int count, int kind)
+{
+  std::vector<std::array<glm::dvec3, 3>> out;
+  if (kind < 2)
+  {
+    const glm::dvec3 shift(0, 0, kind == 0 ? 0.5 : -0.5);
+    out.push_back({ t[0] + shift, t[1] + shift, t[2] + shift });
+    out.push_back({ t[0] + shift, t[2] + shift, t[3] + shift });
+  }
+  else if (count == 3)
+  {
+    const glm::dvec3 n = glm::cross(t[1] - t[0], t[2] - t[0]);
+    int axis = std::fabs(n.y) > std::fabs(n.x) ? 1 : 0;
+    axis = std::fabs(n.z) > std::fabs(n[axis]) ? 2 : axis;
+    glm::dvec3 shift(0.0);
+    shift[axis] = 0.5;
+    out.push_back({ t[0] + shift, t[1] + shift, t[2] + shift });
+    out.push_back({ t[0] - shift, t[1] - shift, t[2] - shift });
+  }
+  return out;
+}
+
+/// The box of cells a face may name: every cell its drawn triangles' box reaches, on the
+/// inner side of a top or bottom face and on both sides of a side quad.
+void CellBox(const std::array<glm::dvec3, 4>& t, int count, const std::vector<std::array<glm::dvec3, 3>>& drawn,
+  const std::array<int64_t, 3>& dims, std::array<int64_t, 3>& first, std::array<int64_t, 3>& last)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    double low = 1e300, high = -1e300;
+    for (int v = 0; v < count; ++v)
+    {
+      low = std::min(low, t[v][a]);
+      high = std::max(high, t[v][a]);
+    }
+    for (const auto& triangle : drawn)
+    {
+      for (const auto& p : triangle)
+      {
+        low = std::min(low, p[a]);
+        high = std::max(high, p[a]);
+      }
+    }
+    if (drawn.empty() && high - low < 1e-6)
+    {
+      // A side quad's constant coordinate: the cells either side of it.
+      const int64_t plane = static_cast<int64_t>(std::llround(low));
+      first[a] = plane - 1;
+      last[a] = plane;
+    }
+    else
+    {
+      first[a] = static_cast<int64_t>(std::floor(low + 1e-9));
+      last[a] = static_cast<int64_t>(std::ceil(high - 1e-9)) - 1;
+      last[a] = std::max(last[a], first[a]);
+    }
+    first[a] = std::max<int64_t>(first[a], 0);
+    last[a] = std::min<int64_t>(last[a], dims[a] - 1);
+  }
+}
+
 /// The cells (natural index) an extracted face of the region may sample through its
-/// interpolated topological coordinates (Sec. 5.2): every cell of the face's box in (i, j,
-/// k) space, on the inner side of a top or bottom face and on both sides of a side face. A
-/// side triangle is drawn half a cell off along its topological normal's largest axis
-/// (RegionCache's AddSideTriangles), whatever its vertices span on that axis: a simplified
-/// triangle spanning cells there names cells half a cell beyond its box on either side.
+/// interpolated topological coordinates (Sec. 5.2): exactly the cells its drawn triangles
+/// (DrawnTriangles) meet; for a side quad, the two cells either side of it. A coarse face is
+/// large and slanted in (i, j, k): its box held many cells it never names (a long sliver
+/// along a fault), and a simplified side triangle names cells half a cell beyond its box.
 void MarkTouchedCells(
   const RegionMesh& mesh, const std::array<int64_t, 3>& dims, std::vector<std::atomic<uint64_t>>& bits)
 {
   const uint32_t interfaces = static_cast<uint32_t>(mesh.layers + 1);
   const auto mark = [&](const uint32_t* vertices, int count, int kind) {
-    std::array<double, 3> low{ 1e300, 1e300, 1e300 }, high{ -1e300, -1e300, -1e300 };
+    std::array<glm::dvec3, 4> t;
     for (int v = 0; v < count; ++v)
     {
       const uint32_t node = vertices[v] / interfaces;
-      const double t[3] = { mesh.topology[node][0], mesh.topology[node][1], double(vertices[v] % interfaces) };
-      for (int a = 0; a < 3; ++a)
-      {
-        low[a] = std::min(low[a], t[a]);
-        high[a] = std::max(high[a], t[a]);
-      }
+      t[v] = glm::dvec3(mesh.topology[node][0], mesh.topology[node][1], double(vertices[v] % interfaces));
     }
-    int offsetAxis = -1;
-    if (kind == 2 && count == 3)
-    {
-      std::array<glm::dvec3, 3> t;
-      for (int v = 0; v < 3; ++v)
-      {
-        const uint32_t node = vertices[v] / interfaces;
-        t[v] = glm::dvec3(mesh.topology[node][0], mesh.topology[node][1], double(vertices[v] % interfaces));
-      }
-      const glm::dvec3 n = glm::cross(t[1] - t[0], t[2] - t[0]);
-      offsetAxis = std::fabs(n.y) > std::fabs(n.x) ? 1 : 0;
-      offsetAxis = std::fabs(n.z) > std::fabs(n[offsetAxis]) ? 2 : offsetAxis;
-    }
+    const auto drawn = DrawnTriangles(t, count, kind);
     std::array<int64_t, 3> first{}, last{};
-    for (int a = 0; a < 3; ++a)
-    {
-      if (a == offsetAxis && high[a] - low[a] >= 1e-6)
-      {
-        first[a] = static_cast<int64_t>(std::floor(low[a] - 0.5));
-        last[a] = static_cast<int64_t>(std::floor(high[a] + 0.5));
-      }
-      else if (high[a] - low[a] < 1e-6)
-      {
-        // Constant coordinate: the cell below a top face, above a bottom face, either side
-        // of a side face.
-        const int64_t t = static_cast<int64_t>(std::llround(low[a]));
-        first[a] = (a == 2 && kind == 0) ? t : t - 1;
-        last[a] = (a == 2 && kind == 1) ? t - 1 : t;
-      }
-      else
-      {
-        first[a] = static_cast<int64_t>(std::floor(low[a]));
-        last[a] = static_cast<int64_t>(std::ceil(high[a])) - 1;
-      }
-      first[a] = std::max<int64_t>(first[a], 0);
-      last[a] = std::min<int64_t>(last[a], dims[a] - 1);
-    }
+    CellBox(t, count, drawn, dims, first, last);
     for (int64_t k = first[2]; k <= last[2]; ++k)
     {
       for (int64_t j = first[1]; j <= last[1]; ++j)
       {
         for (int64_t i = first[0]; i <= last[0]; ++i)
         {
-          const uint64_t n = static_cast<uint64_t>(i + dims[0] * (j + dims[1] * k));
-          bits[n >> 6].fetch_or(uint64_t(1) << (n & 63), std::memory_order_relaxed);
+          const glm::dvec3 cell{ double(i), double(j), double(k) };
+          const bool named = drawn.empty() || std::any_of(drawn.begin(), drawn.end(), [&](const auto& triangle) {
+            return TriangleMeetsCell(triangle[0], triangle[1], triangle[2], cell, 1e-6);
+          });
+          if (named)
+          {
+            const uint64_t n = static_cast<uint64_t>(i + dims[0] * (j + dims[1] * k));
+            bits[n >> 6].fetch_or(uint64_t(1) << (n & 63), std::memory_order_relaxed);
+          }
         }
       }
     }
