@@ -42,32 +42,8 @@ class BusyLoad:
         return False
 
 
-def drawn_frame(view):
-    """The view's last frame as drawn (no render): (height, width, 3) int64."""
-    from vtkmodules.util.numpy_support import vtk_to_numpy
-    from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
-    grab = vtkWindowToImageFilter()
-    grab.SetInput(view.GetRenderWindow())
-    grab.ShouldRerenderOff()
-    grab.ReadFrontBufferOff()
-    grab.Update()
-    image = grab.GetOutput()
-    width, height, _ = image.GetDimensions()
-    return vtk_to_numpy(image.GetPointData().GetScalars())[:, :3].astype(np.int64).reshape(height, width, 3)
-
-
-def save_png(pixels, path):
-    from vtkmodules.util.numpy_support import numpy_to_vtk
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.vtkIOImage import vtkPNGWriter
-    height, width, _ = pixels.shape
-    image = vtkImageData()
-    image.SetDimensions(width, height, 1)
-    image.GetPointData().SetScalars(numpy_to_vtk(pixels.reshape(-1, 3).astype(np.uint8), deep=1))
-    writer = vtkPNGWriter()
-    writer.SetFileName(path)
-    writer.SetInputData(image)
-    writer.Write()
+drawn_frame = resmr_testing.drawn_pixels
+save_png = resmr_testing.save_png
 
 
 def side_by_side(left, right, path):

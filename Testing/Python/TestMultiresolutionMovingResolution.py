@@ -19,8 +19,6 @@ import os
 
 import numpy as np
 from paraview import simple
-from vtkmodules.util.numpy_support import vtk_to_numpy
-from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
 
 import resmr_testing as rt
 
@@ -38,32 +36,11 @@ def check(condition, message):
         failures.append(message)
 
 
-def drawn_pixels(view):
-    """The view's last frame as drawn, without rendering it again: (height, width, 3)."""
-    grab = vtkWindowToImageFilter()
-    grab.SetInput(view.GetRenderWindow())
-    grab.ShouldRerenderOff()
-    grab.ReadFrontBufferOff()
-    grab.Update()
-    image = grab.GetOutput()
-    width, height, _ = image.GetDimensions()
-    pixels = vtk_to_numpy(image.GetPointData().GetScalars())[:, :3].astype(np.int64)
-    return pixels.reshape(height, width, 3)
+drawn_pixels = rt.drawn_pixels
 
 
 def save(pixels, name):
-    from vtkmodules.vtkIOImage import vtkPNGWriter
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.util.numpy_support import numpy_to_vtk
-    height, width, _ = pixels.shape
-    image = vtkImageData()
-    image.SetDimensions(width, height, 1)
-    array = numpy_to_vtk(pixels.reshape(-1, 3).astype(np.uint8), deep=1)
-    image.GetPointData().SetScalars(array)
-    writer = vtkPNGWriter()
-    writer.SetFileName(os.path.join(temp, name))
-    writer.SetInputData(image)
-    writer.Write()
+    rt.save_png(pixels, os.path.join(temp, name))
 
 
 def scale_of(display):

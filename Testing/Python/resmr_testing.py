@@ -150,6 +150,36 @@ def capture_rgb(view, path, width, height):
     return pixels.reshape(height, width, 3)
 
 
+def drawn_pixels(view):
+    """The view's last frame as drawn, without rendering it again: (height, width, 3) int64."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
+    grab = vtkWindowToImageFilter()
+    grab.SetInput(view.GetRenderWindow())
+    grab.ShouldRerenderOff()
+    grab.ReadFrontBufferOff()
+    grab.Update()
+    image = grab.GetOutput()
+    width, height, _ = image.GetDimensions()
+    pixels = vtk_to_numpy(image.GetPointData().GetScalars())[:, :3].astype(np.int64)
+    return pixels.reshape(height, width, 3)
+
+
+def save_png(pixels, path):
+    """Writes (height, width, 3) pixels (0-255) as a PNG."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOImage import vtkPNGWriter
+    height, width, _ = pixels.shape
+    image = vtkImageData()
+    image.SetDimensions(width, height, 1)
+    image.GetPointData().SetScalars(numpy_to_vtk(pixels.reshape(-1, 3).astype(np.uint8), deep=1))
+    writer = vtkPNGWriter()
+    writer.SetFileName(path)
+    writer.SetInputData(image)
+    writer.Write()
+
+
 def cell_ids(pixels):
     """The cell-id colouring decoded: 0 for background, else 1 + i + nx (j + ny k)."""
     return pixels[..., 0] + 256 * pixels[..., 1] + 65536 * pixels[..., 2]
