@@ -321,7 +321,8 @@ void PropertyFile::CheckGeometry(const MultiresolutionFile& geometry) const
     geometry.Header().hashTableSides != this->TableSides)
   {
     throw FileFormatError(this->FilePath + ": made for another geometry than " + geometry.Path() +
-      " (geometry id or grid differs): rebuild it with resmr add-properties");
+      " (geometry id or grid differs; was the .resmr built again?): write its properties anew with resmr "
+      "add-properties, to another file (-o) or after removing this one");
   }
 }
 

@@ -498,6 +498,12 @@ bool TriangleMeetsCell(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, const glm::dvec
   return true;
 }
 
+/// How far (cells) past a drawn triangle a fragment's interpolated cell coordinate may land: the
+/// GPU interpolates it in single precision (half a thousandth of a cell apart at coordinates
+/// near 4,096), so a fragment on a triangle's edge along a cell boundary can name the cell
+/// beyond it, which must be hashed too (else a pixel in the NaN colour, or in another cell's).
+constexpr double NamingMargin = 0.001;
+
 /// The triangles a face is drawn as, each moved as the view moves its cell coordinate
 /// (RegionCache): a top quad half a cell down into its cell (k + 0.5), a bottom one half a cell
 /// up, both split q0-q1-q2, q0-q2-q3; a side triangle half a cell along its topological
@@ -555,9 +561,8 @@ void CellBox(const std::array<glm::dvec3, 4>& t, int count, const std::vector<st
     }
     else
     {
-      first[a] = static_cast<int64_t>(std::floor(low + 1e-9));
-      last[a] = static_cast<int64_t>(std::ceil(high - 1e-9)) - 1;
-      last[a] = std::max(last[a], first[a]);
+      first[a] = static_cast<int64_t>(std::floor(low - NamingMargin));
+      last[a] = static_cast<int64_t>(std::floor(high + NamingMargin));
     }
     first[a] = std::max<int64_t>(first[a], 0);
     last[a] = std::min<int64_t>(last[a], dims[a] - 1);
@@ -591,7 +596,7 @@ void MarkTouchedCells(
         {
           const glm::dvec3 cell{ double(i), double(j), double(k) };
           const bool named = drawn.empty() || std::any_of(drawn.begin(), drawn.end(), [&](const auto& triangle) {
-            return TriangleMeetsCell(triangle[0], triangle[1], triangle[2], cell, 1e-6);
+            return TriangleMeetsCell(triangle[0], triangle[1], triangle[2], cell, NamingMargin);
           });
           if (named)
           {
