@@ -294,8 +294,9 @@ def write_report(results):
         import matplotlib.pyplot as plt
         figure, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
         for e in results["models"]:
-            axes[0].plot([1000 * f["seconds"] for f in e["frames"]], label=e["model"])
-            axes[1].plot([f["tolerance"] for f in e["frames"]], label=e["model"])
+            label = e["model"] + ("" if e.get("load", "idle") == "idle" else f" ({e['load']})")
+            axes[0].plot([1000 * f["seconds"] for f in e["frames"]], label=label)
+            axes[1].plot([f["tolerance"] for f in e["frames"]], label=label)
         axes[0].axhline(1000 / results['fps_target'], color="k", linestyle="--", linewidth=0.8)
         axes[0].set_ylabel("frame ms")
         axes[1].set_ylabel("tolerance px")
