@@ -36,6 +36,8 @@ const char* BuildUsage =
   "                and diamond it recorded)\n"
   "  --fresh       ignore a killed build's scratch folder and start over\n"
   "  --no-disk-check  start even when the disks hold less free space than the build needs\n"
+  "  --keep-faults    keep every fault's columns at every level: no see-through gap where faults\n"
+  "                   bend or meet at coarse levels, for larger coarse regions\n"
   "  Prints a progress bar on stderr and a JSON report on stdout.\n";
 
 int64_t ParseSize(const std::string& text)
@@ -129,6 +131,10 @@ int BuildCommand(int argc, char** argv)
       else if (arg == "--fresh")
       {
         options.resume = false;
+      }
+      else if (arg == "--keep-faults")
+      {
+        options.keepFaults = true;
       }
       else if (arg == "--no-disk-check")
       {

@@ -750,6 +750,13 @@ void LockFaultColumns(ColumnMesh& mesh)
   }
 }
 
+/// The seed as a resumed build must match it: with --keep-faults folded in, so a build is never
+/// resumed under the other choice (the manifest of a default build is unchanged).
+uint64_t ResumeSeed(const HierarchyOptions& options)
+{
+  return options.seed ^ (options.keepFaults ? GoldenGamma : 0);
+}
+
 class Builder
 {
 public:
@@ -1036,7 +1043,7 @@ void Builder::WriteBuildManifest(const MultiresolutionHeader& header, const Hier
   out.PutString(this->Source.Name());
   out.Put(this->Source.Dims());
   out.Put(this->Options.cmax);
-  out.Put(this->Options.seed);
+  out.Put(ResumeSeed(this->Options));
   out.Put(static_cast<int32_t>(this->Options.ranks));
   out.Put(header.dims);
   out.Put(header.box);
@@ -1068,7 +1075,7 @@ bool Builder::ReadBuildManifest(MultiresolutionHeader& header, HierarchyReport& 
   {
     if (in.Get<uint64_t>() != BuildManifestMagic || in.GetString() != this->Source.Name() ||
       in.Get<std::array<int64_t, 3>>() != this->Source.Dims() || in.Get<int64_t>() != this->Options.cmax ||
-      in.Get<uint64_t>() != this->Options.seed || in.Get<int32_t>() != this->Options.ranks)
+      in.Get<uint64_t>() != ResumeSeed(this->Options) || in.Get<int32_t>() != this->Options.ranks)
     {
       return false;
     }
@@ -1338,7 +1345,10 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond, std::vector
   int64_t inputColumns = 0;
   ColumnMesh mesh = MergeRegions(children, childCut, openSides, inputColumns);
   LockCutColumns(mesh, childCut);
-  LockFaultColumns(mesh);
+  if (this->Options.keepFaults)
+  {
+    LockFaultColumns(mesh);
+  }
   const int triangles = diamond.second >= 0 ? 2 : 1;
   const int64_t target = std::min<int64_t>(this->Options.cmax * triangles, (inputColumns + 1) / 2);
   if (mesh.AliveColumns() > target)
