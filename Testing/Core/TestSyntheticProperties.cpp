@@ -199,7 +199,7 @@ int main(int argc, char** argv)
   // and one a pass.
   const std::string geometryPath = temp + "/synth.resmr";
   const std::string fromFiles = temp + "/files.resmrp", fromSpec = temp + "/spec.resmrp";
-  CHECK(CompareWithFiles(resmrTool, temp, 80, 60, 20, 2, 1) >= 2);
+  CHECK(CompareWithFiles(resmrTool, temp, 160, 120, 10, 2, 1) >= 2);
   CHECK(CompareWithFiles(resmrTool, temp, 40, 30, 5, 7, 3) >= 1);
 
   // Again without steps into the same file: the INIT's tables replaced, the steps kept.
