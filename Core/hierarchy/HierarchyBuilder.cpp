@@ -509,14 +509,25 @@ constexpr double NamingMargin = 0.001;
 /// up, both split q0-q1-q2, q0-q2-q3; a side triangle half a cell along its topological
 /// normal's largest axis, either way (the side depends on the file's handedness). Empty for a
 /// side quad, the exact unit face, whose box is already exact.
-std::vector<std::array<glm::dvec3, 3>> DrawnTriangles(const std::array<glm::dvec3, 4>& t, int count, int kind)
+/// At most two drawn triangles of one face, without a heap allocation a face.
+struct Drawn
 {
-  std::vector<std::array<glm::dvec3, 3>> out;
+  std::array<std::array<glm::dvec3, 3>, 2> triangles;
+  int count = 0;
+  const std::array<glm::dvec3, 3>* begin() const { return this->triangles.data(); }
+  const std::array<glm::dvec3, 3>* end() const { return this->triangles.data() + this->count; }
+  bool empty() const { return this->count == 0; }
+};
+
+Drawn DrawnTriangles(const std::array<glm::dvec3, 4>& t, int count, int kind)
+{
+  Drawn out;
   if (kind < 2)
   {
     const glm::dvec3 shift(0, 0, kind == 0 ? 0.5 : -0.5);
-    out.push_back({ t[0] + shift, t[1] + shift, t[2] + shift });
-    out.push_back({ t[0] + shift, t[2] + shift, t[3] + shift });
+    out.triangles[0] = { t[0] + shift, t[1] + shift, t[2] + shift };
+    out.triangles[1] = { t[0] + shift, t[2] + shift, t[3] + shift };
+    out.count = 2;
   }
   else if (count == 3)
   {
@@ -525,16 +536,17 @@ std::vector<std::array<glm::dvec3, 3>> DrawnTriangles(const std::array<glm::dvec
     axis = std::fabs(n.z) > std::fabs(n[axis]) ? 2 : axis;
     glm::dvec3 shift(0.0);
     shift[axis] = 0.5;
-    out.push_back({ t[0] + shift, t[1] + shift, t[2] + shift });
-    out.push_back({ t[0] - shift, t[1] - shift, t[2] - shift });
+    out.triangles[0] = { t[0] + shift, t[1] + shift, t[2] + shift };
+    out.triangles[1] = { t[0] - shift, t[1] - shift, t[2] - shift };
+    out.count = 2;
   }
   return out;
 }
 
 /// The box of cells a face may name: every cell its drawn triangles' box reaches, on the
 /// inner side of a top or bottom face and on both sides of a side quad.
-void CellBox(const std::array<glm::dvec3, 4>& t, int count, const std::vector<std::array<glm::dvec3, 3>>& drawn,
-  const std::array<int64_t, 3>& dims, std::array<int64_t, 3>& first, std::array<int64_t, 3>& last)
+void CellBox(const std::array<glm::dvec3, 4>& t, int count, const Drawn& drawn, const std::array<int64_t, 3>& dims,
+  std::array<int64_t, 3>& first, std::array<int64_t, 3>& last)
 {
   for (int a = 0; a < 3; ++a)
   {
