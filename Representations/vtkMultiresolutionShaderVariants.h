@@ -23,8 +23,9 @@ public:
     bool logScale = false;
     bool gridLines = false;
     bool specular = false;
-    int lighting = 0;   ///< vtkOpenGLRenderer's lighting complexity (0: unlit)
-    int lightCount = 0; ///< the renderer's lights switched on
+    bool tableNormals = false; ///< tops and bottoms only, lit by the normal table
+    int lighting = 0;          ///< vtkOpenGLRenderer's lighting complexity (0: unlit)
+    int lightCount = 0;        ///< the renderer's lights switched on
   };
 
   /// The fragment shader's source for `painting`: its switches defined after the version line

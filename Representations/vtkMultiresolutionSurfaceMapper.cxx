@@ -29,6 +29,7 @@
 #include "vtkOpenGLError.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLRenderer.h"
+#include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
 #include "vtkPolyData.h"
 #include "vtkProperty.h"
@@ -223,6 +224,7 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   std::size_t tableBytes = 0; ///< copied for the model's tables this frame
   vtkShaderProgram* program = nullptr;
   int colorMode = SolidColor;
+  bool lit = false; ///< the last program readied lights the surface
 };
 
 vtkMultiresolutionSurfaceMapper::vtkMultiresolutionSurfaceMapper()
@@ -627,7 +629,7 @@ void vtkMultiresolutionSurfaceMapper::SelectRegions(Frame& frame)
   in.HavePreviousView = true;
 }
 
-vtkShaderProgram* vtkMultiresolutionSurfaceMapper::ReadyProgram(Frame& frame, int colorMode)
+vtkShaderProgram* vtkMultiresolutionSurfaceMapper::ReadyProgram(Frame& frame, int colorMode, bool tableNormals)
 {
   Internals& in = *this->Internal;
   vtkScalarsToColors* table = this->GetLookupTable();
@@ -643,6 +645,8 @@ vtkShaderProgram* vtkMultiresolutionSurfaceMapper::ReadyProgram(Frame& frame, in
   painting.lightCount = painting.lighting > 0 ? lights->GetLightingCount() : 0;
   painting.lighting = painting.lightCount > 0 ? painting.lighting : 0;
   painting.specular = painting.lighting > 0 && look->GetSpecular() > 0;
+  painting.tableNormals = tableNormals;
+  frame.lit = painting.lighting > 0;
   vtkShaderProgram* ready =
     in.Shaders.Ready(frame.window, painting, painting.lighting > 0 ? lights->GetLightingUniforms() : nullptr);
   if (ready && painting.lighting > 0)
@@ -764,7 +768,6 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
   Internals& in = *this->Internal;
   vtkOpenGLState* state = frame.window->GetState();
   in.Timer.Begin();
-  this->SetUniforms(frame);
   state->vtkglEnable(GL_DEPTH_TEST);
   state->vtkglDepthMask(GL_TRUE);
   // Back faces of the closed surface, hidden from outside, are culled (the bottom seen from
@@ -782,17 +785,21 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
   }
   state->vtkglDisable(GL_BLEND);
 
-  for (const resmr::DrawnRegion& drawn : frame.selection.drawn)
+  // Lit tops and bottoms take their normals from the table, once it is loaded: they are
+  // drawn first with a program that computes no facet normal, then the sides with one that
+  // does; otherwise one program draws every face.
+  if (frame.lit && frame.colorMode != CellIdColors && frame.layer < 0 && in.Tables.NormalsReady())
   {
-    const resmr::RegionDrawBuffers* buffers = in.Regions.Prepare(drawn.region, *in.Cache, frame.program);
-    if (!buffers || buffers->indices.empty())
-    {
-      continue;
-    }
-    const std::array<resmr::DrawPart, 3> parts =
-      resmr::PartsToDraw(*buffers, drawn, frame.layer >= 0, in.File->Regions()[drawn.region], frame.view);
-    in.Triangles += static_cast<vtkIdType>(in.Regions.Draw(drawn.region, parts, frame.program));
-    ++in.Drawn;
+    vtkShaderProgram* sides = frame.program;
+    frame.program = this->ReadyProgram(frame, frame.colorMode, true);
+    in.Drawn = this->DrawFaces(frame, { true, true, false });
+    frame.program = sides;
+    frame.window->GetShaderCache()->ReadyShaderProgram(sides); // binds it again
+    this->DrawFaces(frame, { false, false, true });
+  }
+  else
+  {
+    in.Drawn = this->DrawFaces(frame, { true, true, true });
   }
 
   glFrontFace(GL_CCW);
@@ -801,6 +808,34 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
   in.Tables.Unbind();
   in.Timer.End();
   vtkOpenGLCheckErrorMacro("after drawing the multiresolution surface");
+}
+
+int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bool, 3>& kinds)
+{
+  Internals& in = *this->Internal;
+  if (!frame.program)
+  {
+    return 0;
+  }
+  this->SetUniforms(frame);
+  int regions = 0;
+  for (const resmr::DrawnRegion& drawn : frame.selection.drawn)
+  {
+    const resmr::RegionDrawBuffers* buffers = in.Regions.Prepare(drawn.region, *in.Cache, frame.program);
+    if (!buffers || buffers->indices.empty())
+    {
+      continue;
+    }
+    std::array<resmr::DrawPart, 3> parts =
+      resmr::PartsToDraw(*buffers, drawn, frame.layer >= 0, in.File->Regions()[drawn.region], frame.view);
+    for (resmr::DrawPart& part : parts)
+    {
+      part.shown = part.shown && kinds[static_cast<std::size_t>(part.kind)];
+    }
+    in.Triangles += static_cast<vtkIdType>(in.Regions.Draw(drawn.region, parts, frame.program));
+    ++regions;
+  }
+  return regions;
 }
 
 void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)

@@ -174,11 +174,14 @@ private:
   void ChooseTolerance(bool moving);
   /// Selects, asks the loader for what is missing, and waits where the frame must.
   void SelectRegions(Frame& frame);
-  vtkShaderProgram* ReadyProgram(Frame& frame, int colorMode);
+  vtkShaderProgram* ReadyProgram(Frame& frame, int colorMode, bool tableNormals = false);
   void StreamTables(Frame& frame);
   void UploadMeshes(Frame& frame);
   void SetUniforms(Frame& frame);
   void DrawRegions(Frame& frame);
+  /// Draws the selected regions' faces of the kinds flagged (top, bottom, side) with the
+  /// frame's program; the regions drawn.
+  int DrawFaces(Frame& frame, const std::array<bool, 3>& kinds);
   /// Loads pending, errors, readout and the frame-rate controller.
   void FinishFrame(Frame& frame);
 };

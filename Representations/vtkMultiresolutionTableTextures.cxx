@@ -316,7 +316,6 @@ void vtkMultiresolutionTableTextures::Bind(vtkShaderProgram* program, const resm
   const std::array<uint32_t, 3> one{ 1, 1, 1 };
   uniform3i("tableSides", this->HashUploaded ? header.hashTableSides : one);
   uniform3i("offsetSides", this->HashUploaded ? header.hashOffsetSides : one);
-  program->SetUniformi("cellTables", this->NormalsUploaded ? 1 : 0);
   this->OffsetTexture->Activate();
   program->SetUniformi("hashOffsets", this->OffsetTexture->GetTextureUnit());
   this->NormalTexture->Activate();

@@ -57,6 +57,8 @@ public:
 
   /// The hash's offsets are complete on the GPU (cell lookups can be drawn).
   bool HashReady() const { return this->HashUploaded; }
+  /// The top and bottom normal table is complete on the GPU (after the hash and property).
+  bool NormalsReady() const { return this->NormalsUploaded; }
   /// The property table on the GPU (null: none yet).
   const std::shared_ptr<const resmr::PropertyTableData>& UploadedProperty() const { return this->Uploaded; }
   /// A table is still being streamed.

@@ -14,7 +14,8 @@
 //
 // The mapper compiles one variant per painting mode, with these defined (0 or 1):
 // COLOR_MODE (0: solid colour, 1: property, 2: cell id), LAYER_VIEW (one layer drawn),
-// LOG_SCALE, GRID_LINES, SPECULAR, and LIGHTING (0: unlit, 1: headlight, 2: directional
+// LOG_SCALE, GRID_LINES, SPECULAR, TABLE_NORMALS (tops and bottoms lit by the normal
+// table), and LIGHTING (0: unlit, 1: headlight, 2: directional
 // lights, 3: positional lights, as vtkOpenGLRenderer's lighting complexity), with the
 // renderer's light uniforms declared and one call a light generated at //RESMR::Lights.
 // A software rasterizer (llvmpipe) runs both sides of every branch on a uniform, masked;
@@ -31,7 +32,6 @@ uniform ivec3 offsetSides; // r
 uniform usampler3D hashOffsets;  // r0 x r1 x r2, RGB16UI
 uniform usampler3D cellNormals;  // m0 x m1 x m2, RG16UI (top, bottom)
 uniform sampler3D propertyTable; // m0 x m1 x m2, R32F
-uniform int cellTables;          // 0 until the normal table is loaded (after the hash and property)
 uniform int layer;               // -1: the whole model; else the one layer drawn (0-based)
 uniform sampler2D layerProperty; // nx x ny, R32F: that layer's table
 uniform sampler2D colorMap;      // N x 1, RGBA8
@@ -166,21 +166,20 @@ void main()
   }
 #endif
 
-  // Normal (view space): the original cell's top or bottom face normal (Sec. 5.3), the
-  // facet's own for sides, turned to face the eye (two-sided, as VTK lights a surface whose
-  // back may show). A layer's cells are mostly inside the model, and the normal table is
-  // hashed for the external faces' cells only: a layer lights every face by its geometric
-  // normal, per pixel.
-  vec3 facet = normalize(cross(dFdx(viewPosition), dFdy(viewPosition)));
-  facet = (cameraParallel == 1 ? facet.z < 0.0 : dot(facet, viewPosition) > 0.0) ? -facet : facet;
-  vec3 normal = facet;
-#if !LAYER_VIEW
-  if (faceKind < 2 && cellTables == 1)
-  {
-    uvec2 codes = texelFetch(cellNormals, slot, 0).xy;
-    normal = normalize(normalToView * DecodeNormal(faceKind == 0 ? codes.x : codes.y));
-    normal = dot(normal, facet) < 0.0 ? -normal : normal;
-  }
+  // Normal (view space), turned to face the eye (two-sided, as VTK lights a surface whose
+  // back may show): on tops and bottoms once the normal table is loaded, the original cell's
+  // top or bottom face normal (Sec. 5.3); elsewhere the facet's own, per pixel. A layer's
+  // cells are mostly inside the model, and the normal table is hashed for the external
+  // faces' cells only: a layer lights every face by its facet.
+#if TABLE_NORMALS
+  // Drawn apart from the sides: the facet's screen derivatives are a large share of a
+  // software rasterizer's fragment, and a table normal needs none.
+  uvec2 codes = texelFetch(cellNormals, slot, 0).xy;
+  vec3 normal = normalize(normalToView * DecodeNormal(faceKind == 0 ? codes.x : codes.y));
+  normal = (cameraParallel == 1 ? normal.z < 0.0 : dot(normal, viewPosition) > 0.0) ? -normal : normal;
+#else
+  vec3 normal = normalize(cross(dFdx(viewPosition), dFdy(viewPosition)));
+  normal = (cameraParallel == 1 ? normal.z < 0.0 : dot(normal, viewPosition) > 0.0) ? -normal : normal;
 #endif
 #if COLOR_MODE == 1
   vec3 ambientPart = ambientIntensity * color; // a property's colour is ambient and diffuse
