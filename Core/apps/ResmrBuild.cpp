@@ -36,8 +36,9 @@ const char* BuildUsage =
   "                and diamond it recorded)\n"
   "  --fresh       ignore a killed build's scratch folder and start over\n"
   "  --no-disk-check  start even when the disks hold less free space than the build needs\n"
-  "  --keep-faults    keep every fault's columns at every level: no see-through gap where faults\n"
-  "                   bend or meet at coarse levels, for larger coarse regions\n"
+  "  --simplify-faults  simplify each fault block's outline on its own at every level (by\n"
+  "                   default the faults' columns are kept at every level where they fit the\n"
+  "                   region's column budget, so no gap opens where faults bend or meet)\n"
   "  Prints a progress bar on stderr and a JSON report on stdout.\n";
 
 int64_t ParseSize(const std::string& text)
@@ -132,9 +133,9 @@ int BuildCommand(int argc, char** argv)
       {
         options.resume = false;
       }
-      else if (arg == "--keep-faults")
+      else if (arg == "--keep-faults" || arg == "--simplify-faults")
       {
-        options.keepFaults = true;
+        options.keepFaults = arg == "--keep-faults"; // --keep-faults: the default, still accepted
       }
       else if (arg == "--no-disk-check")
       {

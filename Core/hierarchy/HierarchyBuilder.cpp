@@ -226,6 +226,47 @@ int32_t Across(const ColumnMesh& mesh, int32_t column, int e)
   return -1;
 }
 
+/// The columns across the model's faults (ours, not the paper's): a boundary edge whose two
+/// pillars, as topological coordinates, another boundary edge of the mesh runs between the
+/// other way round is the other side of a fault. Regions are cut along column edges, and
+/// where a cut follows a fault its two sides land in different regions: the edge must be
+/// cut there (locked, as every edge between regions) or each region simplifies its side of
+/// the fault on its own and the two part.
+class FaultSides
+{
+public:
+  explicit FaultSides(const ColumnMesh& mesh)
+  {
+    for (int32_t c = 0; c < mesh.ColumnSlots(); ++c)
+    {
+      for (int e = 0; mesh.IsColumnAlive(c) && e < 4; ++e)
+      {
+        if (mesh.IsBoundaryEdge(c, e))
+        {
+          this->Edges.emplace(Key(mesh, c, e, false), c);
+        }
+      }
+    }
+  }
+
+  /// The column across the fault from edge e of `column`, or -1 (no fault there).
+  int32_t Across(const ColumnMesh& mesh, int32_t column, int e) const
+  {
+    const auto found = this->Edges.find(Key(mesh, column, e, true));
+    return found == this->Edges.end() || found->second == column ? -1 : found->second;
+  }
+
+private:
+  static std::array<double, 4> Key(const ColumnMesh& mesh, int32_t column, int e, bool reversed)
+  {
+    const auto& q = mesh.ColumnCorners(column);
+    const auto& a = mesh.TopologicalCoordinate(q[reversed ? (e + 1) % 4 : e]);
+    const auto& b = mesh.TopologicalCoordinate(q[reversed ? e : (e + 1) % 4]);
+    return { a[0], a[1], b[0], b[1] };
+  }
+  std::map<std::array<double, 4>, int32_t> Edges;
+};
+
 /// Open sides of every alive column's cells, from the columns across; edges flagged in `cut`
 /// (one mask a column slot) keep the flags in `openSides` (one byte a cell slot), since the
 /// cells across them lie in another region.
@@ -344,9 +385,12 @@ double QuadricDistance(const ColumnMeshData& mesh)
 /// triangles, the batch size at which GPUs reach full speed, while a diamond's merged mesh
 /// stays a few hundred MB for 100 layers), but at most a 32nd of the model's columns (and at
 /// least 256), so that small models get five or more levels, not a single one.
+/// Columns of a full-size region: the default cmax of models of 131,072 columns or more.
+constexpr int64_t FullRegionColumns = 4096;
+
 int64_t AutomaticCmax(int64_t columns)
 {
-  return std::max<int64_t>(256, std::min<int64_t>(4096, columns / 32));
+  return std::max<int64_t>(256, std::min<int64_t>(FullRegionColumns, columns / 32));
 }
 
 /// Runs task(i) for i in [0, count) on `threads` threads; rethrows the first failure.
@@ -701,17 +745,19 @@ ColumnMesh MergeRegions(const std::vector<ScratchRegion>& children, std::vector<
   return ColumnMesh::FromData(std::move(merged));
 }
 
-/// Cut edges stay cut only where the merged mesh has no column across; their nodes border
-/// another diamond and must not move, so every column touching one is locked.
+/// Cut edges stay cut only where the merged mesh has no column across, on either side of a
+/// fault; their nodes border another diamond and must not move, so every column touching one
+/// is locked.
 void LockCutColumns(ColumnMesh& mesh, std::vector<uint8_t>& childCut)
 {
   const int32_t slots = mesh.ColumnSlots();
+  const FaultSides faults(mesh);
   std::vector<uint8_t> external(static_cast<std::size_t>(mesh.NodeCount()), 0);
   for (int32_t c = 0; c < slots; ++c)
   {
     for (int e = 0; e < 4; ++e)
     {
-      if ((childCut[c] & (1u << e)) && !mesh.IsBoundaryEdge(c, e))
+      if ((childCut[c] & (1u << e)) && (!mesh.IsBoundaryEdge(c, e) || faults.Across(mesh, c, e) >= 0))
       {
         childCut[c] &= static_cast<uint8_t>(~(1u << e));
       }
@@ -732,15 +778,20 @@ void LockCutColumns(ColumnMesh& mesh, std::vector<uint8_t>& childCut)
   }
 }
 
-/// Locks every column touching a fault node (ours, not the paper's): a boundary node whose
-/// topological coordinate another node of the mesh shares, the two sides of a fault at one
-/// pillar. The column collapse simplifies each fault block's outline on its own, so the two
-/// traces of a fault that bends (a staircase across I and J, a junction of faults) parted and
-/// opened a gap one sees through. Kept whole, the columns on both sides keep the original
-/// trace and their cells at every level, and the blocks meet as they do in the grid. (Pinning
-/// the fault nodes alone, letting the columns beside them collapse into them, still left
-/// gaps.)
-void LockFaultColumns(ColumnMesh& mesh)
+/// Locks every column touching a fault node (ours, not the paper's), when they fit: a fault
+/// node is a boundary node whose topological coordinate another node of the mesh shares, the
+/// two sides of a fault at one pillar. The column collapse simplifies each fault block's
+/// outline on its own, so the two traces of a fault that bends (a staircase across I and J, a
+/// junction of faults) part and open a gap one sees through. Kept whole, the columns on both
+/// sides keep the original trace and their cells, and the blocks meet as they do in the
+/// grid. (Pinning the fault nodes alone, letting the columns beside them collapse into them,
+/// kept as many columns and still left gaps.) The faults' columns are kept only while they
+/// and the columns locked already number no more than `limit`, a full-size region's columns
+/// a triangle of the diamond: regions stay within the size memory budgets plan for (though a
+/// level may then not halve the one below, and a small model's regions grow past its small
+/// cmax), and where the faults are longer than that (the coarsest levels of a large model)
+/// they are simplified as before. Returns whether they were locked.
+bool LockFaultColumns(ColumnMesh& mesh, int64_t limit)
 {
   std::map<std::array<double, 2>, int> sharing;
   for (int32_t node = 0; node < mesh.NodeCount(); ++node)
@@ -750,23 +801,41 @@ void LockFaultColumns(ColumnMesh& mesh)
       ++sharing[mesh.TopologicalCoordinate(node)];
     }
   }
+  std::vector<uint8_t> lock(static_cast<std::size_t>(mesh.ColumnSlots()), 0);
   for (int32_t node = 0; node < mesh.NodeCount(); ++node)
   {
     if (mesh.IsNodeAlive(node) && mesh.IsBoundaryNode(node) && sharing[mesh.TopologicalCoordinate(node)] > 1)
     {
       for (const int32_t column : mesh.NodeColumns(node))
       {
-        mesh.SetLocked(column, true);
+        lock[column] = 1;
       }
     }
   }
+  int64_t kept = 0;
+  for (int32_t c = 0; c < mesh.ColumnSlots(); ++c)
+  {
+    kept += mesh.IsColumnAlive(c) && (lock[c] || mesh.IsLocked(c));
+  }
+  if (kept > limit)
+  {
+    return false;
+  }
+  for (int32_t c = 0; c < mesh.ColumnSlots(); ++c)
+  {
+    if (lock[c])
+    {
+      mesh.SetLocked(c, true);
+    }
+  }
+  return true;
 }
 
-/// The seed as a resumed build must match it: with --keep-faults folded in, so a build is never
-/// resumed under the other choice (the manifest of a default build is unchanged).
+/// The seed as a resumed build must match it: with --simplify-faults folded in, so a build is
+/// never resumed under the other choice.
 uint64_t ResumeSeed(const HierarchyOptions& options)
 {
-  return options.seed ^ (options.keepFaults ? GoldenGamma : 0);
+  return options.seed ^ (options.keepFaults ? 0 : GoldenGamma);
 }
 
 class Builder
@@ -1222,6 +1291,7 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns, std::
   std::vector<uint8_t> openSides;
   UpdateOpenSides(halo, std::vector<uint8_t>(static_cast<std::size_t>(halo.ColumnSlots()), 0), openSides);
   region.openSides = KeptCells(openSides, keep, static_cast<std::size_t>(nz));
+  const FaultSides faults(halo);
   for (int32_t c = 0; c < halo.ColumnSlots(); ++c)
   {
     if (!keep[c])
@@ -1231,7 +1301,8 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns, std::
     uint8_t cut = 0;
     for (int e = 0; e < 4; ++e)
     {
-      const int32_t other = Across(halo, c, e);
+      int32_t other = Across(halo, c, e);
+      other = other >= 0 ? other : faults.Across(halo, c, e);
       if (other >= 0 && !keep[other])
       {
         cut |= static_cast<uint8_t>(1u << e);
@@ -1306,6 +1377,7 @@ void Builder::SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const Colum
     }
     side[c] = this->Tree.OnFirstSide(diamond, x, y) ? 1 : 2;
   }
+  const FaultSides faults(mesh);
   for (int which = 1; which <= triangles; ++which)
   {
     std::vector<uint8_t> keep(static_cast<std::size_t>(slots), 0);
@@ -1333,7 +1405,8 @@ void Builder::SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const Colum
       uint8_t cut = mesh.IsLocked(c) ? childCut[c] : 0;
       for (int e = 0; e < 4; ++e)
       {
-        const int32_t other = Across(mesh, c, e);
+        int32_t other = Across(mesh, c, e);
+        other = other >= 0 ? other : faults.Across(mesh, c, e);
         if (other >= 0 && side[other] != which)
         {
           cut |= static_cast<uint8_t>(1u << e);
@@ -1357,12 +1430,12 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond, std::vector
   int64_t inputColumns = 0;
   ColumnMesh mesh = MergeRegions(children, childCut, openSides, inputColumns);
   LockCutColumns(mesh, childCut);
-  if (this->Options.keepFaults)
-  {
-    LockFaultColumns(mesh);
-  }
   const int triangles = diamond.second >= 0 ? 2 : 1;
   const int64_t target = std::min<int64_t>(this->Options.cmax * triangles, (inputColumns + 1) / 2);
+  if (this->Options.keepFaults)
+  {
+    LockFaultColumns(mesh, std::max(this->Options.cmax, FullRegionColumns) * triangles);
+  }
   if (mesh.AliveColumns() > target)
   {
     ColumnCollapse collapse(mesh,

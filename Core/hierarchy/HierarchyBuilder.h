@@ -60,11 +60,12 @@ struct HierarchyOptions
   /// Refuse to start when the disks of the scratch folder and the output have less free
   /// space than the build needs (see BuildDiskNeed).
   bool checkDisk = true;
-  /// Keep every fault's columns whole at every level (LockFaultColumns): coarse levels then
-  /// have no gap where faults bend or meet, but their regions, the roots first, hold every
-  /// fault's columns (on the 10M model the roots grew to 40 MB, past a 128 MB budget's loader
-  /// share). Off by default until the coarsest levels can keep the traces for less.
-  bool keepFaults = false;
+  /// Keep the faults' columns whole (LockFaultColumns) at every level where they fit the
+  /// diamond's column target: no gap where faults bend or meet there. Where they do not (the
+  /// coarsest levels of a large model) the faults are simplified block by block, and gaps up to
+  /// that level's error may open. false: simplified at every level (smaller coarse levels
+  /// only where the faults fit anyway).
+  bool keepFaults = true;
   /// MPI (through ParaView's controller, vtkBuildMultiresolutionHierarchy): this process's
   /// rank among `ranks`, which share the scratch folder and split the leaves and each
   /// level's diamonds. `barrier` must return once every rank has called it (required when
