@@ -28,7 +28,8 @@ parser.add_argument("--resmr", required=True)
 parser.add_argument("--scratch", required=True)
 parser.add_argument("--model", default="400x300x25")
 parser.add_argument("--tolerances", type=float, nargs="+", default=[1, 4, 16, 32, 64, 128, 256, 65536])
-parser.add_argument("--keep-faults", action="store_true", help="build with resmr build --keep-faults")
+parser.add_argument("--simplify-faults", action="store_true",
+                    help="build with resmr build --simplify-faults (each fault block's outline simplified on its own)")
 parser.add_argument("--out", default=os.path.join(HERE, "results", "tolerance_quality"))
 args = parser.parse_args()
 WIDTH, HEIGHT = 1280, 720
@@ -36,11 +37,11 @@ WIDTH, HEIGHT = 1280, 720
 os.makedirs(args.scratch, exist_ok=True)
 dims = args.model.split("x")
 grid = os.path.join(args.scratch, f"faulted_{args.model}.EGRID")
-path = os.path.join(args.scratch, f"faulted_{args.model}{'-keep-faults' if args.keep_faults else ''}.resmr")
+path = os.path.join(args.scratch, f"faulted_{args.model}{'-simplify-faults' if args.simplify_faults else ''}.resmr")
 if not os.path.exists(path):
     if not os.path.exists(grid):
         subprocess.run([args.resmr, "synth", *dims, "-o", grid, "--quiet"], check=True, stdout=subprocess.DEVNULL)
-    subprocess.run([args.resmr, "build", grid, "-o", path, "--quiet", *(["--keep-faults"] if args.keep_faults else [])],
+    subprocess.run([args.resmr, "build", grid, "-o", path, "--quiet", *(["--simplify-faults"] if args.simplify_faults else [])],
                    check=True, stdout=subprocess.DEVNULL)
 
 simple.LoadPlugin(args.plugin, remote=False, ns=globals())
@@ -87,7 +88,7 @@ for camera in cameras:
 
 with open(args.out + ".json", "w") as out:
     json.dump({"model": f"faulted {args.model}", "size": [WIDTH, HEIGHT], "rows": rows}, out, indent=1)
-built = "built with --keep-faults" if args.keep_faults else "default build"
+built = "built with --simplify-faults" if args.simplify_faults else "default build"
 lines = [f"# Picture quality against tolerance (generated faulted model {args.model}, {built}, {WIDTH}x{HEIGHT}, "
          "llvmpipe)", "",
          "Each frame waits for every mesh its tolerance selects and is compared with the exact frame (0 px) of "

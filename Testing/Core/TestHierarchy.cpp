@@ -356,6 +356,74 @@ int64_t CheckCut(const MultiresolutionFile& file, const std::set<std::pair<int, 
   return checked;
 }
 
+/// The boundary nodes of a cut's regions (nodes on an edge only one column of their region
+/// has), by topological coordinate: the distinct positions found there. Two or more at one
+/// pillar are a fault's sides (nodes a region border shares are the same node twice).
+std::map<std::array<float, 2>, std::set<std::vector<double>>> BoundaryPillars(const MultiresolutionFile& file,
+  const std::set<std::pair<int, int64_t>>& cut, std::map<std::pair<int, int64_t>, RegionMesh>& cache)
+{
+  std::map<std::array<float, 2>, std::set<std::vector<double>>> pillars;
+  for (const auto& region : cut)
+  {
+    const RegionRecord* record = file.Find(region.first, region.second);
+    if (!record)
+    {
+      continue;
+    }
+    auto found = cache.find(region);
+    if (found == cache.end())
+    {
+      found = cache.emplace(region, file.ReadRegion(static_cast<std::size_t>(record - file.Regions().data()))).first;
+    }
+    const RegionMesh& mesh = found->second;
+    std::map<std::pair<uint32_t, uint32_t>, int> uses;
+    for (const auto& q : mesh.corners)
+    {
+      for (int e = 0; e < 4; ++e)
+      {
+        const uint32_t a = q[e], b = q[(e + 1) % 4];
+        ++uses[{ std::min(a, b), std::max(a, b) }];
+      }
+    }
+    for (const auto& edge : uses)
+    {
+      for (uint32_t node : { edge.first.first, edge.first.second })
+      {
+        if (edge.second == 1)
+        {
+          pillars[mesh.topology[node]].insert(NodeOf(mesh, node).second);
+        }
+      }
+    }
+  }
+  return pillars;
+}
+
+/// Every fault of the finest level (`faults`: pillars with two sides there) keeps both sides
+/// wherever the cut has either: a side simplified on its own leaves the other alone at the
+/// pillar, and the two part (a gap one sees through). Returns the pillars checked.
+int64_t CheckFaultsWhole(const MultiresolutionFile& file, const std::set<std::pair<int, int64_t>>& cut,
+  std::map<std::pair<int, int64_t>, RegionMesh>& cache, const std::set<std::array<float, 2>>& faults,
+  const std::string& label)
+{
+  int64_t checked = 0, alone = 0;
+  for (const auto& pillar : BoundaryPillars(file, cut, cache))
+  {
+    if (faults.count(pillar.first))
+    {
+      ++checked;
+      alone += pillar.second.size() < 2;
+    }
+  }
+  if (alone)
+  {
+    std::fprintf(stderr, "%s: %lld of %lld fault pillars with one side only\n", label.c_str(),
+      static_cast<long long>(alone), static_cast<long long>(checked));
+  }
+  CHECK(alone == 0);
+  return checked;
+}
+
 void TestHierarchyFile()
 {
   const SyntheticParameters p = SmallModel();
@@ -553,17 +621,34 @@ void TestHierarchyFile()
   }
   CHECK(file.Find(0, 0) && file.Find(0, 0)->error > 0);
 
-  // Conformal cuts: every level whole, and random diamond splits from the roots.
+  // Conformal cuts: every level whole, and random diamond splits from the roots; the faults
+  // of the finest level keep both sides in each (the faults' columns are kept at every level
+  // of a model this small).
   std::map<std::pair<int, int64_t>, RegionMesh> cache;
-  int64_t edges = 0;
-  for (int level = 0; level <= report.leafLevel; ++level)
-  {
+  const auto levelCut = [&](int level) {
     std::set<std::pair<int, int64_t>> cut;
     for (int64_t t = 0; t < DiamondHierarchy::TriangleCount(level); ++t)
     {
       cut.insert({ level, t });
     }
+    return cut;
+  };
+  std::set<std::array<float, 2>> faults;
+  for (const auto& pillar : BoundaryPillars(file, levelCut(report.leafLevel), cache))
+  {
+    if (pillar.second.size() >= 2)
+    {
+      faults.insert(pillar.first);
+    }
+  }
+  std::printf("%zu fault pillars at the finest level\n", faults.size());
+  CHECK(faults.size() > 50);
+  int64_t edges = 0, pillars = 0;
+  for (int level = 0; level <= report.leafLevel; ++level)
+  {
+    const std::set<std::pair<int, int64_t>> cut = levelCut(level);
     edges += CheckCut(file, cut, cache, "level " + std::to_string(level));
+    pillars += CheckFaultsWhole(file, cut, cache, faults, "level " + std::to_string(level));
   }
   std::mt19937_64 random(11);
   for (int trial = 0; trial < 12; ++trial)
@@ -599,8 +684,9 @@ void TestHierarchyFile()
       }
     }
     edges += CheckCut(file, cut, cache, "random cut " + std::to_string(trial));
+    pillars += CheckFaultsWhole(file, cut, cache, faults, "random cut " + std::to_string(trial));
   }
-  CHECK(edges > 100);
+  CHECK(edges > 100 && pillars > 1000);
 
   // Thread count changes nothing but the chunks' order.
   const std::string single = TempPath("single.resmr");
