@@ -381,12 +381,13 @@ double QuadricDistance(const ColumnMeshData& mesh)
   return std::sqrt(largest);
 }
 
-/// Default Cmax: 4096 columns a region (a 64 x 64 patch: top and bottom surfaces of about 16k
+/// Columns of a full-size region: a 64 x 64 patch, top and bottom surfaces of about 16k
 /// triangles, the batch size at which GPUs reach full speed, while a diamond's merged mesh
-/// stays a few hundred MB for 100 layers), but at most a 32nd of the model's columns (and at
-/// least 256), so that small models get five or more levels, not a single one.
-/// Columns of a full-size region: the default cmax of models of 131,072 columns or more.
+/// stays a few hundred MB for 100 layers.
 constexpr int64_t FullRegionColumns = 4096;
+
+/// Default Cmax: a full-size region, but at most a 32nd of the model's columns (and at least
+/// 256), so that small models get five or more levels, not a single one.
 
 int64_t AutomaticCmax(int64_t columns)
 {
