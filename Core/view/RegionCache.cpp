@@ -436,7 +436,7 @@ RegionCache::RegionCache(std::shared_ptr<const MultiresolutionFile> file,
       this->Pinned.push_back(this->KeyOf(r, this->CurrentLayer));
     }
   }
-  this->Loader = std::thread([this] { this->Run(false); });
+  this->Loader = std::thread([this] { this->Run(Role::Idle); });
 #ifdef __linux__
   {
     std::lock_guard<std::mutex> lock(this->Lock);
@@ -444,7 +444,8 @@ RegionCache::RegionCache(std::shared_ptr<const MultiresolutionFile> file,
     this->WindowStart = std::chrono::steady_clock::now();
   }
 #endif
-  this->Standby = std::thread([this] { this->Run(true); });
+  this->Standby = std::thread([this] { this->Run(Role::Standby); });
+  this->Essential = std::thread([this] { this->Run(Role::Essential); });
 }
 
 RegionCache::~RegionCache()
@@ -458,6 +459,7 @@ RegionCache::~RegionCache()
   this->Idle.notify_all();
   this->Loader.join();
   this->Standby.join();
+  this->Essential.join();
 }
 
 bool RegionCache::SetLayer(int32_t layer)
@@ -862,10 +864,11 @@ void RegionCache::InsertLocked(Key key, std::shared_ptr<const RegionDrawBuffers>
   ++this->Changes;
 }
 
-void RegionCache::Run(bool standby)
+void RegionCache::Run(Role role)
 {
+  const bool standby = role == Role::Standby;
 #ifdef __linux__
-  if (!standby)
+  if (role == Role::Idle)
   {
     // Below the render thread: decompression must not take the cores a frame (or a software
     // rasterizer's threads) needs; it uses what the frames leave. At nice 10 it still took a
@@ -878,7 +881,7 @@ void RegionCache::Run(bool standby)
       setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
     }
   }
-  else
+  else if (standby)
   {
     // The standby only loads while the idle loader is starved (see RescueIfStarvedLocked): an
     // ordinary thread, below the render thread. (An unprivileged thread cannot leave
@@ -886,7 +889,8 @@ void RegionCache::Run(bool standby)
     setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
   }
   // So profilers and the view bench can tell them apart.
-  pthread_setname_np(pthread_self(), standby ? "resmr-standby" : "resmr-loader");
+  pthread_setname_np(
+    pthread_self(), role == Role::Idle ? "resmr-loader" : (standby ? "resmr-standby" : "resmr-essential"));
 #endif
   std::unique_lock<std::mutex> lock(this->Lock);
   while (!this->Stopping)
@@ -896,15 +900,41 @@ void RegionCache::Run(bool standby)
       this->StandbyWake.wait(lock);
       continue;
     }
-    if (!this->LoadNextLocked(lock))
+    if (!this->LoadNextLocked(lock, role == Role::Essential))
     {
-      // Either loader may see the end of the work (the other's last read in flight ends
-      // it when nothing else is left).
-      this->Rescuing = this->Rescuing && this->PendingLocked();
-      this->Idle.notify_all();
+      if (role != Role::Essential)
+      {
+        // Either loader may see the end of the work (the other's last read in flight ends
+        // it when nothing else is left).
+        this->Rescuing = this->Rescuing && this->PendingLocked();
+        this->Idle.notify_all();
+      }
       (standby ? this->StandbyWake : this->Wake).wait(lock);
     }
   }
+}
+
+bool RegionCache::StandsInLocked() const
+{
+  return this->CurrentProperty && this->CurrentProperty->name == this->PropertyName &&
+    this->CurrentProperty->layer == this->PropertyLayer;
+}
+
+bool RegionCache::EssentialPendingLocked() const
+{
+  if (!this->HandednessKnown)
+  {
+    return true;
+  }
+  const bool rootWaiting = std::any_of(this->Pinned.begin(), this->Pinned.end(),
+    [&](Key key) { return this->MissingLocked(key) && !this->Loading.count(key); });
+  const bool rootMissing =
+    std::any_of(this->Pinned.begin(), this->Pinned.end(), [&](Key key) { return this->MissingLocked(key); });
+  if (rootWaiting || (!rootMissing && !this->TablesTried && !this->TablesLoading))
+  {
+    return true;
+  }
+  return this->PropertyWanted && this->TablesTried && !this->PropertyLoading && !this->StandsInLocked();
 }
 
 void RegionCache::RescueIfStarvedLocked() const
@@ -947,9 +977,16 @@ void RegionCache::RescueIfStarvedLocked() const
 #endif
 }
 
-bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock)
+bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock, bool essentialOnly)
 {
-  const auto finished = [&]() { this->Idle.notify_all(); };
+  if (essentialOnly && !this->EssentialPendingLocked())
+  {
+    return false;
+  }
+  const auto finished = [&]() {
+    this->Idle.notify_all();
+    this->Wake.notify_all(); // work that waited on this (the tables on the roots) may go
+  };
   if (!this->HandednessKnown)
   {
     // Both loaders may compute it at once: it is the same either way.
@@ -1005,7 +1042,7 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock)
     finished();
     return true;
   }
-  if (this->PropertyWanted && this->TablesTried && !this->PropertyLoading)
+  if (this->PropertyWanted && this->TablesTried && !this->PropertyLoading && !(essentialOnly && this->StandsInLocked()))
   {
     const std::string name = this->PropertyName;
     const int32_t step = this->PropertyStep;
@@ -1053,7 +1090,7 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock)
     return true;
   }
   const int64_t next = this->NextRegionLocked();
-  if (next < 0)
+  if (next < 0 || (essentialOnly && !this->IsPinnedLocked(static_cast<Key>(next))))
   {
     return false;
   }

@@ -37,6 +37,11 @@
 //   thread gets almost nothing; then (work waiting 300 ms, under a tenth of it used, checked
 //   by Request, Pending and WaitIdle) a standby thread at nice 10 loads until nothing is
 //   pending: detail still arrives, a share slower.
+// - What the picture cannot do without is loaded at the process's own priority, by a third
+//   thread that does nothing else (ours): the topology's handedness, the roots, the model's
+//   tables and a property no earlier step of it stands in for. Without them a frame draws
+//   nothing or the solid colour; with two other processes keeping both cores busy, the nice
+//   10 standby took about 30 s to bring a 100M-cell model's colours.
 // - Errors reading the file (damaged chunk) are kept, not thrown on the render thread:
 //   LastError() names the file and the region; the region is never resident.
 #pragma once
@@ -215,12 +220,24 @@ private:
   }
   std::size_t RegionOf(Key key) const { return static_cast<std::size_t>(key / this->LayerSlots); }
   int32_t LayerOf(Key key) const { return static_cast<int32_t>(key % this->LayerSlots) - 1; }
-  /// A loader's loop: the idle loader (SCHED_IDLE on Linux) or the standby, which loads only
-  /// while the idle one is starved.
-  void Run(bool standby);
+  enum class Role
+  {
+    Idle,     ///< below every other thread (SCHED_IDLE on Linux)
+    Standby,  ///< nice 10, only while the idle loader is starved
+    Essential ///< the process's priority, only what the picture cannot do without
+  };
+  /// A loader's loop.
+  void Run(Role role);
   /// Loads the next item (the topology's handedness, the tables, the property, a region),
-  /// the lock released while reading; false when there is nothing this loader can load.
-  bool LoadNextLocked(std::unique_lock<std::mutex>& lock);
+  /// the lock released while reading; false when there is nothing this loader can load
+  /// (with `essentialOnly`, nothing EssentialPendingLocked names).
+  bool LoadNextLocked(std::unique_lock<std::mutex>& lock, bool essentialOnly);
+  /// Work the picture cannot do without is waiting, not being read: the handedness, a root,
+  /// the tables, or a property table with no earlier step of it standing in. Lock held.
+  bool EssentialPendingLocked() const;
+  /// The current property table is an earlier step of the one wanted, which stands in for
+  /// it meanwhile. Lock held.
+  bool StandsInLocked() const;
   /// Sets the standby loading when work has waited a while and the idle loader got almost no
   /// CPU meanwhile. Lock held.
   void RescueIfStarvedLocked() const;
@@ -251,7 +268,7 @@ private:
   std::vector<uint8_t> IsRoot; ///< per region
   mutable std::mutex Lock;
   mutable std::condition_variable Wake, Idle, StandbyWake;
-  std::thread Loader, Standby;
+  std::thread Loader, Standby, Essential;
   std::unordered_set<Key> Loading; ///< being read by a loader
   bool HandednessKnown = false, TablesLoading = false, PropertyLoading = false;
   // Starvation of the idle loader (see RescueIfStarvedLocked).
