@@ -983,118 +983,134 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock, bool essent
   {
     return false;
   }
-  const auto finished = [&]() {
-    this->Idle.notify_all();
-    this->Wake.notify_all(); // work that waited on this (the tables on the roots) may go
-  };
-  if (!this->HandednessKnown)
-  {
-    // Both loaders may compute it at once: it is the same either way.
-    lock.unlock();
-    int handedness = 1;
-    std::string failure;
-    try
-    {
-      handedness = TopologyHandedness(*this->File);
-    }
-    catch (const std::exception& error)
-    {
-      failure = error.what();
-    }
-    lock.lock();
-    this->Handedness = handedness;
-    this->HandednessKnown = true;
-    if (!failure.empty())
-    {
-      this->Error = failure;
-    }
-    finished();
-    return true;
-  }
-  // The roots first (the first image), then the model's tables and the property (colour),
-  // then the regions the view wants.
+  // The handedness, the roots first (the first image), then the model's tables and the
+  // property (colour), then the regions the view wants.
   const bool rootMissing =
     std::any_of(this->Pinned.begin(), this->Pinned.end(), [&](Key key) { return this->MissingLocked(key); });
-  if (!this->TablesTried && !this->TablesLoading && !rootMissing)
+  if (!this->HandednessKnown)
   {
-    this->TablesLoading = true;
-    lock.unlock();
-    std::shared_ptr<ModelTables> tables = std::make_shared<ModelTables>();
-    std::string error;
-    try
+    this->LoadHandednessLocked(lock);
+  }
+  else if (!this->TablesTried && !this->TablesLoading && !rootMissing)
+  {
+    this->LoadTablesLocked(lock);
+  }
+  else if (this->PropertyWanted && this->TablesTried && !this->PropertyLoading &&
+    !(essentialOnly && this->StandsInLocked()))
+  {
+    this->LoadPropertyLocked(lock);
+  }
+  else
+  {
+    const int64_t next = this->NextRegionLocked();
+    if (next < 0 || (essentialOnly && !this->IsPinnedLocked(static_cast<Key>(next))))
     {
-      tables->hash = this->File->ReadHash();
-      tables->normals = this->File->ReadModelArray(ModelChunk::CellNormals);
+      return false;
     }
-    catch (const std::exception& e)
+    this->LoadRegionLocked(lock, static_cast<Key>(next));
+  }
+  this->Idle.notify_all();
+  this->Wake.notify_all(); // work that waited on this (the tables on the roots) may go
+  return true;
+}
+
+void RegionCache::LoadHandednessLocked(std::unique_lock<std::mutex>& lock)
+{
+  // Both loaders may compute it at once: it is the same either way.
+  lock.unlock();
+  int handedness = 1;
+  std::string failure;
+  try
+  {
+    handedness = TopologyHandedness(*this->File);
+  }
+  catch (const std::exception& error)
+  {
+    failure = error.what();
+  }
+  lock.lock();
+  this->Handedness = handedness;
+  this->HandednessKnown = true;
+  if (!failure.empty())
+  {
+    this->Error = failure;
+  }
+}
+
+void RegionCache::LoadTablesLocked(std::unique_lock<std::mutex>& lock)
+{
+  this->TablesLoading = true;
+  lock.unlock();
+  std::shared_ptr<ModelTables> tables = std::make_shared<ModelTables>();
+  std::string error;
+  try
+  {
+    tables->hash = this->File->ReadHash();
+    tables->normals = this->File->ReadModelArray(ModelChunk::CellNormals);
+  }
+  catch (const std::exception& e)
+  {
+    tables.reset();
+    error = e.what();
+  }
+  lock.lock();
+  this->TablesLoading = false;
+  this->TablesTried = true;
+  this->LoadedTables = tables;
+  if (!error.empty())
+  {
+    this->Error = error;
+  }
+}
+
+void RegionCache::LoadPropertyLocked(std::unique_lock<std::mutex>& lock)
+{
+  const std::string name = this->PropertyName;
+  const int32_t step = this->PropertyStep;
+  const int32_t layer = this->PropertyLayer;
+  this->PropertyLoading = true;
+  lock.unlock();
+  std::shared_ptr<PropertyTableData> table;
+  std::string error;
+  try
+  {
+    const int index = this->Properties ? this->Properties->Find(name, step) : -1;
+    if (index < 0)
     {
-      tables.reset();
-      error = e.what();
+      error = (this->Properties ? this->Properties->Path() : std::string("no property file")) + ": property " + name +
+        " step " + std::to_string(step) + " not found";
     }
-    lock.lock();
-    this->TablesLoading = false;
-    this->TablesTried = true;
-    this->LoadedTables = tables;
+    else
+    {
+      table = std::make_shared<PropertyTableData>();
+      table->name = name;
+      table->step = step;
+      table->layer = layer;
+      table->values = layer < 0 ? this->Properties->ReadPacked(static_cast<std::size_t>(index))
+                                : this->Properties->ReadLayer(static_cast<std::size_t>(index), layer);
+    }
+  }
+  catch (const std::exception& e)
+  {
+    table.reset();
+    error = "property " + name + " step " + std::to_string(step) +
+      (layer >= 0 ? " layer " + std::to_string(layer + 1) : std::string()) + ": " + e.what();
+  }
+  lock.lock();
+  this->PropertyLoading = false;
+  if (name == this->PropertyName && step == this->PropertyStep && layer == this->PropertyLayer)
+  {
+    this->PropertyWanted = false;
+    this->CurrentProperty = table; // null when the table could not be read
     if (!error.empty())
     {
       this->Error = error;
     }
-    finished();
-    return true;
   }
-  if (this->PropertyWanted && this->TablesTried && !this->PropertyLoading && !(essentialOnly && this->StandsInLocked()))
-  {
-    const std::string name = this->PropertyName;
-    const int32_t step = this->PropertyStep;
-    const int32_t layer = this->PropertyLayer;
-    this->PropertyLoading = true;
-    lock.unlock();
-    std::shared_ptr<PropertyTableData> table;
-    std::string error;
-    try
-    {
-      const int index = this->Properties ? this->Properties->Find(name, step) : -1;
-      if (index < 0)
-      {
-        error = (this->Properties ? this->Properties->Path() : std::string("no property file")) + ": property " + name +
-          " step " + std::to_string(step) + " not found";
-      }
-      else
-      {
-        table = std::make_shared<PropertyTableData>();
-        table->name = name;
-        table->step = step;
-        table->layer = layer;
-        table->values = layer < 0 ? this->Properties->ReadPacked(static_cast<std::size_t>(index))
-                                  : this->Properties->ReadLayer(static_cast<std::size_t>(index), layer);
-      }
-    }
-    catch (const std::exception& e)
-    {
-      table.reset();
-      error = "property " + name + " step " + std::to_string(step) +
-        (layer >= 0 ? " layer " + std::to_string(layer + 1) : std::string()) + ": " + e.what();
-    }
-    lock.lock();
-    this->PropertyLoading = false;
-    if (name == this->PropertyName && step == this->PropertyStep && layer == this->PropertyLayer)
-    {
-      this->PropertyWanted = false;
-      this->CurrentProperty = table; // null when the table could not be read
-      if (!error.empty())
-      {
-        this->Error = error;
-      }
-    }
-    finished();
-    return true;
-  }
-  const int64_t next = this->NextRegionLocked();
-  if (next < 0 || (essentialOnly && !this->IsPinnedLocked(static_cast<Key>(next))))
-  {
-    return false;
-  }
-  const Key key = static_cast<Key>(next);
+}
+
+void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key)
+{
   const std::size_t region = this->RegionOf(key);
   const int32_t layer = this->LayerOf(key);
   const int handedness = this->Handedness;
@@ -1116,7 +1132,7 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock, bool essent
   this->Loading.erase(key);
   if (this->Stopping)
   {
-    return true;
+    return;
   }
   if (!error.empty())
   {
@@ -1127,8 +1143,6 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock, bool essent
   {
     this->InsertLocked(key, std::move(buffers));
   }
-  finished();
-  return true;
 }
 
 } // namespace resmr

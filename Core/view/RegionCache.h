@@ -232,6 +232,11 @@ private:
   /// the lock released while reading; false when there is nothing this loader can load
   /// (with `essentialOnly`, nothing EssentialPendingLocked names).
   bool LoadNextLocked(std::unique_lock<std::mutex>& lock, bool essentialOnly);
+  // Its steps, each reading with the lock released and recording the result under it.
+  void LoadHandednessLocked(std::unique_lock<std::mutex>& lock);
+  void LoadTablesLocked(std::unique_lock<std::mutex>& lock);
+  void LoadPropertyLocked(std::unique_lock<std::mutex>& lock);
+  void LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key);
   /// Work the picture cannot do without is waiting, not being read: the handedness, a root,
   /// the tables, or a property table with no earlier step of it standing in. Lock held.
   bool EssentialPendingLocked() const;
