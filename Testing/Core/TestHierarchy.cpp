@@ -249,6 +249,23 @@ VertexData VertexOf(const RegionMesh& mesh, uint32_t vertex)
     p[0], p[1], p[2] };
 }
 
+/// A region of the file, read once into `cache`; null if the file has none of that index.
+const RegionMesh* CachedRegion(const MultiresolutionFile& file, const std::pair<int, int64_t>& region,
+  std::map<std::pair<int, int64_t>, RegionMesh>& cache)
+{
+  const RegionRecord* record = file.Find(region.first, region.second);
+  if (!record)
+  {
+    return nullptr;
+  }
+  auto found = cache.find(region);
+  if (found == cache.end())
+  {
+    found = cache.emplace(region, file.ReadRegion(static_cast<std::size_t>(record - file.Regions().data()))).first;
+  }
+  return &found->second;
+}
+
 /// Two checks that the cut has no crack. (1) Every cut edge of every region is walked the
 /// other way by another region of the cut, with bitwise equal nodes, or, where a fault runs
 /// between the two regions, on the same pillars with both sides' faces open. (2) Independently of
@@ -265,17 +282,12 @@ int64_t CheckCut(const MultiresolutionFile& file, const std::set<std::pair<int, 
   int64_t checked = 0;
   for (const auto& region : cut)
   {
-    const RegionRecord* record = file.Find(region.first, region.second);
-    if (!record)
+    const RegionMesh* found = CachedRegion(file, region, cache);
+    if (!found)
     {
       continue;
     }
-    auto found = cache.find(region);
-    if (found == cache.end())
-    {
-      found = cache.emplace(region, file.ReadRegion(static_cast<std::size_t>(record - file.Regions().data()))).first;
-    }
-    for (const CutEdge& edge : CutEdgesOf(found->second))
+    for (const CutEdge& edge : CutEdgesOf(*found))
     {
       const auto match = open.find({ edge.b.first, edge.a.first });
       if (match == open.end())
@@ -291,7 +303,7 @@ int64_t CheckCut(const MultiresolutionFile& file, const std::set<std::pair<int, 
       }
       ++checked;
     }
-    const RegionMesh& mesh = found->second;
+    const RegionMesh& mesh = *found;
     // Top and bottom quads and the simplified side triangles, as the file holds them.
     std::vector<std::vector<uint32_t>> polygons;
     for (const RegionSurface* s : { &mesh.top, &mesh.bottom })
@@ -365,17 +377,12 @@ std::map<std::array<float, 2>, std::set<std::vector<double>>> BoundaryPillars(co
   std::map<std::array<float, 2>, std::set<std::vector<double>>> pillars;
   for (const auto& region : cut)
   {
-    const RegionRecord* record = file.Find(region.first, region.second);
-    if (!record)
+    const RegionMesh* found = CachedRegion(file, region, cache);
+    if (!found)
     {
       continue;
     }
-    auto found = cache.find(region);
-    if (found == cache.end())
-    {
-      found = cache.emplace(region, file.ReadRegion(static_cast<std::size_t>(record - file.Regions().data()))).first;
-    }
-    const RegionMesh& mesh = found->second;
+    const RegionMesh& mesh = *found;
     std::map<std::pair<uint32_t, uint32_t>, int> uses;
     for (const auto& q : mesh.corners)
     {
