@@ -11,7 +11,6 @@ the time since the open began, the share of pixels in saturated colours (the loo
 whether loads are pending and the resident MB. Each run is stored under its --label in
 OUT.json (a run with the same label replaces it); OUT.md sets them side by side."""
 import argparse
-import json
 import os
 import sys
 import time
@@ -22,6 +21,7 @@ from paraview import simple
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "Testing", "Python"))
 import resmr_testing as rt  # noqa: E402
+from labelled_runs import store_run  # noqa: E402
 from view_quality import BusyLoad  # noqa: E402
 
 parser = argparse.ArgumentParser()
@@ -73,11 +73,7 @@ run = {"label": args.label, "model": os.path.basename(args.model), "spinners": a
        "first_sample_s": samples[0]["seconds"] if samples else None,
        "colours_s": first(lambda s: s["saturated"] > 0.005),
        "loaded_s": first(lambda s: s["pending"] == 0)}
-path = args.out + ".json"
-runs = json.load(open(path)) if os.path.exists(path) else []
-runs = [r for r in runs if r["label"] != args.label] + [run]
-with open(path, "w") as out:
-    json.dump(runs, out, indent=1)
+runs = store_run(args.out + ".json", run)
 lines = ["# Opening a model on a busy machine", "",
          "`bench/run_busy_open.py`: the model opened while other processes spin on every core, coloured by PORO, "
          "10 FPS target, 1280x720, 512 MB; seconds from the open to the first frame, to the first frame in the "

@@ -11,12 +11,15 @@ colouring (no table reads, no lighting). The differences are what each part of t
 work costs. Each run is stored under its --label in OUT.json (a run with the same label
 replaces it), so builds can be set side by side; OUT.md shows them all."""
 import argparse
-import json
 import os
 import platform
+import sys
 import time
 
 from paraview import simple
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from labelled_runs import store_run  # noqa: E402
 
 parser = argparse.ArgumentParser()
 parser.add_argument("--plugin", required=True)
@@ -94,11 +97,7 @@ run = {"label": args.label, "model": os.path.basename(args.model), "view": [1280
                                          renderer[0] if renderer else "renderer unknown"),
        "rows": rows}
 
-path = args.out + ".json"
-runs = json.load(open(path)) if os.path.exists(path) else []
-runs = [r for r in runs if r["label"] != args.label] + [run]
-with open(path, "w") as f:
-    json.dump(runs, f, indent=1)
+runs = store_run(args.out + ".json", run)
 
 lines = ["# What a frame costs by what it paints", "",
          "Median of %d moving frames (camera nudged, every selected mesh loaded), 1280x720, FXAA off, "
