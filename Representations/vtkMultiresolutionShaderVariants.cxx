@@ -4,7 +4,6 @@
 #include "vtkOpenGLShaderCache.h"
 #include "vtkShaderProgram.h"
 
-#include "MultiresolutionQuadVS.h"
 #include "MultiresolutionSurfaceFS.h"
 #include "MultiresolutionSurfaceVS.h"
 
@@ -28,7 +27,7 @@ std::string LightTerms(int lighting, int lightCount)
     const std::string n = std::to_string(i);
     terms += lighting == 2
       ? "AddLight(normal, toEye, -lightDirectionVC" + n + ", lightColor" + n + ", 1.0, diffuseSum, specularSum);\n"
-      : "AddAnyLight(normal, toEye, position, lightColor" + n + ", lightDirectionVC" + n + ", lightPositionVC" + n +
+      : "AddAnyLight(normal, toEye, viewPosition, lightColor" + n + ", lightDirectionVC" + n + ", lightPositionVC" + n +
         ", lightAttenuation" + n + ", lightConeAngle" + n + ", lightExponent" + n + ", lightPositional" + n +
         ", diffuseSum, specularSum);\n";
   }
@@ -40,19 +39,12 @@ std::string vtkMultiresolutionShaderVariants::FragmentSource(const Painting& pai
 {
   std::string source = MultiresolutionSurfaceFS;
   const auto flag = [](bool on) { return std::to_string(on ? 1 : 0); };
-  const std::string defines = "#define DEFERRED " + std::to_string(painting.pass) + "\n#define COLOR_MODE " +
-    std::to_string(painting.colorMode) + "\n#define LAYER_VIEW " + flag(painting.layerView) + "\n#define LOG_SCALE " +
-    flag(painting.logScale) + "\n#define GRID_LINES " + flag(painting.gridLines) + "\n#define SPECULAR " +
-    flag(painting.specular) + "\n#define TABLE_NORMALS " + flag(painting.tableNormals) + "\n#define LIGHTING " +
-    std::to_string(painting.lighting) + "\n";
+  const std::string defines = "#define COLOR_MODE " + std::to_string(painting.colorMode) + "\n#define LAYER_VIEW " +
+    flag(painting.layerView) + "\n#define LOG_SCALE " + flag(painting.logScale) + "\n#define GRID_LINES " +
+    flag(painting.gridLines) + "\n#define SPECULAR " + flag(painting.specular) + "\n#define TABLE_NORMALS " +
+    flag(painting.tableNormals) + "\n#define LIGHTING " + std::to_string(painting.lighting) + "\n";
   ReplaceTag(source, "//RESMR::LightUniforms\n", painting.lighting > 0 ? lightUniforms + "\n" : "");
   ReplaceTag(source, "//RESMR::Lights\n", LightTerms(painting.lighting, painting.lightCount));
-  if (painting.pass == 1)
-  {
-    // The visibility pass's one output is unsigned; VTK would declare a vec4 one for the
-    // other passes' gl_FragData, which it renames where it finds them.
-    ReplaceTag(source, "//VTK::Output::Dec\n", "out uvec4 surfaceOut;\n");
-  }
   const std::string versionLine = "//VTK::System::Dec\n";
   ReplaceTag(source, versionLine, versionLine + defines);
   return source;
@@ -63,12 +55,11 @@ vtkShaderProgram* vtkMultiresolutionShaderVariants::Ready(
 {
   const long key = painting.colorMode | (painting.layerView ? 4 : 0) | (painting.logScale ? 8 : 0) |
     (painting.gridLines ? 16 : 0) | (painting.specular ? 32 : 0) | (long(painting.lighting) << 6) |
-    (long(painting.lightCount) << 8) | (painting.tableNormals ? 1L << 40 : 0) | (long(painting.pass) << 41);
+    (long(painting.lightCount) << 8) | (painting.tableNormals ? 1L << 40 : 0);
   auto found = this->Sources.find(key);
   if (found == this->Sources.end())
   {
     found = this->Sources.emplace(key, FragmentSource(painting, lightUniforms ? lightUniforms : "")).first;
   }
-  const char* vertexSource = painting.pass == 2 ? MultiresolutionQuadVS : MultiresolutionSurfaceVS;
-  return window->GetShaderCache()->ReadyShaderProgram(vertexSource, found->second.c_str(), "");
+  return window->GetShaderCache()->ReadyShaderProgram(MultiresolutionSurfaceVS, found->second.c_str(), "");
 }

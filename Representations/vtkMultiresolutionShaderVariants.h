@@ -26,7 +26,6 @@ public:
     bool tableNormals = false; ///< tops and bottoms only, lit by the normal table
     int lighting = 0;          ///< vtkOpenGLRenderer's lighting complexity (0: unlit)
     int lightCount = 0;        ///< the renderer's lights switched on
-    int pass = 0;              ///< 0: one pass; 1: visibility, 2: shading (two passes)
   };
 
   /// The fragment shader's source for `painting`: its switches defined after the version line
@@ -35,8 +34,7 @@ public:
   static std::string FragmentSource(const Painting& painting, const std::string& lightUniforms);
 
   /// The program for `painting` in `window`'s shader cache, compiled the first time and bound;
-  /// null when it does not compile. The shading pass draws a quad over the viewport
-  /// (vtkOpenGLRenderUtilities::RenderQuad), the others the meshes.
+  /// null when it does not compile.
   vtkShaderProgram* Ready(vtkOpenGLRenderWindow* window, const Painting& painting, const char* lightUniforms);
 
 private:

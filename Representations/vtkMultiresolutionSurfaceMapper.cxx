@@ -1,7 +1,7 @@
 #include "vtkMultiresolutionSurfaceMapper.h"
 
 #include "vtkMultiresolutionGpuRegions.h"
-#include "vtkMultiresolutionOffscreenTarget.h"
+#include "vtkMultiresolutionReducedResolution.h"
 #include "vtkMultiresolutionShaderVariants.h"
 #include "vtkMultiresolutionTableTextures.h"
 
@@ -145,7 +145,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   vtkMultiresolutionGpuRegions Regions;
   vtkMultiresolutionTableTextures Tables;
   vtkMultiresolutionShaderVariants Shaders;
-  vtkMultiresolutionOffscreenTarget Offscreen;
+  vtkMultiresolutionReducedResolution Reduced;
   GpuTimer Timer;
 
   // View state and readout.
@@ -182,7 +182,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
 
   void ReleaseGpu()
   {
-    this->Offscreen.ReleaseGraphicsResources(this->Window);
+    this->Reduced.ReleaseGraphicsResources(this->Window);
     this->Regions.ReleaseGraphicsResources();
     this->Tables.ForgetAll(this->Window);
   }
@@ -216,7 +216,7 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   std::shared_ptr<const resmr::PropertyTableData> drawnProperty;
   // The view.
   vtkOpenGLRenderWindow* window = nullptr;
-  resmr::Matrix4 modelToWorld{}, modelToClip{}, modelToView{}, viewToClip{};
+  resmr::Matrix4 modelToWorld{}, modelToClip{}, modelToView{};
   resmr::ViewParameters view;
   resmr::ViewSelection selection;
   // Uploads and drawing.
@@ -224,7 +224,6 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   std::size_t tableBytes = 0; ///< copied for the model's tables this frame
   vtkShaderProgram* program = nullptr;
   int colorMode = SolidColor;
-  int pass = 0;     ///< 0: one pass; 1: visibility, 2: shading
   bool lit = false; ///< the last program readied lights the surface
 };
 
@@ -393,62 +392,15 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   {
     return;
   }
-  this->DrawSurface(frame);
+  // Fill-bound moving frames are drawn at a reduced resolution and stretched onto the view.
+  const bool reduced = frame.scale < 1 && in.Reduced.Begin(frame.window, frame.renderer, frame.scale);
+  frame.scale = reduced ? frame.scale : 1;
+  this->DrawRegions(frame);
+  if (reduced)
+  {
+    in.Reduced.End(frame.window);
+  }
   this->FinishFrame(frame);
-}
-
-void vtkMultiresolutionSurfaceMapper::DrawSurface(Frame& frame)
-{
-  Internals& in = *this->Internal;
-  // Two passes for lit and property colours of the whole model, opaque: the tables are read
-  // and the lights summed once a pixel (vtkMultiresolutionOffscreenTarget). The cell id
-  // colouring is as cheap in one pass; a layer reads a 2D table.
-  in.Timer.Begin();
-  const bool twoPasses = frame.colorMode != CellIdColors && frame.layer < 0 &&
-    frame.actor->GetProperty()->GetOpacity() >= 1 &&
-    in.Offscreen.BeginVisibility(frame.window, frame.renderer, frame.scale);
-  if (twoPasses)
-  {
-    frame.pass = 1;
-    frame.program = this->ReadyProgram(frame, frame.colorMode);
-    this->DrawRegions(frame);
-    this->ShadePixels(frame);
-    in.Offscreen.End(frame.window);
-  }
-  else
-  {
-    // Moving frames too slow for the target are drawn at a reduced resolution and stretched
-    // onto the view.
-    const bool reduced = in.Offscreen.BeginReduced(frame.window, frame.renderer, frame.scale);
-    frame.scale = reduced ? frame.scale : 1;
-    this->DrawRegions(frame);
-    if (reduced)
-    {
-      in.Offscreen.End(frame.window);
-    }
-  }
-  in.Timer.End();
-}
-
-void vtkMultiresolutionSurfaceMapper::ShadePixels(Frame& frame)
-{
-  Internals& in = *this->Internal;
-  frame.pass = 2;
-  frame.program = this->ReadyProgram(frame, frame.colorMode, frame.lit && in.Tables.NormalsReady());
-  if (!frame.program)
-  {
-    return;
-  }
-  this->SetUniforms(frame);
-  // Pixels back to view space, for the lights and for turning normals to the eye.
-  resmr::Matrix4 clipToView{};
-  if (resmr::Invert(frame.viewToClip, clipToView))
-  {
-    std::array<float, 16> packed = resmr::ColumnMajor(clipToView);
-    frame.program->SetUniformMatrix4x4("clipToView", packed.data());
-  }
-  in.Offscreen.Shade(frame.window, frame.program);
-  in.Tables.Unbind();
 }
 
 void vtkMultiresolutionSurfaceMapper::BeginFrame(Frame& frame)
@@ -589,7 +541,6 @@ void vtkMultiresolutionSurfaceMapper::ComputeView(Frame& frame)
   frame.modelToWorld = resmr::Multiply(RowMajor(actorMatrix), mapAxes);
   // VTK's OpenGL key matrices are stored transposed (ready for column-major upload).
   frame.modelToView = resmr::Multiply(resmr::Transpose(RowMajor(worldToView)), frame.modelToWorld);
-  frame.viewToClip = resmr::Transpose(RowMajor(viewToClip));
   int width = 0, height = 0, x0 = 0, y0 = 0;
   frame.renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
   resmr::CameraState state;
@@ -695,16 +646,10 @@ vtkShaderProgram* vtkMultiresolutionSurfaceMapper::ReadyProgram(Frame& frame, in
   painting.lighting = painting.lightCount > 0 ? painting.lighting : 0;
   painting.specular = painting.lighting > 0 && look->GetSpecular() > 0;
   painting.tableNormals = tableNormals;
-  painting.pass = frame.pass;
   frame.lit = painting.lighting > 0;
-  if (frame.pass == 1)
-  {
-    // The visibility pass only needs to know whether faces are lit (a facet normal to keep).
-    painting = { 0, false, false, painting.gridLines, false, tableNormals, frame.lit ? 1 : 0, 0, 1 };
-  }
   vtkShaderProgram* ready =
     in.Shaders.Ready(frame.window, painting, painting.lighting > 0 ? lights->GetLightingUniforms() : nullptr);
-  if (ready && painting.lighting > 0 && frame.pass != 1)
+  if (ready && painting.lighting > 0)
   {
     lights->UpdateLightingUniforms(ready);
   }
@@ -822,6 +767,7 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
 {
   Internals& in = *this->Internal;
   vtkOpenGLState* state = frame.window->GetState();
+  in.Timer.Begin();
   state->vtkglEnable(GL_DEPTH_TEST);
   state->vtkglDepthMask(GL_TRUE);
   // Back faces of the closed surface, hidden from outside, are culled (the bottom seen from
@@ -860,6 +806,7 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
   state->vtkglDisable(GL_CULL_FACE);
   in.Substituted = static_cast<int>(frame.selection.substituted);
   in.Tables.Unbind();
+  in.Timer.End();
   vtkOpenGLCheckErrorMacro("after drawing the multiresolution surface");
 }
 

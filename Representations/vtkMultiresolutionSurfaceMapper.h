@@ -178,12 +178,7 @@ private:
   void StreamTables(Frame& frame);
   void UploadMeshes(Frame& frame);
   void SetUniforms(Frame& frame);
-  /// Draws the surface: in two passes (visibility, then shading) where it can, else in one;
-  /// at the frame's scale.
-  void DrawSurface(Frame& frame);
   void DrawRegions(Frame& frame);
-  /// The shading pass: colours, lights and lines each pixel the visibility pass covered.
-  void ShadePixels(Frame& frame);
   /// Draws the selected regions' faces of the kinds flagged (top, bottom, side) with the
   /// frame's program; the regions drawn.
   int DrawFaces(Frame& frame, const std::array<bool, 3>& kinds);

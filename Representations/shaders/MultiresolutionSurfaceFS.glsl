@@ -13,7 +13,6 @@
 // renderer's lights adds a diffuse and a specular term.
 //
 // The mapper compiles one variant per painting mode, with these defined (0 or 1):
-// DEFERRED (0: one pass; 1: the visibility pass, 2: the shading pass, below),
 // COLOR_MODE (0: solid colour, 1: property, 2: cell id), LAYER_VIEW (one layer drawn),
 // LOG_SCALE, GRID_LINES, SPECULAR, TABLE_NORMALS (tops and bottoms lit by the normal
 // table), and LIGHTING (0: unlit, 1: headlight, 2: directional
@@ -23,18 +22,10 @@
 // compiled out, the unused paths cost nothing (a tenth of a full-screen frame there), and
 // GPUs keep fewer registers.
 
-#if DEFERRED == 2
-// Shading pass: one fragment a pixel of the visibility pass's target.
-uniform usampler2D surfaceData; // RGBA32UI: i, j, k, face kind | line strength | facet normal
-uniform sampler2D surfaceDepth;
-uniform vec2 drawnSize;         // the drawn area of both, pixels
-in vec2 tcoordVC;               // 0 to 1 over the viewport drawn into
-uniform mat4 clipToView;
-#else
 in vec3 cellCoord;
 in vec3 viewPosition;
+
 uniform int faceKind;     // 0: top, 1: bottom, 2: side
-#endif
 uniform ivec3 gridDims;   // nx, ny, nz
 uniform ivec3 tableSides; // m
 uniform ivec3 offsetSides; // r
@@ -126,172 +117,6 @@ void AddAnyLight(vec3 normal, vec3 toEye, vec3 position, vec3 lightColor, vec3 d
 }
 #endif
 
-// The normal turned to face the eye (two-sided, as VTK lights a surface whose back may show).
-vec3 FacingEye(vec3 normal, vec3 position)
-{
-  return (cameraParallel == 1 ? normal.z < 0.0 : dot(normal, position) > 0.0) ? -normal : normal;
-}
-
-// The facet's own normal, per pixel, from the screen derivatives of its position.
-vec3 FacetNormal(vec3 position)
-{
-  return FacingEye(normalize(cross(dFdx(position), dFdy(position))), position);
-}
-
-#if COLOR_MODE == 1
-// The lookup table's colour for a property value (the NaN colour for NaN).
-vec3 MapValue(float value)
-{
-  if (isnan(value))
-  {
-    return nanColor.rgb;
-  }
-#if LOG_SCALE
-  float v = value > 0.0 ? log(value) / log(10.0) : scalarRange.x;
-#else
-  float v = value;
-#endif
-  float span = scalarRange.y - scalarRange.x;
-  float t = span > 0.0 ? clamp((v - scalarRange.x) / span, 0.0, 1.0) : 0.5;
-  int size = textureSize(colorMap, 0).x;
-  return texelFetch(colorMap, ivec2(min(int(t * float(size)), size - 1), 0), 0).rgb;
-}
-#endif
-
-// The material and the renderer's lights applied to `color` at a view-space position whose
-// normal (facing the eye) is `normal`.
-vec3 Lit(vec3 color, vec3 normal, vec3 position)
-{
-#if COLOR_MODE == 1
-  vec3 ambientPart = ambientIntensity * color; // a property's colour is ambient and diffuse
-#else
-  vec3 ambientPart = ambientColorUniform;
-#endif
-  vec3 diffusePart = diffuseIntensity * color;
-#if LIGHTING == 0
-  return ambientPart + diffusePart;
-#else
-  vec3 diffuseSum = vec3(0.0);
-  vec3 specularSum = vec3(0.0);
-#if LIGHTING == 1
-  float df = max(0.0, normal.z);
-  diffuseSum = df * lightColor0;
-#if SPECULAR
-  specularSum = pow(df, specularPower) * lightColor0;
-#endif
-#else
-  vec3 toEye = normalize(-position);
-  //RESMR::Lights
-#endif
-  return ambientPart + diffusePart * diffuseSum + specularColorUniform * specularSum;
-#endif
-}
-
-#if GRID_LINES && DEFERRED != 2
-// How much of the original grid's line covers this fragment, 0 to 1: the distance to the
-// nearest integer of each coordinate, in pixels; the constant axis sits half a cell from any
-// integer with a zero derivative, so it never makes a line. Drawn at a reduced scale, lines
-// keep their width on the view (at least a drawn pixel) and fade where cells shrink below the
-// same size on the view.
-float GridLineStrength(vec3 coordinate)
-{
-  vec3 perPixel = max(fwidth(coordinate), vec3(1e-6));
-  vec3 pixels = abs(fract(coordinate + 0.5) - 0.5) / perPixel;
-  vec3 cellPixels = 1.0 / (perPixel * renderScale);
-  vec3 fade = smoothstep(vec3(3.0), vec3(8.0), cellPixels);
-  float width = max(gridLineWidth * renderScale, min(gridLineWidth, 1.0));
-  vec3 line = (1.0 - smoothstep(vec3(0.5 * width - 0.5), vec3(0.5 * width + 0.5), pixels)) * fade;
-  return max(line.x, max(line.y, line.z));
-}
-#endif
-
-// A unit normal in 2 x 11 bits (octahedral) and back, for the visibility pass's target.
-uint EncodeNormal(vec3 n)
-{
-  vec2 e = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
-  if (n.z < 0.0)
-  {
-    e = (1.0 - abs(e.yx)) * vec2(e.x >= 0.0 ? 1.0 : -1.0, e.y >= 0.0 ? 1.0 : -1.0);
-  }
-  uvec2 q = uvec2(round(clamp(e * 0.5 + 0.5, 0.0, 1.0) * 2047.0));
-  return q.x | (q.y << 11u);
-}
-
-vec3 DecodePacked(uint code)
-{
-  vec2 e = vec2(float(code & 2047u), float((code >> 11u) & 2047u)) / 2047.0 * 2.0 - 1.0;
-  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
-  float t = max(-n.z, 0.0);
-  n.xy -= t * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
-  return normalize(n);
-}
-
-#if DEFERRED == 1
-// Visibility pass (ours): what shading needs of the front fragment, no table read: the cell,
-// the face kind, the grid line's strength and, for faces not lit by the normal table, the
-// facet normal. A software rasterizer shades small triangles in whole blocks of pixels, so a
-// frame's fragments are many times its pixels; the tables are read once a pixel after it.
-void main()
-{
-  ivec3 cell = clamp(ivec3(floor(cellCoord)), ivec3(0), gridDims - 1);
-  uint bits = uint(faceKind);
-#if GRID_LINES
-  bits |= uint(round(GridLineStrength(cellCoord) * 255.0)) << 2u;
-#endif
-#if LIGHTING && !TABLE_NORMALS
-  bits |= EncodeNormal(FacetNormal(viewPosition)) << 10u;
-#endif
-  surfaceOut = uvec4(uvec3(cell), bits);
-}
-#elif DEFERRED == 2
-// Shading pass (ours): the forward path's colour, lighting and grid lines for each pixel the
-// visibility pass covered, and its depth.
-void main()
-{
-  ivec2 texel = ivec2(tcoordVC * drawnSize); // pixel centres: no rounding at the edges
-  float depth = texelFetch(surfaceDepth, texel, 0).r;
-  if (depth >= 1.0)
-  {
-    discard;
-  }
-  uvec4 data = texelFetch(surfaceData, texel, 0);
-  ivec3 cell = ivec3(data.xyz);
-  int kind = int(data.w & 3u);
-  vec4 clip = vec4((vec2(texel) + 0.5) / drawnSize * 2.0 - 1.0, depth * 2.0 - 1.0, 1.0);
-  vec4 view = clipToView * clip;
-  vec3 position = view.xyz / view.w;
-  ivec3 slot = HashSlot(cell);
-#if COLOR_MODE == 1
-  vec3 color = MapValue(texelFetch(propertyTable, slot, 0).r);
-#else
-  vec3 color = solidColor;
-#endif
-#if LIGHTING
-#if TABLE_NORMALS
-  vec3 normal;
-  if (kind < 2)
-  {
-    uvec2 codes = texelFetch(cellNormals, slot, 0).xy;
-    normal = FacingEye(normalize(normalToView * DecodeNormal(kind == 0 ? codes.x : codes.y)), position);
-  }
-  else
-  {
-    normal = DecodePacked(data.w >> 10u);
-  }
-#else
-  vec3 normal = DecodePacked(data.w >> 10u);
-#endif
-#else
-  vec3 normal = vec3(0.0, 0.0, 1.0);
-#endif
-  color = Lit(color, normal, position);
-#if GRID_LINES
-  color = mix(color, gridLineColor, float((data.w >> 2u) & 255u) / 255.0);
-#endif
-  gl_FragData[0] = vec4(color, 1.0);
-  gl_FragDepth = depth;
-}
-#else
 void main()
 {
   ivec3 cell = clamp(ivec3(floor(cellCoord)), ivec3(0), gridDims - 1);
@@ -305,37 +130,97 @@ void main()
   }
 #endif
 #if COLOR_MODE == 2
-  int id = cell.x + gridDims.x * (cell.y + gridDims.y * cell.z) + 1;
-  gl_FragData[0] = vec4(float(id & 255), float((id >> 8) & 255), float((id >> 16) & 255), 255.0) / 255.0;
+  {
+    int id = cell.x + gridDims.x * (cell.y + gridDims.y * cell.z) + 1;
+    gl_FragData[0] = vec4(float(id & 255), float((id >> 8) & 255), float((id >> 16) & 255), 255.0) / 255.0;
+  }
 #else
 #if !LAYER_VIEW
   ivec3 slot = HashSlot(cell);
 #endif
+
   vec3 color = solidColor;
 #if COLOR_MODE == 1
+  {
 #if LAYER_VIEW
-  color = MapValue(texelFetch(layerProperty, cell.xy, 0).r);
+    float value = texelFetch(layerProperty, cell.xy, 0).r;
 #else
-  color = MapValue(texelFetch(propertyTable, slot, 0).r);
+    float value = texelFetch(propertyTable, slot, 0).r;
 #endif
+    if (isnan(value))
+    {
+      color = nanColor.rgb;
+    }
+    else
+    {
+#if LOG_SCALE
+      float v = value > 0.0 ? log(value) / log(10.0) : scalarRange.x;
+#else
+      float v = value;
 #endif
-  // On tops and bottoms once the normal table is loaded, the original cell's top or bottom
-  // face normal (Sec. 5.3); elsewhere the facet's own, per pixel. A layer's cells are mostly
-  // inside the model, and the normal table is hashed for the external faces' cells only: a
-  // layer lights every face by its facet.
+      float span = scalarRange.y - scalarRange.x;
+      float t = span > 0.0 ? clamp((v - scalarRange.x) / span, 0.0, 1.0) : 0.5;
+      int size = textureSize(colorMap, 0).x;
+      color = texelFetch(colorMap, ivec2(min(int(t * float(size)), size - 1), 0), 0).rgb;
+    }
+  }
+#endif
+
+  // Normal (view space), turned to face the eye (two-sided, as VTK lights a surface whose
+  // back may show): on tops and bottoms once the normal table is loaded, the original cell's
+  // top or bottom face normal (Sec. 5.3); elsewhere the facet's own, per pixel. A layer's
+  // cells are mostly inside the model, and the normal table is hashed for the external
+  // faces' cells only: a layer lights every face by its facet.
 #if TABLE_NORMALS
   // Drawn apart from the sides: the facet's screen derivatives are a large share of a
   // software rasterizer's fragment, and a table normal needs none.
   uvec2 codes = texelFetch(cellNormals, slot, 0).xy;
-  vec3 normal = FacingEye(normalize(normalToView * DecodeNormal(faceKind == 0 ? codes.x : codes.y)), viewPosition);
+  vec3 normal = normalize(normalToView * DecodeNormal(faceKind == 0 ? codes.x : codes.y));
+  normal = (cameraParallel == 1 ? normal.z < 0.0 : dot(normal, viewPosition) > 0.0) ? -normal : normal;
 #else
-  vec3 normal = FacetNormal(viewPosition);
+  vec3 normal = normalize(cross(dFdx(viewPosition), dFdy(viewPosition)));
+  normal = (cameraParallel == 1 ? normal.z < 0.0 : dot(normal, viewPosition) > 0.0) ? -normal : normal;
 #endif
-  color = Lit(color, normal, viewPosition);
+#if COLOR_MODE == 1
+  vec3 ambientPart = ambientIntensity * color; // a property's colour is ambient and diffuse
+#else
+  vec3 ambientPart = ambientColorUniform;
+#endif
+  vec3 diffusePart = diffuseIntensity * color;
+#if LIGHTING == 0
+  color = ambientPart + diffusePart;
+#else
+  vec3 diffuseSum = vec3(0.0);
+  vec3 specularSum = vec3(0.0);
+#if LIGHTING == 1
+  float df = max(0.0, normal.z);
+  diffuseSum = df * lightColor0;
+#if SPECULAR
+  specularSum = pow(df, specularPower) * lightColor0;
+#endif
+#else
+  vec3 toEye = normalize(-viewPosition);
+  //RESMR::Lights
+#endif
+  color = ambientPart + diffusePart * diffuseSum + specularColorUniform * specularSum;
+#endif
+
 #if GRID_LINES
-  color = mix(color, gridLineColor, GridLineStrength(cellCoord));
+  {
+    // Distance to the nearest integer of each coordinate, in pixels; the constant axis sits
+    // half a cell from any integer with a zero derivative, so it never makes a line.
+    // Drawn at a reduced scale, lines keep their width on the view (at least a drawn pixel)
+    // and fade where cells shrink below the same size on the view.
+    vec3 perPixel = max(fwidth(cellCoord), vec3(1e-6));
+    vec3 pixels = abs(fract(cellCoord + 0.5) - 0.5) / perPixel;
+    vec3 cellPixels = 1.0 / (perPixel * renderScale);
+    vec3 fade = smoothstep(vec3(3.0), vec3(8.0), cellPixels);
+    float width = max(gridLineWidth * renderScale, min(gridLineWidth, 1.0));
+    vec3 line = (1.0 - smoothstep(vec3(0.5 * width - 0.5), vec3(0.5 * width + 0.5), pixels)) * fade;
+    float strength = max(line.x, max(line.y, line.z));
+    color = mix(color, gridLineColor, strength);
+  }
 #endif
   gl_FragData[0] = vec4(color, 1.0);
 #endif
 }
-#endif
