@@ -42,7 +42,7 @@ public:
   static const char* SourceArrayName() { return "ResMR Source"; }
 
   /// MaximumPixelTolerance's default (see docs/user-guide.md for the measurements behind it).
-  static constexpr double DefaultMaximumPixelTolerance = 64.0;
+  static constexpr double DefaultMaximumPixelTolerance = 48.0;
 
   enum ColorModes
   {

@@ -778,13 +778,17 @@ void RegionCache::EvictLocked(Key key)
   }
 }
 
-int64_t RegionCache::NextRegionLocked()
+int64_t RegionCache::NextRegionLocked(bool roots)
 {
   const auto missing = [&](Key key) { return this->MissingLocked(key); };
   for (Key key : this->Pinned)
   {
     if (missing(key) && !this->Loading.count(key))
     {
+      if (!roots)
+      {
+        return -1; // the essential loader's, and nothing drawn before them
+      }
       return static_cast<int64_t>(key);
     }
   }
@@ -984,25 +988,33 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock, bool essent
     return false;
   }
   // The handedness, the roots first (the first image), then the model's tables and the
-  // property (colour), then the regions the view wants.
+  // property (colour), then the regions the view wants. What the picture cannot do without
+  // is read by the essential loader alone: a loader below the process's priority that took
+  // it held it, and the picture with it, for as long as the machine's other work starved
+  // that loader (on a busy machine the tables, so the colours, never came in a 100 s flight).
+  // A property an earlier step of it stands in for is the other loaders' work.
   const bool rootMissing =
     std::any_of(this->Pinned.begin(), this->Pinned.end(), [&](Key key) { return this->MissingLocked(key); });
   if (!this->HandednessKnown)
   {
+    if (!essentialOnly)
+    {
+      return false; // regions need it
+    }
     this->LoadHandednessLocked(lock);
   }
-  else if (!this->TablesTried && !this->TablesLoading && !rootMissing)
+  else if (essentialOnly && !this->TablesTried && !this->TablesLoading && !rootMissing)
   {
     this->LoadTablesLocked(lock);
   }
   else if (this->PropertyWanted && this->TablesTried && !this->PropertyLoading &&
-    !(essentialOnly && this->StandsInLocked()))
+    essentialOnly != this->StandsInLocked())
   {
     this->LoadPropertyLocked(lock);
   }
   else
   {
-    const int64_t next = this->NextRegionLocked();
+    const int64_t next = this->NextRegionLocked(essentialOnly);
     if (next < 0 || (essentialOnly && !this->IsPinnedLocked(static_cast<Key>(next))))
     {
       return false;

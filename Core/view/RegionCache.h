@@ -229,8 +229,9 @@ private:
   /// A loader's loop.
   void Run(Role role);
   /// Loads the next item (the topology's handedness, the tables, the property, a region),
-  /// the lock released while reading; false when there is nothing this loader can load
-  /// (with `essentialOnly`, nothing EssentialPendingLocked names).
+  /// the lock released while reading; false when there is nothing this loader can load.
+  /// With `essentialOnly` (the essential loader) only what EssentialPendingLocked names, and
+  /// only it reads that: without, the other regions and a property something stands in for.
   bool LoadNextLocked(std::unique_lock<std::mutex>& lock, bool essentialOnly);
   // Its steps, each reading with the lock released and recording the result under it.
   void LoadHandednessLocked(std::unique_lock<std::mutex>& lock);
@@ -247,8 +248,9 @@ private:
   /// CPU meanwhile. Lock held.
   void RescueIfStarvedLocked() const;
   /// The next entry to load (roots, then wanted, then predicted), or -1; may mark loading
-  /// blocked when an entry whose size is known cannot fit. Lock held.
-  int64_t NextRegionLocked();
+  /// blocked when an entry whose size is known cannot fit. Without `roots` (a loader other
+  /// than the essential one) -1 while a root waits to be read. Lock held.
+  int64_t NextRegionLocked(bool roots);
   bool PendingLocked() const;
   bool RootsMissingLocked() const;
   /// Waits (the lock released) while `busy` holds, at most `timeout`; false on timeout.
