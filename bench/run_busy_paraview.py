@@ -2,7 +2,7 @@
 
   pvpython bench/run_busy_paraview.py [--frames 500] [--spinners 2] [--out bench/results/busy_paraview]
 
-Stock ParaView, no plugin: a sphere of 64 triangles (ParaView's own cost of a frame) and one of
+Stock ParaView, no plugin: a sphere of 96 triangles (ParaView's own cost of a frame) and one of
 118,800 triangles filling most of a 1280x720 view (about as many as the multiresolution
 models' coarsest views draw), coloured by an array and lit by the default light kit, FXAA off,
 the camera turned a little every frame. Each is timed idle and then with --spinners processes
@@ -19,7 +19,7 @@ import time
 from paraview import simple
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "Testing", "Python"))
+sys.path.insert(0, os.path.join(HERE, "..", "Testing", "Python"))  # view_quality reads resmr_testing
 from view_quality import BusyLoad  # noqa: E402
 
 parser = argparse.ArgumentParser()

@@ -237,7 +237,7 @@ def write_report(results):
              f"{results['frames']}-frame path, budget {results['budget_mb']} MB)", "",
              f"Machine: {results['machine']['cpu']}, {results['machine']['cores']} cores, "
              f"{results['machine']['memory_gb']} GB, Mesa llvmpipe (no GPU). ParaView's own frame at this size "
-             f"(a 64-triangle sphere) takes {results['empty_frame_ms']:.0f} ms of the {1000 / results['fps_target']:.0f} ms; "
+             f"(a 96-triangle sphere) takes {results['empty_frame_ms']:.0f} ms of the {1000 / results['fps_target']:.0f} ms; "
              f"a 118,800-triangle sphere filling most of the view takes {results['dense_sphere_frame_ms']:.0f} ms. "
              f"FXAA (a view setting, ParaView's default on) is {'on' if results['fxaa'] else 'off'} for every view here; "
              f"{'off' if results['fxaa'] else 'on'}, the small sphere's frame takes "
@@ -518,14 +518,14 @@ if args.child:
         json.dump(entry, saved)
     raise SystemExit
 
-# ParaView's own cost of a frame at this size: with a 64-triangle sphere, what a frame costs
+# ParaView's own cost of a frame at this size: with a 96-triangle sphere, what a frame costs
 # before any model is drawn; with a 118,800-triangle sphere filling most of the view, what this
 # renderer takes for about as many triangles as the multiresolution model's coarsest views.
 results["fxaa"] = bool(args.fxaa)
 results["one_process"] = bool(args.one_process)
 view = new_view(args.fxaa)
 results["empty_frame_ms"] = sphere_frame_ms(view, 8, 8)
-print(f"ParaView's frame with a 64-triangle sphere at 1280x720: {results['empty_frame_ms']:.0f} ms", flush=True)
+print(f"ParaView's frame with a 96-triangle sphere at 1280x720: {results['empty_frame_ms']:.0f} ms", flush=True)
 results["dense_sphere_frame_ms"] = sphere_frame_ms(view, 300, 200, zoom=1.5)
 print(f"ParaView's frame with a 118,800-triangle sphere at 1280x720: {results['dense_sphere_frame_ms']:.0f} ms",
       flush=True)
