@@ -36,9 +36,12 @@ const char* BuildUsage =
   "                and diamond it recorded)\n"
   "  --fresh       ignore a killed build's scratch folder and start over\n"
   "  --no-disk-check  start even when the disks hold less free space than the build needs\n"
-  "  --simplify-faults  simplify each fault block's outline on its own at every level (by\n"
-  "                   default the faults' columns are kept at every level where they fit the\n"
-  "                   region's column budget, so no gap opens where faults bend or meet)\n"
+  "  --fault-columns N  columns a region keeps whole along its faults and borders (default:\n"
+  "                   4096, or Cmax if larger); where the faults need more (the coarsest\n"
+  "                   levels of a large model) the two sides of each fault weld into one\n"
+  "                   surface, the throw drawn as a slope within the level's error\n"
+  "  --simplify-faults  simplify each fault block's outline on its own at every level\n"
+  "                   instead (smaller coarse levels; gaps open where faults bend or meet)\n"
   "  Prints a progress bar on stderr and a JSON report on stdout.\n";
 
 int64_t ParseSize(const std::string& text)
@@ -128,6 +131,14 @@ int BuildCommand(int argc, char** argv)
       else if (arg == "--seed")
       {
         options.seed = std::stoull(OptionValue(a, argc, argv));
+      }
+      else if (arg == "--fault-columns")
+      {
+        options.faultColumns = std::stoll(OptionValue(a, argc, argv));
+        if (options.faultColumns < 1)
+        {
+          throw std::invalid_argument("--fault-columns must be at least 1");
+        }
       }
       else if (arg == "--fresh")
       {

@@ -8,6 +8,7 @@
 #include "ColumnMesh.h"
 #include "DiamondHierarchy.h"
 #include "DiskUse.h"
+#include "FaultWelding.h"
 #include "HashMix.h"
 #include "LeafPartition.h"
 #include "MemoryBudget.h"
@@ -47,6 +48,9 @@ struct ScratchRegion
   ColumnMeshData mesh;
   std::vector<uint8_t> cutEdges;  ///< per column, bit e
   std::vector<uint8_t> openSides; ///< per cell, bit e: side face e is external (see RegionMesh)
+  /// Error the region has beyond its quadrics' (faults welded at its level); not saved: the
+  /// levels above take it as their descendants' error.
+  double weldError = 0;
 };
 
 std::string RegionPath(const std::string& folder, int level, int64_t index)
@@ -832,11 +836,12 @@ bool LockFaultColumns(ColumnMesh& mesh, int64_t limit)
   return true;
 }
 
-/// The seed as a resumed build must match it: with --simplify-faults folded in, so a build is
-/// never resumed under the other choice.
+/// The seed as a resumed build must match it: with the fault options folded in, so a build is
+/// never resumed under another choice.
 uint64_t ResumeSeed(const HierarchyOptions& options)
 {
-  return options.seed ^ (options.keepFaults ? 0 : GoldenGamma);
+  return options.seed ^ (options.keepFaults ? 0 : GoldenGamma) ^
+    (options.faultColumns > 0 ? Mix(static_cast<uint64_t>(options.faultColumns)) : 0);
 }
 
 class Builder
@@ -898,7 +903,8 @@ private:
   void BuildDiamond(const DiamondHierarchy::Diamond& diamond, std::vector<Emitted>& out);
   std::vector<ScratchRegion> LoadChildren(const DiamondHierarchy::Diamond& diamond) const;
   void SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const ColumnMesh& mesh,
-    const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides, std::vector<Emitted>& out);
+    const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides, double weldError,
+    std::vector<Emitted>& out);
   /// Saves the region's scratch file (for the level above) and encodes it.
   void Prepare(int level, int64_t index, const ScratchRegion& region, bool keepScratch, std::vector<Emitted>& out);
   /// Appends a task's regions to the chunk file and records them; with `task` (a one-process
@@ -1018,7 +1024,7 @@ void Builder::Prepare(
   Emitted emitted;
   emitted.record.level = level;
   emitted.record.index = index;
-  const double ownError = QuadricDistance(region.mesh);
+  const double ownError = std::max(QuadricDistance(region.mesh), region.weldError);
   emitted.record.ownError = static_cast<float>(ownError);
   // The file rounds positions to its lattice after simplification: allow one step more.
   const auto& step = this->Header.latticeStep;
@@ -1353,7 +1359,8 @@ std::vector<ScratchRegion> Builder::LoadChildren(const DiamondHierarchy::Diamond
 /// Splits the simplified diamond along its hypotenuse by column centre and emits each
 /// triangle's region with the edges cut towards the other triangle and other diamonds.
 void Builder::SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const ColumnMesh& mesh,
-  const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides, std::vector<Emitted>& out)
+  const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides, double weldError,
+  std::vector<Emitted>& out)
 {
   const int32_t slots = mesh.ColumnSlots();
   const int32_t layers = mesh.Layers();
@@ -1395,6 +1402,7 @@ void Builder::SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const Colum
     ScratchRegion region;
     region.mesh = mesh.Export(&keep);
     region.openSides = KeptCells(openSides, keep, interfaces - 1);
+    region.weldError = weldError;
     for (int32_t c = 0; c < slots; ++c)
     {
       if (!keep[c])
@@ -1433,9 +1441,15 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond, std::vector
   LockCutColumns(mesh, childCut);
   const int triangles = diamond.second >= 0 ? 2 : 1;
   const int64_t target = std::min<int64_t>(this->Options.cmax * triangles, (inputColumns + 1) / 2);
-  if (this->Options.keepFaults)
+  // Faults too long to keep whole here weld instead of parting (FaultWelding.h).
+  double weldError = 0;
+  const int64_t faultColumns =
+    this->Options.faultColumns > 0 ? this->Options.faultColumns : std::max(this->Options.cmax, FullRegionColumns);
+  if (this->Options.keepFaults && !LockFaultColumns(mesh, faultColumns * triangles))
   {
-    LockFaultColumns(mesh, std::max(this->Options.cmax, FullRegionColumns) * triangles);
+    weldError = WeldFaults(mesh).largestMove;
+    // What could not weld (a side's node on a locked border) stays whole until it can.
+    LockFaultColumns(mesh, std::numeric_limits<int64_t>::max());
   }
   if (mesh.AliveColumns() > target)
   {
@@ -1445,7 +1459,7 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond, std::vector
   }
   // Cut edges left are on the diamond's boundary, where columns are locked and unchanged.
   UpdateOpenSides(mesh, childCut, openSides);
-  this->SplitAndEmit(diamond, mesh, childCut, openSides, out);
+  this->SplitAndEmit(diamond, mesh, childCut, openSides, weldError, out);
   this->WorkDone += inputColumns;
   this->Report(this->Phase, this->WorkStart + this->WorkSpan * static_cast<double>(this->WorkDone) / this->WorkTotal);
 }

@@ -60,12 +60,16 @@ struct HierarchyOptions
   /// Refuse to start when the disks of the scratch folder and the output have less free
   /// space than the build needs (see BuildDiskNeed).
   bool checkDisk = true;
-  /// Keep the faults' columns whole (LockFaultColumns) at every level where they fit the
-  /// diamond's column target: no gap where faults bend or meet there. Where they do not (the
-  /// coarsest levels of a large model) the faults are simplified block by block, and gaps up to
-  /// that level's error may open. false: simplified at every level (smaller coarse levels
-  /// only where the faults fit anyway).
+  /// Keep the faults' columns whole (LockFaultColumns) at every level where they fit
+  /// (`faultColumns`): no gap where faults bend or meet there. Where they do not (the
+  /// coarsest levels of a large model) the two sides of each fault weld into one surface
+  /// (FaultWelding.h), the throw drawn as a slope within the level's error. false: each fault
+  /// block simplified on its own at every level (gaps up to each level's error may open where
+  /// faults bend or meet).
   bool keepFaults = true;
+  /// Columns a triangle of a diamond may keep whole along faults and region borders; 0: a
+  /// full-size region's (4,096) or Cmax, whichever is larger.
+  int64_t faultColumns = 0;
   /// MPI (through ParaView's controller, vtkBuildMultiresolutionHierarchy): this process's
   /// rank among `ranks`, which share the scratch folder and split the leaves and each
   /// level's diamonds. `barrier` must return once every rank has called it (required when

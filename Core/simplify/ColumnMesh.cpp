@@ -397,6 +397,102 @@ void ColumnMesh::BuildAdjacencyAndQuadrics()
   this->ComputeOrientation();
 }
 
+double ColumnMesh::MergeNodes(const std::vector<int32_t>& into)
+{
+  const int32_t nodes = this->NodeCount();
+  if (static_cast<int32_t>(into.size()) != nodes)
+  {
+    throw std::logic_error("column mesh: a merge map must name every node");
+  }
+  // Check first, so that a refused merge changes nothing.
+  std::vector<std::vector<int32_t>> groups(static_cast<std::size_t>(nodes));
+  for (int32_t n = 0; n < nodes; ++n)
+  {
+    const int32_t to = into[n];
+    if (to == n)
+    {
+      continue;
+    }
+    if (to < 0 || to >= nodes || into[to] != to || !this->NodeAlive[n] || !this->NodeAlive[to])
+    {
+      throw std::logic_error("column mesh: a merge map must send live nodes to live nodes that stay");
+    }
+    for (int32_t node : { n, to })
+    {
+      for (int32_t column : this->ColumnsOfNode[node])
+      {
+        if (this->Locked[column])
+        {
+          throw std::logic_error("column mesh: a locked column's node cannot merge");
+        }
+      }
+    }
+    groups[to].push_back(n);
+  }
+  for (int32_t c = 0; c < this->ColumnSlots(); ++c)
+  {
+    const auto& q = this->Corners[c];
+    for (int a = 0; this->ColumnAlive[c] && a < 4; ++a)
+    {
+      for (int b = a + 1; b < 4; ++b)
+      {
+        if (into[q[a]] == into[q[b]])
+        {
+          throw std::logic_error("column mesh: a merge would give a column one node twice");
+        }
+      }
+    }
+  }
+  double largest = 0;
+  for (int32_t to = 0; to < nodes; ++to)
+  {
+    std::vector<int32_t>& group = groups[to];
+    if (group.empty())
+    {
+      continue;
+    }
+    group.push_back(to);
+    for (int32_t k = 0; k <= this->LayerCount; ++k)
+    {
+      glm::dvec3 mean(0.0);
+      for (int32_t n : group)
+      {
+        mean += this->Position(n, k) / static_cast<double>(group.size());
+      }
+      for (int32_t n : group)
+      {
+        largest = std::max(largest, glm::length(this->Position(n, k) - mean));
+      }
+      this->SetPosition(to, k, mean);
+      for (int32_t n : group)
+      {
+        if (n != to)
+        {
+          this->NodeQuadric(to, k) += this->NodeQuadric(n, k);
+        }
+      }
+    }
+    for (int32_t n : group)
+    {
+      if (n != to)
+      {
+        this->NodeAlive[n] = 0;
+        auto& columns = this->ColumnsOfNode[to];
+        columns.insert(columns.end(), this->ColumnsOfNode[n].begin(), this->ColumnsOfNode[n].end());
+        this->ColumnsOfNode[n].clear();
+      }
+    }
+  }
+  for (auto& q : this->Corners)
+  {
+    for (int32_t& node : q)
+    {
+      node = into[node];
+    }
+  }
+  return largest;
+}
+
 void ColumnMesh::ComputeOrientation()
 {
   double area = 0;

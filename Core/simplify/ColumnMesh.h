@@ -144,6 +144,13 @@ public:
   /// clockwise: fold-over checks compare with it.
   int Orientation() const { return this->OrientationSign; }
 
+  /// Merges nodes (ours: the hierarchy welds a fault's two sides, see FaultWelding.h):
+  /// node n becomes `into[n]` (n itself: kept), a node that maps to itself. A group takes its
+  /// members' mean position at each interface and the sum of their quadrics, and its columns
+  /// refer to it. Returns the farthest any member's vertex moved. Throws std::logic_error,
+  /// changing nothing, if a column would hold a node twice or a locked column's node would move.
+  double MergeNodes(const std::vector<int32_t>& into);
+
   /// Locked columns are never collapsed (the hierarchy locks diamond boundaries).
   void SetLocked(int32_t column, bool locked) { this->Locked[column] = locked ? 1 : 0; }
   bool IsLocked(int32_t column) const { return this->Locked[column] != 0; }

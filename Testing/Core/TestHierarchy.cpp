@@ -371,8 +371,12 @@ int64_t CheckCut(const MultiresolutionFile& file, const std::set<std::pair<int, 
 /// The boundary nodes of a cut's regions (nodes on an edge only one column of their region
 /// has), by topological coordinate: the distinct positions found there. Two or more at one
 /// pillar are a fault's sides (nodes a region border shares are the same node twice).
+using Pillar = std::array<float, 2>;
+using PillarEdges = std::set<std::pair<Pillar, Pillar>>;
+
 std::map<std::array<float, 2>, std::set<std::vector<double>>> BoundaryPillars(const MultiresolutionFile& file,
-  const std::set<std::pair<int, int64_t>>& cut, std::map<std::pair<int, int64_t>, RegionMesh>& cache)
+  const std::set<std::pair<int, int64_t>>& cut, std::map<std::pair<int, int64_t>, RegionMesh>& cache,
+  PillarEdges* walked = nullptr)
 {
   std::map<std::array<float, 2>, std::set<std::vector<double>>> pillars;
   for (const auto& region : cut)
@@ -402,24 +406,60 @@ std::map<std::array<float, 2>, std::set<std::vector<double>>> BoundaryPillars(co
         }
       }
     }
+    for (const auto& q : mesh.corners)
+    {
+      for (int e = 0; walked && e < 4; ++e)
+      {
+        const uint32_t a = q[e], b = q[(e + 1) % 4];
+        if (uses[{ std::min(a, b), std::max(a, b) }] == 1)
+        {
+          walked->insert({ mesh.topology[a], mesh.topology[b] });
+        }
+      }
+    }
   }
   return pillars;
 }
 
 /// Every fault of the finest level (`faults`: pillars with two sides there) keeps both sides
 /// wherever the cut has either: a side simplified on its own leaves the other alone at the
-/// pillar, and the two part (a gap one sees through). Returns the pillars checked.
+/// pillar, and the two part (a gap one sees through). With `outline` (the finest level's
+/// outline pillars), a fault may also be welded: one node at the pillar, whose boundary edges
+/// (where a weld meets a kept stretch of the fault) each have the other side's edge between
+/// the same pillars; pillars on the outline are left out. Returns the pillars checked.
 int64_t CheckFaultsWhole(const MultiresolutionFile& file, const std::set<std::pair<int, int64_t>>& cut,
   std::map<std::pair<int, int64_t>, RegionMesh>& cache, const std::set<std::array<float, 2>>& faults,
-  const std::string& label)
+  const std::string& label, const std::set<Pillar>* outline = nullptr)
 {
   int64_t checked = 0, alone = 0;
-  for (const auto& pillar : BoundaryPillars(file, cut, cache))
+  PillarEdges walked;
+  for (const auto& pillar : BoundaryPillars(file, cut, cache, &walked))
   {
-    if (faults.count(pillar.first))
+    if (faults.count(pillar.first) && !(outline && outline->count(pillar.first)))
     {
       ++checked;
-      alone += pillar.second.size() < 2;
+      bool partnered = outline != nullptr;
+      for (const auto& edge : walked)
+      {
+        if (edge.first == pillar.first || edge.second == pillar.first)
+        {
+          partnered = partnered && walked.count({ edge.second, edge.first });
+        }
+      }
+      alone += pillar.second.size() < 2 && !partnered;
+      if (pillar.second.size() < 2 && !partnered && getenv("DEBUG_ALONE"))
+      {
+        std::fprintf(stderr, " alone (%g %g):", pillar.first[0], pillar.first[1]);
+        for (const auto& edge : walked)
+        {
+          if (edge.first == pillar.first || edge.second == pillar.first)
+          {
+            std::fprintf(stderr, " (%g %g)->(%g %g)%s", edge.first[0], edge.first[1], edge.second[0], edge.second[1],
+              walked.count({ edge.second, edge.first }) ? "=" : "!");
+          }
+        }
+        std::fprintf(stderr, "\n");
+      }
     }
   }
   if (alone)
@@ -429,6 +469,52 @@ int64_t CheckFaultsWhole(const MultiresolutionFile& file, const std::set<std::pa
   }
   CHECK(alone == 0);
   return checked;
+}
+
+/// A conformal cut: 40 random splits of diamonds whose triangles are all in the cut, from the
+/// roots.
+std::set<std::pair<int, int64_t>> RandomCut(const DiamondHierarchy& tree, int leafLevel, std::mt19937_64& random)
+{
+  std::set<std::pair<int, int64_t>> cut{ { 0, 0 }, { 0, 1 } };
+  for (int step = 0; step < 40; ++step)
+  {
+    std::vector<DiamondHierarchy::Diamond> splittable;
+    for (int level = 0; level < leafLevel; ++level)
+    {
+      for (const auto& d : tree.Diamonds(level))
+      {
+        if (cut.count({ level, d.first }) && (d.second < 0 || cut.count({ level, d.second })))
+        {
+          splittable.push_back(d);
+        }
+      }
+    }
+    if (splittable.empty())
+    {
+      break;
+    }
+    const auto& d = splittable[random() % splittable.size()];
+    for (int64_t t : { d.first, d.second })
+    {
+      if (t >= 0)
+      {
+        cut.erase({ d.level, t });
+        cut.insert({ d.level + 1, 2 * t });
+        cut.insert({ d.level + 1, 2 * t + 1 });
+      }
+    }
+  }
+  return cut;
+}
+
+std::set<std::pair<int, int64_t>> LevelCut(int level)
+{
+  std::set<std::pair<int, int64_t>> cut;
+  for (int64_t t = 0; t < DiamondHierarchy::TriangleCount(level); ++t)
+  {
+    cut.insert({ level, t });
+  }
+  return cut;
 }
 
 void TestHierarchyFile()
@@ -632,14 +718,7 @@ void TestHierarchyFile()
   // of the finest level keep both sides in each (the faults' columns are kept at every level
   // of a model this small).
   std::map<std::pair<int, int64_t>, RegionMesh> cache;
-  const auto levelCut = [&](int level) {
-    std::set<std::pair<int, int64_t>> cut;
-    for (int64_t t = 0; t < DiamondHierarchy::TriangleCount(level); ++t)
-    {
-      cut.insert({ level, t });
-    }
-    return cut;
-  };
+  const auto levelCut = LevelCut;
   std::set<std::array<float, 2>> faults;
   for (const auto& pillar : BoundaryPillars(file, levelCut(report.leafLevel), cache))
   {
@@ -660,36 +739,7 @@ void TestHierarchyFile()
   std::mt19937_64 random(11);
   for (int trial = 0; trial < 12; ++trial)
   {
-    std::set<std::pair<int, int64_t>> cut{ { 0, 0 }, { 0, 1 } };
-    for (int step = 0; step < 40; ++step)
-    {
-      // Split a random diamond whose triangles are all in the cut.
-      std::vector<DiamondHierarchy::Diamond> splittable;
-      for (int level = 0; level < report.leafLevel; ++level)
-      {
-        for (const auto& d : tree.Diamonds(level))
-        {
-          if (cut.count({ level, d.first }) && (d.second < 0 || cut.count({ level, d.second })))
-          {
-            splittable.push_back(d);
-          }
-        }
-      }
-      if (splittable.empty())
-      {
-        break;
-      }
-      const auto& d = splittable[random() % splittable.size()];
-      for (int64_t t : { d.first, d.second })
-      {
-        if (t >= 0)
-        {
-          cut.erase({ d.level, t });
-          cut.insert({ d.level + 1, 2 * t });
-          cut.insert({ d.level + 1, 2 * t + 1 });
-        }
-      }
-    }
+    const std::set<std::pair<int, int64_t>> cut = RandomCut(tree, report.leafLevel, random);
     edges += CheckCut(file, cut, cache, "random cut " + std::to_string(trial));
     pillars += CheckFaultsWhole(file, cut, cache, faults, "random cut " + std::to_string(trial));
   }
@@ -754,6 +804,110 @@ void TestHierarchyFile()
   resmr_testing::ExpectError<FileFormatError>(
     "not ours", [&] { MultiresolutionFile f(damaged); }, { damaged, "not a multiresolution" });
   std::remove(damaged.c_str());
+  std::remove(path.c_str());
+}
+
+/// Faults too long to keep whole (here every fault: `faultColumns` 1) weld at the coarse
+/// levels. Every level and random cut stays closed and crack-free, no fault side stands alone
+/// (no gap), and a welded pillar's region counts half the throw there in its error.
+void TestWeldedFaults()
+{
+  const SyntheticParameters p = SmallModel();
+  const std::string path = TempPath("welded.resmr");
+  HierarchyOptions options;
+  options.cmax = 64;
+  options.threads = 2;
+  options.faultColumns = 1;
+  SyntheticLayerSource source(p, "synth:small");
+  const HierarchyReport report = BuildHierarchy(source, path, options);
+  const MultiresolutionFile file(path);
+  std::map<std::pair<int, int64_t>, RegionMesh> cache;
+  PillarEdges walked;
+  std::set<Pillar> faults, outline;
+  std::map<Pillar, double> halfThrow;
+  for (const auto& pillar : BoundaryPillars(file, LevelCut(report.leafLevel), cache, &walked))
+  {
+    if (pillar.second.size() >= 2)
+    {
+      faults.insert(pillar.first);
+    }
+    if (pillar.second.size() == 2)
+    {
+      const std::vector<double>& a = *pillar.second.begin();
+      const std::vector<double>& b = *pillar.second.rbegin();
+      double& half = halfThrow[pillar.first];
+      for (std::size_t v = 0; v < a.size(); v += 3)
+      {
+        half = std::max(half, std::hypot(a[v] - b[v], a[v + 1] - b[v + 1], a[v + 2] - b[v + 2]) / 2);
+      }
+    }
+  }
+  for (const auto& edge : walked)
+  {
+    if (!walked.count({ edge.second, edge.first }))
+    {
+      outline.insert(edge.first);
+      outline.insert(edge.second);
+    }
+  }
+  CHECK(faults.size() > 50);
+  const auto& step = file.Header().latticeStep;
+  const double rounding = std::hypot(step[0], step[1], step[2]);
+  int64_t welded = 0, pillars = 0, underrated = 0;
+  for (int level = 0; level < report.leafLevel; ++level)
+  {
+    const std::string label = "welded, level " + std::to_string(level);
+    const auto cut = LevelCut(level);
+    CheckCut(file, cut, cache, label);
+    pillars += CheckFaultsWhole(file, cut, cache, faults, label, &outline);
+    for (const auto& region : cut)
+    {
+      const RegionMesh* mesh = CachedRegion(file, region, cache);
+      if (!mesh)
+      {
+        continue;
+      }
+      std::map<std::pair<uint32_t, uint32_t>, int> uses;
+      for (const auto& q : mesh->corners)
+      {
+        for (int e = 0; e < 4; ++e)
+        {
+          ++uses[{ std::min(q[e], q[(e + 1) % 4]), std::max(q[e], q[(e + 1) % 4]) }];
+        }
+      }
+      std::set<uint32_t> boundary;
+      for (const auto& edge : uses)
+      {
+        if (edge.second == 1)
+        {
+          boundary.insert({ edge.first.first, edge.first.second });
+        }
+      }
+      const float error = file.Find(region.first, region.second)->error;
+      for (uint32_t node = 0; node < mesh->topology.size(); ++node)
+      {
+        const auto found = halfThrow.find(mesh->topology[node]);
+        if (found != halfThrow.end() && !boundary.count(node))
+        {
+          ++welded;
+          underrated += error < found->second - rounding;
+        }
+      }
+    }
+  }
+  std::printf("welded: %lld fault nodes inside their regions, %lld pillars checked\n", static_cast<long long>(welded),
+    static_cast<long long>(pillars));
+  CHECK(welded > 20 && pillars > 20);
+  CHECK(underrated == 0);
+  const DiamondHierarchy tree(
+    file.Header().box[0], file.Header().box[1], file.Header().box[2], file.Header().box[3], file.Header().leafLevel);
+  std::mt19937_64 random(12);
+  for (int trial = 0; trial < 12; ++trial)
+  {
+    const auto cut = RandomCut(tree, report.leafLevel, random);
+    CheckCut(file, cut, cache, "welded, random cut " + std::to_string(trial));
+    CheckFaultsWhole(file, cut, cache, faults, "welded, random cut " + std::to_string(trial), &outline);
+  }
   std::remove(path.c_str());
 }
 
@@ -1042,6 +1196,7 @@ int main()
   TestDiamondTree();
   TestBuildSchedule();
   TestHierarchyFile();
+  TestWeldedFaults();
   TestMapAxesInFile();
   TestFailedBuildLeavesNothing();
   if (resmr_testing::Failures)

@@ -1,13 +1,15 @@
 """Every level of the hierarchy watertight and painted honestly.
 
-On the faulted synthetic model, Reek and Brugge (each built with `resmr build`, by default and
-with `--simplify-faults`, and `resmr add-properties`), drawn at tolerances from 1 px to 65536 px
+On the faulted synthetic model, Reek and Brugge (each built with `resmr build` by default, with
+`--fault-columns 1` and with `--simplify-faults`, and `resmr add-properties`), drawn at tolerances from 1 px to 65536 px
 (every level from the leaves to the roots: each doubling) from 4 cameras, and at 8 random
 tolerances from random cameras (random conformal cuts, seeded):
 - no see-through hole in a default build (background pixels that no background of the exact
   frame, 0 px, the same camera, Cell Id colouring, reaches: image_metrics.see_through_holes):
   the faults' columns are kept at every level of these models, and where a region border
-  follows a fault its two sides are locked as any border is. With `--simplify-faults` (each
+  follows a fault its two sides are locked as any border is; nor with `--fault-columns 1`, where
+  no fault fits and the two sides of every fault weld into one surface above the leaves, as
+  at the coarsest levels of a large model. With `--simplify-faults` (each
   fault block's outline simplified on its own) the holes are counted and printed, not
   asserted: 45 to 68 of the 76 frames of each model;
 - no fragment names a cell without a value: coloured by PORO (a value in every active cell),
@@ -46,11 +48,12 @@ CAMERAS = [("above", [0.3, -0.5, 0.8], 1.0), ("side", [1.0, -0.3, 0.25], 1.3),
 view = rt.image_view(WIDTH, HEIGHT)
 failures = []
 rng = random.Random(31)
-for (name, grid), keep in [(m, k) for m in MODELS for k in (True, False)]:
-    label = name + ("" if keep else " (--simplify-faults)")
-    path = os.path.join(temp, name + ("" if keep else "-simplify-faults") + ".resmr")
+BUILDS = [("", [], True), ("welded", ["--fault-columns", "1"], True), ("simplify-faults", ["--simplify-faults"], False)]
+for (name, grid), (variant, options, watertight) in [(m, b) for m in MODELS for b in BUILDS]:
+    label = name + (f" ({' '.join(options)})" if options else "")
+    path = os.path.join(temp, name + ("-" + variant if variant else "") + ".resmr")
     if not os.path.exists(path):
-        rt.run_resmr("build", grid, "-o", path, "--quiet", *([] if keep else ["--simplify-faults"]))
+        rt.run_resmr("build", grid, "-o", path, "--quiet", *options)
         rt.run_resmr("add-properties", path, grid)
     # Each cell's PORO by natural index (NaN where inactive), from the grid reader.
     grid_data = servermanager.Fetch(simple.EGRIDReader(FileName=grid, ApplyMapAxes=0))
@@ -92,10 +95,10 @@ for (name, grid), keep in [(m, k) for m in MODELS for k in (True, False)]:
         frames_with_holes += holes > 0
         if holes:
             print(f"  {label} {camera} {tolerance:g} px: {holes} see-through hole pixels, {depth} deep")
-            if keep:
+            if watertight:
                 failures.append(f"{label} {camera} {tolerance:g} px: {holes} see-through hole pixels")
         display.PaintBy = "Property"
-        tag = f"{name}-{camera}-{tolerance:g}px"
+        tag = f"{name}{'-' + variant if variant else ''}-{camera}-{tolerance:g}px"
         pixels = rt.capture_rgb(view, os.path.join(temp, tag + ".png"), WIDTH, HEIGHT)
         nan = im.nan_pixels(pixels, NAN)
         worst_nan = max(worst_nan, nan)
