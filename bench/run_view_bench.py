@@ -20,6 +20,8 @@ import shutil
 import subprocess
 import time
 
+import numpy as np
+
 from paraview import simple
 
 import view_quality
@@ -184,10 +186,11 @@ def thread_cpu_ms():
     return totals
 
 
-def run_path(view, display, bounds, readout, samples=None):
+def run_path(view, display, bounds, readout, samples=None, background=None):
     """Renders the path, one row a frame; with `samples` (a list), every --quality-every-th
-    frame's camera and tolerance are added to it, and the frame 60% along (in the zoom) is kept
-    as drawn in samples' first entry's "drawn" (one read-back, so the path is barely touched)."""
+    frame's camera and tolerance are added to it, with the pixels it covered as drawn (those not
+    in the `background` colour: one read-back between frames, outside the timing), and the
+    frame 60% along (in the zoom) is kept as drawn in its row's "drawn"."""
     frames = []
     path = camera_path(view, bounds, args.frames)
     keep = int(0.6 * len(path))
@@ -214,6 +217,9 @@ def run_path(view, display, bounds, readout, samples=None):
             if samples is not None and args.quality_every > 0 and index % args.quality_every == 0:
                 samples.append({"frame": index, "position": list(position), "focal": list(focal),
                                 "tolerance": row["tolerance"], "render_scale": row["render_scale"]})
+                if background is not None:
+                    drawn = view_quality.drawn_frame(view)
+                    samples[-1]["drawn_covered"] = np.any(drawn != background, axis=2)
             if samples is not None and index == keep:
                 row["drawn"] = view_quality.drawn_frame(view)
         frames.append(row)
@@ -377,6 +383,8 @@ def measure_multiresolution(model):
     """The Multiresolution Surface on `model`'s path: an entry of results["models"]."""
     grid, path = prepare(model)
     view = new_view(args.fxaa)
+    simple.Render(view)
+    background = view_quality.drawn_frame(view)[0, 0]  # the empty view's colour
     rss_before = rss_mb()
     start = time.perf_counter()
     reader = simple.OpenDataFile(path)
@@ -393,7 +401,7 @@ def measure_multiresolution(model):
     bounds = reader.GetDataInformation().GetBounds()
     samples = []
     with view_quality.BusyLoad(args.busy):
-        frames = run_path(view, display, bounds, True, samples)
+        frames = run_path(view, display, bounds, True, samples, background)
     kept = next((f for f in frames if "drawn" in f), None)
     times = [f["seconds"] for f in frames]
     target_s = 1 / args.fps

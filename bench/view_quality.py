@@ -5,7 +5,9 @@ frame-rate controller chose for it and at 0 px, both in the Cell Id colouring, a
 image, see-through holes, silhouette distance; the same tolerance in the property colouring,
 unlit, counts the pixels in the lookup table's NaN colour. The re-renders wait for every mesh
 (the picture the tolerance stands for, not one still loading) under a budget large enough to
-hold the exact frame. Also a fixed background load (--busy N: N processes spinning at normal
+hold the exact frame. The frame as it was drawn on the path (meshes still loading standing in
+for theirs, at the reduced resolution of a moving frame) is checked for see-through holes
+too, against the same exact frame. Also a fixed background load (--busy N: N processes spinning at normal
 priority for the length of the timed path), as a workstation running a simulation has."""
 import os
 import shutil
@@ -65,6 +67,13 @@ def measure(view, display, samples, budget_mb, folder):
     lut = simple.GetColorTransferFunction("PORO")
     lut.NanColor = NAN_COLOR
     camera = view.GetActiveCamera()
+    # Black behind the Cell Id frames: the colouring's 0, no cell's id (any other colour would
+    # read as a cell, and no hole could be seen).
+    background = list(view.Background)
+    palette = getattr(view, "UseColorPaletteForBackground", None)
+    if palette is not None:
+        view.UseColorPaletteForBackground = 0
+    view.Background = [0.0, 0.0, 0.0]
 
     def shot(tolerance, paint, name):
         display.PaintBy = paint
@@ -79,6 +88,10 @@ def measure(view, display, samples, budget_mb, folder):
         exact = resmr_testing.cell_ids(shot(0, "Cell Id", f"{tag}-0px-cellid.png"))
         got = resmr_testing.cell_ids(shot(sample["tolerance"], "Cell Id", f"{tag}-cellid.png"))
         sample.update(image_metrics.compare(got, exact))
+        covered = sample.pop("drawn_covered", None)
+        if covered is not None:
+            holes, depth = image_metrics.see_through_holes(covered.astype(np.int64), exact)
+            sample["drawn_hole_pixels"], sample["drawn_hole_depth_px"] = holes, depth
         ambient, diffuse = display.Ambient, display.Diffuse
         display.Ambient, display.Diffuse = 1.0, 0.0
         sample["nan_pixels"] = image_metrics.nan_pixels(shot(sample["tolerance"], "Property", f"{tag}-poro.png"),
@@ -86,7 +99,11 @@ def measure(view, display, samples, budget_mb, folder):
         display.Ambient, display.Diffuse = ambient, diffuse
         print(f"  frame {sample['frame']}: {sample['tolerance']:.1f} px, {100 * sample['within_2px']:.1f}% within 2 px, "
               f"{100 * sample['cell_agreement']:.1f}% same cell, {sample['hole_pixels']} hole px, "
-              f"{sample['nan_pixels']} NaN px, silhouette {sample['silhouette_px']} px", flush=True)
+              f"{sample['nan_pixels']} NaN px, silhouette {sample['silhouette_px']} px; as drawn "
+              f"{sample.get('drawn_hole_pixels', '-')} hole px", flush=True)
+    view.Background = background
+    if palette is not None:
+        view.UseColorPaletteForBackground = palette
     return samples
 
 
@@ -106,6 +123,9 @@ def summary(samples):
             "hole_depth_max_px": max(s["hole_depth_px"] for s in samples),
             "nan_pixels_max": max(s["nan_pixels"] for s in samples),
             "silhouette_px_max": max(s["silhouette_px"] for s in samples),
+            "drawn_frames_with_holes": sum(1 for s in samples if s.get("drawn_hole_pixels", 0) > 0),
+            "drawn_hole_pixels_max": max(s.get("drawn_hole_pixels", 0) for s in samples),
+            "drawn_hole_depth_max_px": max(s.get("drawn_hole_depth_px", 0) for s in samples),
             "sampled_tolerance_p50": float(np.percentile([s["tolerance"] for s in samples], 50)),
             "sampled_tolerance_p90": float(np.percentile([s["tolerance"] for s in samples], 90))}
 
@@ -119,10 +139,13 @@ def report_lines(models, out_name):
     lines = ["", "Picture quality of every sampled frame (drawn again at the tolerance the controller chose, and at "
              "0 px, in the Cell Id colouring): 'within 2 px' is the share of pixels whose cell (or background) the "
              "exact image has within 2 pixels; holes are background pixels no background of the exact image reaches "
-             "(see-through gaps); NaN pixels are painted in the lookup table's NaN colour.", "",
+             "(see-through gaps); NaN pixels are painted in the lookup table's NaN colour. 'As drawn': the same holes in "
+             "the frame the user saw on the path (meshes still loading stood in for by coarser ones, a moving frame's "
+             "reduced resolution).", "",
              "| model | load | samples | tolerance p50 / p90 px | within 2 px: min / p10 / p50 | frames >= 95% | "
-             "same cell p50 / min | frames with holes | largest hole px (depth) | NaN px max | silhouette px max |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "same cell p50 / min | frames with holes | largest hole px (depth) | as drawn: frames with holes | "
+             "as drawn: largest hole px (depth) | NaN px max | silhouette px max |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for e in rows:
         lines.append(
             f"| {e['model']} | {e.get('load', 'idle')} | {e['quality_samples']} | "
@@ -130,7 +153,9 @@ def report_lines(models, out_name):
             f"{100 * e['within_2px_min']:.1f}% / {100 * e['within_2px_p10']:.1f}% / {100 * e['within_2px_p50']:.1f}% | "
             f"{100 * e['frames_within_2px_95']:.0f}% | {100 * e['cell_agreement_p50']:.1f}% / "
             f"{100 * e['cell_agreement_min']:.1f}% | {e['frames_with_holes']} | {e['hole_pixels_max']} "
-            f"({e['hole_depth_max_px']}) | {e['nan_pixels_max']} | {e['silhouette_px_max']} |")
+            f"({e['hole_depth_max_px']}) | {e.get('drawn_frames_with_holes', '-')} | "
+            f"{e.get('drawn_hole_pixels_max', '-')} ({e.get('drawn_hole_depth_max_px', '-')}) | "
+            f"{e['nan_pixels_max']} | {e['silhouette_px_max']} |")
     for e in rows:
         example = e.get("moving_example")
         if example:
