@@ -9,6 +9,7 @@
 #include "CornerPointGeometry.h"
 #include "CornerPointModel.h"
 #include "EclipseGrid.h"
+#include "FaultWelding.h"
 #include "MeshQuality.h"
 #include "SyntheticReservoir.h"
 
@@ -401,6 +402,67 @@ void TestFault()
     CHECK(!(west && east));
   }
   CHECK(resmr::MeasureHexahedra(resmr::ToHexMesh(mesh), mesh.Orientation()).inverted == 0);
+}
+
+/// TestFault's grid: 4 x 3 x 2 cells of 10 m, columns i >= 2 thrown down 5 m.
+resmr::ColumnMesh ThrownGrid()
+{
+  auto corners = [](int64_t i, int64_t j, int64_t k, double out[8][3]) {
+    for (int c = 0; c < 8; ++c)
+    {
+      out[c][0] = 10.0 * static_cast<double>(i + (c & 1));
+      out[c][1] = 10.0 * static_cast<double>(j + ((c >> 1) & 1));
+      out[c][2] = 1000.0 + (i >= 2 ? 5.0 : 0.0) + static_cast<double>(k + (c >> 2));
+    }
+  };
+  return resmr::ColumnMesh::FromCells({ 4, 3, 2 }, corners, std::vector<bool>(24, true), 0, 4, 0, 3);
+}
+
+void TestWeldFaults()
+{
+  // Welded: the four split pillars become one node each, at the mean of the two sides (2.5 m
+  // from each), and the columns across the fault become neighbours.
+  resmr::ColumnMesh mesh = ThrownGrid();
+  const int32_t fault = mesh.ColumnCorners(5)[2]; // (1, 1)'s corner on pillar (2, 2), west side
+  const glm::dvec3 west = mesh.Position(fault, 1);
+  const resmr::FaultWeld weld = resmr::WeldFaults(mesh);
+  CHECK(weld.edges == 3 && weld.nodes == 4);
+  CHECK(std::fabs(weld.largestMove - 2.5) < 1e-9);
+  CHECK(!mesh.IsBoundaryEdge(5, 1) && !mesh.IsBoundaryEdge(6, 3));
+  CHECK(mesh.ColumnCorners(5)[1] == mesh.ColumnCorners(6)[0] && mesh.ColumnCorners(5)[2] == mesh.ColumnCorners(6)[3]);
+  const int32_t joined = mesh.ColumnCorners(5)[2];
+  CHECK(glm::length(mesh.Position(joined, 1) - (west + glm::dvec3(0, 0, 2.5))) < 1e-9);
+  CHECK(mesh.NodeColumns(joined).size() == 4);
+  CHECK(resmr::MeasureHexahedra(resmr::ToHexMesh(mesh), mesh.Orientation()).inverted == 0);
+  int64_t boundaryNodes = 0;
+  for (int32_t n = 0; n < mesh.NodeCount(); ++n)
+  {
+    boundaryNodes += mesh.IsNodeAlive(n) && mesh.IsBoundaryNode(n);
+  }
+  CHECK(boundaryNodes == 14); // the outline of a 4 x 3 grid only
+  // A locked column keeps its nodes: the fault edges touching it stay apart, and so does a
+  // pillar both of whose welded edges touch one.
+  resmr::ColumnMesh locked = ThrownGrid();
+  locked.SetLocked(1, true); // (1, 0), on pillars (2, 0) and (2, 1)
+  const resmr::FaultWeld partial = resmr::WeldFaults(locked);
+  CHECK(partial.edges == 1 && partial.nodes == 2);
+  CHECK(locked.IsBoundaryEdge(1, 1) && locked.IsBoundaryEdge(5, 1) && !locked.IsBoundaryEdge(9, 1));
+  // MergeNodes refuses, changing nothing, what would break the mesh.
+  resmr::ColumnMesh grid = Grid(2, 1, 1);
+  std::vector<int32_t> into(static_cast<std::size_t>(grid.NodeCount()));
+  for (int32_t n = 0; n < grid.NodeCount(); ++n)
+  {
+    into[n] = n;
+  }
+  into[1] = 0; // two corners of column 0
+  resmr_testing::ExpectError<std::logic_error>(
+    "merge within a column", [&] { grid.MergeNodes(into); }, { "one node twice" });
+  CHECK(grid.ColumnCorners(0)[1] == 1 && grid.IsNodeAlive(1));
+  into[1] = 1;
+  into[2] = 0; // nodes of columns 1 and 0 only, but column 1 is locked
+  grid.SetLocked(1, true);
+  resmr_testing::ExpectError<std::logic_error>(
+    "merge into a locked column", [&] { grid.MergeNodes(into); }, { "locked" });
 }
 
 resmr::ColumnMesh Reek(std::vector<bool>& active, resmr::CornerPointGeometry*& geometryOut)
@@ -846,6 +908,7 @@ int main(int argc, char** argv)
   TestRandomSimplificationInvariants();
   TestDoubletCascade();
   TestFault();
+  TestWeldFaults();
   TestRealModel();
   TestLockedColumns();
   TestEdgeRotation();
