@@ -157,16 +157,15 @@ vtkMultiresolutionGpuRegions::RegionMap::iterator vtkMultiresolutionGpuRegions::
 }
 
 void vtkMultiresolutionGpuRegions::ReleaseUnwanted(
-  const std::vector<std::size_t>& order, RegionMap::iterator entry, std::size_t gpuShare)
+  const std::vector<std::size_t>& order, std::size_t position, RegionMap::iterator entry, std::size_t gpuShare)
 {
   std::vector<std::pair<std::size_t, std::size_t>> mirrored;
   for (const auto& copy : this->Regions)
   {
     mirrored.emplace_back(copy.first, copy.second->Bytes);
   }
-  const std::set<std::size_t> wanted(order.begin(), order.end());
   for (std::size_t region :
-    resmr::CopiesToRelease(mirrored, wanted, this->GpuBytes, entry->second->NextPieceBytes(), gpuShare))
+    resmr::CopiesToRelease(mirrored, order, position, this->GpuBytes, entry->second->NextPieceBytes(), gpuShare))
   {
     this->Erase(this->Regions.find(region));
   }
@@ -200,8 +199,8 @@ bool vtkMultiresolutionGpuRegions::Upload(const resmr::RegionCache& cache, const
     {
       // Pieces copy a little more than the cache holds (vertices shared at piece seams), so
       // mirroring the cache can still pass the share: copies this frame does not want go
-      // next (the cache still has them), then uploads wait.
-      this->ReleaseUnwanted(order, found, gpuShare);
+      // next (the cache still has them), then copies it needs less, then uploads wait.
+      this->ReleaseUnwanted(order, n, found, gpuShare);
       if (overShare())
       {
         return true;

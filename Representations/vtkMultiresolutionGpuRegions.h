@@ -65,8 +65,10 @@ private:
   /// The region's copy, started from the cache's buffers if it has none; end() if neither.
   RegionMap::iterator Find(std::size_t region, const resmr::RegionCache& cache);
   void Erase(RegionMap::iterator entry);
-  /// Frees copies not in `order` until the next piece of `entry` fits `gpuShare`.
-  void ReleaseUnwanted(const std::vector<std::size_t>& order, RegionMap::iterator entry, std::size_t gpuShare);
+  /// Frees copies not in `order`, then those after `position` in it, until the next piece of
+  /// `entry` fits `gpuShare`.
+  void ReleaseUnwanted(
+    const std::vector<std::size_t>& order, std::size_t position, RegionMap::iterator entry, std::size_t gpuShare);
 
   RegionMap Regions;
   std::size_t GpuBytes = 0;

@@ -43,7 +43,9 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <limits>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -460,7 +462,8 @@ bool vtkMultiresolutionSurfaceMapper::OpenFiles(Frame& frame)
         in.Properties = properties;
       }
       in.Selector.reset(new resmr::ViewSelector(*in.File));
-      in.Cache.reset(new resmr::RegionCache(in.File, in.Properties, resmr::MainMemoryShare(this->MemoryBudgetMB)));
+      in.Cache.reset(
+        new resmr::RegionCache(in.File, in.Properties, resmr::MainMemoryShare(this->MemoryBudgetMB), true));
       in.FilePath = frame.filePath;
       in.PropertyPath = frame.propertyPath;
       in.PropertyStamp = frame.propertyStamp;
@@ -598,13 +601,23 @@ void vtkMultiresolutionSurfaceMapper::SelectRegions(Frame& frame)
   // Select, and ask for what is missing and what the next frame will probably want.
   const auto resident = [&cache](std::size_t region) { return cache.IsResident(region); };
   frame.selection = in.Selector->Select(frame.view, resident);
-  std::vector<std::size_t> predicted;
+  // Regions whose error shows draw their simplified side: their exact one is not loaded.
+  std::vector<std::size_t> predicted, simplified;
   if (in.HavePreviousView)
   {
     const auto all = [](std::size_t) { return true; };
-    predicted = in.Selector->Select(resmr::PredictNextView(in.PreviousView, frame.view), all).wanted;
+    const resmr::ViewParameters next = resmr::PredictNextView(in.PreviousView, frame.view);
+    predicted = in.Selector->Select(next, all).wanted;
+    simplified = resmr::RegionsPastCoarseSide(*in.File, predicted, next);
   }
-  cache.Request(frame.selection.wanted, predicted);
+  const auto request = [&]() {
+    std::vector<std::size_t> lean = resmr::RegionsPastCoarseSide(*in.File, frame.selection.wanted, frame.view);
+    const std::set<std::size_t> wanted(frame.selection.wanted.begin(), frame.selection.wanted.end());
+    std::copy_if(simplified.begin(), simplified.end(), std::back_inserter(lean),
+      [&](std::size_t r) { return !wanted.count(r); }); // this frame's choice first
+    cache.Request(frame.selection.wanted, predicted, lean);
+  };
+  request();
   // The roots stand in for everything, so a frame missing them (the first of a file or a
   // layer) blocks until the loader has them, never polling: they are the smallest meshes
   // and load first, and no frame shows a hole where the model is. Detail never waits here.
@@ -622,7 +635,7 @@ void vtkMultiresolutionSurfaceMapper::SelectRegions(Frame& frame)
       cache.WaitIdle(
         std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()));
       frame.selection = in.Selector->Select(frame.view, resident);
-      cache.Request(frame.selection.wanted, predicted);
+      request();
     }
   }
   in.PreviousView = frame.view;
@@ -804,10 +817,22 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
 
   glFrontFace(GL_CCW);
   state->vtkglDisable(GL_CULL_FACE);
-  in.Substituted = static_cast<int>(frame.selection.substituted);
+  in.Substituted = static_cast<int>(frame.selection.substituted + this->SidesStandingIn(frame));
   in.Tables.Unbind();
   in.Timer.End();
   vtkOpenGLCheckErrorMacro("after drawing the multiresolution surface");
+}
+
+std::size_t vtkMultiresolutionSurfaceMapper::SidesStandingIn(const Frame& frame) const
+{
+  // A region whose exact side is wanted but not loaded yet draws its simplified one meanwhile.
+  std::size_t count = 0;
+  for (const resmr::DrawnRegion& drawn : frame.selection.drawn)
+  {
+    const auto buffers = this->Internal->Cache->Get(drawn.region);
+    count += frame.layer < 0 && buffers && !buffers->exactSides && drawn.projectedError <= resmr::CoarseSidePixels;
+  }
+  return count;
 }
 
 int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bool, 3>& kinds)

@@ -182,6 +182,8 @@ private:
   /// Draws the selected regions' faces of the kinds flagged (top, bottom, side) with the
   /// frame's program; the regions drawn.
   int DrawFaces(Frame& frame, const std::array<bool, 3>& kinds);
+  /// Drawn regions showing their simplified side while their exact one loads.
+  std::size_t SidesStandingIn(const Frame& frame) const;
   /// Loads pending, errors, readout and the frame-rate controller.
   void FinishFrame(Frame& frame);
 };

@@ -21,7 +21,8 @@
 //   the run's thickness, within the error the region already has; on many-layer models this
 //   removes most of the coarse levels' stacked top faces (half the frame time of an overview
 //   of the synthetic 100M model under llvmpipe). Columns with a cut edge are never sealed,
-//   so regions meet as before; nor are the leaves, which keep the original faces exactly.
+//   so regions meet as before; nor are the leaves, which keep the original faces exactly
+//   (the viewer seals their runs of no thickness, whose faces hide nothing).
 // - The file stores top and bottom quads and the simplified side triangles
 //   (SideSurfaceSimplification.h); side quads are derived on demand (ExtractSurfaces).
 // - The single-layer view needs no stored surface: ExtractLayerSurfaces() derives it from the

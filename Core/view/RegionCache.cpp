@@ -275,24 +275,44 @@ void UseOriginalSideFaces(RegionMesh& mesh)
   ExtractSurfaces(mesh);
   mesh.sideTriangles.clear();
   mesh.sideTriangles.reserve(mesh.side.quads.size() * 2);
+  const auto at = [&](uint32_t vertex) { return &mesh.positions[static_cast<std::size_t>(vertex) * 3]; };
+  const auto same = [&](uint32_t a, uint32_t b) { return std::equal(at(a), at(a) + 3, at(b)); };
   for (const auto& quad : mesh.side.quads)
   {
+    if (same(quad[0], quad[1]) && same(quad[2], quad[3]))
+    {
+      continue; // a cell of no thickness at either end: the face covers nothing
+    }
     mesh.sideTriangles.push_back({ quad[0], quad[1], quad[2] });
     mesh.sideTriangles.push_back({ quad[0], quad[2], quad[3] });
   }
 }
 
 RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
-  const std::array<double, 3>& origin, int handedness, int32_t layer)
+  const std::array<double, 3>& origin, int handedness, int32_t layer, bool exactSides)
 {
   RegionMesh mesh = file.ReadRegion(region); // not ReadRegionSurfaces: the buffers need positions
   if (layer >= 0)
   {
     return PrepareLayerDrawBuffers(mesh, layer, origin, handedness);
   }
+  if (!(mesh.sealedPinchThickness > 0))
+  {
+    // Leaves (and older files) seal only runs of no thickness at all: their faces lie on one
+    // another inside the solid and hide nothing, but on models that pinch out they are most
+    // of the leaves' top and bottom triangles.
+    mesh.sealedPinchThickness = std::numeric_limits<double>::min();
+  }
   const std::vector<std::array<uint32_t, 3>> simplifiedSide = mesh.sideTriangles;
   UseOriginalSideFaces(mesh);
+  // Without a simplified side in the file, the exact one is the only side there is.
+  const bool exact = exactSides || simplifiedSide.empty();
+  if (!exact)
+  {
+    mesh.sideTriangles.clear();
+  }
   RegionDrawBuffers out = PrepareRegionDrawBuffers(mesh, origin, handedness);
+  out.exactSides = exact;
   AddCoarseSide(mesh, simplifiedSide, origin, handedness, out);
   return out;
 }
@@ -417,23 +437,26 @@ RegionDrawBuffers PrepareLayerDrawBuffers(
 }
 
 RegionCache::RegionCache(std::shared_ptr<const MultiresolutionFile> file,
-  std::shared_ptr<const PropertyFile> properties, std::size_t budgetBytes)
+  std::shared_ptr<const PropertyFile> properties, std::size_t budgetBytes, bool simplifiedSides)
   : File(std::move(file))
   , Properties(std::move(properties))
+  , SimplifiedSides(simplifiedSides)
   , BudgetBytes(budgetBytes)
 {
   const auto& origin = this->File->Header().latticeOrigin;
   this->ModelOrigin = { origin[0], origin[1], -origin[2] };
-  this->LayerSlots = static_cast<uint64_t>(std::max<int64_t>(this->File->Header().dims[2], 0)) + 1;
+  this->LayerSlots = static_cast<uint64_t>(std::max<int64_t>(this->File->Header().dims[2], 0)) + 2;
   const std::size_t count = this->File->Regions().size();
   this->IsRoot.assign(count, 0);
+  this->IsLeaf.assign(count, 0);
   for (std::size_t r = 0; r < count; ++r)
   {
+    this->IsLeaf[r] = this->File->Regions()[r].level == this->File->Header().leafLevel;
     if (this->File->Regions()[r].level == 0)
     {
       this->Roots.push_back(r);
       this->IsRoot[r] = 1;
-      this->Pinned.push_back(this->KeyOf(r, this->CurrentLayer));
+      this->Pinned.push_back(this->RequestKeyLocked(r, this->CurrentLayer, true));
     }
   }
   this->Loader = std::thread([this] { this->Run(Role::Idle); });
@@ -464,7 +487,7 @@ RegionCache::~RegionCache()
 
 bool RegionCache::SetLayer(int32_t layer)
 {
-  if (layer < -1 || static_cast<uint64_t>(layer + 1) >= this->LayerSlots)
+  if (layer < -1 || layer >= this->SimplifiedLayer())
   {
     return false;
   }
@@ -478,7 +501,7 @@ bool RegionCache::SetLayer(int32_t layer)
     this->Pinned.clear();
     for (std::size_t r : this->Roots)
     {
-      this->Pinned.push_back(this->KeyOf(r, layer));
+      this->Pinned.push_back(this->RequestKeyLocked(r, layer, true));
     }
     // The old layer's request is void: its regions become evictable, and none loads now.
     this->Wanted.clear();
@@ -503,12 +526,21 @@ std::shared_ptr<const RegionDrawBuffers> RegionCache::Get(std::size_t region) co
 {
   std::lock_guard<std::mutex> lock(this->Lock);
   const auto found = this->Entries.find(this->KeyOf(region, this->CurrentLayer));
-  return found == this->Entries.end() ? nullptr : found->second.buffers;
+  if (found != this->Entries.end() && found->second.buffers)
+  {
+    return found->second.buffers;
+  }
+  if (this->CurrentLayer >= 0 || !this->SimplifiedSides)
+  {
+    return nullptr;
+  }
+  const auto simplified = this->Entries.find(this->KeyOf(region, this->SimplifiedLayer()));
+  return simplified == this->Entries.end() ? nullptr : simplified->second.buffers;
 }
 
 std::shared_ptr<const RegionDrawBuffers> RegionCache::Get(std::size_t region, int32_t layer) const
 {
-  if (layer < -1 || static_cast<uint64_t>(layer + 1) >= this->LayerSlots)
+  if (layer < -1 || layer >= this->SimplifiedLayer())
   {
     return nullptr;
   }
@@ -522,7 +554,8 @@ bool RegionCache::IsResident(std::size_t region) const
   return this->Get(region) != nullptr;
 }
 
-void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vector<std::size_t>& predicted)
+void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vector<std::size_t>& predicted,
+  const std::vector<std::size_t>& simplified)
 {
   {
     std::lock_guard<std::mutex> lock(this->Lock);
@@ -535,9 +568,21 @@ void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vec
     this->Clock += 2;
     const std::size_t count = this->IsRoot.size();
     const int32_t layer = this->CurrentLayer;
+    std::vector<uint8_t> lean;
+    if (this->SimplifiedSides && layer < 0)
+    {
+      lean.assign(count, 0);
+      for (std::size_t r : simplified)
+      {
+        lean[r < count ? r : 0] = r < count;
+      }
+    }
+    const auto keyOf = [&](std::size_t r, int32_t l) {
+      return this->RequestKeyLocked(r, l, l < 0 && !lean.empty() && lean[r]);
+    };
     for (std::size_t r : wanted)
     {
-      const Key key = this->KeyOf(r, layer);
+      const Key key = r < count ? keyOf(r, layer) : 0;
       if (r < count && this->InWanted.insert(key).second)
       {
         this->Wanted.push_back(key);
@@ -545,7 +590,7 @@ void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vec
       }
     }
     const auto predict = [&](std::size_t r, int32_t l) {
-      const Key key = this->KeyOf(r, l);
+      const Key key = r < count ? keyOf(r, l) : 0;
       if (r < count && !this->InWanted.count(key) && this->InPredicted.insert(key).second)
       {
         this->Predicted.push_back(key);
@@ -559,7 +604,7 @@ void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vec
     // The next layer switch is probably to a neighbour: its roots, so that it need not wait.
     for (const int32_t next : { layer + 1, layer - 1 })
     {
-      if (layer >= 0 && next >= 0 && static_cast<uint64_t>(next + 1) < this->LayerSlots)
+      if (layer >= 0 && next >= 0 && next < this->SimplifiedLayer())
       {
         for (std::size_t r : this->Roots)
         {
@@ -738,7 +783,20 @@ std::string RegionCache::LastError() const
 
 bool RegionCache::IsPinnedLocked(Key key) const
 {
-  return this->IsRoot[this->RegionOf(key)] && this->LayerOf(key) == this->CurrentLayer;
+  return std::find(this->Pinned.begin(), this->Pinned.end(), key) != this->Pinned.end();
+}
+
+RegionCache::Key RegionCache::RequestKeyLocked(std::size_t region, int32_t layer, bool simplified) const
+{
+  const Key whole = this->KeyOf(region, layer);
+  if (layer >= 0 || !this->SimplifiedSides || this->IsLeaf[region] || !(simplified || this->IsRoot[region]))
+  {
+    return whole;
+  }
+  // Resident with its exact side already: that copy serves, and nothing is read again.
+  const auto found = this->Entries.find(whole);
+  const bool haveWhole = found != this->Entries.end() && found->second.buffers;
+  return haveWhole && !this->IsRoot[region] ? whole : this->KeyOf(region, this->SimplifiedLayer());
 }
 
 std::vector<RegionCache::Key> RegionCache::EvictableLocked(Key key) const
@@ -1133,8 +1191,9 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key)
   try
   {
     // ReadRegion, not ReadRegionSurfaces: the buffers need the positions.
+    const bool simplified = layer == this->SimplifiedLayer();
     buffers = std::make_shared<RegionDrawBuffers>(
-      LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin, handedness, layer));
+      LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin, handedness, simplified ? -1 : layer, !simplified));
   }
   catch (const std::exception& e)
   {

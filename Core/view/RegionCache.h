@@ -29,7 +29,10 @@
 //   next region of the request cannot fit, loading stops there (Pending() false) until the
 //   next Request or SetBudget.
 // - Buffers are made from MultiresolutionFile::ReadRegion (ReadRegionSurfaces drops the
-//   positions).
+//   positions). Leaves are drawn with their runs of no thickness sealed (RegionMesh.h) and no
+//   side face of no area. With simplified sides (ours), a whole-model region above the leaves
+//   may be held without its exact side (see Request): on models of many layers that side is
+//   most of a coarse region's bytes, and a region whose error shows draws the simplified one.
 // - Property tables (Sec. 5.4: one value a hash slot) load the same way, off the render
 //   thread; the previous table stays current until the new one is ready.
 // - Loading runs on a thread below the render thread (SCHED_IDLE on Linux: it takes only
@@ -76,6 +79,9 @@ struct RegionDrawBuffers
   /// (see UseOriginalSideFaces); for regions whose error projects to a few pixels or more.
   /// 0 when absent (a layer's buffers).
   uint32_t coarseSideIndices = 0;
+  /// false: the exact side was left out (sideIndices 0; RegionCache's simplified sides), the
+  /// coarse side stands for it.
+  bool exactSides = true;
   int32_t layer = -1; ///< the layer drawn (0-based), -1: the whole model
   /// Normal cones of the top and bottom parts (RegionSurface::cone). A layer's faces are not
   /// the region's stored surfaces, so their culling needs their own cones.
@@ -111,9 +117,11 @@ RegionDrawBuffers PrepareLayerDrawBuffers(
   const RegionMesh& mesh, int32_t layer, const std::array<double, 3>& origin, int handedness);
 
 /// What the cache loads for a region: its mesh read and checked, its own side faces, buffers;
-/// of one layer (0-based) when `layer` >= 0.
+/// of one layer (0-based) when `layer` >= 0. Without `exactSides` (the whole model only) the
+/// region's own side faces are left out when the file has its simplified side: on models of
+/// many layers they are most of a coarse region's bytes.
 RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
-  const std::array<double, 3>& origin, int handedness, int32_t layer = -1);
+  const std::array<double, 3>& origin, int handedness, int32_t layer = -1, bool exactSides = true);
 
 /// A run of a region's triangles copied to the GPU as one piece: indices [first, end) and
 /// the vertices [lowVertex, highVertex] they use.
@@ -149,9 +157,10 @@ struct ModelTables
 class RegionCache
 {
 public:
-  /// Starts the loader thread. `properties` may be null.
+  /// Starts the loader thread. `properties` may be null. With `simplifiedSides`, whole-model
+  /// regions above the leaves may be loaded without their exact side (see Request).
   RegionCache(std::shared_ptr<const MultiresolutionFile> file, std::shared_ptr<const PropertyFile> properties,
-    std::size_t budgetBytes);
+    std::size_t budgetBytes, bool simplifiedSides = false);
   ~RegionCache(); ///< stops and joins the loader thread
   RegionCache(const RegionCache&) = delete;
   RegionCache& operator=(const RegionCache&) = delete;
@@ -170,14 +179,20 @@ public:
   int32_t Layer() const;
 
   /// The buffers of a resident region (of the current layer, or of `layer`), or null. Never
-  /// blocks on loading.
+  /// blocks on loading. Of the whole model: with its exact side when resident so, else
+  /// without (RegionDrawBuffers::exactSides).
   std::shared_ptr<const RegionDrawBuffers> Get(std::size_t region) const;
   std::shared_ptr<const RegionDrawBuffers> Get(std::size_t region, int32_t layer) const;
   bool IsResident(std::size_t region) const;
 
   /// The frame's wanted regions in loading order (replaces the previous request), then regions
-  /// wanted by predicted frames, loaded after and evicted first.
-  void Request(const std::vector<std::size_t>& wanted, const std::vector<std::size_t>& predicted = {});
+  /// wanted by predicted frames, loaded after and evicted first. With simplified sides (see
+  /// the constructor), regions in `simplified` above the leaves are wanted without their
+  /// exact side unless they are resident with it; the roots always are (they stand in for
+  /// everything, and their exact side is most of their bytes); the rest are wanted whole, and
+  /// Get returns them without their exact side until they are.
+  void Request(const std::vector<std::size_t>& wanted, const std::vector<std::size_t>& predicted = {},
+    const std::vector<std::size_t>& simplified = {});
   /// Asks for a property table (name, step): the packed table, or the 2D table of `layer`
   /// (0-based); Property() keeps the previous one until it loads.
   void RequestProperty(const std::string& name, int32_t step, int32_t layer = -1);
@@ -212,7 +227,8 @@ public:
   void SetStarvationWindow(std::chrono::milliseconds window);
 
 private:
-  /// Entries are keyed by (region, layer): region * (nk + 1) + layer + 1.
+  /// Entries are keyed by (region, layer): region * (nk + 2) + layer + 1, the whole model's
+  /// buffers without their exact side at layer nk.
   using Key = uint64_t;
   Key KeyOf(std::size_t region, int32_t layer) const
   {
@@ -269,10 +285,16 @@ private:
   std::shared_ptr<const PropertyFile> Properties;
   std::array<double, 3> ModelOrigin{};
   int Handedness = 1;
-  uint64_t LayerSlots = 1; ///< nk + 1
+  uint64_t LayerSlots = 1; ///< nk + 2
   int32_t CurrentLayer = -1;
+  bool SimplifiedSides = false;
   std::vector<std::size_t> Roots;
-  std::vector<uint8_t> IsRoot; ///< per region
+  std::vector<uint8_t> IsRoot, IsLeaf; ///< per region
+  /// The layer a key of the whole model without its exact side has (nk).
+  int32_t SimplifiedLayer() const { return static_cast<int32_t>(this->LayerSlots) - 2; }
+  /// The key of `region` in `layer` as a request wants it (`simplified`: its exact side may
+  /// be left out). Lock held.
+  Key RequestKeyLocked(std::size_t region, int32_t layer, bool simplified) const;
   mutable std::mutex Lock;
   mutable std::condition_variable Wake, Idle, StandbyWake;
   std::thread Loader, Standby, Essential;

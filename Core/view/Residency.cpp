@@ -1,6 +1,9 @@
 // Residency and stand-ins (paper Sec. 6.2); see Residency.h.
 #include "Residency.h"
 
+#include <algorithm>
+#include <map>
+
 namespace resmr
 {
 
@@ -15,20 +18,41 @@ std::size_t GpuShare(int budgetMB)
 }
 
 std::vector<std::size_t> CopiesToRelease(const std::vector<std::pair<std::size_t, std::size_t>>& mirrored,
-  const std::set<std::size_t>& wanted, std::size_t gpuBytes, std::size_t pieceBytes, std::size_t gpuShare)
+  const std::vector<std::size_t>& order, std::size_t position, std::size_t gpuBytes, std::size_t pieceBytes,
+  std::size_t gpuShare)
 {
+  std::map<std::size_t, std::size_t> rank; // a region's first place in the order
+  for (std::size_t n = order.size(); n-- > 0;)
+  {
+    rank[order[n]] = n;
+  }
+  std::vector<std::pair<std::size_t, std::size_t>> later; // (rank, bytes) of copies after `position`
   std::vector<std::size_t> release;
   for (const auto& copy : mirrored)
+  {
+    const auto found = rank.find(copy.first);
+    if (found == rank.end())
+    {
+      if (gpuBytes + pieceBytes > gpuShare)
+      {
+        release.push_back(copy.first);
+        gpuBytes -= copy.second;
+      }
+    }
+    else if (found->second > position)
+    {
+      later.emplace_back(found->second, copy.second);
+    }
+  }
+  std::sort(later.rbegin(), later.rend());
+  for (const auto& copy : later)
   {
     if (gpuBytes + pieceBytes <= gpuShare)
     {
       break;
     }
-    if (wanted.count(copy.first) == 0)
-    {
-      release.push_back(copy.first);
-      gpuBytes -= copy.second;
-    }
+    release.push_back(order[copy.first]);
+    gpuBytes -= copy.second;
   }
   return release;
 }
@@ -57,12 +81,27 @@ bool MayStandIn(const PropertyTableData* table, const PropertyRequest& request)
   return request.wanted && table && table->name == request.name && table->layer == request.layer;
 }
 
+std::vector<std::size_t> RegionsPastCoarseSide(
+  const MultiresolutionFile& file, const std::vector<std::size_t>& regions, const ViewParameters& view)
+{
+  std::vector<std::size_t> past;
+  for (std::size_t r : regions)
+  {
+    if (r < file.Regions().size() && ProjectedErrorPixels(file.Regions()[r], view) > CoarseSidePixels)
+    {
+      past.push_back(r);
+    }
+  }
+  return past;
+}
+
 std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers, const DrawnRegion& drawn, bool layerView,
   const RegionRecord& region, const ViewParameters& view)
 {
   const bool top = !layerView ? drawn.top : !SurfaceCulled(buffers.topCone, region, view);
   const bool bottom = !layerView ? drawn.bottom : !SurfaceCulled(buffers.bottomCone, region, view);
-  const bool coarseSide = buffers.coarseSideIndices > 0 && drawn.projectedError > CoarseSidePixels;
+  const bool coarseSide =
+    buffers.coarseSideIndices > 0 && (drawn.projectedError > CoarseSidePixels || !buffers.exactSides);
   const uint32_t exactSide = buffers.topIndices + buffers.bottomIndices;
   DrawPart side{ drawn.side, exactSide, buffers.sideIndices, 2 };
   if (coarseSide)

@@ -27,12 +27,15 @@ std::size_t MainMemoryShare(int budgetMB);
 /// The GPU mirror's share: the rest of the budget.
 std::size_t GpuShare(int budgetMB);
 
-/// GPU copies to release, in order, before a piece of `pieceBytes` can be copied: copies not
-/// `wanted` this frame (the cache still has them), taken from `mirrored` (region, bytes on the
-/// GPU) in its order until `gpuBytes` plus the piece fit `gpuShare`. The result may not be
-/// enough: then uploads wait.
+/// GPU copies to release, in order, before a piece of `pieceBytes` of the region at
+/// `position` in `order` (the frame's regions, most needed first) can be copied, until
+/// `gpuBytes` plus the piece fit `gpuShare`: copies of regions not in `order` (the cache still
+/// has them), taken from `mirrored` (region, bytes on the GPU) in its order; then copies of
+/// regions after `position`, the last first, so that a coarse region the cut needs is never
+/// kept out by finer ones copied before it. The result may not be enough: then uploads wait.
 std::vector<std::size_t> CopiesToRelease(const std::vector<std::pair<std::size_t, std::size_t>>& mirrored,
-  const std::set<std::size_t>& wanted, std::size_t gpuBytes, std::size_t pieceBytes, std::size_t gpuShare);
+  const std::vector<std::size_t>& order, std::size_t position, std::size_t gpuBytes, std::size_t pieceBytes,
+  std::size_t gpuShare);
 
 /// The property table a frame asks for.
 struct PropertyRequest
@@ -59,6 +62,11 @@ bool MayStandIn(const PropertyTableData* table, const PropertyRequest& request);
 /// Projected error (pixels) past which a region's simplified side replaces its exact one.
 constexpr double CoarseSidePixels = 2.0;
 
+/// The regions of `regions` whose error seen from `view` passes CoarseSidePixels: they draw
+/// their simplified side, so the cache need not hold their exact one (RegionCache::Request).
+std::vector<std::size_t> RegionsPastCoarseSide(
+  const MultiresolutionFile& file, const std::vector<std::size_t>& regions, const ViewParameters& view);
+
 /// A run of a region's indices drawn as one kind of face (0 top, 1 bottom, 2 side).
 struct DrawPart
 {
@@ -72,7 +80,8 @@ struct DrawPart
 /// (`layerView`) by their own cones against `region` and `view`. Where the region's error
 /// already shows (over CoarseSidePixels) its simplified side is drawn, when it has one: the
 /// geometry is no closer than that error anyway, and on models of many layers it is most of
-/// the triangles.
+/// the triangles. Buffers loaded without their exact side draw the simplified one whatever the
+/// error.
 std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers, const DrawnRegion& drawn, bool layerView,
   const RegionRecord& region, const ViewParameters& view);
 

@@ -336,6 +336,11 @@ bool SurfaceCulled(const std::array<float, 4>& cone, const RegionRecord& region,
   return !(cone[3] > -1.5f) || BackFacing(cone, Corners(region), view);
 }
 
+double ProjectedErrorPixels(const RegionRecord& region, const ViewParameters& view)
+{
+  return ProjectedError(region, view);
+}
+
 ViewSelection ViewSelector::Select(const ViewParameters& view, const std::function<bool(std::size_t)>& resident) const
 {
   const auto& regions = this->File->Regions();

@@ -108,6 +108,9 @@ private:
 /// view, whose faces are not those surfaces, culls its layer's top and bottom the same way.
 bool SurfaceCulled(const std::array<float, 4>& cone, const RegionRecord& region, const ViewParameters& view);
 
+/// A region's error in pixels seen from `view` (Lindstrom's bound, as Select splits by it).
+double ProjectedErrorPixels(const RegionRecord& region, const ViewParameters& view);
+
 /// Where the camera will probably be a frame ahead: the last two views extrapolated linearly
 /// (eye and clip matrix), for loading ahead of need.
 ViewParameters PredictNextView(const ViewParameters& previous, const ViewParameters& current);

@@ -233,11 +233,16 @@ void TestResidency()
 
   // Copies not wanted go, in the mirror's order, until the piece fits.
   const std::vector<std::pair<std::size_t, std::size_t>> mirrored{ { 1, 100 }, { 2, 200 }, { 3, 300 }, { 4, 50 } };
-  CHECK((CopiesToRelease(mirrored, { 2, 4 }, 650, 100, 500) == std::vector<std::size_t>{ 1, 3 }));
-  CHECK((CopiesToRelease(mirrored, { 2, 4 }, 650, 100, 700) == std::vector<std::size_t>{ 1 }));
-  CHECK(CopiesToRelease(mirrored, { 2, 4 }, 650, 100, 750).empty());
+  CHECK((CopiesToRelease(mirrored, { 2, 4 }, 2, 650, 100, 500) == std::vector<std::size_t>{ 1, 3 }));
+  CHECK((CopiesToRelease(mirrored, { 2, 4 }, 2, 650, 100, 700) == std::vector<std::size_t>{ 1 }));
+  CHECK(CopiesToRelease(mirrored, { 2, 4 }, 2, 650, 100, 750).empty());
   // Not enough even so: everything not wanted, and uploads then wait.
-  CHECK((CopiesToRelease(mirrored, { 2, 4 }, 650, 100, 100) == std::vector<std::size_t>{ 1, 3 }));
+  CHECK((CopiesToRelease(mirrored, { 2, 4 }, 2, 650, 100, 100) == std::vector<std::size_t>{ 1, 3 }));
+  // Then copies the frame needs less than the one at `position` (later in the order), the
+  // last first; never one before it.
+  CHECK((CopiesToRelease(mirrored, { 5, 4, 2, 3 }, 0, 650, 100, 500) == std::vector<std::size_t>{ 1, 3 }));
+  CHECK((CopiesToRelease(mirrored, { 5, 4, 2, 3 }, 0, 650, 100, 300) == std::vector<std::size_t>{ 1, 3, 2 }));
+  CHECK((CopiesToRelease(mirrored, { 4, 2, 5, 3 }, 2, 650, 100, 100) == std::vector<std::size_t>{ 1, 3 }));
 
   // Tables: the one asked for, earlier steps of the same property and layer stand in.
   PropertyRequest request;

@@ -15,6 +15,7 @@
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
 #include "RegionCache.h"
+#include "RegionMesh.h"
 #include "UploadPacer.h"
 #include "ViewSelection.h"
 
@@ -29,6 +30,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <random>
@@ -825,6 +827,98 @@ void TestCoarseSides(const std::string& path)
   }
   std::printf("%s: coarse levels' sides %zu triangles exact, %zu simplified\n", path.c_str(), exact / 3, coarse / 3);
   CHECK(coarse > 0 && coarse < exact);
+}
+
+/// Positions of a quad's corners, as a sorted set (the same face walked either way).
+std::array<std::array<double, 3>, 4> QuadPlace(const RegionMesh& mesh, const std::array<uint32_t, 4>& quad)
+{
+  std::array<std::array<double, 3>, 4> place;
+  for (int v = 0; v < 4; ++v)
+    for (int a = 0; a < 3; ++a)
+      place[v][a] = mesh.positions[std::size_t(quad[v]) * 3 + a];
+  std::sort(place.begin(), place.end());
+  return place;
+}
+
+/// Leaves drawn with their runs of no thickness sealed lose only top and bottom faces lying
+/// on one another (each removed top face has a removed bottom face at the same corners), and
+/// on a model that pinches out, many. Regions loaded without their exact side keep the same
+/// top, bottom and simplified side; leaves always keep their exact side. The cache with
+/// simplified sides holds the roots and the regions wanted simplified without their exact
+/// side, the others with it, and a region held with it serves a simplified request.
+void TestSimplifiedSides(const std::string& path)
+{
+  const auto file = std::make_shared<const MultiresolutionFile>(path);
+  const int handedness = TopologyHandedness(*file);
+  const auto& o = file->Header().latticeOrigin;
+  const std::array<double, 3> origin{ o[0], o[1], -o[2] };
+  std::size_t unsealed = 0, sealed = 0, unpaired = 0, fullBytes = 0, leanBytes = 0;
+  for (std::size_t r = 0; r < file->Regions().size(); ++r)
+  {
+    const bool leaf = file->Regions()[r].level == file->Header().leafLevel;
+    const RegionDrawBuffers full = LoadRegionDrawBuffers(*file, r, origin, handedness);
+    const RegionDrawBuffers lean = LoadRegionDrawBuffers(*file, r, origin, handedness, -1, false);
+    CHECK(full.exactSides && (leaf || !lean.exactSides)); // the cache never asks it of a leaf
+    CHECK(lean.topIndices == full.topIndices && lean.bottomIndices == full.bottomIndices);
+    CHECK(lean.coarseSideIndices == full.coarseSideIndices && (leaf || lean.sideIndices == 0));
+    fullBytes += leaf ? 0 : full.Bytes();
+    leanBytes += leaf ? 0 : lean.Bytes();
+    if (!leaf)
+      continue;
+    RegionMesh open = file->ReadRegion(r); // the file's leaves: nothing sealed
+    ExtractSurfaces(open);
+    RegionMesh closed = file->ReadRegion(r);
+    closed.sealedPinchThickness = std::numeric_limits<double>::min();
+    ExtractSurfaces(closed);
+    CHECK(full.topIndices == 6 * closed.top.quads.size());
+    unsealed += open.top.quads.size() + open.bottom.quads.size();
+    sealed += closed.top.quads.size() + closed.bottom.quads.size();
+    std::multiset<std::array<std::array<double, 3>, 4>> tops, bottoms;
+    for (const auto& q : open.top.quads)
+      tops.insert(QuadPlace(open, q));
+    for (const auto& q : closed.top.quads)
+      tops.erase(tops.find(QuadPlace(closed, q)));
+    for (const auto& q : open.bottom.quads)
+      bottoms.insert(QuadPlace(open, q));
+    for (const auto& q : closed.bottom.quads)
+      bottoms.erase(bottoms.find(QuadPlace(closed, q)));
+    for (const auto& place : tops)
+    {
+      const auto match = bottoms.find(place);
+      if (match == bottoms.end())
+        ++unpaired;
+      else
+        bottoms.erase(match);
+    }
+    unpaired += bottoms.size();
+  }
+  std::printf("%s: leaves' tops and bottoms %zu, %zu with runs of no thickness sealed; coarse regions %zu bytes, "
+              "%zu without their exact side\n",
+    path.c_str(), unsealed, sealed, fullBytes, leanBytes);
+  CHECK(unpaired == 0);
+  CHECK(sealed < unsealed);
+  CHECK(leanBytes < fullBytes);
+
+  RegionCache cache(file, nullptr, SIZE_MAX, true);
+  std::vector<std::size_t> wanted;
+  for (std::size_t r = 0; r < file->Regions().size(); ++r)
+    if (file->Regions()[r].level <= 1)
+      wanted.push_back(r);
+  cache.Request(wanted, {}, wanted);
+  CHECK(cache.WaitIdle(std::chrono::seconds(20)));
+  for (std::size_t r : wanted)
+    CHECK(cache.Get(r) && !cache.Get(r)->exactSides);
+  const std::size_t simplifiedBytes = cache.ResidentBytes();
+  cache.Request(wanted); // with their exact sides, but the roots
+  CHECK(cache.WaitIdle(std::chrono::seconds(20)));
+  for (std::size_t r : wanted)
+    CHECK(cache.Get(r) && cache.Get(r)->exactSides == (file->Regions()[r].level > 0));
+  CHECK(cache.ResidentBytes() > simplifiedBytes);
+  const std::size_t count = cache.ResidentCount();
+  cache.Request(wanted, {}, wanted); // held with their exact side: nothing is read again
+  CHECK(cache.WaitIdle(std::chrono::seconds(20)) && cache.ResidentCount() == count);
+  for (std::size_t r : wanted)
+    CHECK(cache.Get(r)->exactSides == (file->Regions()[r].level > 0));
 }
 
 /// Pieces a region's buffers go to the GPU in (NextDrawPiece): they cover the indices in
@@ -1650,6 +1744,7 @@ int main(int argc, char** argv)
       [&] {
         TestCoarseSides(reek);
         TestCoarseSides(synth);
+        TestSimplifiedSides(synth);
         TestDrawPieces(reek);
         TestDrawPieces(synth);
       } },
