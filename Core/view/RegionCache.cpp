@@ -574,7 +574,10 @@ void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vec
       lean.assign(count, 0);
       for (std::size_t r : simplified)
       {
-        lean[r < count ? r : 0] = r < count;
+        if (r < count)
+        {
+          lean[r] = 1;
+        }
       }
     }
     const auto keyOf = [&](std::size_t r, int32_t l) {
