@@ -517,13 +517,20 @@ std::set<std::pair<int, int64_t>> LevelCut(int level)
   return cut;
 }
 
+/// Options for the small model: Cmax 64, two threads.
+HierarchyOptions SmallOptions()
+{
+  HierarchyOptions options;
+  options.cmax = 64;
+  options.threads = 2;
+  return options;
+}
+
 void TestHierarchyFile()
 {
   const SyntheticParameters p = SmallModel();
   const std::string path = TempPath("small.resmr");
-  HierarchyOptions options;
-  options.cmax = 64;
-  options.threads = 2;
+  HierarchyOptions options = SmallOptions();
   SyntheticLayerSource source(p, "synth:small");
   const HierarchyReport report = BuildHierarchy(source, path, options);
   CHECK(report.leafLevel >= 4);
@@ -812,13 +819,10 @@ void TestHierarchyFile()
 /// (no gap), and a welded pillar's region counts half the throw there in its error.
 void TestWeldedFaults()
 {
-  const SyntheticParameters p = SmallModel();
   const std::string path = TempPath("welded.resmr");
-  HierarchyOptions options;
-  options.cmax = 64;
-  options.threads = 2;
+  HierarchyOptions options = SmallOptions();
   options.faultColumns = 1;
-  SyntheticLayerSource source(p, "synth:small");
+  SyntheticLayerSource source(SmallModel(), "synth:small");
   const HierarchyReport report = BuildHierarchy(source, path, options);
   const MultiresolutionFile file(path);
   std::map<std::pair<int, int64_t>, RegionMesh> cache;
