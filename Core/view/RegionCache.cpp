@@ -784,6 +784,11 @@ std::string RegionCache::LastError() const
   return this->Error;
 }
 
+std::size_t RegionCache::WantedIndexLocked(Key key) const
+{
+  return static_cast<std::size_t>(std::find(this->Wanted.begin(), this->Wanted.end(), key) - this->Wanted.begin());
+}
+
 bool RegionCache::IsPinnedLocked(Key key) const
 {
   return std::find(this->Pinned.begin(), this->Pinned.end(), key) != this->Pinned.end();
@@ -823,6 +828,20 @@ std::vector<RegionCache::Key> RegionCache::EvictableLocked(Key key) const
   for (const auto& o : order)
   {
     keys.push_back(o.second);
+  }
+  if (wanted)
+  {
+    // Then what the frame wants after it, the last first: the request is in order of need,
+    // and loaders working side by side may have finished a later region first.
+    const auto at = std::find(this->Wanted.begin(), this->Wanted.end(), key);
+    for (auto later = this->Wanted.end(); at != this->Wanted.end() && later-- != at + 1;)
+    {
+      const auto found = this->Entries.find(*later);
+      if (found != this->Entries.end() && found->second.buffers && !this->IsPinnedLocked(*later))
+      {
+        keys.push_back(*later);
+      }
+    }
   }
   return keys;
 }
@@ -878,6 +897,7 @@ int64_t RegionCache::NextRegionLocked(bool roots)
         if (this->Bytes - freeable + known > this->BudgetBytes)
         {
           (wanted ? this->WantedBlocked : this->PredictedBlocked) = true;
+          this->WantedBlockedAt = wanted ? this->WantedIndexLocked(key) : this->WantedBlockedAt;
           break;
         }
       }
@@ -892,6 +912,10 @@ void RegionCache::InsertLocked(Key key, std::shared_ptr<const RegionDrawBuffers>
   Entry& entry = this->Entries[key];
   const std::size_t need = buffers->Bytes();
   entry.bytes = need;
+  if (this->WantedBlocked && this->InWanted.count(key) && this->WantedIndexLocked(key) > this->WantedBlockedAt)
+  {
+    return; // read beside one that could not fit, which stopped the loading before it
+  }
   if (!this->IsPinnedLocked(key) && this->Bytes + need > this->BudgetBytes)
   {
     const bool inWanted = this->InWanted.count(key) != 0, inPredicted = this->InPredicted.count(key) != 0;
@@ -907,6 +931,7 @@ void RegionCache::InsertLocked(Key key, std::shared_ptr<const RegionDrawBuffers>
       if (inWanted)
       {
         this->WantedBlocked = true;
+        this->WantedBlockedAt = this->WantedIndexLocked(key);
       }
       else if (inPredicted)
       {

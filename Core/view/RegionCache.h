@@ -17,14 +17,15 @@
 //   layer k come from the same decoded mesh (PrepareLayerDrawBuffers). SetLayer picks the
 //   layer that Get, IsResident and Request deal in; buffers are cached per (region, layer)
 //   under the one budget, and the current layer's roots take the roots' place below.
-// - Resident bytes (the buffers' sizes) stay within the budget, except that the roots and
-//   the regions requested by the newest frame are never evicted to load others: when the
-//   wanted set outgrows the budget, loading stops there (the selection then draws ancestors).
-//   Least recently requested regions are evicted first. Precisely: roots load whatever the
-//   budget; any other region becomes resident only if the total then is within the budget
-//   (after evicting, least recently requested first, regions neither roots nor wanted by the
-//   newest Request; predicted ones only for a wanted one), so ResidentBytes() <=
-//   max(budget, bytes of the roots). SetBudget evicts at once what may go; what stays (roots,
+// - Resident bytes (the buffers' sizes) stay within the budget, except that the roots are
+//   never evicted, nor the regions requested by the newest frame to load others it needs
+//   less: when the wanted set outgrows the budget, loading stops there (the selection then
+//   draws ancestors). Least recently requested regions are evicted first. Precisely: roots
+//   load whatever the budget; any other region becomes resident only if the total then is
+//   within the budget (after evicting, least recently requested first, regions neither roots
+//   nor wanted by the newest Request; predicted ones only for a wanted one; and for a wanted
+//   one, then, the wanted regions after it in the request, the last first), so
+//   ResidentBytes() <= max(budget, bytes of the roots). SetBudget evicts at once what may go; what stays (roots,
 //   the newest frame's regions) may exceed a lowered budget until the next Request. When the
 //   next region of the request cannot fit, loading stops there (Pending() false) until the
 //   next Request or SetBudget.
@@ -275,7 +276,8 @@ private:
   bool MissingLocked(Key key) const;
   /// The current layer's roots are pinned. Lock held.
   bool IsPinnedLocked(Key key) const;
-  /// Resident entries that may be evicted to load `key`, least recently requested first.
+  /// Resident entries that may be evicted to load `key`, least recently requested first; for a
+  /// wanted `key`, then the wanted ones after it, the last first.
   std::vector<Key> EvictableLocked(Key key) const;
   /// Makes room and inserts, or refuses (blocking the rest of the request). Lock held.
   void InsertLocked(Key key, std::shared_ptr<const RegionDrawBuffers> buffers);
@@ -324,6 +326,9 @@ private:
   std::vector<Key> Wanted, Predicted;
   std::unordered_set<Key> InWanted, InPredicted;
   bool WantedBlocked = false, PredictedBlocked = false; ///< loading stopped for the budget
+  std::size_t WantedBlockedAt = 0;                      ///< where in Wanted, while WantedBlocked
+  /// A key's place in Wanted (its size if absent). Lock held.
+  std::size_t WantedIndexLocked(Key key) const;
   std::size_t Resident = 0;
   std::vector<Key> Pinned; ///< the current layer's roots
   std::string Error;
