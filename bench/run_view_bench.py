@@ -220,6 +220,7 @@ def run_path(view, display, bounds, readout, samples=None, background=None):
                 if background is not None:
                     drawn = view_quality.drawn_frame(view)
                     samples[-1]["drawn_covered"] = np.any(drawn != background, axis=2)
+                    samples[-1]["drawn_pixels"] = drawn.astype(np.uint8)  # kept to show its holes
             if samples is not None and index == keep:
                 row["drawn"] = view_quality.drawn_frame(view)
         frames.append(row)

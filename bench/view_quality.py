@@ -7,7 +7,8 @@ unlit, counts the pixels in the lookup table's NaN colour. The re-renders wait f
 (the picture the tolerance stands for, not one still loading) under a budget large enough to
 hold the exact frame. The frame as it was drawn on the path (meshes still loading standing in
 for theirs, at the reduced resolution of a moving frame) is checked for see-through holes
-too, against the same exact frame. Also a fixed background load (--busy N: N processes spinning at normal
+too, against the same exact frame; a frame with any is saved with them in magenta
+(frameNNNN-as-drawn-holes.png in the sample folder). Also a fixed background load (--busy N: N processes spinning at normal
 priority for the length of the timed path), as a workstation running a simulation has."""
 import os
 import shutil
@@ -89,9 +90,15 @@ def measure(view, display, samples, budget_mb, folder):
         got = resmr_testing.cell_ids(shot(sample["tolerance"], "Cell Id", f"{tag}-cellid.png"))
         sample.update(image_metrics.compare(got, exact))
         covered = sample.pop("drawn_covered", None)
+        drawn = sample.pop("drawn_pixels", None)
         if covered is not None:
             holes, depth = image_metrics.see_through_holes(covered.astype(np.int64), exact)
             sample["drawn_hole_pixels"], sample["drawn_hole_depth_px"] = holes, depth
+            if holes and drawn is not None:
+                # The frame as drawn with its hole pixels in magenta, to find where they are.
+                marked = drawn.astype(np.int64)
+                marked[image_metrics.hole_mask(covered.astype(np.int64), exact)] = [255, 0, 255]
+                save_png(marked, os.path.join(folder, f"{tag}-as-drawn-holes.png"))
         ambient, diffuse = display.Ambient, display.Diffuse
         display.Ambient, display.Diffuse = 1.0, 0.0
         sample["nan_pixels"] = image_metrics.nan_pixels(shot(sample["tolerance"], "Property", f"{tag}-poro.png"),

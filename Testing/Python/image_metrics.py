@@ -46,11 +46,10 @@ def _dilate(mask):
     return out
 
 
-def see_through_holes(got, exact):
+def hole_mask(got, exact):
     """Background pixels of `got` that no background of the exact image reaches through
     `got`'s background (4-connected): gaps in the surface one sees through, not a silhouette
-    drawn a little inside the exact one. Returns (pixels, deepest: the largest distance in
-    pixels from a hole pixel to the hole's edge)."""
+    drawn a little inside the exact one."""
     open_ = got == 0
     reached = open_ & (exact == 0)
     while True:
@@ -58,7 +57,13 @@ def see_through_holes(got, exact):
         if np.array_equal(grown, reached):
             break
         reached = grown
-    holes = open_ & ~reached
+    return open_ & ~reached
+
+
+def see_through_holes(got, exact):
+    """The pixels of hole_mask (see-through gaps) and the deepest: the largest distance in
+    pixels from a hole pixel to the hole's edge."""
+    holes = hole_mask(got, exact)
     count = int(holes.sum())
     depth = 0
     remaining = holes
