@@ -8,8 +8,9 @@ unlit, counts the pixels in the lookup table's NaN colour. The re-renders wait f
 hold the exact frame. The frame as it was drawn on the path (meshes still loading standing in
 for theirs, at the reduced resolution of a moving frame) is checked for see-through holes
 too, against the same exact frame; a frame with any is saved with them in magenta
-(frameNNNN-as-drawn-holes.png in the sample folder). Also a fixed background load (--busy N: N processes spinning at normal
-priority for the length of the timed path), as a workstation running a simulation has."""
+(frameNNNN-as-drawn-holes.png in the sample folder). Also a fixed background load (--busy N:
+N processes spinning at normal priority for the length of the timed path), as a workstation
+running a simulation has."""
 import os
 import shutil
 import subprocess
