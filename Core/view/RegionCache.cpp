@@ -916,6 +916,28 @@ void RegionCache::InsertLocked(Key key, std::shared_ptr<const RegionDrawBuffers>
   {
     return; // read beside one that could not fit, which stopped the loading before it
   }
+  if (this->IsPinnedLocked(key))
+  {
+    // A root goes in whatever the budget; what another loader put in meanwhile makes room,
+    // the least needed first, so the roots and the budget hold together.
+    std::vector<Key> order = this->EvictableLocked(std::numeric_limits<Key>::max());
+    for (auto later = this->Wanted.rbegin(); later != this->Wanted.rend(); ++later)
+    {
+      const auto found = this->Entries.find(*later);
+      if (found != this->Entries.end() && found->second.buffers && !this->IsPinnedLocked(*later))
+      {
+        order.push_back(*later);
+      }
+    }
+    for (Key e : order)
+    {
+      if (this->Bytes + need <= this->BudgetBytes)
+      {
+        break;
+      }
+      this->EvictLocked(e);
+    }
+  }
   if (!this->IsPinnedLocked(key) && this->Bytes + need > this->BudgetBytes)
   {
     const bool inWanted = this->InWanted.count(key) != 0, inPredicted = this->InPredicted.count(key) != 0;
