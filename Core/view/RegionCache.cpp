@@ -784,6 +784,17 @@ std::string RegionCache::LastError() const
   return this->Error;
 }
 
+bool RegionCache::EarlierWantedLoadingLocked(Key key) const
+{
+  if (!this->InWanted.count(key))
+  {
+    return false;
+  }
+  const std::size_t at = this->WantedIndexLocked(key);
+  return std::any_of(this->Loading.begin(), this->Loading.end(),
+    [&](Key other) { return other != key && this->InWanted.count(other) && this->WantedIndexLocked(other) < at; });
+}
+
 std::size_t RegionCache::WantedIndexLocked(Key key) const
 {
   return static_cast<std::size_t>(std::find(this->Wanted.begin(), this->Wanted.end(), key) - this->Wanted.begin());
@@ -1250,7 +1261,14 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key)
     error = e.what();
   }
   lock.lock();
+  // Regions go in in the request's order: one read beside an earlier one waits for it, so
+  // that loading stops at the first region that cannot fit, as with one loader.
+  while (!this->Stopping && this->EarlierWantedLoadingLocked(key))
+  {
+    this->Idle.wait(lock);
+  }
   this->Loading.erase(key);
+  this->Idle.notify_all();
   if (this->Stopping)
   {
     return;
