@@ -114,11 +114,11 @@ int BuildCommand(int argc, char** argv)
       }
       else if (arg == "--cmax")
       {
-        options.cmax = std::stoll(OptionValue(a, argc, argv));
+        options.cmax = ParseInteger(OptionValue(a, argc, argv), "--cmax");
       }
       else if (arg == "--threads")
       {
-        options.threads = std::stoi(OptionValue(a, argc, argv));
+        options.threads = static_cast<int>(ParseInteger(OptionValue(a, argc, argv), "--threads"));
       }
       else if (arg == "--memory")
       {
@@ -134,7 +134,7 @@ int BuildCommand(int argc, char** argv)
       }
       else if (arg == "--fault-columns")
       {
-        options.faultColumns = std::stoll(OptionValue(a, argc, argv));
+        options.faultColumns = ParseInteger(OptionValue(a, argc, argv), "--fault-columns");
         if (options.faultColumns < 1)
         {
           throw std::invalid_argument("--fault-columns must be at least 1");

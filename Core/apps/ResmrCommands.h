@@ -3,7 +3,10 @@
 
 #include "CornerPointModel.h"
 
+#include <cerrno>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -41,6 +44,23 @@ inline const char* OptionValue(int& a, int argc, char** argv)
     throw std::invalid_argument(std::string(argv[a]) + " needs a value");
   }
   return argv[++a];
+}
+
+/// `text` as a whole number; throws std::invalid_argument naming `what` if it is not one.
+inline int64_t ParseInteger(const char* text, const char* what)
+{
+  errno = 0;
+  char* end = nullptr;
+  const long long value = std::strtoll(text, &end, 10);
+  if (errno == ERANGE)
+  {
+    throw std::invalid_argument(std::string(what) + " is too large (got '" + text + "')");
+  }
+  if (errno != 0 || end == text || *end != '\0')
+  {
+    throw std::invalid_argument(std::string(what) + " must be a whole number (got '" + text + "')");
+  }
+  return value;
 }
 
 /// resmr synth NX NY NZ -o FILE [options]; argv[1] is "synth".

@@ -34,22 +34,6 @@ const char* SynthUsage =
   "  --quiet         no progress on stderr\n"
   "  Prints a JSON summary (files, counts, fractions, time, peak memory) on stdout.\n";
 
-int64_t ParseInteger(const char* text, const char* what)
-{
-  errno = 0;
-  char* end = nullptr;
-  const long long value = std::strtoll(text, &end, 10);
-  if (errno == ERANGE)
-  {
-    throw std::invalid_argument(std::string(what) + " is too large (got '" + text + "')");
-  }
-  if (errno != 0 || end == text || *end != '\0')
-  {
-    throw std::invalid_argument(std::string(what) + " must be a whole number (got '" + text + "')");
-  }
-  return value;
-}
-
 double ParseNumber(const char* text, const char* what)
 {
   errno = 0;
