@@ -844,14 +844,21 @@ std::vector<RegionCache::Key> RegionCache::EvictableLocked(Key key) const
   {
     // Then what the frame wants after it, the last first: the request is in order of need,
     // and loaders working side by side may have finished a later region first.
-    const auto at = std::find(this->Wanted.begin(), this->Wanted.end(), key);
-    for (auto later = this->Wanted.end(); at != this->Wanted.end() && later-- != at + 1;)
+    const std::vector<Key> later = this->ResidentWantedFromLocked(this->WantedIndexLocked(key) + 1);
+    keys.insert(keys.end(), later.begin(), later.end());
+  }
+  return keys;
+}
+
+std::vector<RegionCache::Key> RegionCache::ResidentWantedFromLocked(std::size_t first) const
+{
+  std::vector<Key> keys;
+  for (std::size_t n = this->Wanted.size(); n-- > first;)
+  {
+    const auto found = this->Entries.find(this->Wanted[n]);
+    if (found != this->Entries.end() && found->second.buffers && !this->IsPinnedLocked(this->Wanted[n]))
     {
-      const auto found = this->Entries.find(*later);
-      if (found != this->Entries.end() && found->second.buffers && !this->IsPinnedLocked(*later))
-      {
-        keys.push_back(*later);
-      }
+      keys.push_back(this->Wanted[n]);
     }
   }
   return keys;
@@ -932,14 +939,8 @@ void RegionCache::InsertLocked(Key key, std::shared_ptr<const RegionDrawBuffers>
     // A root goes in whatever the budget; what another loader put in meanwhile makes room,
     // the least needed first, so the roots and the budget hold together.
     std::vector<Key> order = this->EvictableLocked(std::numeric_limits<Key>::max());
-    for (auto later = this->Wanted.rbegin(); later != this->Wanted.rend(); ++later)
-    {
-      const auto found = this->Entries.find(*later);
-      if (found != this->Entries.end() && found->second.buffers && !this->IsPinnedLocked(*later))
-      {
-        order.push_back(*later);
-      }
-    }
+    const std::vector<Key> wanted = this->ResidentWantedFromLocked(0);
+    order.insert(order.end(), wanted.begin(), wanted.end());
     for (Key e : order)
     {
       if (this->Bytes + need <= this->BudgetBytes)

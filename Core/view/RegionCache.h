@@ -329,6 +329,8 @@ private:
   std::size_t WantedBlockedAt = 0;                      ///< where in Wanted, while WantedBlocked
   /// A key's place in Wanted (its size if absent). Lock held.
   std::size_t WantedIndexLocked(Key key) const;
+  /// Resident, unpinned entries of Wanted from place `first` on, the last first. Lock held.
+  std::vector<Key> ResidentWantedFromLocked(std::size_t first) const;
   /// Another loader is reading a region the newest frame wants before `key`. Lock held.
   bool EarlierWantedLoadingLocked(Key key) const;
   std::size_t Resident = 0;
