@@ -25,6 +25,7 @@ import numpy as np
 from paraview import simple
 
 import view_quality
+from view_quality import resmr_testing
 
 parser = argparse.ArgumentParser()
 parser.add_argument("--plugin", required=True)
@@ -186,10 +187,10 @@ def thread_cpu_ms():
     return totals
 
 
-def run_path(view, display, bounds, readout, samples=None, background=None):
+def run_path(view, display, bounds, readout, samples=None, holes_as_drawn=False):
     """Renders the path, one row a frame; with `samples` (a list), every --quality-every-th
-    frame's camera and tolerance are added to it, with the pixels it covered as drawn (those not
-    in the `background` colour: one read-back between frames, outside the timing), and the
+    frame's camera and tolerance are added to it, with `holes_as_drawn` the pixels it covered as
+    drawn (its depth buffer: read back between frames, outside the timing), and the
     frame 60% along (in the zoom) is kept as drawn in its row's "drawn"."""
     frames = []
     path = camera_path(view, bounds, args.frames)
@@ -217,10 +218,9 @@ def run_path(view, display, bounds, readout, samples=None, background=None):
             if samples is not None and args.quality_every > 0 and index % args.quality_every == 0:
                 samples.append({"frame": index, "position": list(position), "focal": list(focal),
                                 "tolerance": row["tolerance"], "render_scale": row["render_scale"]})
-                if background is not None:
-                    drawn = view_quality.drawn_frame(view)
-                    samples[-1]["drawn_covered"] = np.any(drawn != background, axis=2)
-                    samples[-1]["drawn_pixels"] = drawn.astype(np.uint8)  # kept to show its holes
+                if holes_as_drawn:
+                    samples[-1]["drawn_covered"] = resmr_testing.drawn_covered(view)
+                    samples[-1]["drawn_pixels"] = view_quality.drawn_frame(view).astype(np.uint8)  # to show its holes
             if samples is not None and index == keep:
                 row["drawn"] = view_quality.drawn_frame(view)
         frames.append(row)
@@ -264,9 +264,9 @@ def write_report(results):
                      f"{e['max_resident_mb']:.0f} | {e['max_rss_mb']:.0f} | "
                      f"{stock_cell(e, 'stock_first_image_s', 2)} | {stock_cell(e, 'stock_p50_ms', 0)} | "
                      f"{stock_cell(e, 'stock_p99_ms', 0)} | {stock_cell(e, 'stock_max_rss_mb', 0)} |")
-    for e in results["models"]:
-        if "stock_skipped" in e:
-            lines.append(f"\nStock ParaView on {e['model']}: {e['stock_skipped']}.")
+    skipped = {e["model"]: e["stock_skipped"] for e in results["models"] if "stock_skipped" in e}
+    for model, why in skipped.items():  # once a model, whatever the loads it ran under
+        lines.append(f"\nStock ParaView on {model}: {why}.")
     if any("frames_over_target_during_reclaim" in e for e in results["models"]):
         lines += ["", "Frames over the target and the machine: the kernel's DAMON reclaim thread (kdamond) takes "
                   "the cores for 40-75 ms about every 5.2 s on this VM (bench/results/cpu_gaps.md). Each frame "
@@ -385,7 +385,6 @@ def measure_multiresolution(model):
     grid, path = prepare(model)
     view = new_view(args.fxaa)
     simple.Render(view)
-    background = view_quality.drawn_frame(view)[0, 0]  # the empty view's colour
     rss_before = rss_mb()
     start = time.perf_counter()
     reader = simple.OpenDataFile(path)
@@ -402,7 +401,7 @@ def measure_multiresolution(model):
     bounds = reader.GetDataInformation().GetBounds()
     samples = []
     with view_quality.BusyLoad(args.busy):
-        frames = run_path(view, display, bounds, True, samples, background)
+        frames = run_path(view, display, bounds, True, samples, holes_as_drawn=True)
     kept = next((f for f in frames if "drawn" in f), None)
     times = [f["seconds"] for f in frames]
     target_s = 1 / args.fps

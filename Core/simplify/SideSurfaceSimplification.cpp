@@ -28,6 +28,8 @@ constexpr double FoldCosine = -0.9;        ///< two triangles of an edge facing 
 // Fractions of the bounding box diagonal: rounding allowed on the distance bound and on the
 // quadric error, and the quadric costs that count as equal.
 constexpr double BoundRounding = 1e-9, QuadricRounding = 1e-6, CostStep = 1e-7;
+/// Barycentric weights this far below 0 (or above 1) still count as inside a triangle.
+constexpr double PaintedSlack = 1e-9;
 
 /// Position in a z-up frame, so that the quads' turn gives outward normals.
 Vec At(const RegionMesh& mesh, uint32_t vertex)
@@ -89,6 +91,24 @@ double SquaredDistance(const Vec& p, const Vec& a, const Vec& b, const Vec& c)
   return Dot2(ap - ab * (vb * denominator) - ac * (vc * denominator));
 }
 
+/// Where a triangle with topological coordinates (ta, tb, tc) paints the coordinate t, as the
+/// weights (u, v) of b and c: the least-squares solution, since t may leave the triangle's
+/// plane of coordinates (a wall turning a corner). False where the coordinates span no plane.
+bool PaintedAt(const Vec& ta, const Vec& tb, const Vec& tc, const Vec& t, double& u, double& v)
+{
+  const Vec e1 = tb - ta, e2 = tc - ta, d = t - ta;
+  const double a11 = Dot2(e1), a12 = glm::dot(e1, e2), a22 = Dot2(e2);
+  const double determinant = a11 * a22 - a12 * a12;
+  if (!(determinant > 1e-12 * a11 * a22))
+  {
+    return false;
+  }
+  const double b1 = glm::dot(e1, d), b2 = glm::dot(e2, d);
+  u = (a22 * b1 - a12 * b2) / determinant;
+  v = (a11 * b2 - a12 * b1) / determinant;
+  return true;
+}
+
 class Simplifier
 {
 public:
@@ -136,6 +156,7 @@ private:
   void Collapse(uint32_t from, uint32_t to);
 
   std::vector<Vec> Position; ///< centred on the bounding box, z up
+  std::vector<Vec> Topology; ///< (ti, tj, tk), what the viewer interpolates to paint a cell
   std::vector<uint32_t> Global;
   std::vector<Triangle> Triangles;
   std::vector<uint8_t> Alive;
@@ -196,9 +217,13 @@ Simplifier::Simplifier(const RegionMesh& mesh, const std::vector<Triangle>& inpu
   this->QuadricLimit = error + QuadricRounding * diagonal;
   this->Quantum = diagonal > 0 ? CostStep * diagonal : 1;
   this->Position.resize(n);
+  this->Topology.resize(n);
+  const uint32_t interfaces = static_cast<uint32_t>(mesh.layers + 1);
   for (std::size_t v = 0; v < n; ++v)
   {
     this->Position[v] = At(mesh, this->Global[v]) - centre;
+    const auto& node = mesh.topology[this->Global[v] / interfaces];
+    this->Topology[v] = Vec(node[0], node[1], this->Global[v] % interfaces);
   }
 
   this->Star.resize(n);
@@ -475,45 +500,44 @@ bool Simplifier::Check(uint32_t from, uint32_t to)
   }
 
   // Every vertex removed so far that rides on the fan, and `from` itself, must stay within
-  // the bound of the new fan; each goes to its nearest new triangle.
+  // the bound of the new fan, both from its triangles and from where they paint its
+  // topological coordinate; each rides on the triangle that paints it.
   this->Carried.clear();
   double largest = 0;
-  const double enough = this->Tolerance * this->Tolerance;
-  auto place = [&](uint32_t vertex, uint32_t was) {
+  auto place = [&](uint32_t vertex) {
     const Vec& q = this->Position[vertex];
-    double best = std::numeric_limits<double>::infinity();
-    uint32_t nearest = this->Kept[0];
-    // The triangle it rode on first, if kept: on a flat fan it mostly still holds it.
-    const bool kept = std::find(this->Kept.begin(), this->Kept.end(), was) != this->Kept.end();
-    for (std::size_t i = kept ? 0 : 1; i <= this->Kept.size(); ++i)
+    double nearest = std::numeric_limits<double>::infinity(), painting = nearest, outside = nearest;
+    uint32_t painter = this->Kept[0];
+    for (uint32_t t : this->Kept)
     {
-      const uint32_t t = i == 0 ? was : this->Kept[i - 1];
-      if (i > 0 && t == was)
-      {
-        continue;
-      }
       Triangle c = this->Triangles[t];
       std::replace(c.begin(), c.end(), from, to);
-      const double d = SquaredDistance(q, this->Position[c[0]], this->Position[c[1]], this->Position[c[2]]);
-      if (d < best)
+      const Vec &a = this->Position[c[0]], &b = this->Position[c[1]], &d = this->Position[c[2]];
+      nearest = std::min(nearest, SquaredDistance(q, a, b, d));
+      double u = 0, v = 0;
+      if (PaintedAt(this->Topology[c[0]], this->Topology[c[1]], this->Topology[c[2]], this->Topology[vertex], u, v))
       {
-        best = d;
-        nearest = t;
-        if (d <= enough)
+        // The triangle whose coordinates hold the vertex's paints it; outside every one
+        // (rounding, a corner), the nearest extrapolates.
+        const double out = std::max({ 0.0, -u - PaintedSlack, -v - PaintedSlack, u + v - 1 - PaintedSlack });
+        const double error = Dot2(a + u * (b - a) + v * (d - a) - q);
+        if (out < outside || (out == outside && error < painting))
         {
-          break;
+          outside = out;
+          painting = error;
+          painter = t;
         }
       }
     }
-    this->Carried.push_back({ vertex, nearest });
-    largest = std::max(largest, best);
+    this->Carried.push_back({ vertex, painter });
+    largest = std::max({ largest, nearest, painting });
   };
-  place(from, None);
+  place(from);
   for (std::size_t j = 0; j < k && largest <= this->BoundLimit * this->BoundLimit; ++j)
   {
     for (uint32_t rider : this->Riders[this->RingTriangle[j]])
     {
-      place(rider, this->RingTriangle[j]);
+      place(rider);
     }
   }
   this->PlannedError = std::sqrt(largest);

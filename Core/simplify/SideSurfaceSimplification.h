@@ -19,17 +19,23 @@
 //   edges (used by one triangle) are exactly the input's and the side meets the top and
 //   bottom surfaces and the next regions as before.
 // - Error, in model units of distance: every removed vertex lies within maxError + 1e-9 x the
-//   diagonal of the side surface's bounding box (rounding) of the output triangles (maxError
-//   below 0 or NaN counts as 0). The bound is exact, not an estimate: each removed vertex
-//   rides on its nearest triangle and is measured again whenever that triangle changes. It
-//   is one-sided: between vertices, the output may leave the input farther.
+//   diagonal of the side surface's bounding box (rounding) of the output triangles, and of
+//   the point where the output paints its topological coordinate (ti, tj, tk): the point of
+//   the triangle whose interpolated coordinates equal the vertex's, as the viewer paints the
+//   original cells (maxError below 0 or NaN counts as 0). So a wall's layers and columns are
+//   drawn within the error of their place: a wall of thin layers, flat but of uneven
+//   thickness, is no longer one pair of triangles whose interpolated layers stray by many
+//   layers. The bound is exact, not an estimate: each removed vertex rides on the triangle
+//   that paints it and is measured again whenever that triangle changes. It is one-sided:
+//   between vertices, the output may leave the input farther.
 // - Order: cheapest quadric error first (Garland-Heckbert: the area-weighted planes of the
 //   input triangles merged into the kept vertex) as a root-mean-square distance, the measure
 //   of RegionRecord::error; it must not pass maxError + 1e-6 x that diagonal either (the
 //   quadric's own rounding). Costs within 1e-7 of the diagonal tie and go shorter edge first
 //   (coplanar collapses cost 0: walls thin out evenly instead of piling fans onto one
 //   vertex), then the vertex with fewer triangles, then by vertex numbers. Coplanar collapses
-//   are always done, so leaf regions (maxError 0) still simplify planar walls; positions
+//   that paint every cell in place are always done, so leaf regions (maxError 0) still
+//   simplify planar walls of even layers; positions
 //   already rounded to the file's lattice are planar only to within it, so add the lattice
 //   step's length to maxError for them.
 // - A collapse is refused if it would break the link condition or duplicate a triangle, turn

@@ -1,7 +1,8 @@
 // Tests of the side surface simplification (paper Sec. 4.3): hand-built walls (planar walls
 // reduced to their borders, curved walls kept exact at error 0, time on a large surface), then
 // every region of synthetic hierarchies: locked vertices kept, border edges unchanged, no
-// degenerate or turned triangle, every removed vertex within the error of the output, the
+// degenerate or turned triangle, every removed vertex within the error of the output and of
+// where the output paints its topological coordinate, the
 // reduction above the leaves, determinism.
 #include "CoreTesting.h"
 
@@ -124,8 +125,53 @@ double BoxDistance(const glm::dvec3& p, const Box& box)
 struct Measured
 {
   int64_t input = 0, output = 0, removed = 0;
-  double farthest = 0; ///< of a removed vertex from the output
+  double farthest = 0;  ///< of a removed vertex from the output
+  double misplaced = 0; ///< of a removed vertex from where the output paints its coordinate
 };
+
+/// Topological coordinate (ti, tj, tk) of a vertex: what the viewer interpolates to paint.
+glm::dvec3 TopologyOf(const RegionMesh& mesh, uint32_t vertex)
+{
+  const uint32_t interfaces = static_cast<uint32_t>(mesh.layers + 1);
+  const auto& node = mesh.topology[vertex / interfaces];
+  return { node[0], node[1], static_cast<double>(vertex % interfaces) };
+}
+
+/// Distance from vertex v to the point where `output` paints v's topological coordinate: on
+/// the triangle whose interpolated coordinates hold it (least squares off the triangle's
+/// plane of coordinates), the least outside one where none holds it.
+double PaintedDistance(const RegionMesh& mesh, const Triangles& output, uint32_t v)
+{
+  const glm::dvec3 t = TopologyOf(mesh, v);
+  double outside = std::numeric_limits<double>::infinity(), distance = outside;
+  for (const auto& o : output)
+  {
+    const glm::dvec3 ta = TopologyOf(mesh, o[0]), tb = TopologyOf(mesh, o[1]), tc = TopologyOf(mesh, o[2]);
+    const glm::dvec3 low = glm::min(ta, glm::min(tb, tc)), high = glm::max(ta, glm::max(tb, tc));
+    if (outside == 0 && (glm::any(glm::lessThan(t, low - 1e-6)) || glm::any(glm::greaterThan(t, high + 1e-6))))
+    {
+      continue; // a triangle holding it is found; this one cannot
+    }
+    const glm::dvec3 e1 = tb - ta, e2 = tc - ta, d = t - ta;
+    const double a11 = glm::dot(e1, e1), a12 = glm::dot(e1, e2), a22 = glm::dot(e2, e2);
+    const double det = a11 * a22 - a12 * a12;
+    if (!(det > 1e-12 * a11 * a22))
+    {
+      continue;
+    }
+    const double u = (a22 * glm::dot(e1, d) - a12 * glm::dot(e2, d)) / det;
+    const double w = (a11 * glm::dot(e2, d) - a12 * glm::dot(e1, d)) / det;
+    const double out = std::max({ 0.0, -u - 1e-9, -w - 1e-9, u + w - 1 - 1e-9 });
+    const glm::dvec3 a = At(mesh, o[0]);
+    const double error = glm::length(a + u * (At(mesh, o[1]) - a) + w * (At(mesh, o[2]) - a) - At(mesh, v));
+    if (out < outside || (out == outside && error < distance))
+    {
+      outside = out;
+      distance = error;
+    }
+  }
+  return distance;
+}
 
 /// Simplifies the region's side surface and checks the contract; returns the counts.
 Measured CheckRegion(const RegionMesh& mesh, double maxError, const std::string& label)
@@ -262,23 +308,28 @@ Measured CheckRegion(const RegionMesh& mesh, double maxError, const std::string&
       }
     }
     m.farthest = std::max(m.farthest, best);
+    m.misplaced = std::max(m.misplaced, PaintedDistance(mesh, output, v));
   }
   CHECK(m.farthest <= reach * (1 + 1e-9));
+  // Its cell corner is painted within the error of its place too.
+  CHECK(m.misplaced <= reach * (1 + 1e-9));
   // The reported error is the largest distance (measured to the nearest triangle it rides on).
   CHECK(stats.largestError <= reach);
   CHECK(m.removed == 0 || stats.largestError >= m.farthest * (1 - 1e-6) - tolerance);
-  if (m.farthest > reach * (1 + 1e-9) || lost || turned || thin)
+  if (m.farthest > reach * (1 + 1e-9) || m.misplaced > reach * (1 + 1e-9) || lost || turned || thin)
   {
-    std::fprintf(stderr, "%s: farthest %g (error %g), %lld locked lost, %lld turned, %lld thin\n", label.c_str(),
-      m.farthest, maxError, static_cast<long long>(lost), static_cast<long long>(turned), static_cast<long long>(thin));
+    std::fprintf(stderr, "%s: farthest %g, painted %g away (error %g), %lld locked lost, %lld turned, %lld thin\n",
+      label.c_str(), m.farthest, m.misplaced, maxError, static_cast<long long>(lost), static_cast<long long>(turned),
+      static_cast<long long>(thin));
   }
   return m;
 }
 
 /// An nx x ny block of columns on vertical or bent pillars, every cell active. `bend` moves
 /// interface k of every pillar outward in x and y by bend * k^2 (curved walls);
-/// `slope` tilts the layers, so quads are planar only where `bend` is 0.
-RegionMesh Block(int nx, int ny, int layers, double bend, double slope)
+/// `slope` tilts the layers, so quads are planar only where `bend` is 0; `uneven` makes the
+/// layers' thickness 3 +- uneven, odd layers thicker.
+RegionMesh Block(int nx, int ny, int layers, double bend, double slope, double uneven = 0)
 {
   RegionMesh mesh;
   mesh.layers = layers;
@@ -293,7 +344,7 @@ RegionMesh Block(int nx, int ny, int layers, double bend, double slope)
         const double outX = (2 * i > nx) - (2 * i < nx), outY = (2 * j > ny) - (2 * j < ny);
         mesh.positions.push_back(100.0 * i + bend * k * k * outX);
         mesh.positions.push_back(100.0 * j + bend * k * k * outY);
-        mesh.positions.push_back(2000.0 + 3.0 * k + slope * i);
+        mesh.positions.push_back(2000.0 + 3.0 * k + uneven * (k % 2) + slope * i);
       }
     }
   }
@@ -325,6 +376,17 @@ void TestHandBuilt()
     CHECK(m.output == 2 * 2 * (7 + 3));
     CHECK(m.farthest <= 1e-9);
   }
+  // Planar walls of uneven layers: a wall cannot become one fan of its border, whose
+  // interpolated layers would stray from the true ones; at error 0 every interface stays,
+  // only the vertices inside a row go (each row a straight line of evenly spaced columns).
+  // An error of a layer's thickness lets interfaces go.
+  const RegionMesh uneven = Block(7, 3, 12, 0, 0.7, 1.0);
+  const Measured inPlace = CheckRegion(uneven, 0, "uneven layers, error 0");
+  CHECK(inPlace.misplaced <= 1e-9);
+  CHECK(inPlace.output < inPlace.input && inPlace.output > 2 * 2 * (7 + 3)); // more than the border's fan
+  const Measured layered = CheckRegion(uneven, 3.0, "uneven layers, error 3");
+  CHECK(layered.output < inPlace.output && layered.misplaced > 0.1);
+
   // Curved walls at error 0: only vertices lying on the surface left may go (collinear along a
   // wall's rows); a larger error removes more.
   const RegionMesh curved = Block(6, 5, 10, 0.4, 0.3);

@@ -165,6 +165,24 @@ def drawn_pixels(view):
     return pixels.reshape(height, width, 3)
 
 
+def drawn_covered(view):
+    """The pixels the view's last frame covered, without rendering it again: its depth buffer
+    below the far plane, (height, width) bool. A colour cannot tell: a lit surface may take the
+    background's exact colour."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
+    grab = vtkWindowToImageFilter()
+    grab.SetInput(view.GetRenderWindow())
+    grab.ShouldRerenderOff()
+    grab.ReadFrontBufferOff()
+    grab.SetInputBufferTypeToZBuffer()
+    grab.Update()
+    image = grab.GetOutput()
+    width, height, _ = image.GetDimensions()
+    depth = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(height, width)
+    return depth < 1.0
+
+
 def save_png(pixels, path):
     """Writes (height, width, 3) pixels (0-255) as a PNG."""
     from vtkmodules.util.numpy_support import numpy_to_vtk
