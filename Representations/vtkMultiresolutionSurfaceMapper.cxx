@@ -608,10 +608,10 @@ void vtkMultiresolutionSurfaceMapper::SelectRegions(Frame& frame)
     const auto all = [](std::size_t) { return true; };
     const resmr::ViewParameters next = resmr::PredictNextView(in.PreviousView, frame.view);
     predicted = in.Selector->Select(next, all).wanted;
-    simplified = resmr::RegionsPastCoarseSide(*in.File, predicted, next);
+    simplified = resmr::RegionsWithSimplifiedSide(*in.File, predicted, next);
   }
   const auto request = [&]() {
-    std::vector<std::size_t> lean = resmr::RegionsPastCoarseSide(*in.File, frame.selection.wanted, frame.view);
+    std::vector<std::size_t> lean = resmr::RegionsWithSimplifiedSide(*in.File, frame.selection.wanted, frame.view);
     const std::set<std::size_t> wanted(frame.selection.wanted.begin(), frame.selection.wanted.end());
     std::copy_if(simplified.begin(), simplified.end(), std::back_inserter(lean),
       [&](std::size_t r) { return !wanted.count(r); }); // this frame's choice first
@@ -830,7 +830,8 @@ std::size_t vtkMultiresolutionSurfaceMapper::SidesStandingIn(const Frame& frame)
   for (const resmr::DrawnRegion& drawn : frame.selection.drawn)
   {
     const auto buffers = this->Internal->Cache->Get(drawn.region);
-    count += frame.layer < 0 && buffers && !buffers->exactSides && drawn.projectedError <= resmr::CoarseSidePixels;
+    count += frame.layer < 0 && buffers && !buffers->exactSides &&
+      !resmr::DrawsSimplifiedSide(this->Internal->File->Header().version, drawn.projectedError, frame.view);
   }
   return count;
 }
@@ -851,8 +852,8 @@ int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bo
     {
       continue;
     }
-    std::array<resmr::DrawPart, 3> parts =
-      resmr::PartsToDraw(*buffers, drawn, frame.layer >= 0, in.File->Regions()[drawn.region], frame.view);
+    std::array<resmr::DrawPart, 3> parts = resmr::PartsToDraw(
+      *buffers, drawn, frame.layer >= 0, in.File->Regions()[drawn.region], frame.view, in.File->Header().version);
     for (resmr::DrawPart& part : parts)
     {
       part.shown = part.shown && kinds[static_cast<std::size_t>(part.kind)];

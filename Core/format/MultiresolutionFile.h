@@ -2,8 +2,10 @@
 // LZO-compressed one chunk each and concatenated, with an index of offsets, sizes, bounding
 // volumes, errors and normal cones, laid out for memory mapping.
 //
-// Layout (little-endian), version 5 (the same as 4; from 5 on, the builder seals pinched-out
-// runs when it extracts surfaces and readers must too, see RegionMesh.h):
+// Layout (little-endian), version 6 (the same bytes as 4 and 5; from 5 on, the builder seals
+// pinched-out runs when it extracts surfaces and readers must too, see RegionMesh.h; from 6
+// on, each simplified side paints every cell within the region's error of its place,
+// SideSurfaceSimplification.h, so viewers may draw it in place of the exact side):
 //   header (256 bytes, CRC-32 at its end): magic, version, grid dimensions, hierarchy box,
 //     position lattice, leaf level, Cmax, region and model-chunk counts, perfect-hash sizes,
 //     geometry id, then the input's map placement (flags, MAPAXES' 6 values, MAPUNITS and
@@ -49,9 +51,11 @@ namespace resmr
 
 struct MultiresolutionHeader
 {
-  static constexpr uint32_t Version = 5;
+  static constexpr uint32_t Version = 6;
   static constexpr uint32_t OldestVersion = 3; ///< older files are refused
-  uint32_t version = Version;                  ///< the file's, when read
+  /// The first version whose simplified sides paint every cell in place (see above).
+  static constexpr uint32_t SidesInPlaceVersion = 6;
+  uint32_t version = Version; ///< the file's, when read
   std::array<int64_t, 3> dims{};
   std::array<double, 4> box{};           ///< hierarchy box: xmin, ymin, xmax, ymax
   std::array<double, 3> latticeOrigin{}; ///< x, y, depth

@@ -81,27 +81,38 @@ bool MayStandIn(const PropertyTableData* table, const PropertyRequest& request)
   return request.wanted && table && table->name == request.name && table->layer == request.layer;
 }
 
-std::vector<std::size_t> RegionsPastCoarseSide(
+bool DrawsSimplifiedSide(uint32_t fileVersion, double projectedError, const ViewParameters& view)
+{
+  // The simplified side strays from the exact one by up to the region's own error: from
+  // SidesInPlaceVersion on it is also drawn in frames coarser than CoarseSidePixels where
+  // that error, twice over, still projects within the tolerance.
+  return projectedError > CoarseSidePixels ||
+    (fileVersion >= MultiresolutionHeader::SidesInPlaceVersion && view.tolerancePixels > CoarseSidePixels &&
+      2 * projectedError <= view.tolerancePixels);
+}
+
+std::vector<std::size_t> RegionsWithSimplifiedSide(
   const MultiresolutionFile& file, const std::vector<std::size_t>& regions, const ViewParameters& view)
 {
-  std::vector<std::size_t> past;
+  std::vector<std::size_t> simplified;
   for (std::size_t r : regions)
   {
-    if (r < file.Regions().size() && ProjectedErrorPixels(file.Regions()[r], view) > CoarseSidePixels)
+    if (r < file.Regions().size() &&
+      DrawsSimplifiedSide(file.Header().version, ProjectedErrorPixels(file.Regions()[r], view), view))
     {
-      past.push_back(r);
+      simplified.push_back(r);
     }
   }
-  return past;
+  return simplified;
 }
 
 std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers, const DrawnRegion& drawn, bool layerView,
-  const RegionRecord& region, const ViewParameters& view)
+  const RegionRecord& region, const ViewParameters& view, uint32_t fileVersion)
 {
   const bool top = !layerView ? drawn.top : !SurfaceCulled(buffers.topCone, region, view);
   const bool bottom = !layerView ? drawn.bottom : !SurfaceCulled(buffers.bottomCone, region, view);
-  const bool coarseSide =
-    buffers.coarseSideIndices > 0 && (drawn.projectedError > CoarseSidePixels || !buffers.exactSides);
+  const bool coarseSide = buffers.coarseSideIndices > 0 &&
+    (DrawsSimplifiedSide(fileVersion, drawn.projectedError, view) || !buffers.exactSides);
   const uint32_t exactSide = buffers.topIndices + buffers.bottomIndices;
   DrawPart side{ drawn.side, exactSide, buffers.sideIndices, 2 };
   if (coarseSide)

@@ -130,7 +130,7 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
   const auto& h = file.Header();
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
 
-  ExpectGeometryRefused("version 6", valid, "format version 6", Set<uint32_t>(Version, 6));
+  ExpectGeometryRefused("version 7", valid, "format version 7", Set<uint32_t>(Version, 7));
   ExpectGeometryRefused("version 2", valid, "format version 2", Set<uint32_t>(Version, 2));
   ExpectGeometryRefused("header size", valid, "'header size'", Set<uint32_t>(HeaderSize, 255));
   ExpectGeometryRefused("nx 0", valid, "'dimensions (nx)' is 0", Set<int64_t>(Dims, 0));

@@ -267,7 +267,8 @@ void TestResidency()
   const PropertyRequest none = RequestFor(nullptr, "PORO", 2, -1);
   CHECK(!none.wanted && none.step == 2);
 
-  // Parts: top, bottom, exact side; the simplified side past CoarseSidePixels.
+  // Parts: top, bottom, exact side; in files before SidesInPlaceVersion the simplified side
+  // past CoarseSidePixels.
   RegionDrawBuffers buffers;
   buffers.topIndices = 30;
   buffers.bottomIndices = 60;
@@ -278,32 +279,61 @@ void TestResidency()
   drawn.projectedError = CoarseSidePixels;
   const RegionRecord record{};
   const ViewParameters view;
-  std::array<DrawPart, 3> parts = PartsToDraw(buffers, drawn, false, record, view);
+  const uint32_t before = MultiresolutionHeader::SidesInPlaceVersion - 1, now = MultiresolutionHeader::Version;
+  std::array<DrawPart, 3> parts = PartsToDraw(buffers, drawn, false, record, view, before);
   CHECK(!parts[0].shown && parts[0].first == 0 && parts[0].count == 30 && parts[0].kind == 0);
   CHECK(parts[1].shown && parts[1].first == 30 && parts[1].count == 60 && parts[1].kind == 1);
   CHECK(parts[2].shown && parts[2].first == 90 && parts[2].count == 90 && parts[2].kind == 2);
   drawn.projectedError = 2.5;
-  parts = PartsToDraw(buffers, drawn, false, record, view);
+  parts = PartsToDraw(buffers, drawn, false, record, view, before);
   CHECK(parts[2].first == 180 && parts[2].count == 12);
+  // From SidesInPlaceVersion also where twice the error is within a tolerance past
+  // CoarseSidePixels (6 px here); never at 1 px or 0 px.
+  CHECK(MultiresolutionHeader::Version >= MultiresolutionHeader::SidesInPlaceVersion);
+  ViewParameters moving;
+  moving.tolerancePixels = 6;
+  drawn.projectedError = 0.25;
+  parts = PartsToDraw(buffers, drawn, false, record, moving, now);
+  CHECK(parts[2].first == 180 && parts[2].count == 12);
+  parts = PartsToDraw(buffers, drawn, false, record, moving, before);
+  CHECK(parts[2].first == 90 && parts[2].count == 90);
+  parts = PartsToDraw(buffers, drawn, false, record, view, now);
+  CHECK(view.tolerancePixels == 1 && parts[2].first == 90 && parts[2].count == 90);
+  moving.tolerancePixels = 3;
+  drawn.projectedError = 1.75;
+  parts = PartsToDraw(buffers, drawn, false, record, moving, now);
+  CHECK(parts[2].first == 90 && parts[2].count == 90);
+  ViewParameters exact;
+  exact.tolerancePixels = 0;
+  parts = PartsToDraw(buffers, drawn, false, record, exact, now);
+  CHECK(parts[2].first == 90 && parts[2].count == 90);
+  CHECK(
+    DrawsSimplifiedSide(now, 2.5, exact) && !DrawsSimplifiedSide(now, 0, exact) && !DrawsSimplifiedSide(now, 0, view));
+  CHECK(DrawsSimplifiedSide(now, 1.5, moving) && DrawsSimplifiedSide(now, 0, moving));
+  CHECK(!DrawsSimplifiedSide(before, CoarseSidePixels, view) && DrawsSimplifiedSide(before, 2.5, exact));
+  buffers.exactSides = false; // loaded without its exact side: the simplified one meanwhile
+  parts = PartsToDraw(buffers, drawn, false, record, exact, now);
+  CHECK(parts[2].first == 180 && parts[2].count == 12);
+  buffers.exactSides = true;
   buffers.coarseSideIndices = 0; // none stored: the exact side
-  parts = PartsToDraw(buffers, drawn, false, record, view);
+  parts = PartsToDraw(buffers, drawn, false, record, view, now);
   CHECK(parts[2].first == 90 && parts[2].count == 90);
   // A layer's top and bottom go by their own cones: an empty cone (cosine -2) is culled.
   buffers.topCone = { 0.f, 0.f, 1.f, -2.f };
   buffers.bottomCone = { 0.f, 0.f, 1.f, -2.f };
   drawn.top = drawn.bottom = true;
-  parts = PartsToDraw(buffers, drawn, true, record, view);
+  parts = PartsToDraw(buffers, drawn, true, record, view, now);
   CHECK(!parts[0].shown && !parts[1].shown && parts[2].shown);
   buffers.topCone = { 0.f, 0.f, 1.f, 1.f }; // every top normal straight up
   RegionRecord box{};
   box.bounds = { 0, 0, 0, 1, 1, 1 }; // x, y, depth: z from -1 to 0
   ViewParameters above;
   above.eye = { 0.5, 0.5, 10 };
-  parts = PartsToDraw(buffers, drawn, true, box, above);
+  parts = PartsToDraw(buffers, drawn, true, box, above, now);
   CHECK(parts[0].shown && !parts[1].shown);
   ViewParameters below;
   below.eye = { 0.5, 0.5, -10 };
-  parts = PartsToDraw(buffers, drawn, true, box, below);
+  parts = PartsToDraw(buffers, drawn, true, box, below, now);
   CHECK(!parts[0].shown);
 }
 
