@@ -4,11 +4,14 @@ with pvpython:
   pvpython bench/run_tolerance_quality.py --plugin PLUGIN.so --resmr build/bin/resmr \
       --scratch bench/scratch/quality [--model 400x300x25] [--tolerances 1 4 16 64 256 65536]
 
-Builds the generated faulted model (the demo's, 3M cells) and draws it at 1280x720 from three
-cameras (an overview, a close look, a low flight along a fault) at each tolerance, waiting for
-every mesh, in the Cell Id colouring, against the exact frame (0 px): the share of pixels
-within 2 px of the exact image, cell agreement, see-through holes, silhouette distance, and
-the triangles drawn (Testing/Python/image_metrics.py). Results: bench/results/tolerance_quality.{md,json}."""
+Builds the generated faulted model (the demo's, 3M cells; --model NIxNJxNK for another size)
+and draws it at 1280x720 from four cameras (an overview from two sides, a close look, a low
+flight along a fault) at each tolerance, waiting for every mesh, in the Cell Id colouring,
+against the exact frame (0 px): the share of pixels within 2 px of the exact image, cell
+agreement, see-through holes, silhouette distance, the triangles drawn
+(Testing/Python/image_metrics.py), and below 2^24 cells where the missed pixels are (first
+layer or below). Results: bench/results/tolerance_quality.{md,json}; the 400x400x100 model's
+(100 layers): bench/results/tolerance_quality_400x400x100.{md,json}."""
 import argparse
 import json
 import os
@@ -57,6 +60,7 @@ b = reader.GetDataInformation().GetBounds()
 cx, cy, cz = (b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2
 size = max(b[1] - b[0], b[3] - b[2])
 cameras = {"overview": ((cx + 1.2 * size, cy, cz + 0.6 * size), (cx, cy, cz)),
+           "overview, a quarter turn": ((cx, cy + 1.2 * size, cz + 0.6 * size), (cx, cy, cz)),
            "close look": ((cx + 0.3 * size, cy - 0.2 * size, cz + 0.15 * size), (cx, cy, cz)),
            "low flight": ((b[0] + 0.3 * (b[1] - b[0]), cy - 0.05 * size, b[5] + 0.02 * size),
                           (b[0] + 0.4 * (b[1] - b[0]), cy, cz))}
@@ -74,6 +78,10 @@ def draw(camera, tolerance):
     return ids, int(display.GetPropertyValue("TrianglesDrawn"))
 
 
+# Cell ids are 24-bit: below 2^24 cells the layer of each pixel's cell is known, and the pixels
+# a frame misses can be told apart: on first-layer cells (the top, mostly) or below (walls).
+nx, ny, nz = (int(v) for v in dims)
+layers_known = nx * ny * nz < 2 ** 24
 rows = []
 for camera in cameras:
     exact, exact_triangles = draw(camera, 0)
@@ -81,6 +89,10 @@ for camera in cameras:
         got, triangles = draw(camera, tolerance)
         row = {"camera": camera, "tolerance": tolerance, "triangles": triangles, "exact_triangles": exact_triangles}
         row.update(image_metrics.compare(got, exact))
+        if layers_known:
+            missed = image_metrics.missed_pixels(got, exact)
+            row["missed_below_first_layer"] = int((missed & (exact > nx * ny)).sum())
+            row["missed"] = int(missed.sum())
         rows.append(row)
         print(f"{camera} {tolerance:g} px: {100 * row['within_2px']:.1f}% within 2 px, {100 * row['cell_agreement']:.1f}% "
               f"same cell, {row['hole_pixels']} hole px, silhouette {row['silhouette_px']} px, {triangles} triangles",
@@ -93,11 +105,15 @@ lines = [f"# Picture quality against tolerance (generated faulted model {args.mo
          "llvmpipe)", "",
          "Each frame waits for every mesh its tolerance selects and is compared with the exact frame (0 px) of "
          "the same camera in the Cell Id colouring: 'within 2 px' is the share of pixels whose cell (or the "
-         "background) the exact frame has within 2 pixels.", "",
-         "| camera | tolerance px | within 2 px | same cell | hole px | silhouette px | triangles (0 px: all) |",
-         "|---|---|---|---|---|---|---|"]
+         "background) the exact frame has within 2 pixels; 'missed below layer 1' is the share of the other "
+         "pixels whose exact cell lies below the first layer (walls: the outside and the faults, where every "
+         "layer shows).", "",
+         "| camera | tolerance px | within 2 px | missed below layer 1 | same cell | hole px | silhouette px | "
+         "triangles (0 px: all) |",
+         "|---|---|---|---|---|---|---|---|"]
 for row in rows:
-    lines.append(f"| {row['camera']} | {row['tolerance']:g} | {100 * row['within_2px']:.1f}% | "
+    below = (f"{100 * row['missed_below_first_layer'] / row['missed']:.0f}%" if row.get("missed") else "-")
+    lines.append(f"| {row['camera']} | {row['tolerance']:g} | {100 * row['within_2px']:.1f}% | {below} | "
                  f"{100 * row['cell_agreement']:.1f}% | {row['hole_pixels']} | {row['silhouette_px']} | "
                  f"{row['triangles']:,} ({row['exact_triangles']:,}) |")
 with open(args.out + ".md", "w") as out:

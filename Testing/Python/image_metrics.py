@@ -20,21 +20,26 @@ def cell_agreement(got, exact):
     return float(np.mean(got[both] == exact[both])) if both.any() else 0.0
 
 
-def within_pixels(got, exact, reach=2):
-    """Share of the pixels either covers whose content (a cell, or the background) appears in
-    the other image within `reach` pixels (a square): a cell drawn up to `reach` pixels from
-    where the exact image has it still counts, a cell or a hole the exact image has nowhere
-    near does not."""
-    covered = (got > 0) | (exact > 0)
-    if not covered.any():
-        return 1.0
+def missed_pixels(got, exact, reach=2):
+    """The pixels either covers whose content (a cell, or the background) the other image has
+    nowhere within `reach` pixels (a square): a cell drawn up to `reach` pixels from where
+    the exact image has it is not missed, a cell or a hole the exact image has nowhere near
+    is."""
     found_got = np.zeros(got.shape, bool)    # got's pixel has its match in exact nearby
     found_exact = np.zeros(got.shape, bool)  # exact's pixel has its match in got nearby
     for dy in range(-reach, reach + 1):
         for dx in range(-reach, reach + 1):
             found_got |= _shifted(exact, dy, dx, -1) == got
             found_exact |= _shifted(got, dy, dx, -1) == exact
-    return float(np.mean((found_got & found_exact)[covered]))
+    return ((got > 0) | (exact > 0)) & ~(found_got & found_exact)
+
+
+def within_pixels(got, exact, reach=2):
+    """Share of the pixels either covers that missed_pixels does not count."""
+    covered = (got > 0) | (exact > 0)
+    if not covered.any():
+        return 1.0
+    return 1.0 - float(missed_pixels(got, exact, reach).sum()) / float(covered.sum())
 
 
 def _dilate(mask):
