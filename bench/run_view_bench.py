@@ -187,10 +187,11 @@ def thread_cpu_ms():
     return totals
 
 
-def run_path(view, display, bounds, readout, samples=None, holes_as_drawn=False):
+def run_path(view, display, bounds, readout, samples=None, background=None):
     """Renders the path, one row a frame; with `samples` (a list), every --quality-every-th
-    frame's camera and tolerance are added to it, with `holes_as_drawn` the pixels it covered as
-    drawn (its depth buffer: read back between frames, outside the timing), and the
+    frame's camera and tolerance are added to it, with the pixels it covered as drawn (those
+    not in the `background` colour or nearer than the far plane: read back between frames,
+    outside the timing), and the
     frame 60% along (in the zoom) is kept as drawn in its row's "drawn"."""
     frames = []
     path = camera_path(view, bounds, args.frames)
@@ -218,8 +219,8 @@ def run_path(view, display, bounds, readout, samples=None, holes_as_drawn=False)
             if samples is not None and args.quality_every > 0 and index % args.quality_every == 0:
                 samples.append({"frame": index, "position": list(position), "focal": list(focal),
                                 "tolerance": row["tolerance"], "render_scale": row["render_scale"]})
-                if holes_as_drawn:
-                    samples[-1]["drawn_covered"] = resmr_testing.drawn_covered(view)
+                if background is not None:
+                    samples[-1]["drawn_covered"] = resmr_testing.drawn_covered(view, background)
                     samples[-1]["drawn_pixels"] = view_quality.drawn_frame(view).astype(np.uint8)  # to show its holes
             if samples is not None and index == keep:
                 row["drawn"] = view_quality.drawn_frame(view)
@@ -385,6 +386,7 @@ def measure_multiresolution(model):
     grid, path = prepare(model)
     view = new_view(args.fxaa)
     simple.Render(view)
+    background = view_quality.drawn_frame(view)[0, 0]  # the empty view's colour
     rss_before = rss_mb()
     start = time.perf_counter()
     reader = simple.OpenDataFile(path)
@@ -401,7 +403,7 @@ def measure_multiresolution(model):
     bounds = reader.GetDataInformation().GetBounds()
     samples = []
     with view_quality.BusyLoad(args.busy):
-        frames = run_path(view, display, bounds, True, samples, holes_as_drawn=True)
+        frames = run_path(view, display, bounds, True, samples, background)
     kept = next((f for f in frames if "drawn" in f), None)
     times = [f["seconds"] for f in frames]
     target_s = 1 / args.fps

@@ -165,10 +165,11 @@ def drawn_pixels(view):
     return pixels.reshape(height, width, 3)
 
 
-def drawn_covered(view):
-    """The pixels the view's last frame covered, without rendering it again: its depth buffer
-    below the far plane, (height, width) bool. A colour cannot tell: a lit surface may take the
-    background's exact colour."""
+def drawn_covered(view, background):
+    """The pixels the view's last frame covered, without rendering it again, (height, width)
+    bool: those not in the `background` colour (RGB 0-255) or nearer than the far plane. The
+    colour alone cannot tell (a lit surface may take the background's exact colour), nor the
+    depth alone (the orientation axes' corner clears it)."""
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
     grab = vtkWindowToImageFilter()
@@ -180,7 +181,7 @@ def drawn_covered(view):
     image = grab.GetOutput()
     width, height, _ = image.GetDimensions()
     depth = vtk_to_numpy(image.GetPointData().GetScalars()).reshape(height, width)
-    return depth < 1.0
+    return (depth < 1.0) | np.any(drawn_pixels(view) != np.asarray(background), axis=2)
 
 
 def save_png(pixels, path):
