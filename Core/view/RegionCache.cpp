@@ -784,15 +784,17 @@ std::string RegionCache::LastError() const
   return this->Error;
 }
 
-bool RegionCache::EarlierWantedLoadingLocked(Key key) const
+bool RegionCache::EarlierWantedLoadingLocked(Key key, bool passIdle) const
 {
   if (!this->InWanted.count(key))
   {
     return false;
   }
   const std::size_t at = this->WantedIndexLocked(key);
-  return std::any_of(this->Loading.begin(), this->Loading.end(),
-    [&](Key other) { return other != key && this->InWanted.count(other) && this->WantedIndexLocked(other) < at; });
+  return std::any_of(this->Loading.begin(), this->Loading.end(), [&](Key other) {
+    return other != key && !(passIdle && this->IdleLoading.count(other)) && this->InWanted.count(other) &&
+      this->WantedIndexLocked(other) < at;
+  });
 }
 
 std::size_t RegionCache::WantedIndexLocked(Key key) const
@@ -1024,7 +1026,7 @@ void RegionCache::Run(Role role)
       this->StandbyWake.wait(lock);
       continue;
     }
-    if (!this->LoadNextLocked(lock, role == Role::Essential))
+    if (!this->LoadNextLocked(lock, role))
     {
       if (role != Role::Essential)
       {
@@ -1101,8 +1103,9 @@ void RegionCache::RescueIfStarvedLocked() const
 #endif
 }
 
-bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock, bool essentialOnly)
+bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock, Role role)
 {
+  const bool essentialOnly = role == Role::Essential;
   if (essentialOnly && !this->EssentialPendingLocked())
   {
     return false;
@@ -1139,7 +1142,7 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock, bool essent
     {
       return false;
     }
-    this->LoadRegionLocked(lock, static_cast<Key>(next));
+    this->LoadRegionLocked(lock, static_cast<Key>(next), role);
   }
   this->Idle.notify_all();
   this->Wake.notify_all(); // work that waited on this (the tables on the roots) may go
@@ -1241,12 +1244,16 @@ void RegionCache::LoadPropertyLocked(std::unique_lock<std::mutex>& lock)
   }
 }
 
-void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key)
+void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, Role role)
 {
   const std::size_t region = this->RegionOf(key);
   const int32_t layer = this->LayerOf(key);
   const int handedness = this->Handedness;
   this->Loading.insert(key);
+  if (role == Role::Idle)
+  {
+    this->IdleLoading.insert(key);
+  }
   lock.unlock();
   std::shared_ptr<RegionDrawBuffers> buffers;
   std::string error;
@@ -1263,12 +1270,17 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key)
   }
   lock.lock();
   // Regions go in in the request's order: one read beside an earlier one waits for it, so
-  // that loading stops at the first region that cannot fit, as with one loader.
-  while (!this->Stopping && this->EarlierWantedLoadingLocked(key))
+  // that loading stops at the first region that cannot fit, as with one loader. Not for the
+  // idle loader's reads, though: on a busy machine it may not run for seconds, and the
+  // standby and essential loaders waiting on it brought in almost nothing (a 100 s flight of
+  // the 100M model with two cores busy held under 60 MB of 512); the earlier region, when it
+  // comes, evicts later ones to fit (InsertLocked).
+  while (!this->Stopping && this->EarlierWantedLoadingLocked(key, role != Role::Idle))
   {
     this->Idle.wait(lock);
   }
   this->Loading.erase(key);
+  this->IdleLoading.erase(key);
   this->Idle.notify_all();
   if (this->Stopping)
   {

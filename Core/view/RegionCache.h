@@ -249,12 +249,12 @@ private:
   /// the lock released while reading; false when there is nothing this loader can load.
   /// With `essentialOnly` (the essential loader) only what EssentialPendingLocked names, and
   /// only it reads that: without, the other regions and a property something stands in for.
-  bool LoadNextLocked(std::unique_lock<std::mutex>& lock, bool essentialOnly);
+  bool LoadNextLocked(std::unique_lock<std::mutex>& lock, Role role);
   // Its steps, each reading with the lock released and recording the result under it.
   void LoadHandednessLocked(std::unique_lock<std::mutex>& lock);
   void LoadTablesLocked(std::unique_lock<std::mutex>& lock);
   void LoadPropertyLocked(std::unique_lock<std::mutex>& lock);
-  void LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key);
+  void LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, Role role);
   /// Work the picture cannot do without is waiting, not being read: the handedness, a root,
   /// the tables, or a property table with no earlier step of it standing in. Lock held.
   bool EssentialPendingLocked() const;
@@ -300,7 +300,8 @@ private:
   mutable std::mutex Lock;
   mutable std::condition_variable Wake, Idle, StandbyWake;
   std::thread Loader, Standby, Essential;
-  std::unordered_set<Key> Loading; ///< being read by a loader
+  std::unordered_set<Key> Loading;     ///< being read by a loader
+  std::unordered_set<Key> IdleLoading; ///< of those, by the idle loader
   bool HandednessKnown = false, TablesLoading = false, PropertyLoading = false;
   // Starvation of the idle loader (see RescueIfStarvedLocked).
   mutable bool Rescuing = false;
@@ -332,7 +333,9 @@ private:
   /// Resident, unpinned entries of Wanted from place `first` on, the last first. Lock held.
   std::vector<Key> ResidentWantedFromLocked(std::size_t first) const;
   /// Another loader is reading a region the newest frame wants before `key`. Lock held.
-  bool EarlierWantedLoadingLocked(Key key) const;
+  /// Whether a wanted region earlier than `key` is being read; with `passIdle`, not counting
+  /// those the idle loader reads (the machine's other work may starve it for seconds).
+  bool EarlierWantedLoadingLocked(Key key, bool passIdle) const;
   std::size_t Resident = 0;
   std::vector<Key> Pinned; ///< the current layer's roots
   std::string Error;
