@@ -247,8 +247,8 @@ private:
   void Run(Role role);
   /// Loads the next item (the topology's handedness, the tables, the property, a region),
   /// the lock released while reading; false when there is nothing this loader can load.
-  /// With `essentialOnly` (the essential loader) only what EssentialPendingLocked names, and
-  /// only it reads that: without, the other regions and a property something stands in for.
+  /// As the essential loader (`role`) only what EssentialPendingLocked names, and
+  /// only it reads that; the others, the other regions and a property something stands in for.
   bool LoadNextLocked(std::unique_lock<std::mutex>& lock, Role role);
   // Its steps, each reading with the lock released and recording the result under it.
   void LoadHandednessLocked(std::unique_lock<std::mutex>& lock);
@@ -332,9 +332,9 @@ private:
   std::size_t WantedIndexLocked(Key key) const;
   /// Resident, unpinned entries of Wanted from place `first` on, the last first. Lock held.
   std::vector<Key> ResidentWantedFromLocked(std::size_t first) const;
-  /// Another loader is reading a region the newest frame wants before `key`. Lock held.
-  /// Whether a wanted region earlier than `key` is being read; with `passIdle`, not counting
-  /// those the idle loader reads (the machine's other work may starve it for seconds).
+  /// Another loader is reading a region the newest frame wants before `key`; with `passIdle`,
+  /// not counting the idle loader's reads (the machine's other work may starve it for
+  /// seconds). Lock held.
   bool EarlierWantedLoadingLocked(Key key, bool passIdle) const;
   std::size_t Resident = 0;
   std::vector<Key> Pinned; ///< the current layer's roots

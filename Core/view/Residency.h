@@ -59,8 +59,8 @@ bool IsRequested(const PropertyTableData* table, const PropertyRequest& request)
 /// property is never drawn through this one's colour map.
 bool MayStandIn(const PropertyTableData* table, const PropertyRequest& request);
 
-/// Projected error (pixels) past which a region of a file older than SidesInPlaceVersion draws
-/// its simplified side in place of its exact one.
+/// Projected error (pixels) past which a region draws its simplified side in place of its exact
+/// one, whatever the file's version (see DrawsSimplifiedSide).
 constexpr double CoarseSidePixels = 2.0;
 
 /// Whether a region whose error projects to `projectedError` pixels in a frame of `view` draws
