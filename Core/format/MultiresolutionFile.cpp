@@ -554,15 +554,15 @@ void CheckHeader(const MultiresolutionHeader& h, const std::string& path)
     }
   }
   // Active flags of every layer, then the offset, cell and normal tables in pieces of at most
-  // ModelPieceBytes.
+  // ModelPieceBytes; then the pieces of a wall depth table, if any (from version 7 on).
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
   const uint64_t offsets = uint64_t(h.hashOffsetSides[0]) * h.hashOffsetSides[1] * h.hashOffsetSides[2];
   const uint64_t chunks =
     static_cast<uint64_t>(h.dims[2]) + ModelPieces(offsets * 6) + ModelPieces(slots * 8) + ModelPieces(slots * 4);
-  if (h.modelChunkCount != chunks)
+  if (h.modelChunkCount < chunks)
   {
     BadField(path, "model chunk count", std::to_string(h.modelChunkCount),
-      std::to_string(chunks) + " for " + std::to_string(h.dims[2]) + " layers and the hash's sides");
+      "at least " + std::to_string(chunks) + " for " + std::to_string(h.dims[2]) + " layers and the hash's sides");
   }
   const uint64_t cells = static_cast<uint64_t>(h.dims[0] * h.dims[1] * h.dims[2]);
   if (h.hashedCells < 1 || h.hashedCells > slots || h.hashedCells > cells)
@@ -625,10 +625,11 @@ void CheckModelChunks(const std::vector<ModelChunk>& model, const Multiresolutio
   const uint64_t layer = static_cast<uint64_t>(h.dims[0] * h.dims[1]);
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
   const uint64_t offsets = uint64_t(h.hashOffsetSides[0]) * h.hashOffsetSides[1] * h.hashOffsetSides[2];
-  const uint64_t expected[5] = { 0, (layer + 7) / 8, offsets * 6, slots * 8, slots * 4 };
-  const char* const names[5] = { "", "active flags", "hash offset table", "hash cell table", "cell normal table" };
+  const uint64_t expected[6] = { 0, (layer + 7) / 8, offsets * 6, slots * 8, slots * 4, 0 };
+  const char* const names[6] = { "", "active flags", "hash offset table", "hash cell table", "cell normal table",
+    "wall depth table" };
   std::vector<uint8_t> layerSeen(static_cast<std::size_t>(h.dims[2]), 0);
-  uint64_t total[5] = {}, pieces[5] = {};
+  uint64_t total[6] = {}, pieces[6] = {};
   for (const ModelChunk& m : model)
   {
     const std::string place = path + ": model chunk " + names[m.kind] + " part " + std::to_string(m.part);
@@ -663,6 +664,11 @@ void CheckModelChunks(const std::vector<ModelChunk>& model, const Multiresolutio
         std::to_string(pieces[kind]) + " chunks, " + std::to_string(expected[kind]) +
         " expected from the header's hash sides (corrupt)");
     }
+  }
+  if (pieces[ModelChunk::WallDepths] > 0 && pieces[ModelChunk::WallDepths] != ModelPieces(total[ModelChunk::WallDepths]))
+  {
+    throw FileFormatError(path + ": wall depth table of " + std::to_string(total[ModelChunk::WallDepths]) +
+      " bytes in " + std::to_string(pieces[ModelChunk::WallDepths]) + " chunks (corrupt)");
   }
 }
 
@@ -1040,7 +1046,7 @@ void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
     const uint32_t reserved = index.Get<uint32_t>();
     const std::string place = path + ": model chunk record " + std::to_string(i) + " (kind " + std::to_string(m.kind) +
       ", part " + std::to_string(m.part) + ")";
-    if (m.kind < ModelChunk::ActiveLayer || m.kind > ModelChunk::CellNormals || reserved != 0)
+    if (m.kind < ModelChunk::ActiveLayer || m.kind > ModelChunk::WallDepths || reserved != 0)
     {
       throw FileFormatError(place + ": unknown kind or reserved bytes set (corrupt)");
     }
@@ -1191,8 +1197,8 @@ std::vector<uint8_t> MultiresolutionFile::ReadModelArray(uint32_t kind) const
   std::sort(pieces.begin(), pieces.end(), [](const ModelChunk* a, const ModelChunk* b) { return a->part < b->part; });
   std::vector<uint8_t> out;
   const char* const names[] = { "model array", "active flags", "hash offset table", "hash cell table",
-    "cell normal table" };
-  const std::string name = names[kind <= ModelChunk::CellNormals ? kind : 0];
+    "cell normal table", "wall depth table" };
+  const std::string name = names[kind <= ModelChunk::WallDepths ? kind : 0];
   for (std::size_t p = 0; p < pieces.size(); ++p)
   {
     const std::string place = this->FilePath + ": " + name + " (model chunk kind " + std::to_string(kind) + ") piece " +
@@ -1205,6 +1211,16 @@ std::vector<uint8_t> MultiresolutionFile::ReadModelArray(uint32_t kind) const
     out.insert(out.end(), raw.begin(), raw.end());
   }
   return out;
+}
+
+WallDepthTable MultiresolutionFile::ReadWallDepths() const
+{
+  const auto bytes = this->ReadModelArray(ModelChunk::WallDepths);
+  if (bytes.empty())
+  {
+    return WallDepthTable{};
+  }
+  return DecodeWallDepthTable(bytes, this->Head.dims, this->FilePath + ": wall depth table");
 }
 
 RegionMesh MultiresolutionFile::ReadRegion(std::size_t i) const

@@ -2,10 +2,11 @@
 // LZO-compressed one chunk each and concatenated, with an index of offsets, sizes, bounding
 // volumes, errors and normal cones, laid out for memory mapping.
 //
-// Layout (little-endian), version 6 (the same bytes as 4 and 5; from 5 on, the builder seals
-// pinched-out runs when it extracts surfaces and readers must too, see RegionMesh.h; from 6
-// on, each simplified side paints every cell within the region's error of its place,
-// SideSurfaceSimplification.h, so viewers may draw it in place of the exact side):
+// Layout (little-endian), version 7 (the same bytes as 4 to 6 but for one more kind of model
+// chunk; from 5 on, the builder seals pinched-out runs when it extracts surfaces and readers
+// must too, see RegionMesh.h; from 6 on, each simplified side paints every cell within the
+// region's error of its place, SideSurfaceSimplification.h, so viewers may draw it in place
+// of the exact side; from 7 on, a wall depth table, WallDepthTable.h):
 //   header (256 bytes, CRC-32 at its end): magic, version, grid dimensions, hierarchy box,
 //     position lattice, leaf level, Cmax, region and model-chunk counts, perfect-hash sizes,
 //     geometry id, then the input's map placement (flags, MAPAXES' 6 values, MAPUNITS and
@@ -15,7 +16,9 @@
 //   trailer (32 bytes): index offset and size, CRC-32 of the index, magic "RESMRIDX"
 // Model chunks hold what belongs to the grid, not to a region: the active flags of each
 // layer, and the property side of Sec. 5.3-5.4 (perfect spatial hash of the cells the
-// extracted faces touch, the cell of each hash slot, top and bottom normals a slot). Property
+// extracted faces touch, the cell of each hash slot, top and bottom normals a slot) and the
+// wall depth table (every wall's layer interfaces, for the viewer to find a wall pixel's
+// layer from its depth). Property
 // values never live here (Sec. 5.5): they go to property files (PropertyFile.h) that name
 // this file's geometry id, so adding properties never rewrites geometry.
 // A file is only trusted once the trailer, the index CRC and every offset and size check out
@@ -36,6 +39,7 @@
 #include "ChunkStorage.h"
 #include "CornerPointModel.h"
 #include "PerfectSpatialHash.h"
+#include "WallDepthTable.h"
 #include "RegionMesh.h"
 
 #include <array>
@@ -51,7 +55,7 @@ namespace resmr
 
 struct MultiresolutionHeader
 {
-  static constexpr uint32_t Version = 6;
+  static constexpr uint32_t Version = 7;
   static constexpr uint32_t OldestVersion = 3; ///< older files are refused
   /// The first version whose simplified sides paint every cell in place (see above).
   static constexpr uint32_t SidesInPlaceVersion = 6;
@@ -109,7 +113,8 @@ struct ModelChunk
     ActiveLayer = 1, ///< part k: one bit a cell of layer k (i fastest), 1 = active
     HashOffsets = 2, ///< the offset table: r^3 x 3 uint16
     HashCells = 3,   ///< per slot, uint64 natural cell index i + nx (j + ny k); all ones if empty
-    CellNormals = 4  ///< per slot, two uint16 (top, bottom face normal, NormalQuantization.h)
+    CellNormals = 4, ///< per slot, two uint16 (top, bottom face normal, NormalQuantization.h)
+    WallDepths = 5   ///< the wall depth table (WallDepthTable.h), from version 7 on; optional
   };
   uint32_t kind = 0;
   uint32_t part = 0; ///< layer, or piece of a long array (pieces of at most 2^28 bytes)
@@ -234,6 +239,9 @@ public:
   std::vector<uint8_t> ReadModelArray(uint32_t kind) const;
   /// The perfect spatial hash of the cells the extracted faces touch (Sec. 5.4).
   PerfectSpatialHash ReadHash() const;
+  /// The wall depth table (WallDepthTable.h); empty when the file has none (before version 7,
+  /// or a model without walls). Throws FileFormatError for a damaged one.
+  WallDepthTable ReadWallDepths() const;
   /// The record of (level, index), or nullptr.
   const RegionRecord* Find(int32_t level, int64_t index) const;
 

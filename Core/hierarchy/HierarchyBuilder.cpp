@@ -15,6 +15,7 @@
 #include "MultiresolutionFile.h"
 #include "NormalQuantization.h"
 #include "PerfectSpatialHash.h"
+#include "WallDepthTable.h"
 #include "RegionMesh.h"
 #include "SideSurfaceSimplification.h"
 #include "ThreadGroup.h"
@@ -30,6 +31,7 @@
 #include <exception>
 #include <limits>
 #include <map>
+#include <iterator>
 #include <mutex>
 #include <stdexcept>
 #include <sys/stat.h>
@@ -1564,11 +1566,20 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
   }
   const int threads = this->ThreadsFor(4 * this->Options.cmax * (nz + 1) * 64);
   this->Phase = "property side";
+  std::vector<WallFace> walls; // the leaves' wall faces, for the wall depth table
+  std::mutex wallsMutex;
   ParallelFor(static_cast<int64_t>(keys.size()), threads, [&](int64_t n) {
     const auto& key = keys[static_cast<std::size_t>(n)];
     RegionMesh mesh = parts[static_cast<std::size_t>(this->Parts[key])]->ReadRegion(this->Records[key], header);
     ExtractSurfaces(mesh); // the exact side faces, which views draw for regions of small error
     MarkTouchedCells(mesh, dims, touched);
+    if (key.first == header.leafLevel)
+    {
+      std::vector<WallFace> faces;
+      CollectWallFaces(mesh, nx, faces);
+      std::lock_guard<std::mutex> lock(wallsMutex);
+      std::move(faces.begin(), faces.end(), std::back_inserter(walls));
+    }
     this->Report(this->Phase, 0.95 + 0.03 * static_cast<double>(n + 1) / static_cast<double>(keys.size()));
   });
   parts.clear();
@@ -1654,6 +1665,18 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
   }
   std::vector<std::atomic<uint64_t>>().swap(touched);
   this->Chunks->AddModelArray(ModelChunk::CellNormals, slotNormals.data(), slotNormals.size() * 4, model);
+  std::vector<std::array<uint16_t, 2>>().swap(slotNormals);
+
+  // Wall depths (ours, WallDepthTable.h), in a fixed order whatever the threads did; keys of
+  // (j nx + i) 4 + face + 1 fit 32 bits below 2^30 columns.
+  if (!walls.empty() && static_cast<uint64_t>(nx * ny) < (uint64_t(1) << 30))
+  {
+    std::sort(walls.begin(), walls.end(), [](const WallFace& a, const WallFace& b) { return a.key < b.key; });
+    const auto bytes = EncodeWallDepthTable(BuildWallDepthTable(walls, static_cast<int32_t>(nz), nx));
+    report.wallFaces = walls.size();
+    std::vector<WallFace>().swap(walls);
+    this->Chunks->AddModelArray(ModelChunk::WallDepths, bytes.data(), bytes.size(), model);
+  }
 }
 
 /// Creates the scratch folder, or finds in it the last level every rank finished (-1: none)

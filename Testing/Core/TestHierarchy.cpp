@@ -158,7 +158,8 @@ std::multiset<FaceKey> FacesOf(const RegionMesh& mesh)
 }
 
 /// The original model's external faces, from one column mesh of the whole grid.
-std::multiset<FaceKey> OriginalFaces(const SyntheticParameters& p)
+/// The original model as one region mesh, open sides and surfaces extracted.
+RegionMesh OriginalMesh(const SyntheticParameters& p)
 {
   SyntheticReservoir model(p);
   CornerPointModel deck;
@@ -194,7 +195,12 @@ std::multiset<FaceKey> OriginalFaces(const SyntheticParameters& p)
   mesh.cutEdges.assign(mesh.corners.size(), 0);
   ComputeOpenSides(mesh);
   ExtractSurfaces(mesh);
-  return FacesOf(mesh);
+  return mesh;
+}
+
+std::multiset<FaceKey> OriginalFaces(const SyntheticParameters& p)
+{
+  return FacesOf(OriginalMesh(p));
 }
 
 /// A region's cut edges as (node data of a, node data of b) in the direction the region
@@ -817,6 +823,66 @@ void TestHierarchyFile()
 /// Faults too long to keep whole (here every fault: `faultColumns` 1) weld at the coarse
 /// levels. Every level and random cut stays closed and crack-free, no fault side stands alone
 /// (no gap), and a welded pillar's region counts half the throw there in its error.
+/// The wall depth table holds every wall face of the original grid, each with its corners'
+/// interface depths and nearest open cells; a damaged table is an error naming it.
+void TestWallDepths()
+{
+  SyntheticParameters p = SmallModel();
+  p.nz = 12;
+  const std::string path = TempPath("walls.resmr");
+  SyntheticLayerSource source(p, "synth:walls");
+  const HierarchyReport report = BuildHierarchy(source, path, SmallOptions());
+  const MultiresolutionFile file(path);
+  const WallDepthTable table = file.ReadWallDepths();
+  const RegionMesh original = OriginalMesh(p);
+  std::vector<WallFace> expected;
+  CollectWallFaces(original, p.nx, expected);
+  CHECK(!expected.empty() && table.faces == expected.size() && report.wallFaces == expected.size());
+  CHECK(table.layers == p.nz);
+  int64_t outline = 0, faultFaces = 0, mismatched = 0;
+  for (const WallFace& f : expected)
+  {
+    const uint32_t column = (f.key - 1) / 4, face = (f.key - 1) % 4;
+    const uint32_t i = column % uint32_t(p.nx), j = column / uint32_t(p.nx);
+    const bool onOutline = (face == 0 && i == 0) || (face == 1 && i + 1 == uint32_t(p.nx)) || (face == 2 && j == 0) ||
+      (face == 3 && j + 1 == uint32_t(p.ny));
+    (onOutline ? outline : faultFaces) += 1;
+    const std::size_t slot = static_cast<std::size_t>(table.hash.Slot(i, j, face));
+    const float* texel = &table.texels[slot * std::size_t(p.nz + 1) * 3];
+    bool same = table.keys[slot] == f.key;
+    const double step = file.Header().latticeStep[2]; // the file's positions are on its lattice
+    for (int64_t k = 0; same && k <= p.nz; ++k)
+    {
+      same = std::fabs(texel[3 * k] - f.depthA[k]) <= step && std::fabs(texel[3 * k + 1] - f.depthB[k]) <= step &&
+        texel[3 * k + 2] == float(f.open[std::min<int64_t>(k, p.nz - 1)]);
+    }
+    mismatched += same ? 0 : 1;
+  }
+  CHECK(mismatched == 0);
+  CHECK(outline > 0 && faultFaces > 0); // the small model has faults
+  // Depths grow down a face; a nearest open cell is open: active, with this side open.
+  int64_t badOrder = 0;
+  for (const WallFace& f : expected)
+  {
+    for (std::size_t k = 0; k + 1 < f.depthA.size(); ++k)
+    {
+      badOrder += f.depthA[k] > f.depthA[k + 1] || f.depthB[k] > f.depthB[k + 1] ? 1 : 0;
+    }
+  }
+  CHECK(badOrder == 0);
+  // Damaged: cut short, or a cell out of range.
+  auto bytes = EncodeWallDepthTable(table);
+  resmr_testing::ExpectError<FileFormatError>("short wall table", [&] {
+    DecodeWallDepthTable(std::vector<uint8_t>(bytes.begin(), bytes.end() - 4), file.Header().dims, "walls");
+  }, { "walls", "corrupt" });
+  float big = 1e9f;
+  std::memcpy(&bytes[bytes.size() - 4], &big, 4);
+  resmr_testing::ExpectError<FileFormatError>("wall cell out of range", [&] {
+    DecodeWallDepthTable(bytes, file.Header().dims, "walls");
+  }, { "walls", "out of range" });
+  std::remove(path.c_str());
+}
+
 void TestWeldedFaults()
 {
   const std::string path = TempPath("welded.resmr");
@@ -1022,7 +1088,7 @@ void TestMapAxesInFile()
   // Versions this build does not know are refused by number.
   writeBytes(withVersion(2));
   resmr_testing::ExpectError<FileFormatError>("version 2", [&] { MultiresolutionFile f(damaged); },
-    { damaged, "format version 2", "versions 3 to 6", "resmr build" });
+    { damaged, "format version 2", "versions 3 to 7", "resmr build" });
   const std::string newer = std::to_string(MultiresolutionHeader::Version + 1);
   writeBytes(withVersion(MultiresolutionHeader::Version + 1));
   resmr_testing::ExpectError<FileFormatError>(
@@ -1207,6 +1273,7 @@ int main()
   TestDiamondTree();
   TestBuildSchedule();
   TestHierarchyFile();
+  TestWallDepths();
   TestWeldedFaults();
   TestMapAxesInFile();
   TestFailedBuildLeavesNothing();
