@@ -24,6 +24,7 @@ public:
     bool gridLines = false;
     bool specular = false;
     bool tableNormals = false; ///< tops and bottoms only, lit by the normal table
+    bool wallDepths = false;   ///< side fragments find their layer in the wall depth table
     int lighting = 0;          ///< vtkOpenGLRenderer's lighting complexity (0: unlit)
     int lightCount = 0;        ///< the renderer's lights switched on
   };

@@ -659,6 +659,7 @@ vtkShaderProgram* vtkMultiresolutionSurfaceMapper::ReadyProgram(Frame& frame, in
   painting.lighting = painting.lightCount > 0 ? painting.lighting : 0;
   painting.specular = painting.lighting > 0 && look->GetSpecular() > 0;
   painting.tableNormals = tableNormals;
+  painting.wallDepths = !tableNormals && frame.layer < 0 && in.Tables.WallsReady();
   frame.lit = painting.lighting > 0;
   vtkShaderProgram* ready =
     in.Shaders.Ready(frame.window, painting, painting.lighting > 0 ? lights->GetLightingUniforms() : nullptr);
@@ -689,6 +690,7 @@ void vtkMultiresolutionSurfaceMapper::StreamTables(Frame& frame)
   }
   in.Tables.StreamProperty(frame.window, loaded, in.File->Header(), budget, !frame.bounded);
   in.Tables.StreamNormals(frame.window, budget, !frame.bounded);
+  in.Tables.UploadWalls(frame.window, *in.Cache);
   frame.tableBytes = resmr::TableBytesPerFrame - budget;
   // The wanted table once on the GPU; until then an earlier time step of the same property
   // and layer stands in (as an ancestor does for a mesh), anything else is drawn in the solid

@@ -273,6 +273,59 @@ void vtkMultiresolutionTableTextures::StreamProperty(vtkOpenGLRenderWindow* wind
   }
 }
 
+void vtkMultiresolutionTableTextures::UploadWalls(vtkOpenGLRenderWindow* window, const resmr::RegionCache& cache)
+{
+  const std::shared_ptr<const resmr::ModelTables> tables = cache.Tables();
+  if (this->WallsTried || !this->NormalsUploaded || !tables)
+  {
+    return;
+  }
+  this->WallsTried = true;
+  const resmr::WallDepthTable& walls = tables->walls;
+  // Slot s lies at (s mod rows, s / rows) of the key texture and, k along x, of the depth
+  // texture: 3D textures of at most 2048 a side.
+  const uint64_t slots = walls.hash.TableSize();
+  const uint32_t interfaces = static_cast<uint32_t>(walls.layers + 1);
+  const uint32_t rows = static_cast<uint32_t>(std::min<uint64_t>(slots, 1024));
+  const uint64_t slabs = (slots + rows - 1) / rows;
+  if (walls.Empty() || interfaces > resmr::PerfectSpatialHash::MaxSide || slabs > resmr::PerfectSpatialHash::MaxSide)
+  {
+    return;
+  }
+  std::vector<uint32_t> keys(static_cast<std::size_t>(rows * slabs), 0);
+  std::copy(walls.keys.begin(), walls.keys.end(), keys.begin());
+  std::vector<float> texels(keys.size() * interfaces * 3, 0.f);
+  std::copy(walls.texels.begin(), walls.texels.end(), texels.begin());
+  window->GetState()->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  UploadInteger3D(this->WallOffsetTexture, window, walls.hash.offsetSides, 3, GL_RGB16UI, GL_RGB_INTEGER,
+    walls.hash.offsets.data());
+  const auto setup = [window](vtkTextureObject* texture, unsigned int internalFormat, unsigned int format,
+                       unsigned int type) {
+    texture->SetContext(window);
+    texture->ResetFormatAndType();
+    texture->SetInternalFormat(internalFormat);
+    texture->SetFormat(format);
+    texture->SetDataType(type);
+    texture->SetMinificationFilter(vtkTextureObject::Nearest);
+    texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+  };
+  setup(this->WallKeyTexture, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT);
+  this->WallKeyTexture->Create3DFromRaw(rows, static_cast<unsigned int>(slabs), 1, 1, VTK_UNSIGNED_INT, keys.data());
+  setup(this->WallDepthTexture, GL_RGB32F, GL_RGB, GL_FLOAT);
+  this->WallDepthTexture->Create3DFromRaw(
+    interfaces, rows, static_cast<unsigned int>(slabs), 3, VTK_FLOAT, texels.data());
+  this->WallTableSides = walls.hash.tableSides;
+  this->WallOffsetSides = walls.hash.offsetSides;
+  this->WallRows = static_cast<int>(rows);
+  this->WallSearchSteps = 0;
+  while ((1 << this->WallSearchSteps) < walls.layers)
+  {
+    ++this->WallSearchSteps;
+  }
+  this->WallsUploaded = true;
+  this->AllocatedThisFrame = true;
+}
+
 void vtkMultiresolutionTableTextures::UpdateColorMap(vtkOpenGLRenderWindow* window, vtkScalarsToColors* table)
 {
   if (table == this->ColorTable && table->GetMTime() == this->ColorTableTime)
@@ -326,6 +379,19 @@ void vtkMultiresolutionTableTextures::Bind(vtkShaderProgram* program, const resm
   program->SetUniformi("layerProperty", this->LayerPropertyTexture->GetTextureUnit());
   this->ColorTexture->Activate();
   program->SetUniformi("colorMap", this->ColorTexture->GetTextureUnit());
+  if (this->WallsUploaded)
+  {
+    uniform3i("wallTableSides", this->WallTableSides);
+    uniform3i("wallOffsetSides", this->WallOffsetSides);
+    program->SetUniformi("wallRows", this->WallRows);
+    program->SetUniformi("wallSearchSteps", this->WallSearchSteps);
+    this->WallOffsetTexture->Activate();
+    program->SetUniformi("wallOffsets", this->WallOffsetTexture->GetTextureUnit());
+    this->WallKeyTexture->Activate();
+    program->SetUniformi("wallKeys", this->WallKeyTexture->GetTextureUnit());
+    this->WallDepthTexture->Activate();
+    program->SetUniformi("wallDepths", this->WallDepthTexture->GetTextureUnit());
+  }
 }
 
 void vtkMultiresolutionTableTextures::Unbind()
@@ -335,6 +401,12 @@ void vtkMultiresolutionTableTextures::Unbind()
   this->ColorTexture->Deactivate();
   this->OffsetTexture->Deactivate();
   this->NormalTexture->Deactivate();
+  if (this->WallsUploaded)
+  {
+    this->WallOffsetTexture->Deactivate();
+    this->WallKeyTexture->Deactivate();
+    this->WallDepthTexture->Deactivate();
+  }
 }
 
 void vtkMultiresolutionTableTextures::CancelUploads(vtkWindow* window)
@@ -353,6 +425,8 @@ void vtkMultiresolutionTableTextures::Forget(vtkWindow* window)
 {
   this->HashUploaded = false;
   this->NormalsUploaded = false;
+  this->WallsUploaded = false;
+  this->WallsTried = false;
   this->Uploaded.reset();
   this->CancelUploads(window);
 }
@@ -370,4 +444,9 @@ void vtkMultiresolutionTableTextures::ReleaseGraphicsResources(vtkWindow* window
   this->PropertyTexture->ReleaseGraphicsResources(window);
   this->LayerPropertyTexture->ReleaseGraphicsResources(window);
   this->ColorTexture->ReleaseGraphicsResources(window);
+  this->WallOffsetTexture->ReleaseGraphicsResources(window);
+  this->WallKeyTexture->ReleaseGraphicsResources(window);
+  this->WallDepthTexture->ReleaseGraphicsResources(window);
+  this->WallsUploaded = false;
+  this->WallsTried = false;
 }

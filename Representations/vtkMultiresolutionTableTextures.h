@@ -52,6 +52,9 @@ public:
   /// table at once, a packed table a slab at a time over the texture no longer drawn.
   void StreamProperty(vtkOpenGLRenderWindow* window, const std::shared_ptr<const resmr::PropertyTableData>& loaded,
     const resmr::MultiresolutionHeader& header, std::size_t& budget, bool unbounded);
+  /// Copies the wall depth table (WallDepthTable.h) once the normals are in, at once (a few
+  /// MB to tens of MB); nothing for files without one.
+  void UploadWalls(vtkOpenGLRenderWindow* window, const resmr::RegionCache& cache);
   /// Refills the colour map when the lookup table changed.
   void UpdateColorMap(vtkOpenGLRenderWindow* window, vtkScalarsToColors* table);
 
@@ -59,6 +62,8 @@ public:
   bool HashReady() const { return this->HashUploaded; }
   /// The top and bottom normal table is complete on the GPU (after the hash and property).
   bool NormalsReady() const { return this->NormalsUploaded; }
+  /// The wall depth table is on the GPU: side fragments may find their layer from their depth.
+  bool WallsReady() const { return this->WallsUploaded; }
   /// The property table on the GPU (null: none yet).
   const std::shared_ptr<const resmr::PropertyTableData>& UploadedProperty() const { return this->Uploaded; }
   /// A table is still being streamed.
@@ -91,6 +96,14 @@ private:
   vtkSmartPointer<vtkTextureObject> PropertyTexture = vtkSmartPointer<vtkTextureObject>::New();
   vtkNew<vtkTextureObject> ColorTexture;
   vtkNew<vtkTextureObject> LayerPropertyTexture; ///< nx x ny R32F: one layer's table
+  vtkNew<vtkTextureObject> WallOffsetTexture;    ///< the wall hash's offsets, RGB16UI
+  vtkNew<vtkTextureObject> WallKeyTexture;       ///< rows x slabs R32UI: each slot's face key
+  vtkNew<vtkTextureObject> WallDepthTexture;     ///< (nk + 1) x rows x slabs RGB32F
+  bool WallsUploaded = false;
+  bool WallsTried = false; ///< uploaded, or found none or too large for 3D textures
+  std::array<uint32_t, 3> WallTableSides{ 1, 1, 1 }, WallOffsetSides{ 1, 1, 1 };
+  int WallRows = 1;        ///< slots a slab of the key and depth textures
+  int WallSearchSteps = 0; ///< binary search steps over the layers
   bool HashUploaded = false;                     ///< the offsets
   bool NormalsUploaded = false;                  ///< the cells' normals (after the offsets)
   std::shared_ptr<const resmr::PropertyTableData> Uploaded;

@@ -70,12 +70,15 @@ void CollectWallFaces(const RegionMesh& leaf, int64_t nx, std::vector<WallFace>&
         std::swap(a, b);
       }
       std::vector<uint8_t> open(layers);
+      std::size_t run = 0, longest = 0;
       for (std::size_t k = 0; k < layers; ++k)
       {
         open[k] = leaf.active[c * layers + k] && ((leaf.openSides[c * layers + k] >> e) & 1);
+        run = open[k] ? run + 1 : 0;
+        longest = std::max(longest, run);
       }
       WallFace face;
-      if (!NearestOpen(open, face.open))
+      if (longest < std::min<std::size_t>(MinWallRun, layers) || !NearestOpen(open, face.open))
       {
         continue;
       }

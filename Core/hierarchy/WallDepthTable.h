@@ -10,9 +10,12 @@
 // them, and the viewer picks the layer whose interval holds the fragment's depth.
 //
 // Contract:
-// - A wall face is an original column's side (i, j, face) with at least one open side cell
-//   (RegionMesh::openSides); face 0: I- (topological i = i), 1: I+ (i + 1), 2: J- (j = j),
-//   3: J+ (j + 1). Its key is (j nx + i) 4 + face + 1 (0: an empty slot).
+// - A wall face is an original column's side (i, j, face) with a run of at least
+//   MinWallRun open side cells one above the other (RegionMesh::openSides), or of all its
+//   layers on models of fewer; face 0: I- (topological i = i), 1: I+ (i + 1), 2: J- (j = j),
+//   3: J+ (j + 1). Its key is (j nx + i) 4 + face + 1 (0: an empty slot). Shorter runs (the
+//   sides of pinched-out cells, most of a model's open side cells, mostly hidden inside it)
+//   show a few layers at most, which the coordinates paint within a few layers anyway.
 // - Each face holds, for every interface k = 0..nk, the depth at its two corners, A (the
 //   lower topological coordinate along the face) and B, as the leaf meshes give them (faults
 //   split corners: each side of a fault has its own), and for every cell k below an
@@ -54,6 +57,9 @@ struct WallDepthTable
   std::vector<float> texels;   ///< (nk + 1) x 3 a slot
   bool Empty() const { return this->faces == 0; }
 };
+
+/// Open side cells one above the other that make a face a wall.
+constexpr int32_t MinWallRun = 4;
 
 /// The key of (i, j, face), 0-based.
 inline uint32_t WallFaceKey(uint32_t i, uint32_t j, uint32_t face, uint32_t nx)

@@ -1182,6 +1182,22 @@ void RegionCache::LoadTablesLocked(std::unique_lock<std::mutex>& lock)
   {
     tables->hash = this->File->ReadHash();
     tables->normals = this->File->ReadModelArray(ModelChunk::CellNormals);
+    try
+    {
+      tables->walls = this->File->ReadWallDepths();
+      const float below = static_cast<float>(-this->ModelOrigin[2]); // the origin's depth
+      for (std::size_t t = 0; t < tables->walls.texels.size(); t += 3)
+      {
+        tables->walls.texels[t] -= below;
+        tables->walls.texels[t + 1] -= below;
+      }
+    }
+    catch (const FileFormatError& e)
+    {
+      // Only the walls' layers are lost: they are painted as before, from the coordinates.
+      tables->walls = WallDepthTable{};
+      tables->wallsError = e.what();
+    }
   }
   catch (const std::exception& e)
   {

@@ -148,11 +148,14 @@ struct PropertyTableData
   std::vector<float> values; ///< one a hash slot (packed), or nx ny values (a layer, i fastest)
 };
 
-/// The model's lookup tables for painting (Sec. 5.3-5.4): the hash and each slot's normals.
+/// The model's lookup tables for painting (Sec. 5.3-5.4): the hash and each slot's normals,
+/// and the wall depths (ours, WallDepthTable.h) with depths below the cache's origin.
 struct ModelTables
 {
   PerfectSpatialHash hash;
   std::vector<uint8_t> normals; ///< 4 bytes a hash slot (top, bottom); empty in older files
+  WallDepthTable walls;         ///< empty in older files, or when damaged (wallsError)
+  std::string wallsError;       ///< why a damaged wall table was left out (the rest paints)
 };
 
 class RegionCache

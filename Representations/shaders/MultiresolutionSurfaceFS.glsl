@@ -15,7 +15,7 @@
 // The mapper compiles one variant per painting mode, with these defined (0 or 1):
 // COLOR_MODE (0: solid colour, 1: property, 2: cell id), LAYER_VIEW (one layer drawn),
 // LOG_SCALE, GRID_LINES, SPECULAR, TABLE_NORMALS (tops and bottoms lit by the normal
-// table), and LIGHTING (0: unlit, 1: headlight, 2: directional
+// table), WALL_DEPTHS (side fragments find their layer from their depth, below), and LIGHTING (0: unlit, 1: headlight, 2: directional
 // lights, 3: positional lights, as vtkOpenGLRenderer's lighting complexity), with the
 // renderer's light uniforms declared and one call a light generated at //RESMR::Lights.
 // A software rasterizer (llvmpipe) runs both sides of every branch on a uniform, masked;
@@ -79,6 +79,90 @@ vec3 DecodeNormal(uint code)
   return normalize(n);
 }
 
+#if WALL_DEPTHS
+// Wall depths (ours, WallDepthTable.h): a coarse wall paints each cell within its error of its
+// place, many layers on a many-layer model; the wall's true interfaces at the fragment's place
+// along the face give its layer exactly. Faces are hashed by (i, j, face) as cells are.
+in float modelDepth;             // depth below the origin, as the table's
+uniform usampler3D wallOffsets;  // the wall hash's offsets, RGB16UI
+uniform usampler3D wallKeys;     // rows x slabs, R32UI: (j nx + i) 4 + face + 1 a slot
+uniform sampler3D wallDepths;    // (nk + 1) x rows x slabs, RGB32F: depth at A, at B, open cell
+uniform ivec3 wallTableSides;
+uniform ivec3 wallOffsetSides;
+uniform int wallRows;
+uniform int wallSearchSteps;     // 2^steps >= nk
+
+ivec2 WallSlot(ivec3 face)
+{
+  ivec3 offset = ivec3(texelFetch(wallOffsets, Modulo(face, wallOffsetSides), 0).xyz);
+  ivec3 h = Modulo(face, wallTableSides) + offset;
+  h -= wallTableSides * ivec3(greaterThanEqual(h, wallTableSides));
+  int slot = h.x + wallTableSides.x * (h.y + wallTableSides.y * h.z);
+  int row = Modulo(ivec3(slot), ivec3(wallRows)).x;
+  return ivec2(row, int(round(float(slot - row) / float(wallRows))));
+}
+
+float WallDepthAt(ivec2 slot, int k, float along)
+{
+  vec2 d = texelFetch(wallDepths, ivec3(k, slot), 0).xy;
+  return mix(d.x, d.y, along);
+}
+
+// A side fragment's layer: the interpolated one when the fragment lies within half a pixel
+// of its interfaces (always at the finest level), else the one whose interfaces hold its
+// depth, then the nearest cell the exact wall shows. Returns (layer, pixels to the nearer
+// interface, the layer's thickness in pixels), or layer -1 off the table's faces (a face
+// slanted in (i, j, k), where a coarse triangle spans a corner).
+vec3 WallLayer(ivec3 cell, vec3 topoNormal, float depthPerPixel)
+{
+  if (topoNormal.z >= max(topoNormal.x, topoNormal.y))
+  {
+    return vec3(-1.0);
+  }
+  // The face is the column's lower or upper one on its constant axis: the one in the table.
+  int axis = topoNormal.x >= topoNormal.y ? 0 : 1;
+  float along = fract(axis == 0 ? cellCoord.y : cellCoord.x);
+  uint key = (uint(cell.x) + uint(gridDims.x) * uint(cell.y)) * 4u + uint(2 * axis) + 1u;
+  ivec2 low = WallSlot(ivec3(cell.xy, 2 * axis));
+  ivec2 high = WallSlot(ivec3(cell.xy, 2 * axis + 1));
+  bool isLow = texelFetch(wallKeys, ivec3(low, 0), 0).r == key;
+  bool isHigh = texelFetch(wallKeys, ivec3(high, 0), 0).r == key + 1u;
+  if (!isLow && !isHigh)
+  {
+    return vec3(-1.0);
+  }
+  ivec2 slot = isLow ? low : high;
+  int k = cell.z;
+  vec3 t = texelFetch(wallDepths, ivec3(k, slot), 0).xyz;
+  float top = mix(t.x, t.y, along);
+  float bottom = WallDepthAt(slot, k + 1, along);
+  float slack = 0.5 * depthPerPixel;
+  if (modelDepth < top - slack || modelDepth > bottom + slack)
+  {
+    int lo = 0;
+    int hi = gridDims.z - 1;
+    for (int s = 0; s < wallSearchSteps && lo < hi; ++s)
+    {
+      int mid = (lo + hi + 1) / 2;
+      if (WallDepthAt(slot, mid, along) <= modelDepth)
+      {
+        lo = mid;
+      }
+      else
+      {
+        hi = mid - 1;
+      }
+    }
+    k = lo;
+    t = texelFetch(wallDepths, ivec3(k, slot), 0).xyz;
+    top = mix(t.x, t.y, along);
+    bottom = WallDepthAt(slot, k + 1, along);
+  }
+  float perPixel = max(depthPerPixel, 1e-20);
+  return vec3(t.z, min(abs(modelDepth - top), abs(bottom - modelDepth)) / perPixel, (bottom - top) / perPixel);
+}
+#endif
+
 #if LIGHTING > 1
 // One light's diffuse and specular share at this fragment (`toLight` unit, from the fragment).
 void AddLight(vec3 normal, vec3 toEye, vec3 toLight, vec3 lightColor, float attenuation,
@@ -127,6 +211,17 @@ void main()
     // on screen, where interpolation strays past either interface. Their cell is in the
     // layer; top and bottom faces keep the k their vertices give.
     cell.z = layer;
+  }
+#endif
+#if WALL_DEPTHS
+  // Derivatives outside any branch: every fragment of a quad takes them.
+  vec3 topoNormal = abs(cross(dFdx(cellCoord), dFdy(cellCoord)));
+  float depthPerPixel = fwidth(modelDepth);
+  vec3 wall = vec3(-1.0);
+  if (faceKind == 2)
+  {
+    wall = WallLayer(cell, topoNormal, depthPerPixel);
+    cell.z = wall.x >= 0.0 ? int(wall.x) : cell.z;
   }
 #endif
 #if COLOR_MODE == 2
@@ -214,6 +309,11 @@ void main()
     vec3 perPixel = max(fwidth(cellCoord), vec3(1e-6));
     vec3 pixels = abs(fract(cellCoord + 0.5) - 0.5) / perPixel;
     vec3 cellPixels = 1.0 / (perPixel * renderScale);
+#if WALL_DEPTHS
+    // A wall's layer lines where its true interfaces are.
+    pixels.z = wall.x >= 0.0 ? wall.y : pixels.z;
+    cellPixels.z = wall.x >= 0.0 ? wall.z / renderScale : cellPixels.z;
+#endif
     vec3 fade = smoothstep(vec3(3.0), vec3(8.0), cellPixels);
     float width = max(gridLineWidth * renderScale, min(gridLineWidth, 1.0));
     vec3 line = (1.0 - smoothstep(vec3(0.5 * width - 0.5), vec3(0.5 * width + 0.5), pixels)) * fade;

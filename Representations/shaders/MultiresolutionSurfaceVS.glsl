@@ -15,10 +15,12 @@ uniform mat4 modelToView;
 
 out vec3 cellCoord;
 out vec3 viewPosition;
+out float modelDepth; // depth below the origin: the wall depth table's frame
 
 void main()
 {
   gl_Position = modelToClip * vec4(vertexPosition, 1.0);
   viewPosition = (modelToView * vec4(vertexPosition, 1.0)).xyz;
   cellCoord = cellCoordinate;
+  modelDepth = -vertexPosition.z;
 }
