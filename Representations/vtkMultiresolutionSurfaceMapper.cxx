@@ -139,8 +139,9 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   std::unique_ptr<resmr::ViewSelector> Selector;
   std::unique_ptr<resmr::RegionCache> Cache;
   std::string Error;
-  std::string LayerError; ///< why Layer cannot be drawn, empty if it can
-  std::string Reported;   ///< the last error sent to vtkErrorMacro (each failure once)
+  std::string LayerError;   ///< why Layer cannot be drawn, empty if it can
+  std::string Reported;     ///< the last error sent to vtkErrorMacro (each failure once)
+  bool WallsWarned = false; ///< a damaged wall depth table was reported
 
   // GPU side.
   vtkOpenGLRenderWindow* Window = nullptr;
@@ -226,7 +227,8 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   std::size_t tableBytes = 0; ///< copied for the model's tables this frame
   vtkShaderProgram* program = nullptr;
   int colorMode = SolidColor;
-  bool lit = false; ///< the last program readied lights the surface
+  bool lit = false;            ///< the last program readied lights the surface
+  bool clockwiseFront = false; ///< glFrontFace is GL_CW (a mirroring transform, back faces culled)
 };
 
 vtkMultiresolutionSurfaceMapper::vtkMultiresolutionSurfaceMapper()
@@ -468,6 +470,7 @@ bool vtkMultiresolutionSurfaceMapper::OpenFiles(Frame& frame)
       in.PropertyPath = frame.propertyPath;
       in.PropertyStamp = frame.propertyStamp;
       in.Reported.clear();
+      in.WallsWarned = false;
     }
     catch (const std::exception& error)
     {
@@ -691,6 +694,13 @@ void vtkMultiresolutionSurfaceMapper::StreamTables(Frame& frame)
   in.Tables.StreamProperty(frame.window, loaded, in.File->Header(), budget, !frame.bounded);
   in.Tables.StreamNormals(frame.window, budget, !frame.bounded);
   in.Tables.UploadWalls(frame.window, *in.Cache);
+  const auto tables = in.Cache->Tables();
+  if (tables && !tables->wallsError.empty() && !in.WallsWarned)
+  {
+    // The rest paints; walls take their layers from the coordinates, as before the table.
+    vtkWarningMacro(<< tables->wallsError << "; walls are painted without it");
+    in.WallsWarned = true;
+  }
   frame.tableBytes = resmr::TableBytesPerFrame - budget;
   // The wanted table once on the GPU; until then an earlier time step of the same property
   // and layer stands in (as an ancestor does for a mesh), anything else is drawn in the solid
@@ -754,6 +764,10 @@ void vtkMultiresolutionSurfaceMapper::SetUniforms(Frame& frame)
   glUniform3i(glGetUniformLocation(static_cast<GLuint>(program->GetHandle()), "gridDims"), int(header.dims[0]),
     int(header.dims[1]), int(header.dims[2]));
   in.Tables.Bind(program, header);
+  // The side a side fragment's cell lies on (RegionCache's offsets): by the handedness and
+  // the triangle's turn on the screen, which gl_FrontFacing gives as glFrontFace sets it.
+  const auto tables = in.Cache->Tables();
+  program->SetUniformi("wallSideSign", (tables ? tables->handedness : 1) * (frame.clockwiseFront ? -1 : 1));
   program->SetUniformi("layer", frame.layer);
   vtkProperty* look = frame.actor->GetProperty();
   if (frame.colorMode == PropertyColors)
@@ -792,7 +806,8 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
     state->vtkglEnable(GL_CULL_FACE);
     state->vtkglCullFace(GL_BACK);
     // Restored after drawing (vtkOpenGLState does not track it).
-    glFrontFace(resmr::LinearDeterminant(frame.modelToWorld) < 0 ? GL_CW : GL_CCW);
+    frame.clockwiseFront = resmr::LinearDeterminant(frame.modelToWorld) < 0;
+    glFrontFace(frame.clockwiseFront ? GL_CW : GL_CCW);
   }
   else
   {
@@ -860,6 +875,9 @@ int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bo
     {
       part.shown = part.shown && kinds[static_cast<std::size_t>(part.kind)];
     }
+    // A leaf's sides are the original faces: their coordinates name the layer exactly.
+    const bool leaf = in.File->Regions()[drawn.region].level == in.File->Header().leafLevel;
+    frame.program->SetUniformi("wallLookup", leaf ? 0 : 1);
     in.Triangles += static_cast<vtkIdType>(in.Regions.Draw(drawn.region, parts, frame.program));
     ++regions;
   }

@@ -297,10 +297,10 @@ void vtkMultiresolutionTableTextures::UploadWalls(vtkOpenGLRenderWindow* window,
   std::vector<float> texels(keys.size() * interfaces * 3, 0.f);
   std::copy(walls.texels.begin(), walls.texels.end(), texels.begin());
   window->GetState()->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  UploadInteger3D(this->WallOffsetTexture, window, walls.hash.offsetSides, 3, GL_RGB16UI, GL_RGB_INTEGER,
-    walls.hash.offsets.data());
-  const auto setup = [window](vtkTextureObject* texture, unsigned int internalFormat, unsigned int format,
-                       unsigned int type) {
+  UploadInteger3D(
+    this->WallOffsetTexture, window, walls.hash.offsetSides, 3, GL_RGB16UI, GL_RGB_INTEGER, walls.hash.offsets.data());
+  const auto setup = [window](
+                       vtkTextureObject* texture, unsigned int internalFormat, unsigned int format, unsigned int type) {
     texture->SetContext(window);
     texture->ResetFormatAndType();
     texture->SetInternalFormat(internalFormat);

@@ -102,10 +102,10 @@ private:
   bool WallsUploaded = false;
   bool WallsTried = false; ///< uploaded, or found none or too large for 3D textures
   std::array<uint32_t, 3> WallTableSides{ 1, 1, 1 }, WallOffsetSides{ 1, 1, 1 };
-  int WallRows = 1;        ///< slots a slab of the key and depth textures
-  int WallSearchSteps = 0; ///< binary search steps over the layers
-  bool HashUploaded = false;                     ///< the offsets
-  bool NormalsUploaded = false;                  ///< the cells' normals (after the offsets)
+  int WallRows = 1;             ///< slots a slab of the key and depth textures
+  int WallSearchSteps = 0;      ///< binary search steps over the layers
+  bool HashUploaded = false;    ///< the offsets
+  bool NormalsUploaded = false; ///< the cells' normals (after the offsets)
   std::shared_ptr<const resmr::PropertyTableData> Uploaded;
   std::unique_ptr<SlabUpload> OffsetUpload, NormalUpload, PropertyUpload;
   /// The property texture drawn before the current one, copied over by the next table.

@@ -89,6 +89,10 @@ set_property(TEST Multiresolution.Layer APPEND PROPERTY ENVIRONMENT "RESMR_EXECU
 # Every level and random cuts: no see-through hole, no pixel in the NaN colour.
 resmr_add_pvpython_test(Multiresolution.EveryLevel TestMultiresolutionEveryLevel.py)
 set_property(TEST Multiresolution.EveryLevel APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+# Walls show their layers where they are at every level (the wall depth table), and do worse
+# with it damaged.
+resmr_add_pvpython_test(Multiresolution.WallLayers TestMultiresolutionWallLayers.py)
+set_property(TEST Multiresolution.WallLayers APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
 # Lit as stock ParaView lights its surfaces: light kit, headlight and material (PSNR).
 resmr_add_pvpython_test(Multiresolution.Lighting TestMultiresolutionLighting.py)
 set_property(TEST Multiresolution.Lighting APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")

@@ -665,7 +665,8 @@ void CheckModelChunks(const std::vector<ModelChunk>& model, const Multiresolutio
         " expected from the header's hash sides (corrupt)");
     }
   }
-  if (pieces[ModelChunk::WallDepths] > 0 && pieces[ModelChunk::WallDepths] != ModelPieces(total[ModelChunk::WallDepths]))
+  if (pieces[ModelChunk::WallDepths] > 0 &&
+    pieces[ModelChunk::WallDepths] != ModelPieces(total[ModelChunk::WallDepths]))
   {
     throw FileFormatError(path + ": wall depth table of " + std::to_string(total[ModelChunk::WallDepths]) +
       " bytes in " + std::to_string(pieces[ModelChunk::WallDepths]) + " chunks (corrupt)");
@@ -907,8 +908,8 @@ void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader 
 MultiresolutionFile::MultiresolutionFile(const std::string& path)
   : FilePath(path)
 {
-  this->Data = MapOwnFile(path, HeaderBytes + IndexTrailerBytes, HeaderMagic, "multiresolution", ".resmr", this->Size,
-    this->Descriptor);
+  this->Data = MapOwnFile(
+    path, HeaderBytes + IndexTrailerBytes, HeaderMagic, "multiresolution", ".resmr", this->Size, this->Descriptor);
   try
   {
     ByteReader head(this->Data, HeaderBytes, path + ": header");

@@ -39,8 +39,8 @@
 #include "ChunkStorage.h"
 #include "CornerPointModel.h"
 #include "PerfectSpatialHash.h"
-#include "WallDepthTable.h"
 #include "RegionMesh.h"
+#include "WallDepthTable.h"
 
 #include <array>
 #include <cstdint>

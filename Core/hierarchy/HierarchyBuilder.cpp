@@ -15,10 +15,10 @@
 #include "MultiresolutionFile.h"
 #include "NormalQuantization.h"
 #include "PerfectSpatialHash.h"
-#include "WallDepthTable.h"
 #include "RegionMesh.h"
 #include "SideSurfaceSimplification.h"
 #include "ThreadGroup.h"
+#include "WallDepthTable.h"
 
 #include <algorithm>
 #include <atomic>
@@ -29,9 +29,9 @@
 #include <cstring>
 #include <dirent.h>
 #include <exception>
+#include <iterator>
 #include <limits>
 #include <map>
-#include <iterator>
 #include <mutex>
 #include <stdexcept>
 #include <sys/stat.h>

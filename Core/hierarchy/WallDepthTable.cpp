@@ -89,8 +89,10 @@ void CollectWallFaces(const RegionMesh& leaf, int64_t nx, std::vector<WallFace>&
       face.depthB.resize(layers + 1);
       for (std::size_t k = 0; k <= layers; ++k)
       {
-        face.depthA[k] = static_cast<float>(leaf.positions[leaf.Vertex(a, static_cast<int32_t>(k)) * std::size_t(3) + 2]);
-        face.depthB[k] = static_cast<float>(leaf.positions[leaf.Vertex(b, static_cast<int32_t>(k)) * std::size_t(3) + 2]);
+        face.depthA[k] =
+          static_cast<float>(leaf.positions[leaf.Vertex(a, static_cast<int32_t>(k)) * std::size_t(3) + 2]);
+        face.depthB[k] =
+          static_cast<float>(leaf.positions[leaf.Vertex(b, static_cast<int32_t>(k)) * std::size_t(3) + 2]);
       }
       out.push_back(std::move(face));
     }
@@ -174,8 +176,8 @@ WallDepthTable DecodeWallDepthTable(
   const auto bad = [&](const std::string& what) { return FileFormatError(place + ": " + what + " (corrupt)"); };
   if (table.layers != dims[2])
   {
-    throw bad("wall depth table of " + std::to_string(table.layers) + " layers for a model of " +
-      std::to_string(dims[2]));
+    throw bad(
+      "wall depth table of " + std::to_string(table.layers) + " layers for a model of " + std::to_string(dims[2]));
   }
   for (int a = 0; a < 3; ++a)
   {

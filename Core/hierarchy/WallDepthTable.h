@@ -53,8 +53,8 @@ struct WallDepthTable
   int32_t layers = 0; ///< nk
   uint64_t faces = 0;
   PerfectSpatialHash hash;
-  std::vector<uint32_t> keys;  ///< a slot each
-  std::vector<float> texels;   ///< (nk + 1) x 3 a slot
+  std::vector<uint32_t> keys; ///< a slot each
+  std::vector<float> texels;  ///< (nk + 1) x 3 a slot
   bool Empty() const { return this->faces == 0; }
 };
 

@@ -1175,8 +1175,9 @@ void RegionCache::LoadHandednessLocked(std::unique_lock<std::mutex>& lock)
 void RegionCache::LoadTablesLocked(std::unique_lock<std::mutex>& lock)
 {
   this->TablesLoading = true;
-  lock.unlock();
   std::shared_ptr<ModelTables> tables = std::make_shared<ModelTables>();
+  tables->handedness = this->Handedness; // known before the tables are read
+  lock.unlock();
   std::string error;
   try
   {

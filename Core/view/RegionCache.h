@@ -155,6 +155,7 @@ struct ModelTables
   PerfectSpatialHash hash;
   std::vector<uint8_t> normals; ///< 4 bytes a hash slot (top, bottom); empty in older files
   WallDepthTable walls;         ///< empty in older files, or when damaged (wallsError)
+  int handedness = 1;           ///< the topology's (TopologyHandedness), for the side faces' offsets
   std::string wallsError;       ///< why a damaged wall table was left out (the rest paints)
 };
 

@@ -91,6 +91,8 @@ uniform ivec3 wallTableSides;
 uniform ivec3 wallOffsetSides;
 uniform int wallRows;
 uniform int wallSearchSteps;     // 2^steps >= nk
+uniform int wallSideSign;        // the topology's handedness, negated when glFrontFace is GL_CW
+uniform int wallLookup;          // 0: the region's sides are the original faces (a leaf)
 
 ivec2 WallSlot(ivec3 face)
 {
@@ -108,30 +110,67 @@ float WallDepthAt(ivec2 slot, int k, float along)
   return mix(d.x, d.y, along);
 }
 
-// A side fragment's layer: the interpolated one when the fragment lies within half a pixel
-// of its interfaces (always at the finest level), else the one whose interfaces hold its
-// depth, then the nearest cell the exact wall shows. Returns (layer, pixels to the nearer
-// interface, the layer's thickness in pixels), or layer -1 off the table's faces (a face
-// slanted in (i, j, k), where a coarse triangle spans a corner).
-vec3 WallLayer(ivec3 cell, vec3 topoNormal, float depthPerPixel)
+// A side fragment's cell on the wall it lies on: the layer is the interpolated one when the
+// fragment lies within half a pixel of its interfaces (always at the finest level), else the
+// one whose interfaces hold its depth, then the nearest cell the exact wall shows. False off
+// the table's faces (a triangle nearer level in (i, j, k) than upright, or whose coordinates
+// name no column with a wall nearby); else `lines`: pixels to the nearer interface and the
+// layer's thickness in pixels.
+bool WallCell(inout ivec3 cell, vec3 topoNormal, float depthPerPixel, out vec2 lines)
 {
-  if (topoNormal.z >= max(topoNormal.x, topoNormal.y))
+  lines = vec2(0.0);
+  vec3 size = abs(topoNormal);
+  if (size.z >= max(size.x, size.y))
   {
-    return vec3(-1.0);
+    return false;
   }
-  // The face is the column's lower or upper one on its constant axis: the one in the table.
-  int axis = topoNormal.x >= topoNormal.y ? 0 : 1;
-  float along = fract(axis == 0 ? cellCoord.y : cellCoord.x);
-  uint key = (uint(cell.x) + uint(gridDims.x) * uint(cell.y)) * 4u + uint(2 * axis) + 1u;
-  ivec2 low = WallSlot(ivec3(cell.xy, 2 * axis));
-  ivec2 high = WallSlot(ivec3(cell.xy, 2 * axis + 1));
-  bool isLow = texelFetch(wallKeys, ivec3(low, 0), 0).r == key;
-  bool isHigh = texelFetch(wallKeys, ivec3(high, 0), 0).r == key + 1u;
-  if (!isLow && !isHigh)
+  // The face: the column's lower or upper one on the constant axis of the fragment's
+  // coordinates, or on the other axis where a coarse wall runs slanted in (i, j) over a
+  // staircase outline; the first the table holds.
+  // The face tried first is the one the triangle's turn names: its topological normal is the
+  // cross product of the coordinate's screen derivatives, signed by the turn on the screen,
+  // and the cell lies against it times the handedness (RegionCache's offsets).
+  int axis = size.x >= size.y ? 0 : 1;
+  float normal = (axis == 0 ? topoNormal.x : topoNormal.y) * (gl_FrontFacing ? 1.0 : -1.0);
+  int upper = -float(wallSideSign) * normal > 0.0 ? 0 : 1; // 0: the cell's lower face
+  uint base = (uint(cell.x) + uint(gridDims.x) * uint(cell.y)) * 4u + 1u;
+  ivec2 slot = ivec2(0);
+  int faceAxis = -1;
+  for (int n = 0; n < 4 && faceAxis < 0; ++n)
   {
-    return vec3(-1.0);
+    int a = n < 2 ? axis : 1 - axis;
+    int face = 2 * a + (n % 2 == 0 ? upper : 1 - upper);
+    ivec2 s = WallSlot(ivec3(cell.xy, face));
+    if (texelFetch(wallKeys, ivec3(s, 0), 0).r == base + uint(face))
+    {
+      slot = s;
+      faceAxis = a;
+    }
   }
-  ivec2 slot = isLow ? low : high;
+  // Off the model where such a wall cuts a step of it: the faces of the columns beside this
+  // one that face it (I+ of the column before it in i, I- of the one after, J+, J-).
+  for (int n = 0; n < 4 && faceAxis < 0; ++n)
+  {
+    int a = n / 2;
+    ivec2 beside = cell.xy + (a == 0 ? ivec2(n % 2 == 0 ? -1 : 1, 0) : ivec2(0, n % 2 == 0 ? -1 : 1));
+    int face = 2 * a + (n % 2 == 0 ? 1 : 0);
+    if (all(greaterThanEqual(beside, ivec2(0))) && all(lessThan(beside, gridDims.xy)))
+    {
+      ivec2 s = WallSlot(ivec3(beside, face));
+      uint key = (uint(beside.x) + uint(gridDims.x) * uint(beside.y)) * 4u + 1u + uint(face);
+      if (texelFetch(wallKeys, ivec3(s, 0), 0).r == key)
+      {
+        slot = s;
+        faceAxis = a;
+        cell.xy = beside; // the wall's own column, whose cells have values
+      }
+    }
+  }
+  if (faceAxis < 0)
+  {
+    return false;
+  }
+  float along = fract(faceAxis == 0 ? cellCoord.y : cellCoord.x);
   int k = cell.z;
   vec3 t = texelFetch(wallDepths, ivec3(k, slot), 0).xyz;
   float top = mix(t.x, t.y, along);
@@ -159,7 +198,9 @@ vec3 WallLayer(ivec3 cell, vec3 topoNormal, float depthPerPixel)
     bottom = WallDepthAt(slot, k + 1, along);
   }
   float perPixel = max(depthPerPixel, 1e-20);
-  return vec3(t.z, min(abs(modelDepth - top), abs(bottom - modelDepth)) / perPixel, (bottom - top) / perPixel);
+  cell.z = int(t.z);
+  lines = vec2(min(abs(modelDepth - top), abs(bottom - modelDepth)), bottom - top) / perPixel;
+  return true;
 }
 #endif
 
@@ -215,13 +256,13 @@ void main()
 #endif
 #if WALL_DEPTHS
   // Derivatives outside any branch: every fragment of a quad takes them.
-  vec3 topoNormal = abs(cross(dFdx(cellCoord), dFdy(cellCoord)));
+  vec3 topoNormal = cross(dFdx(cellCoord), dFdy(cellCoord));
   float depthPerPixel = fwidth(modelDepth);
-  vec3 wall = vec3(-1.0);
-  if (faceKind == 2)
+  bool onWall = false;
+  vec2 wallLines = vec2(0.0);
+  if (faceKind == 2 && wallLookup == 1)
   {
-    wall = WallLayer(cell, topoNormal, depthPerPixel);
-    cell.z = wall.x >= 0.0 ? int(wall.x) : cell.z;
+    onWall = WallCell(cell, topoNormal, depthPerPixel, wallLines);
   }
 #endif
 #if COLOR_MODE == 2
@@ -311,8 +352,8 @@ void main()
     vec3 cellPixels = 1.0 / (perPixel * renderScale);
 #if WALL_DEPTHS
     // A wall's layer lines where its true interfaces are.
-    pixels.z = wall.x >= 0.0 ? wall.y : pixels.z;
-    cellPixels.z = wall.x >= 0.0 ? wall.z / renderScale : cellPixels.z;
+    pixels.z = onWall ? wallLines.x : pixels.z;
+    cellPixels.z = onWall ? wallLines.y / renderScale : cellPixels.z;
 #endif
     vec3 fade = smoothstep(vec3(3.0), vec3(8.0), cellPixels);
     float width = max(gridLineWidth * renderScale, min(gridLineWidth, 1.0));

@@ -872,14 +872,13 @@ void TestWallDepths()
   CHECK(badOrder == 0);
   // Damaged: cut short, or a cell out of range.
   auto bytes = EncodeWallDepthTable(table);
-  resmr_testing::ExpectError<FileFormatError>("short wall table", [&] {
-    DecodeWallDepthTable(std::vector<uint8_t>(bytes.begin(), bytes.end() - 4), file.Header().dims, "walls");
-  }, { "walls", "corrupt" });
+  resmr_testing::ExpectError<FileFormatError>("short wall table",
+    [&] { DecodeWallDepthTable(std::vector<uint8_t>(bytes.begin(), bytes.end() - 4), file.Header().dims, "walls"); },
+    { "walls", "corrupt" });
   float big = 1e9f;
   std::memcpy(&bytes[bytes.size() - 4], &big, 4);
-  resmr_testing::ExpectError<FileFormatError>("wall cell out of range", [&] {
-    DecodeWallDepthTable(bytes, file.Header().dims, "walls");
-  }, { "walls", "out of range" });
+  resmr_testing::ExpectError<FileFormatError>("wall cell out of range",
+    [&] { DecodeWallDepthTable(bytes, file.Header().dims, "walls"); }, { "walls", "out of range" });
   std::remove(path.c_str());
 }
 

@@ -25,6 +25,8 @@ Cases, from a small synthetic model built with its properties:
 - damaged root chunk: the same in a root region: named likewise; the other root still draws;
 - damaged hash chunk: a byte of the perfect hash's offset table changed: the loader names the
   file and the table; the geometry draws in the solid colour (no cell can be looked up);
+- damaged wall depth table: a byte of the wall depth table changed: a warning names the file
+  and the table; the model draws coloured by PORO, walls painted from their coordinates;
 - damaged property table: a byte of PORO's packed table changed in the .resmrp: the
   representation names the property file and PORO; the geometry draws in the solid colour;
 - cut while open: the .resmr cut in place after the roots loaded: the loader names the file
@@ -149,21 +151,20 @@ def index_of(blob):
 
 
 # The .resmr index: one 192-byte record a region (level, index, ..., at byte 104 the mesh
-# chunk's offset and stored size), then one 32-byte record a model chunk (kind, part, offset,
-# stored size). The header's region count is not needed: records are read while they look like
-# regions.
+# chunk's offset and stored size), as many as the header's region count (at byte 128), then
+# one 32-byte record a model chunk (kind, part, offset, stored size).
 index_offset, index_size = index_of(data)
 regions = []
+region_count = struct.unpack_from("<Q", data, 128)[0]
 position = index_offset
-while position + 192 <= index_offset + index_size:
+for _ in range(region_count):
     level, _, number = struct.unpack_from("<iiq", data, position)
     chunk, stored = struct.unpack_from("<QI", data, position + 104)
-    if not 0 <= level <= 40 or not 256 <= chunk < index_offset:
-        break
     regions.append((level, number, chunk, stored))
     position += 192
 model = [struct.unpack_from("<IIQI", data, p) for p in range(position, index_offset + index_size, 32)]
 hash_offsets = [m for m in model if m[0] == 2]
+walls = [m for m in model if m[0] == 5]
 leaf = max(regions, key=lambda r: (r[0], r[3]))
 root = max((r for r in regions if r[0] == 0), key=lambda r: r[3])
 # The .resmrp index: per table a 32-byte name, step, report number, days, minimum, maximum,
@@ -173,8 +174,9 @@ poro = None
 for position in range(p_offset, p_offset + p_size, 56 + 20 * (1 + NZ)):
     if property_data[position:position + 32].split(b"\0")[0] == b"PORO":
         poro = struct.unpack_from("<QI", property_data, position + 56)
-if len(regions) < 4 or len(hash_offsets) != 1 or poro is None:
-    rt.fail(f"could not read the indexes: {len(regions)} regions, {len(hash_offsets)} hash offset chunks, PORO {poro}")
+if len(regions) < 4 or len(hash_offsets) != 1 or len(walls) != 1 or poro is None:
+    rt.fail(f"could not read the indexes: {len(regions)} regions, {len(hash_offsets)} hash offset chunks, "
+            f"{len(walls)} wall depth chunks, PORO {poro}")
 print(f"{good}: {len(data)} bytes, {len(regions)} regions, {len(model)} model chunks; leaf damaged: level "
       f"{leaf[0]} index {leaf[1]}, root: index {root[1]}")
 
@@ -232,6 +234,8 @@ cases = [
      [f"region (level 0, index {root[1]}) mesh at byte {root[2]}", "checksum mismatch"], "display", "less"),
     ("damaged hash chunk", write("hash", flipped(data, hash_offsets[0][2] + hash_offsets[0][3] // 2), P), None,
      ["hash offset table", f"at byte {hash_offsets[0][2]}", "checksum mismatch"], "display", "solid"),
+    ("damaged wall depth table", write("walls", flipped(data, walls[0][2] + walls[0][3] // 2), P), None, [], None,
+     "property"),
     ("damaged property table", write("poro", data, flipped(P, poro[0] + poro[1] // 2)), ".resmrp",
      ["PORO", f"at byte {poro[0]}", "checksum mismatch"], "display", "solid"),
     ("cut while open", write("cut", data, P), None, ["cut or rewritten in place"], "display", "roots"),
@@ -306,6 +310,9 @@ for name, path, named, fragments, where, drawn in cases:
                         f"the good file {good_covered}")
     if drawn in ("less", "roots") and not (0 < covered and triangles > 0):
         problems.append(f"drew nothing ({triangles} triangles, {covered} pixels)")
+    if name == "damaged wall depth table" and not any(
+            "WARN|" in line and path in line and "wall depth table" in line for line in output.splitlines()):
+        problems.append("no warning naming the file and the wall depth table")
     if name == "missing .resmrp" and result["arrays"]:
         problems.append(f"properties listed without a property file: {result['arrays']}")
     failures.extend(f"{name}: {p}" for p in problems)

@@ -140,6 +140,9 @@ if cached_files_usable():
     print(f"reusing {path} and its .resmrp")
 else:
     grid = stem + ".EGRID"
+    for stale in (path, stem + ".resmrp"):
+        if os.path.exists(stale):
+            os.remove(stale)  # an older format's, or a pair an interrupted run left unmatched
     for command in (["synth", str(nx), str(ny), str(nz), "-o", grid, "--quiet"],
                     ["build", grid, "-o", path, "--quiet"],
                     ["add-properties", path, grid]):

@@ -22,6 +22,8 @@ resmr = os.environ["RESMR_EXECUTABLE"]
 os.makedirs(args.temp, exist_ok=True)
 egrid = os.path.join(args.data, "spe9/opmflow2022_run_of_opm-data_SPE9_CP/SPE9_CP.EGRID")
 path = os.path.join(args.temp, "spe9.resmr")
+if os.path.exists(path[:-6] + ".resmrp"):
+    os.remove(path[:-6] + ".resmrp")  # an earlier run's, for the geometry built before
 subprocess.run([resmr, "build", egrid, "-o", path, "--quiet"], capture_output=True, text=True, check=True)
 subprocess.run([resmr, "add-properties", path, egrid], capture_output=True, text=True, check=True)
 
