@@ -369,28 +369,24 @@ void vtkMultiresolutionTableTextures::Bind(vtkShaderProgram* program, const resm
   const std::array<uint32_t, 3> one{ 1, 1, 1 };
   uniform3i("tableSides", this->HashUploaded ? header.hashTableSides : one);
   uniform3i("offsetSides", this->HashUploaded ? header.hashOffsetSides : one);
-  this->OffsetTexture->Activate();
-  program->SetUniformi("hashOffsets", this->OffsetTexture->GetTextureUnit());
-  this->NormalTexture->Activate();
-  program->SetUniformi("cellNormals", this->NormalTexture->GetTextureUnit());
-  this->PropertyTexture->Activate();
-  program->SetUniformi("propertyTable", this->PropertyTexture->GetTextureUnit());
-  this->LayerPropertyTexture->Activate();
-  program->SetUniformi("layerProperty", this->LayerPropertyTexture->GetTextureUnit());
-  this->ColorTexture->Activate();
-  program->SetUniformi("colorMap", this->ColorTexture->GetTextureUnit());
+  const auto bind = [program](vtkTextureObject* texture, const char* sampler) {
+    texture->Activate();
+    program->SetUniformi(sampler, texture->GetTextureUnit());
+  };
+  bind(this->OffsetTexture, "hashOffsets");
+  bind(this->NormalTexture, "cellNormals");
+  bind(this->PropertyTexture, "propertyTable");
+  bind(this->LayerPropertyTexture, "layerProperty");
+  bind(this->ColorTexture, "colorMap");
   if (this->WallsUploaded)
   {
     uniform3i("wallTableSides", this->WallTableSides);
     uniform3i("wallOffsetSides", this->WallOffsetSides);
     program->SetUniformi("wallRows", this->WallRows);
     program->SetUniformi("wallSearchSteps", this->WallSearchSteps);
-    this->WallOffsetTexture->Activate();
-    program->SetUniformi("wallOffsets", this->WallOffsetTexture->GetTextureUnit());
-    this->WallKeyTexture->Activate();
-    program->SetUniformi("wallKeys", this->WallKeyTexture->GetTextureUnit());
-    this->WallDepthTexture->Activate();
-    program->SetUniformi("wallDepths", this->WallDepthTexture->GetTextureUnit());
+    bind(this->WallOffsetTexture, "wallOffsets");
+    bind(this->WallKeyTexture, "wallKeys");
+    bind(this->WallDepthTexture, "wallDepths");
   }
 }
 

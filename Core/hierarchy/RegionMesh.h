@@ -29,7 +29,9 @@
 //   hexahedral mesh on load.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -64,6 +66,19 @@ struct RegionMesh
   int64_t NodeCount() const { return static_cast<int64_t>(this->topology.size()); }
   int64_t ColumnCount() const { return static_cast<int64_t>(this->corners.size()); }
   int64_t VertexCount() const { return this->NodeCount() * (this->layers + 1); }
+  /// The column's (i, j): the lowest topological coordinates of its corners (the column's
+  /// cell indices, 0-based, in a mesh of whole cells).
+  std::array<float, 2> ColumnCell(std::size_t column) const
+  {
+    const auto& q = this->corners[column];
+    std::array<float, 2> low = this->topology[q[0]];
+    for (int n = 1; n < 4; ++n)
+    {
+      low[0] = std::min(low[0], this->topology[q[n]][0]);
+      low[1] = std::min(low[1], this->topology[q[n]][1]);
+    }
+    return low;
+  }
   uint32_t Vertex(uint32_t node, int32_t interface) const
   {
     return node * static_cast<uint32_t>(this->layers + 1) + static_cast<uint32_t>(interface);

@@ -48,12 +48,7 @@ void CollectWallFaces(const RegionMesh& leaf, int64_t nx, std::vector<WallFace>&
   for (std::size_t c = 0; c < leaf.corners.size(); ++c)
   {
     const auto& q = leaf.corners[c];
-    float i = leaf.topology[q[0]][0], j = leaf.topology[q[0]][1];
-    for (int n = 1; n < 4; ++n)
-    {
-      i = std::min(i, leaf.topology[q[n]][0]);
-      j = std::min(j, leaf.topology[q[n]][1]);
-    }
+    const auto [i, j] = leaf.ColumnCell(c);
     for (int e = 0; e < 4; ++e)
     {
       uint32_t a = q[e], b = q[(e + 1) % 4];

@@ -189,14 +189,8 @@ std::map<std::pair<int64_t, int64_t>, std::size_t> ColumnsByCell(const RegionMes
   }
   for (std::size_t c = 0; c < mesh.corners.size(); ++c)
   {
-    const auto& q = mesh.corners[c];
-    float i = mesh.topology[q[0]][0], j = mesh.topology[q[0]][1];
-    for (int n = 1; n < 4; ++n)
-    {
-      i = std::min(i, mesh.topology[q[n]][0]);
-      j = std::min(j, mesh.topology[q[n]][1]);
-    }
-    columns[{ static_cast<int64_t>(i), static_cast<int64_t>(j) }] = c;
+    const auto cell = mesh.ColumnCell(c);
+    columns[{ static_cast<int64_t>(cell[0]), static_cast<int64_t>(cell[1]) }] = c;
   }
   return columns;
 }

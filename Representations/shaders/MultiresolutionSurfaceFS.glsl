@@ -124,12 +124,11 @@ bool WallCell(inout ivec3 cell, vec3 topoNormal, float depthPerPixel, out vec2 l
   {
     return false;
   }
-  // The face: the column's lower or upper one on the constant axis of the fragment's
-  // coordinates, or on the other axis where a coarse wall runs slanted in (i, j) over a
-  // staircase outline; the first the table holds.
-  // The face tried first is the one the triangle's turn names: its topological normal is the
-  // cross product of the coordinate's screen derivatives, signed by the turn on the screen,
-  // and the cell lies against it times the handedness (RegionCache's offsets).
+  // The face: the first the table holds of the column's faces on the constant axis of the
+  // fragment's coordinates, then on the other (a coarse wall running slanted in (i, j) over a
+  // staircase outline). First the one the triangle's turn names: its topological normal is
+  // the cross product of the coordinate's screen derivatives, signed by the turn on the
+  // screen, and the cell lies against it times the handedness (RegionCache's offsets).
   int axis = size.x >= size.y ? 0 : 1;
   float normal = (axis == 0 ? topoNormal.x : topoNormal.y) * (gl_FrontFacing ? 1.0 : -1.0);
   int upper = -float(wallSideSign) * normal > 0.0 ? 0 : 1; // 0: the cell's lower face
