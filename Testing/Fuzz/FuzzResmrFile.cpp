@@ -1,6 +1,6 @@
 // Fuzz target for the .resmr reader (MultiresolutionFile: header, trailer, index) and its
 // region decoder (ReadRegion of every region), with the model chunks (active flags of every
-// layer, the perfect spatial hash and its cell and normal tables).
+// layer, the perfect spatial hash and its cell and normal tables, the wall depth table).
 //
 // libFuzzer build (see run_fuzz.sh):
 //   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I Core Core/*.cpp FuzzResmrFile.cpp -llzo2
@@ -197,6 +197,22 @@ int ReadEverything(const resmr::MultiresolutionFile& file, std::string& firstErr
     file.ReadHash();
     file.ReadModelArray(resmr::ModelChunk::HashCells);
     file.ReadModelArray(resmr::ModelChunk::CellNormals);
+  }
+  catch (const resmr::FileFormatError& error)
+  {
+    refuse(error);
+  }
+  try
+  {
+    // The wall depth table: a damaged one costs only itself.
+    const resmr::WallDepthTable walls = file.ReadWallDepths();
+    const std::size_t stride = static_cast<std::size_t>(walls.layers + 1) * 3;
+    if (!walls.Empty() &&
+      (walls.keys.size() != walls.hash.TableSize() || walls.texels.size() != walls.keys.size() * stride))
+    {
+      BrokenInvariant("wall depth table of " + std::to_string(walls.keys.size()) + " keys for " +
+        std::to_string(walls.hash.TableSize()) + " slots");
+    }
   }
   catch (const resmr::FileFormatError& error)
   {
