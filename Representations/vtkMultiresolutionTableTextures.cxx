@@ -282,19 +282,22 @@ void vtkMultiresolutionTableTextures::UploadWalls(vtkOpenGLRenderWindow* window,
   }
   this->WallsTried = true;
   const resmr::WallDepthTable& walls = tables->walls;
-  // Slot s lies at (s mod rows, s / rows) of the key texture and, k along x, of the depth
-  // texture: 3D textures of at most 2048 a side.
+  // Slot s lies at (s mod rows, s / rows) of the key texture; face row r, k along x, at
+  // (r mod rows, r / rows) of the depth texture: 3D textures of at most 2048 a side.
   const uint64_t slots = walls.hash.TableSize();
   const uint32_t interfaces = static_cast<uint32_t>(walls.layers + 1);
-  const uint32_t rows = static_cast<uint32_t>(std::min<uint64_t>(slots, 1024));
-  const uint64_t slabs = (slots + rows - 1) / rows;
-  if (walls.Empty() || interfaces > resmr::PerfectSpatialHash::MaxSide || slabs > resmr::PerfectSpatialHash::MaxSide)
+  const uint32_t slotRows = static_cast<uint32_t>(std::min<uint64_t>(slots, 1024));
+  const uint32_t faceRows = static_cast<uint32_t>(std::min<uint64_t>(walls.faces, 1024));
+  const uint64_t slotSlabs = (slots + slotRows - 1) / std::max<uint32_t>(slotRows, 1);
+  const uint64_t faceSlabs = (walls.faces + faceRows - 1) / std::max<uint32_t>(faceRows, 1);
+  const uint64_t most = resmr::PerfectSpatialHash::MaxSide;
+  if (walls.Empty() || interfaces > most || slotSlabs > most || faceSlabs > most)
   {
     return;
   }
-  std::vector<uint32_t> keys(static_cast<std::size_t>(rows * slabs), 0);
-  std::copy(walls.keys.begin(), walls.keys.end(), keys.begin());
-  std::vector<float> texels(keys.size() * interfaces * 3, 0.f);
+  std::vector<std::array<uint32_t, 2>> keys(static_cast<std::size_t>(slotRows * slotSlabs), { 0, 0 });
+  std::copy(walls.slots.begin(), walls.slots.end(), keys.begin());
+  std::vector<float> texels(static_cast<std::size_t>(faceRows * faceSlabs) * interfaces * 3, 0.f);
   std::copy(walls.texels.begin(), walls.texels.end(), texels.begin());
   window->GetState()->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   UploadInteger3D(
@@ -309,14 +312,16 @@ void vtkMultiresolutionTableTextures::UploadWalls(vtkOpenGLRenderWindow* window,
     texture->SetMinificationFilter(vtkTextureObject::Nearest);
     texture->SetMagnificationFilter(vtkTextureObject::Nearest);
   };
-  setup(this->WallKeyTexture, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT);
-  this->WallKeyTexture->Create3DFromRaw(rows, static_cast<unsigned int>(slabs), 1, 1, VTK_UNSIGNED_INT, keys.data());
+  setup(this->WallKeyTexture, GL_RG32UI, GL_RG_INTEGER, GL_UNSIGNED_INT);
+  this->WallKeyTexture->Create3DFromRaw(
+    slotRows, static_cast<unsigned int>(slotSlabs), 1, 2, VTK_UNSIGNED_INT, keys.data());
   setup(this->WallDepthTexture, GL_RGB32F, GL_RGB, GL_FLOAT);
   this->WallDepthTexture->Create3DFromRaw(
-    interfaces, rows, static_cast<unsigned int>(slabs), 3, VTK_FLOAT, texels.data());
+    interfaces, faceRows, static_cast<unsigned int>(faceSlabs), 3, VTK_FLOAT, texels.data());
   this->WallTableSides = walls.hash.tableSides;
   this->WallOffsetSides = walls.hash.offsetSides;
-  this->WallRows = static_cast<int>(rows);
+  this->WallRows = static_cast<int>(slotRows);
+  this->WallFaceRows = static_cast<int>(faceRows);
   this->WallSearchSteps = 0;
   while ((1 << this->WallSearchSteps) < walls.layers)
   {
@@ -383,6 +388,7 @@ void vtkMultiresolutionTableTextures::Bind(vtkShaderProgram* program, const resm
     uniform3i("wallTableSides", this->WallTableSides);
     uniform3i("wallOffsetSides", this->WallOffsetSides);
     program->SetUniformi("wallRows", this->WallRows);
+    program->SetUniformi("wallFaceRows", this->WallFaceRows);
     program->SetUniformi("wallSearchSteps", this->WallSearchSteps);
     bind(this->WallOffsetTexture, "wallOffsets");
     bind(this->WallKeyTexture, "wallKeys");

@@ -97,12 +97,13 @@ private:
   vtkNew<vtkTextureObject> ColorTexture;
   vtkNew<vtkTextureObject> LayerPropertyTexture; ///< nx x ny R32F: one layer's table
   vtkNew<vtkTextureObject> WallOffsetTexture;    ///< the wall hash's offsets, RGB16UI
-  vtkNew<vtkTextureObject> WallKeyTexture;       ///< rows x slabs R32UI: each slot's face key
-  vtkNew<vtkTextureObject> WallDepthTexture;     ///< (nk + 1) x rows x slabs RGB32F
+  vtkNew<vtkTextureObject> WallKeyTexture;       ///< rows x slabs RG32UI: each slot's key and row
+  vtkNew<vtkTextureObject> WallDepthTexture;     ///< (nk + 1) x rows x slabs RGB32F: the faces
   bool WallsUploaded = false;
   bool WallsTried = false; ///< uploaded, or found none or too large for 3D textures
   std::array<uint32_t, 3> WallTableSides{ 1, 1, 1 }, WallOffsetSides{ 1, 1, 1 };
-  int WallRows = 1;             ///< slots a slab of the key and depth textures
+  int WallRows = 1;             ///< slots a slab of the key texture
+  int WallFaceRows = 1;         ///< faces a slab of the depth texture
   int WallSearchSteps = 0;      ///< binary search steps over the layers
   bool HashUploaded = false;    ///< the offsets
   bool NormalsUploaded = false; ///< the cells' normals (after the offsets)

@@ -112,15 +112,14 @@ WallDepthTable BuildWallDepthTable(const std::vector<WallFace>& faces, int32_t l
     cells.push_back({ column % columns, column / columns, (f.key - 1) % 4 });
   }
   table.hash = BuildPerfectSpatialHash(cells);
-  const std::size_t slots = static_cast<std::size_t>(table.hash.TableSize());
   const std::size_t stride = static_cast<std::size_t>(layers + 1) * 3;
-  table.keys.assign(slots, 0);
-  table.texels.assign(slots * stride, 0.f);
+  table.slots.assign(static_cast<std::size_t>(table.hash.TableSize()), { 0, 0 });
+  table.texels.assign(faces.size() * stride, 0.f);
   for (std::size_t f = 0; f < faces.size(); ++f)
   {
     const std::size_t slot = static_cast<std::size_t>(table.hash.Slot(cells[f][0], cells[f][1], cells[f][2]));
-    table.keys[slot] = faces[f].key;
-    float* texel = &table.texels[slot * stride];
+    table.slots[slot] = { faces[f].key, static_cast<uint32_t>(f) };
+    float* texel = &table.texels[f * stride];
     for (int32_t k = 0; k <= layers; ++k)
     {
       texel[3 * k] = faces[f].depthA[static_cast<std::size_t>(k)];
@@ -148,7 +147,7 @@ std::vector<uint8_t> EncodeWallDepthTable(const WallDepthTable& table)
   {
     out.PutBytes(o.data(), 6);
   }
-  out.PutBytes(table.keys.data(), table.keys.size() * 4);
+  out.PutBytes(table.slots.data(), table.slots.size() * 8);
   out.PutBytes(table.texels.data(), table.texels.size() * 4);
   return std::move(out.Bytes);
 }
@@ -184,7 +183,7 @@ WallDepthTable DecodeWallDepthTable(
   }
   const uint64_t slots = table.hash.TableSize();
   const uint64_t stride = static_cast<uint64_t>(table.layers + 1) * 3;
-  const uint64_t expected = 36 + table.hash.OffsetTableSize() * 6 + slots * 4 + slots * stride * 4;
+  const uint64_t expected = 36 + table.hash.OffsetTableSize() * 6 + slots * 8 + table.faces * stride * 4;
   if (table.faces > slots || bytes.size() != expected)
   {
     throw bad("wall depth table of " + std::to_string(bytes.size()) + " bytes, " + std::to_string(expected) +
@@ -202,25 +201,25 @@ WallDepthTable DecodeWallDepthTable(
       }
     }
   }
-  table.keys.resize(static_cast<std::size_t>(slots));
-  in.GetBytes(table.keys.data(), table.keys.size() * 4);
-  table.texels.resize(static_cast<std::size_t>(slots * stride));
+  table.slots.resize(static_cast<std::size_t>(slots));
+  in.GetBytes(table.slots.data(), table.slots.size() * 8);
+  table.texels.resize(static_cast<std::size_t>(table.faces * stride));
   in.GetBytes(table.texels.data(), table.texels.size() * 4);
   const uint64_t keyLimit = static_cast<uint64_t>(dims[0] * dims[1]) * 4;
-  for (std::size_t s = 0; s < table.keys.size(); ++s)
+  for (std::size_t s = 0; s < table.slots.size(); ++s)
   {
-    if (table.keys[s] > keyLimit)
+    if (table.slots[s][0] > keyLimit || (table.slots[s][0] != 0 && table.slots[s][1] >= table.faces))
     {
-      throw bad("wall face key " + std::to_string(table.keys[s]) + " beyond the model");
+      throw bad("wall slot " + std::to_string(s) + ": key " + std::to_string(table.slots[s][0]) + " or row " +
+        std::to_string(table.slots[s][1]) + " beyond the model or the table");
     }
-    const float* texel = &table.texels[s * stride];
-    for (uint64_t v = 0; v < stride; ++v)
+  }
+  for (uint64_t v = 0; v < table.texels.size(); ++v)
+  {
+    const float value = table.texels[static_cast<std::size_t>(v)];
+    if (!std::isfinite(value) || (v % 3 == 2 && (value < 0 || value >= float(table.layers))))
     {
-      const bool cell = v % 3 == 2;
-      if (!std::isfinite(texel[v]) || (cell && (texel[v] < 0 || texel[v] >= float(table.layers))))
-      {
-        throw bad("wall depth or cell not finite or out of range in slot " + std::to_string(s));
-      }
+      throw bad("wall depth or cell not finite or out of range in row " + std::to_string(v / stride));
     }
   }
   return table;

@@ -21,11 +21,13 @@
 //   split corners: each side of a fault has its own), and for every cell k below an
 //   interface the nearest open cell of the face (k itself when open; the upper one on a tie):
 //   a fragment that lands on a cell the exact wall does not show names one it does.
-// - Faces are packed by a perfect spatial hash of (i, j, face) (PerfectSpatialHash.h); keys
-//   mark membership. Slot s holds texels [s (nk + 1), (s + 1)(nk + 1)) of three floats (depth
-//   A, depth B, nearest open cell; the last interface's third value repeats the one above).
-// - Memory: (nk + 1) x 12 bytes a face slot, faces about the model's outline and its faults
-//   times two (a surface of the model, never its volume).
+// - Faces are found by a perfect spatial hash of (i, j, face) (PerfectSpatialHash.h): each
+//   slot holds its face's key (membership) and row. Row r holds texels [r (nk + 1),
+//   (r + 1)(nk + 1)) of three floats (depth A, depth B, nearest open cell; the last
+//   interface's third value repeats the one above). Faces are lines, which spatial hashes
+//   pack loosely (a third of the slots filled): rows keep the texels to the faces alone.
+// - Memory: 8 bytes a slot and (nk + 1) x 12 bytes a face, faces about the model's outline
+//   and its faults times two (a surface of the model, never its volume).
 #pragma once
 
 #include "PerfectSpatialHash.h"
@@ -53,8 +55,8 @@ struct WallDepthTable
   int32_t layers = 0; ///< nk
   uint64_t faces = 0;
   PerfectSpatialHash hash;
-  std::vector<uint32_t> keys; ///< a slot each
-  std::vector<float> texels;  ///< (nk + 1) x 3 a slot
+  std::vector<std::array<uint32_t, 2>> slots; ///< a slot each: key (0: empty), row
+  std::vector<float> texels;                  ///< (nk + 1) x 3 a face (row)
   bool Empty() const { return this->faces == 0; }
 };
 
@@ -75,7 +77,7 @@ void CollectWallFaces(const RegionMesh& leaf, int64_t nx, std::vector<WallFace>&
 WallDepthTable BuildWallDepthTable(const std::vector<WallFace>& faces, int32_t layers, int64_t nx);
 
 /// The table as stored (ModelChunk::WallDepths): a little-endian header (nk, faces, m, r),
-/// the offsets, the keys and the texels.
+/// the offsets, the slots (key, row) and the rows' texels.
 std::vector<uint8_t> EncodeWallDepthTable(const WallDepthTable& table);
 /// Decodes and checks a stored table against the model's dims; throws FileFormatError
 /// naming `place`.

@@ -85,28 +85,36 @@ vec3 DecodeNormal(uint code)
 // along the face give its layer exactly. Faces are hashed by (i, j, face) as cells are.
 in float modelDepth;             // depth below the origin, as the table's
 uniform usampler3D wallOffsets;  // the wall hash's offsets, RGB16UI
-uniform usampler3D wallKeys;     // rows x slabs, R32UI: (j nx + i) 4 + face + 1 a slot
-uniform sampler3D wallDepths;    // (nk + 1) x rows x slabs, RGB32F: depth at A, at B, open cell
+uniform usampler3D wallKeys;     // rows x slabs, RG32UI a slot: key (j nx + i) 4 + face + 1, row
+uniform sampler3D wallDepths;    // (nk + 1) x rows x slabs, RGB32F a face: depth at A, at B, open cell
 uniform ivec3 wallTableSides;
 uniform ivec3 wallOffsetSides;
-uniform int wallRows;
+uniform int wallRows;            // slots a slab of wallKeys
+uniform int wallFaceRows;        // faces a slab of wallDepths
 uniform int wallSearchSteps;     // 2^steps >= nk
 uniform int wallSideSign;        // the topology's handedness, negated when glFrontFace is GL_CW
 uniform int wallLookup;          // 0: the region's sides are the original faces (a leaf)
 
-ivec2 WallSlot(ivec3 face)
+// n as (n mod rows, n / rows), a texel of a table laid out in slabs of `rows`.
+ivec2 InSlabs(int n, int rows)
+{
+  int row = Modulo(ivec3(n), ivec3(rows)).x;
+  return ivec2(row, int(round(float(n - row) / float(rows))));
+}
+
+// The face's slot: its key, and its row of the depth table.
+uvec2 WallSlot(ivec3 face)
 {
   ivec3 offset = ivec3(texelFetch(wallOffsets, Modulo(face, wallOffsetSides), 0).xyz);
   ivec3 h = Modulo(face, wallTableSides) + offset;
   h -= wallTableSides * ivec3(greaterThanEqual(h, wallTableSides));
   int slot = h.x + wallTableSides.x * (h.y + wallTableSides.y * h.z);
-  int row = Modulo(ivec3(slot), ivec3(wallRows)).x;
-  return ivec2(row, int(round(float(slot - row) / float(wallRows))));
+  return texelFetch(wallKeys, ivec3(InSlabs(slot, wallRows), 0), 0).rg;
 }
 
-float WallDepthAt(ivec2 slot, int k, float along)
+float WallDepthAt(ivec2 faceAt, int k, float along)
 {
-  vec2 d = texelFetch(wallDepths, ivec3(k, slot), 0).xy;
+  vec2 d = texelFetch(wallDepths, ivec3(k, faceAt), 0).xy;
   return mix(d.x, d.y, along);
 }
 
@@ -133,16 +141,16 @@ bool WallCell(inout ivec3 cell, vec3 topoNormal, float depthPerPixel, out vec2 l
   float normal = (axis == 0 ? topoNormal.x : topoNormal.y) * (gl_FrontFacing ? 1.0 : -1.0);
   int upper = -float(wallSideSign) * normal > 0.0 ? 0 : 1; // 0: the cell's lower face
   uint base = (uint(cell.x) + uint(gridDims.x) * uint(cell.y)) * 4u + 1u;
-  ivec2 slot = ivec2(0);
+  ivec2 faceAt = ivec2(0);
   int faceAxis = -1;
   for (int n = 0; n < 4 && faceAxis < 0; ++n)
   {
     int a = n < 2 ? axis : 1 - axis;
     int face = 2 * a + (n % 2 == 0 ? upper : 1 - upper);
-    ivec2 s = WallSlot(ivec3(cell.xy, face));
-    if (texelFetch(wallKeys, ivec3(s, 0), 0).r == base + uint(face))
+    uvec2 s = WallSlot(ivec3(cell.xy, face));
+    if (s.x == base + uint(face))
     {
-      slot = s;
+      faceAt = InSlabs(int(s.y), wallFaceRows);
       faceAxis = a;
     }
   }
@@ -155,11 +163,11 @@ bool WallCell(inout ivec3 cell, vec3 topoNormal, float depthPerPixel, out vec2 l
     int face = 2 * a + (n % 2 == 0 ? 1 : 0);
     if (all(greaterThanEqual(beside, ivec2(0))) && all(lessThan(beside, gridDims.xy)))
     {
-      ivec2 s = WallSlot(ivec3(beside, face));
+      uvec2 s = WallSlot(ivec3(beside, face));
       uint key = (uint(beside.x) + uint(gridDims.x) * uint(beside.y)) * 4u + 1u + uint(face);
-      if (texelFetch(wallKeys, ivec3(s, 0), 0).r == key)
+      if (s.x == key)
       {
-        slot = s;
+        faceAt = InSlabs(int(s.y), wallFaceRows);
         faceAxis = a;
         cell.xy = beside; // the wall's own column, whose cells have values
       }
@@ -171,9 +179,9 @@ bool WallCell(inout ivec3 cell, vec3 topoNormal, float depthPerPixel, out vec2 l
   }
   float along = fract(faceAxis == 0 ? cellCoord.y : cellCoord.x);
   int k = cell.z;
-  vec3 t = texelFetch(wallDepths, ivec3(k, slot), 0).xyz;
+  vec3 t = texelFetch(wallDepths, ivec3(k, faceAt), 0).xyz;
   float top = mix(t.x, t.y, along);
-  float bottom = WallDepthAt(slot, k + 1, along);
+  float bottom = WallDepthAt(faceAt, k + 1, along);
   float slack = 0.5 * depthPerPixel;
   if (modelDepth < top - slack || modelDepth > bottom + slack)
   {
@@ -182,7 +190,7 @@ bool WallCell(inout ivec3 cell, vec3 topoNormal, float depthPerPixel, out vec2 l
     for (int s = 0; s < wallSearchSteps && lo < hi; ++s)
     {
       int mid = (lo + hi + 1) / 2;
-      if (WallDepthAt(slot, mid, along) <= modelDepth)
+      if (WallDepthAt(faceAt, mid, along) <= modelDepth)
       {
         lo = mid;
       }
@@ -192,9 +200,9 @@ bool WallCell(inout ivec3 cell, vec3 topoNormal, float depthPerPixel, out vec2 l
       }
     }
     k = lo;
-    t = texelFetch(wallDepths, ivec3(k, slot), 0).xyz;
+    t = texelFetch(wallDepths, ivec3(k, faceAt), 0).xyz;
     top = mix(t.x, t.y, along);
-    bottom = WallDepthAt(slot, k + 1, along);
+    bottom = WallDepthAt(faceAt, k + 1, along);
   }
   float perPixel = max(depthPerPixel, 1e-20);
   cell.z = int(t.z);

@@ -848,8 +848,8 @@ void TestWallDepths()
       (face == 3 && j + 1 == uint32_t(p.ny));
     (onOutline ? outline : faultFaces) += 1;
     const std::size_t slot = static_cast<std::size_t>(table.hash.Slot(i, j, face));
-    const float* texel = &table.texels[slot * std::size_t(p.nz + 1) * 3];
-    bool same = table.keys[slot] == f.key;
+    const float* texel = &table.texels[table.slots[slot][1] * std::size_t(p.nz + 1) * 3];
+    bool same = table.slots[slot][0] == f.key;
     const double step = file.Header().latticeStep[2]; // the file's positions are on its lattice
     for (int64_t k = 0; same && k <= p.nz; ++k)
     {

@@ -207,11 +207,10 @@ int ReadEverything(const resmr::MultiresolutionFile& file, std::string& firstErr
     // The wall depth table: a damaged one costs only itself.
     const resmr::WallDepthTable walls = file.ReadWallDepths();
     const std::size_t stride = static_cast<std::size_t>(walls.layers + 1) * 3;
-    if (!walls.Empty() &&
-      (walls.keys.size() != walls.hash.TableSize() || walls.texels.size() != walls.keys.size() * stride))
+    if (!walls.Empty() && (walls.slots.size() != walls.hash.TableSize() || walls.texels.size() != walls.faces * stride))
     {
-      BrokenInvariant("wall depth table of " + std::to_string(walls.keys.size()) + " keys for " +
-        std::to_string(walls.hash.TableSize()) + " slots");
+      BrokenInvariant("wall depth table of " + std::to_string(walls.slots.size()) + " slots for " +
+        std::to_string(walls.hash.TableSize()) + ", " + std::to_string(walls.texels.size()) + " texel values");
     }
   }
   catch (const resmr::FileFormatError& error)
