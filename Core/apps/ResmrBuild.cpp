@@ -205,6 +205,11 @@ int BuildCommand(int argc, char** argv)
     {
       std::fputc('\n', stderr);
     }
+    if (!report.wallsLeftOut.empty())
+    {
+      std::fprintf(stderr, "resmr: warning: %s: no wall depth table (%s); walls are painted from their coordinates\n",
+        output.c_str(), report.wallsLeftOut.c_str());
+    }
     struct rusage usage;
     getrusage(RUSAGE_SELF, &usage);
     std::printf(

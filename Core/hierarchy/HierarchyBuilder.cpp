@@ -1669,14 +1669,30 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
 
   // Wall depths (ours, WallDepthTable.h), in a fixed order whatever the threads did; keys of
   // (j nx + i) 4 + face + 1 fit 32 bits below 2^30 columns.
-  if (!walls.empty() && static_cast<uint64_t>(nx * ny) < (uint64_t(1) << 30))
+  // The table is an aid to painting: a model it cannot be made for keeps the rest of the build.
+  if (walls.empty())
   {
-    std::sort(walls.begin(), walls.end(), [](const WallFace& a, const WallFace& b) { return a.key < b.key; });
-    const auto bytes = EncodeWallDepthTable(BuildWallDepthTable(walls, static_cast<int32_t>(nz), nx));
-    report.wallFaces = walls.size();
-    std::vector<WallFace>().swap(walls);
-    this->Chunks->AddModelArray(ModelChunk::WallDepths, bytes.data(), bytes.size(), model);
+    return;
   }
+  if (static_cast<uint64_t>(nx * ny) >= (uint64_t(1) << 30))
+  {
+    report.wallsLeftOut = "2^30 columns or more: wall face keys would not fit 32 bits";
+    return;
+  }
+  std::sort(walls.begin(), walls.end(), [](const WallFace& a, const WallFace& b) { return a.key < b.key; });
+  std::vector<uint8_t> bytes;
+  try
+  {
+    bytes = EncodeWallDepthTable(BuildWallDepthTable(walls, static_cast<int32_t>(nz), nx));
+  }
+  catch (const std::invalid_argument& e)
+  {
+    report.wallsLeftOut = e.what(); // no perfect hash within the texture limits
+    return;
+  }
+  report.wallFaces = walls.size();
+  std::vector<WallFace>().swap(walls);
+  this->Chunks->AddModelArray(ModelChunk::WallDepths, bytes.data(), bytes.size(), model);
 }
 
 /// Creates the scratch folder, or finds in it the last level every rank finished (-1: none)

@@ -92,6 +92,9 @@ struct HierarchyReport
   int64_t resumedTasks = 0;          ///< of those, the ones a resumed build found finished
   uint64_t hashedCells = 0, hashSlots = 0, hashOffsets = 0; ///< perfect hash (Sec. 5.4)
   uint64_t wallFaces = 0;                                   ///< faces of the wall depth table (WallDepthTable.h)
+  /// Why the file has no wall depth table though the model has walls (empty: it has one, or
+  /// no walls); the file is whole without it, its walls painted from their coordinates.
+  std::string wallsLeftOut;
   uint64_t fileBytes = 0;
   /// Peak bytes of the scratch folder, and of the scratch folder with the file being written.
   uint64_t peakScratchBytes = 0, peakDiskBytes = 0;
