@@ -374,7 +374,7 @@ int main(int argc, char** argv)
   }
   Tool = argv[1];
   Temp = argv[2];
-  Run("mkdir -p '" + Temp + "'");
+  Run("rm -rf '" + Temp + "' && mkdir -p '" + Temp + "'"); // nothing of an earlier run
   const bool passed = resmr_testing::RunNamedTests({
     { "Matrices", TestMatrices },
     { "CameraToView", TestCameraToView },
