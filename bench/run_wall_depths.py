@@ -16,7 +16,6 @@ import json
 import os
 import platform
 import shutil
-import struct
 import subprocess
 import sys
 import time
@@ -47,20 +46,9 @@ if not os.path.exists(path + "p"):
     subprocess.run([args.resmr, "build", SPEC, "-o", path, "--quiet"], check=True, stdout=subprocess.DEVNULL)
     subprocess.run([args.resmr, "add-properties", path, SPEC], check=True, stdout=subprocess.DEVNULL)
 
-# The copy: one byte of the wall depth chunk (model chunk kind 5) changed; the index (region
-# records as many as the header's count at byte 128, then 32-byte model records) finds it.
-with open(path, "rb") as source:
-    data = bytearray(source.read())
-index_offset, index_size = struct.unpack_from("<QQ", data, len(data) - 32)
-first_model = index_offset + 192 * struct.unpack_from("<Q", data, 128)[0]
-walls = [struct.unpack_from("<IIQI", data, p) for p in range(first_model, index_offset + index_size, 32)]
-walls = [w for w in walls if w[0] == 5]
-if len(walls) != 1:
-    sys.exit(f"{path}: {len(walls)} wall depth chunks, 1 expected")
-data[walls[0][2] + walls[0][3] // 2] ^= 0x5A
 damaged = os.path.join(args.scratch, f"walls_{NX}x{NY}x{NZ}-damaged.resmr")
-with open(damaged, "wb") as out:
-    out.write(data)
+if not resmr_testing.damage_wall_table(path, damaged):
+    sys.exit(f"{path}: not exactly one wall depth chunk")
 shutil.copyfile(path + "p", damaged + "p")  # the geometry id is the chunks' recorded checksums
 
 simple.LoadPlugin(args.plugin, remote=False, ns=globals())

@@ -13,7 +13,6 @@ the viewer warns and paints the walls from their coordinates, as before the tabl
 worse: at most MAX_SHARE_WITHOUT in the worst frame, so this test fails if the table stops
 being used."""
 import os
-import struct
 
 import numpy as np
 from paraview import simple
@@ -37,21 +36,10 @@ path = os.path.join(temp, "walls.resmr")
 rt.run_resmr("synth", str(NX), str(NY), str(NZ), "-o", grid, "--faults", "6", "--throw", "0.4", "--quiet")
 rt.run_resmr("build", grid, "-o", path, "--quiet")
 
-# The copy with a damaged wall depth table: its model chunk (kind 5) found through the index
-# (192-byte region records, as many as the header's count at byte 128, then 32-byte model
-# records: kind, part, offset, stored size).
-with open(path, "rb") as source:
-    data = bytearray(source.read())
-index_offset, index_size = struct.unpack_from("<QQ", data, len(data) - 32)
-first_model = index_offset + 192 * struct.unpack_from("<Q", data, 128)[0]
-walls = [struct.unpack_from("<IIQI", data, p) for p in range(first_model, index_offset + index_size, 32)]
-walls = [w for w in walls if w[0] == 5]
-if len(walls) != 1:
-    rt.fail(f"{path}: {len(walls)} wall depth chunks, 1 expected")
-data[walls[0][2] + walls[0][3] // 2] ^= 0x5A
+# The copy with a damaged wall depth table.
 damaged = os.path.join(temp, "walls-damaged.resmr")
-with open(damaged, "wb") as out:
-    out.write(data)
+if not rt.damage_wall_table(path, damaged):
+    rt.fail(f"{path}: not exactly one wall depth chunk")
 
 view = rt.image_view(WIDTH, HEIGHT)
 

@@ -269,3 +269,24 @@ def unlit(display):
     display.Ambient = 1.0
     display.Diffuse = 0.0
     display.Specular = 0.0
+
+
+def damage_wall_table(path, out):
+    """Writes to `out` a copy of the .resmr `path` with one byte of its wall depth table (model
+    chunk kind 5) changed: the viewer warns and paints walls from their coordinates, as files
+    without the table. The index (192-byte region records, as many as the header's count at
+    byte 128, then 32-byte model records: kind, part, offset, stored size) finds the chunk.
+    False if the file has not exactly one wall depth chunk."""
+    import struct
+    with open(path, "rb") as source:
+        data = bytearray(source.read())
+    index_offset, index_size = struct.unpack_from("<QQ", data, len(data) - 32)
+    first_model = index_offset + 192 * struct.unpack_from("<Q", data, 128)[0]
+    records = [struct.unpack_from("<IIQI", data, p) for p in range(first_model, index_offset + index_size, 32)]
+    walls = [r for r in records if r[0] == 5]
+    if len(walls) != 1:
+        return False
+    data[walls[0][2] + walls[0][3] // 2] ^= 0x5A
+    with open(out, "wb") as target:
+        target.write(data)
+    return True
