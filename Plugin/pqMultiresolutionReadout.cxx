@@ -31,6 +31,7 @@ pqMultiresolutionReadout pqMultiresolutionReadout::Pull(vtkSMProxy* surface)
   pqMultiresolutionReadout readout;
   surface->UpdatePropertyInformation();
   readout.Tolerance = vtkSMPropertyHelper(surface, "CurrentTolerance").GetAsDouble();
+  readout.EstimatedError = vtkSMPropertyHelper(surface, "CurrentEstimatedError").GetAsDouble();
   readout.RenderScale = vtkSMPropertyHelper(surface, "CurrentRenderScale").GetAsDouble();
   readout.Moving = vtkSMPropertyHelper(surface, "CurrentFrameMoving").GetAsInt() != 0;
   readout.TargetFrameRate = vtkSMPropertyHelper(surface, "TargetFrameRate").GetAsDouble();

@@ -10,6 +10,7 @@ class vtkSMProxy;
 struct pqMultiresolutionReadout
 {
   double Tolerance = 0;       ///< px, of the last frame
+  double EstimatedError = 0;  ///< px, the last frame's estimated error
   double TargetFrameRate = 0; ///< 0: fixed tolerance
   double RenderScale = 1;     ///< of the last frame: below 1 while moving frames are reduced
   bool Moving = false;        ///< the last frame used the frame-rate controller's tolerance

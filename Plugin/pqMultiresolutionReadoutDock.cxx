@@ -34,6 +34,9 @@ pqMultiresolutionReadoutDock::pqMultiresolutionReadoutDock(QWidget* parent)
     return value;
   };
   this->Tolerance = row(tr("Tolerance"), tr("Projected error tolerance of the last frame, pixels"));
+  this->Estimated = row(tr("Estimated error"),
+    tr("The last frame's estimated error, pixels: the largest typical distance of a drawn region from the "
+       "original grid, seen at its centre (the tolerance bounds the largest, seen at the nearest point)"));
   this->Resident = row(tr("Resident"), tr("Memory held by loaded meshes, of the memory budget"));
   this->Triangles = row(tr("Triangles drawn"), tr("Triangles drawn in the last frame"));
   this->Regions = row(tr("Regions drawn"),
@@ -124,6 +127,7 @@ void pqMultiresolutionReadoutDock::updateReadout()
     ? tr("holding %1 fps, drawn at %2% resolution").arg(readout.TargetFrameRate).arg(qRound(100 * readout.RenderScale))
     : tr("holding %1 fps").arg(readout.TargetFrameRate);
   this->Tolerance->setText(tr("%1 px (%2)").arg(readout.Tolerance, 0, 'f', 2).arg(holding));
+  this->Estimated->setText(tr("%1 px").arg(readout.EstimatedError, 0, 'f', 2));
   this->Resident->setText(tr("%1 MB of %2 MB").arg(readout.ResidentMB, 0, 'f', 1).arg(readout.BudgetMB));
   this->Triangles->setText(locale.toString(static_cast<qlonglong>(readout.Triangles)));
   this->Regions->setText(tr("%1 (%2 standing in)").arg(readout.Regions).arg(readout.Substituted));

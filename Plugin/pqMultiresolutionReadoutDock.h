@@ -30,6 +30,7 @@ private:
   QTimer Update; ///< coalesces the signals that ask for an update into one pull
   QLabel* Source;
   QLabel* Tolerance;
+  QLabel* Estimated;
   QLabel* Resident;
   QLabel* Triangles;
   QLabel* Regions;

@@ -159,8 +159,9 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   bool HavePreviousView = false;
   resmr::ViewParameters PreviousView;
   double Tolerance = 1;
-  double RenderScale = 1;  ///< the last frame's
-  bool Controlled = false; ///< the last frame used the controller's tolerance
+  double RenderScale = 1;    ///< the last frame's
+  double EstimatedError = 0; ///< the last frame's (ViewSelection::estimatedErrorPixels)
+  bool Controlled = false;   ///< the last frame used the controller's tolerance
   bool HaveLastClip = false;
   resmr::Matrix4 LastClip{}; ///< the last frame's model to clip transform
   vtkIdType Triangles = 0;
@@ -248,6 +249,10 @@ int vtkMultiresolutionSurfaceMapper::FillInputPortInformation(int, vtkInformatio
 double vtkMultiresolutionSurfaceMapper::GetCurrentTolerance() const
 {
   return this->Internal->Tolerance;
+}
+double vtkMultiresolutionSurfaceMapper::GetCurrentEstimatedError() const
+{
+  return this->Internal->EstimatedError;
 }
 double vtkMultiresolutionSurfaceMapper::GetCurrentRenderScale() const
 {
@@ -580,6 +585,7 @@ void vtkMultiresolutionSurfaceMapper::ChooseTolerance(bool moving)
     // frame is the user's picture at the user's tolerance, and the controller waits for the
     // next move where it was.
     in.Controller.SetMaximumPixels(std::max(this->MaximumPixelTolerance, this->PixelTolerance));
+    in.Controller.SetMaximumEstimatedPixels(this->MaximumEstimatedError);
     if (!in.ControllerRunning)
     {
       in.Controller.Reset(resmr::ControllerStartTolerance(this->PixelTolerance));
@@ -918,6 +924,7 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
     static_cast<long long>(in.Triangles), in.Tolerance);
   in.FrameMs = ElapsedMs(frame.start) + in.Timer.Ms();
   in.RenderScale = frame.scale;
+  in.EstimatedError = frame.selection.estimatedErrorPixels;
   in.Controlled = frame.controlled;
   if (frame.controlled)
   {
@@ -932,6 +939,8 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
       resmr::CutRange same;
       same.refineBelow = frame.selection.refineBelowPixels;
       same.coarsenAt = frame.selection.coarsenAtPixels;
+      same.bound = frame.selection.largestProjectedError;
+      same.estimate = frame.selection.estimatedErrorPixels;
       in.Controller.Update(measuredMs / 1000, complete, same, frame.bounded);
     }
   }
@@ -944,6 +953,7 @@ void vtkMultiresolutionSurfaceMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "PixelTolerance: " << this->PixelTolerance << "\n";
   os << indent << "TargetFrameRate: " << this->TargetFrameRate << "\n";
   os << indent << "MaximumPixelTolerance: " << this->MaximumPixelTolerance << "\n";
+  os << indent << "MaximumEstimatedError: " << this->MaximumEstimatedError << "\n";
   os << indent << "MovingResolutionFloor: " << this->MovingResolutionFloor << "\n";
   os << indent << "MemoryBudgetMB: " << this->MemoryBudgetMB << "\n";
   os << indent << "GridLines: " << this->GridLines << "\n";

@@ -42,7 +42,9 @@ public:
   static const char* SourceArrayName() { return "ResMR Source"; }
 
   /// MaximumPixelTolerance's default (see docs/user-guide.md for the measurements behind it).
-  static constexpr double DefaultMaximumPixelTolerance = 48.0;
+  static constexpr double DefaultMaximumPixelTolerance = 128.0;
+  /// MaximumEstimatedError's default (see docs/user-guide.md for the measurements behind it).
+  static constexpr double DefaultMaximumEstimatedError = 1.0;
 
   enum ColorModes
   {
@@ -67,6 +69,13 @@ public:
   /// rather than coarser. 65536 lets the controller coarsen as far as it likes.
   vtkSetClampMacro(MaximumPixelTolerance, double, 0.5, 65536.0);
   vtkGetMacro(MaximumPixelTolerance, double);
+
+  /// The quality floor on what the picture shows: the largest estimated error, in pixels, a
+  /// moving frame may have (the regions' typical errors seen at their centres, see
+  /// GetCurrentEstimatedError); the controller refines a frame past it whatever its time. 0:
+  /// no such floor, MaximumPixelTolerance alone.
+  vtkSetClampMacro(MaximumEstimatedError, double, 0.0, 65536.0);
+  vtkGetMacro(MaximumEstimatedError, double);
 
   /// Frames per second to hold by adjusting the tolerance (Sec. 6.3); 0: fixed tolerance.
   vtkSetClampMacro(TargetFrameRate, double, 0.0, 1000.0);
@@ -107,6 +116,9 @@ public:
   ///@{
   /// Live readout, updated each render.
   double GetCurrentTolerance() const;
+  /// The last frame's estimated error, pixels: the largest typical error of a drawn region seen
+  /// at its centre (what the bound, the tolerance, overstates); 0 for leaves alone.
+  double GetCurrentEstimatedError() const;
   /// The fraction of the view's width and height the last frame was drawn at (1: full).
   double GetCurrentRenderScale() const;
   /// Whether the last frame was a moving frame at the frame-rate controller's tolerance (a
@@ -148,6 +160,7 @@ private:
   double PixelTolerance = 1.0;
   double TargetFrameRate = 0.0;
   double MaximumPixelTolerance = DefaultMaximumPixelTolerance;
+  double MaximumEstimatedError = DefaultMaximumEstimatedError;
   double MovingResolutionFloor = 0.5;
   int MemoryBudgetMB = 1024;
   bool GridLines = true;

@@ -239,6 +239,10 @@ void vtkMultiresolutionSurfaceRepresentation::SetMaximumPixelTolerance(double pi
 {
   this->Mapper->SetMaximumPixelTolerance(pixels);
 }
+void vtkMultiresolutionSurfaceRepresentation::SetMaximumEstimatedError(double pixels)
+{
+  this->Mapper->SetMaximumEstimatedError(pixels);
+}
 void vtkMultiresolutionSurfaceRepresentation::SetMovingResolutionFloor(double fraction)
 {
   this->Mapper->SetMovingResolutionFloor(fraction);
@@ -270,6 +274,10 @@ void vtkMultiresolutionSurfaceRepresentation::SetLayer(int layer)
 double vtkMultiresolutionSurfaceRepresentation::GetCurrentTolerance()
 {
   return this->Mapper->GetCurrentTolerance();
+}
+double vtkMultiresolutionSurfaceRepresentation::GetCurrentEstimatedError()
+{
+  return this->Mapper->GetCurrentEstimatedError();
 }
 int vtkMultiresolutionSurfaceRepresentation::GetCurrentFrameControlled()
 {

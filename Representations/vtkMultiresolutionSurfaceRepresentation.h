@@ -75,6 +75,7 @@ public:
   void SetPixelTolerance(double pixels);
   void SetTargetFrameRate(double fps);
   void SetMaximumPixelTolerance(double pixels);
+  void SetMaximumEstimatedError(double pixels);
   void SetMovingResolutionFloor(double fraction);
   void SetMemoryBudgetMB(int megabytes);
   void SetGridLines(bool show);
@@ -83,6 +84,7 @@ public:
   void SetWaitForDetailMs(int milliseconds);
   void SetLayer(int layer);
   double GetCurrentTolerance();
+  double GetCurrentEstimatedError();
   double GetCurrentRenderScale();
   int GetCurrentFrameControlled();
   double GetResidentMB();

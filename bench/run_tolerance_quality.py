@@ -75,7 +75,7 @@ def draw(camera, tolerance):
     ids = resmr_testing.cell_ids(resmr_testing.capture_rgb(view, os.path.join(args.scratch, "frame.png"),
                                                            WIDTH, HEIGHT))
     display.UpdatePropertyInformation()
-    return ids, int(display.GetPropertyValue("TrianglesDrawn"))
+    return ids, int(display.GetPropertyValue("TrianglesDrawn")), display.GetPropertyValue("CurrentEstimatedError")
 
 
 # Cell ids are 24-bit: below 2^24 cells the layer of each pixel's cell is known, and the pixels
@@ -84,17 +84,18 @@ nx, ny, nz = (int(v) for v in dims)
 layers_known = nx * ny * nz < 2 ** 24
 rows = []
 for camera in cameras:
-    exact, exact_triangles = draw(camera, 0)
+    exact, exact_triangles, _ = draw(camera, 0)
     for tolerance in args.tolerances:
-        got, triangles = draw(camera, tolerance)
-        row = {"camera": camera, "tolerance": tolerance, "triangles": triangles, "exact_triangles": exact_triangles}
+        got, triangles, estimated = draw(camera, tolerance)
+        row = {"camera": camera, "tolerance": tolerance, "estimated_px": estimated, "triangles": triangles,
+               "exact_triangles": exact_triangles}
         row.update(image_metrics.compare(got, exact))
         if layers_known:
             missed = image_metrics.missed_pixels(got, exact)
             row["missed_below_first_layer"] = int((missed & (exact > nx * ny)).sum())
             row["missed"] = int(missed.sum())
         rows.append(row)
-        print(f"{camera} {tolerance:g} px: {100 * row['within_2px']:.1f}% within 2 px, {100 * row['cell_agreement']:.1f}% "
+        print(f"{camera} {tolerance:g} px (estimated {estimated:.2f} px): {100 * row['within_2px']:.1f}% within 2 px, {100 * row['cell_agreement']:.1f}% "
               f"same cell, {row['hole_pixels']} hole px, silhouette {row['silhouette_px']} px, {triangles} triangles",
               flush=True)
 
@@ -107,13 +108,15 @@ lines = [f"# Picture quality against tolerance (generated faulted model {args.mo
          "the same camera in the Cell Id colouring: 'within 2 px' is the share of pixels whose cell (or the "
          "background) the exact frame has within 2 pixels; 'missed below layer 1' is the share of the other "
          "pixels whose exact cell lies below the first layer (walls: the outside and the faults, where every "
-         "layer shows).", "",
-         "| camera | tolerance px | within 2 px | missed below layer 1 | same cell | hole px | silhouette px | "
+         "layer shows). 'estimated px' is the frame's estimated error (the largest typical error of a drawn "
+         "region, seen at its centre; CurrentEstimatedError), what the frame rate steers by beside the "
+         "tolerance, a bound.", "",
+         "| camera | tolerance px | estimated px | within 2 px | missed below layer 1 | same cell | hole px | silhouette px | "
          "triangles (0 px: all) |",
-         "|---|---|---|---|---|---|---|---|"]
+         "|---|---|---|---|---|---|---|---|---|"]
 for row in rows:
     below = (f"{100 * row['missed_below_first_layer'] / row['missed']:.0f}%" if row.get("missed") else "-")
-    lines.append(f"| {row['camera']} | {row['tolerance']:g} | {100 * row['within_2px']:.1f}% | {below} | "
+    lines.append(f"| {row['camera']} | {row['tolerance']:g} | {row['estimated_px']:.2f} | {100 * row['within_2px']:.1f}% | {below} | "
                  f"{100 * row['cell_agreement']:.1f}% | {row['hole_pixels']} | {row['silhouette_px']} | "
                  f"{row['triangles']:,} ({row['exact_triangles']:,}) |")
 with open(args.out + ".md", "w") as out:

@@ -46,6 +46,8 @@ parser.add_argument("--quality-every", type=int, default=10,
                     help="draw every Nth frame again at its tolerance and at 0 px and compare (0: off)")
 parser.add_argument("--max-tolerance", type=float, default=None,
                     help="Maximum Pixel Tolerance (the quality floor); default: the representation's")
+parser.add_argument("--max-estimated-error", type=float, default=None,
+                    help="Maximum Estimated Error (the floor on the estimate); default: the representation's")
 parser.add_argument("--busy", type=int, default=0, help=argparse.SUPPRESS)  # one child's load
 parser.add_argument("--stock", action="store_true")
 parser.add_argument("--stock-max-cells", type=float, default=50e6,
@@ -211,6 +213,7 @@ def run_path(view, display, bounds, readout, samples=None, background=None):
         if readout:
             display.UpdatePropertyInformation()
             row.update(tolerance=display.GetPropertyValue("CurrentTolerance"),
+                       estimated_px=display.GetPropertyValue("CurrentEstimatedError"),
                        triangles=display.GetPropertyValue("TrianglesDrawn"),
                        resident_mb=display.GetPropertyValue("ResidentMB"),
                        substituted=display.GetPropertyValue("RegionsSubstituted"),
@@ -218,7 +221,8 @@ def run_path(view, display, bounds, readout, samples=None, background=None):
                        render_scale=display.GetPropertyValue("CurrentRenderScale"))
             if samples is not None and args.quality_every > 0 and index % args.quality_every == 0:
                 samples.append({"frame": index, "position": list(position), "focal": list(focal),
-                                "tolerance": row["tolerance"], "render_scale": row["render_scale"]})
+                                "tolerance": row["tolerance"], "estimated_px": row["estimated_px"],
+                                "render_scale": row["render_scale"]})
                 if background is not None:
                     samples[-1]["drawn_covered"] = resmr_testing.drawn_covered(view, background)
                     samples[-1]["drawn_pixels"] = view_quality.drawn_frame(view).astype(np.uint8)  # to show its holes
@@ -400,6 +404,8 @@ def measure_multiresolution(model):
     first_image = time.perf_counter() - start
     if args.max_tolerance is not None:
         display.MaximumPixelTolerance = args.max_tolerance
+    if args.max_estimated_error is not None:
+        display.MaximumEstimatedError = args.max_estimated_error
     bounds = reader.GetDataInformation().GetBounds()
     samples = []
     with view_quality.BusyLoad(args.busy):
@@ -414,7 +420,8 @@ def measure_multiresolution(model):
              "max_rss_mb": max(f["rss_mb"] for f in frames), "frames": frames,
              "frames_reduced": sum(1 for f in frames if f.get("render_scale", 1) < 1) / len(frames),
              "moving_floor": args.moving_floor, "load": f"{args.busy} cores busy" if args.busy else "idle",
-             "max_tolerance": display.MaximumPixelTolerance}
+             "max_tolerance": display.MaximumPixelTolerance,
+             "max_estimated_error": display.MaximumEstimatedError}
     # Attribution, not the target: frames during which the kernel's reclaim thread ran (it
     # takes 50-60 ms of CPU every ~5.2 s on this VM), and the p99 of the others.
     quiet = [f["seconds"] for f in frames if f["kernel_reclaim_ms"] == 0]
@@ -508,6 +515,8 @@ def run_child(part, model, entry=None):
                "--child", part, "--child-out", out]
     if args.max_tolerance is not None:
         command += ["--max-tolerance", str(args.max_tolerance)]
+    if args.max_estimated_error is not None:
+        command += ["--max-estimated-error", str(args.max_estimated_error)]
     done = subprocess.run(command + (["--fxaa"] if args.fxaa else []))
     if done.returncode != 0:
         raise SystemExit(f"run_view_bench: measuring {part} on {model} failed (exit {done.returncode}; "

@@ -368,7 +368,7 @@ void PutRecord(ByteWriter& out, const RegionRecord& r)
 {
   const std::size_t start = out.Bytes.size();
   out.Put(r.level);
-  out.Put(static_cast<int32_t>(0));
+  out.Put(std::max(r.typicalError, 0.f));
   out.Put(r.index);
   out.Put(r.columns);
   out.Put(r.activeCells);
@@ -389,11 +389,20 @@ void PutRecord(ByteWriter& out, const RegionRecord& r)
 }
 
 /// A record as PutRecord wrote it; `reservedZero` tells whether its unused bytes are zero.
-RegionRecord GetRecord(ByteReader& in, bool& reservedZero)
+/// Before TypicalErrorVersion the typical error's four bytes were reserved too.
+RegionRecord GetRecord(ByteReader& in, uint32_t version, bool& reservedZero)
 {
   RegionRecord r;
   r.level = in.Get<int32_t>();
-  const int32_t reserved = in.Get<int32_t>();
+  int32_t reserved = 0;
+  if (version >= MultiresolutionHeader::TypicalErrorVersion)
+  {
+    r.typicalError = in.Get<float>();
+  }
+  else
+  {
+    reserved = in.Get<int32_t>();
+  }
   r.index = in.Get<int64_t>();
   r.columns = in.Get<int64_t>();
   r.activeCells = in.Get<int64_t>();
@@ -605,6 +614,12 @@ void CheckRecord(const RegionRecord& r, const MultiresolutionHeader& h, const st
   if (!std::isfinite(r.error) || !std::isfinite(r.ownError) || r.error < 0 || r.ownError < 0)
   {
     fail("error " + Number(r.error) + " or own error " + Number(r.ownError) + " is not finite and non-negative");
+  }
+  // A mean never passes the largest (a float's rounding aside).
+  if (h.version >= MultiresolutionHeader::TypicalErrorVersion &&
+    !(r.typicalError >= 0 && r.typicalError <= r.ownError * (1 + 1e-5f) + 1e-30f))
+  {
+    fail("typical error " + Number(r.typicalError) + " is not between 0 and the own error " + Number(r.ownError));
   }
   for (const auto* cone : { &r.topCone, &r.bottomCone })
   {
@@ -997,7 +1012,7 @@ void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
   for (uint64_t i = 0; i < this->Head.regionCount; ++i)
   {
     bool reservedZero = false;
-    RegionRecord r = GetRecord(index, reservedZero);
+    RegionRecord r = GetRecord(index, this->Head.version, reservedZero);
     const std::string place = path + ": index record " + std::to_string(i) + " (level " + std::to_string(r.level) +
       ", region " + std::to_string(r.index) + ")";
     if (!reservedZero)

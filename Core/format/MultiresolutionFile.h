@@ -55,10 +55,12 @@ namespace resmr
 
 struct MultiresolutionHeader
 {
-  static constexpr uint32_t Version = 7;
+  static constexpr uint32_t Version = 8;
   static constexpr uint32_t OldestVersion = 3; ///< older files are refused
   /// The first version whose simplified sides paint every cell in place (see above).
   static constexpr uint32_t SidesInPlaceVersion = 6;
+  /// From this version on a region record carries its typical error (RegionRecord::typicalError).
+  static constexpr uint32_t TypicalErrorVersion = 8;
   uint32_t version = Version; ///< the file's, when read
   std::array<int64_t, 3> dims{};
   std::array<double, 4> box{};           ///< hierarchy box: xmin, ymin, xmax, ymax
@@ -101,6 +103,11 @@ struct RegionRecord
   /// both regions of a diamond and never smaller than a child's.
   float error = 0;
   float ownError = 0; ///< the same for this region's own simplification only
+  /// Ours: the typical distance of this region's own surfaces from the original grid's, the
+  /// area-weighted root mean square of the quadric distances its ownError is the largest of;
+  /// what the view estimates the picture's real error from (ViewSelection.h). Negative:
+  /// unknown (files before TypicalErrorVersion).
+  float typicalError = -1;
   std::array<float, 4> topCone{}, bottomCone{};
   std::array<ChunkRef, ChunkCount> chunks{};
 };

@@ -387,6 +387,25 @@ double QuadricDistance(const ColumnMeshData& mesh)
   return std::sqrt(largest);
 }
 
+/// The typical quadric distance (ours): the root mean square over the surfaces, weighted by
+/// the area each vertex's quadric stands for, of what QuadricDistance takes the largest of.
+double TypicalQuadricDistance(const ColumnMeshData& mesh)
+{
+  double error = 0, weights = 0;
+  for (std::size_t v = 0; v < mesh.quadrics.size(); ++v)
+  {
+    const Quadric& q = mesh.quadrics[v];
+    const double weight = q.q[0] + q.q[4] + q.q[7];
+    if (weight > 0)
+    {
+      const glm::dvec3 p(mesh.positions[v * 3], mesh.positions[v * 3 + 1], mesh.positions[v * 3 + 2]);
+      error += std::max(q.Error(p), 0.0);
+      weights += weight;
+    }
+  }
+  return weights > 0 ? std::sqrt(error / weights) : 0;
+}
+
 /// Columns of a full-size region: a 64 x 64 patch, top and bottom surfaces of about 16k
 /// triangles, the batch size at which GPUs reach full speed, while a diamond's merged mesh
 /// stays a few hundred MB for 100 layers.
@@ -1028,6 +1047,8 @@ void Builder::Prepare(
   emitted.record.index = index;
   const double ownError = std::max(QuadricDistance(region.mesh), region.weldError);
   emitted.record.ownError = static_cast<float>(ownError);
+  emitted.record.typicalError =
+    std::min(static_cast<float>(TypicalQuadricDistance(region.mesh)), emitted.record.ownError);
   // The file rounds positions to its lattice after simplification: allow one step more.
   const auto& step = this->Header.latticeStep;
   emitted.mesh = ToRegionMesh(region, this->Header, level == this->Header.leafLevel ? 0.f : emitted.record.ownError,
@@ -2103,7 +2124,12 @@ std::vector<uint8_t> Builder::ReadJournal(const BuildSchedule& schedule, Hierarc
     done[static_cast<std::size_t>(found->second)] = 1;
     chunkEnd = std::max(chunkEnd, in.Get<uint64_t>());
     const uint64_t count = in.Get<uint64_t>();
-    std::vector<Emitted> regions(std::min<uint64_t>(count, 2));
+    // Records are this build's structs: a journal of another resmr version has other sizes.
+    if (count > 2 || bytes.size() != 28 + count * (sizeof(RegionRecord) + sizeof(std::array<double, 6>)))
+    {
+      throw std::runtime_error(path + ": written by another version of resmr (build with --fresh)");
+    }
+    std::vector<Emitted> regions(count);
     for (auto& emitted : regions)
     {
       emitted.record = in.Get<RegionRecord>();

@@ -11,12 +11,34 @@ void FrameRateController::Reset(double tolerancePixels)
 {
   this->Pixels = std::clamp(tolerancePixels, MinimumPixels, this->Ceiling);
   this->RenderScale = 1;
+  this->EstimateBlock = MaximumPixels;
+  this->LastGoodCoarsenAt = 0;
 }
 
 void FrameRateController::SetMaximumPixels(double pixels)
 {
   this->Ceiling = std::isfinite(pixels) ? std::clamp(pixels, MinimumPixels, MaximumPixels) : MaximumPixels;
   this->Pixels = std::min(this->Pixels, this->Ceiling);
+}
+
+void FrameRateController::SetMaximumEstimatedPixels(double pixels)
+{
+  this->EstimateCeiling = pixels > 0 ? pixels : std::numeric_limits<double>::infinity();
+}
+
+double FrameRateController::EstimateLimit(const CutRange& same) const
+{
+  if (!std::isfinite(this->EstimateCeiling))
+  {
+    return MaximumPixels;
+  }
+  // Strictly below the block: at it, the cut that broke the floor comes back.
+  const double blocked = std::nextafter(this->EstimateBlock, 0.0);
+  if (!(same.estimate > 0) || !(same.bound > 0))
+  {
+    return blocked;
+  }
+  return std::min(blocked, same.bound * EstimateAim * this->EstimateCeiling / same.estimate);
 }
 
 void FrameRateController::SetScaleFloor(double floor)
@@ -34,6 +56,32 @@ double FrameRateController::Update(double frameSeconds, bool complete, const Cut
   // Frame times jitter from frame to frame (loads, uploads, the system), so the tolerance is
   // held in a band below the target, and the slow tail stays inside it.
   const double ratio = frameSeconds / this->TargetSeconds;
+  if (complete && same.estimate > this->EstimateCeiling && this->Pixels > MinimumPixels)
+  {
+    // Past the estimated-error floor (the view came closer to what this cut simplified, or a
+    // step coarsened more than the estimate's proportion foretold): refine, and coarsen no
+    // more up to where the last cut within the floor began to change.
+    this->EstimateBlock =
+      this->LastGoodCoarsenAt > 0 && this->LastGoodCoarsenAt <= this->Pixels ? this->LastGoodCoarsenAt : this->Pixels;
+    this->LastGoodCoarsenAt = 0;
+    const double limit = this->EstimateLimit(same);
+    const double from = same.refineBelow < this->Pixels && same.refineBelow > 0 ? same.refineBelow : this->Pixels;
+    this->Pixels =
+      std::clamp(std::max(std::min(from, limit), this->Pixels * MaxRefineStep), MinimumPixels, this->Ceiling);
+    if (ratio > HighFraction && moving)
+    {
+      // Slow as well: the pixels pay for the detail the floor wants.
+      this->RenderScale = std::max(this->Floor, this->RenderScale / std::min(4.0, std::sqrt(ratio / AimFraction)));
+    }
+    return this->Pixels;
+  }
+  if (complete && same.estimate <= this->EstimateCeiling)
+  {
+    this->LastGoodCoarsenAt = std::isfinite(same.coarsenAt) ? same.coarsenAt : 0;
+  }
+  // The block lifts slowly: the view moves on, and the cut it kept out may be fine there.
+  this->EstimateBlock = std::min(MaximumPixels, this->EstimateBlock * BlockRelease);
+  const double limit = this->EstimateLimit(same);
   if (ratio > HighFraction)
   {
     const double factor = std::min(4.0, std::sqrt(ratio / AimFraction)); // near or over budget: back off now
@@ -43,7 +91,9 @@ double FrameRateController::Update(double frameSeconds, bool complete, const Cut
       this->RenderScale = std::max(this->Floor, this->RenderScale / factor);
       return this->Pixels;
     }
-    return this->Coarsen(factor, same);
+    const double before = this->Pixels;
+    this->Pixels = std::max(before, std::min(this->Coarsen(factor, same), limit));
+    return this->Pixels;
   }
   if (ratio < LowFraction && complete)
   {

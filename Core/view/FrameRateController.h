@@ -37,6 +37,20 @@
 // - The quality floor (ours): the tolerance never rises above Ceiling (SetMaximumPixels), the
 //   coarsest picture the user accepts while moving; a frame still too slow there is late
 //   rather than wrong. MaximumPixels as the ceiling lets the controller go as far as it likes.
+// - Steered by the estimated error (ours): the bound overstates the picture's real error, and
+//   by how much depends on the view (a low flight's bound is its nearest box corner's, far
+//   below what is seen), so the floor is also set on the frame's estimated error
+//   (ViewSelection::estimatedErrorPixels, SetMaximumEstimatedPixels). Taking the estimate as
+//   proportional to the cut's bound, the tolerance may not rise past the one whose estimate
+//   would be EstimateAim of that floor, and a complete frame whose estimate is past the floor
+//   refines to it (a quarter at most a frame) whatever its time: late rather than wrong. The
+//   aim below the floor keeps a cut's steps from flipping the frames between two cuts. The
+//   estimate does not grow smoothly with the tolerance (merging a diamond of a coarse level
+//   can double it), so a step that took the estimate past the floor also blocks coarsening
+//   from where the cut before it began to change (its CutRange::coarsenAt); without it the
+//   frames flipped between the two cuts every other frame. The block rises by BlockRelease a
+//   frame, as the view moves on. Ceiling still holds, so the bound limits what an estimate can
+//   let through.
 #pragma once
 
 #include <limits>
@@ -51,6 +65,10 @@ struct CutRange
 {
   double refineBelow = std::numeric_limits<double>::infinity();
   double coarsenAt = 0;
+  /// The cut's largest projected error and its estimated error (ViewSelection), pixels; an
+  /// estimate of 0 or less says nothing.
+  double bound = 0;
+  double estimate = 0;
 };
 
 class FrameRateController
@@ -63,6 +81,10 @@ public:
   static constexpr double LowFraction = 0.6, HighFraction = 0.85, AimFraction = 0.7;
   /// The most one frame lowers the tolerance by, as a factor (see CutRange).
   static constexpr double MaxRefineStep = 0.25;
+  /// Where, as a fraction of the estimated-error floor, steps steered by the estimate aim.
+  static constexpr double EstimateAim = 0.8;
+  /// How fast, as a factor a frame, a block on coarsening set by the estimate lifts.
+  static constexpr double BlockRelease = 1.02;
 
   /// The default ScaleFloor: half the width and height, a quarter of the pixels, where a
   /// cell of two pixels and a grid line of one still show.
@@ -76,6 +98,8 @@ public:
   /// The coarsest tolerance moving frames may use, in [MinimumPixels, MaximumPixels].
   void SetMaximumPixels(double pixels);
   double MaximumTolerance() const { return this->Ceiling; }
+  /// The coarsest estimated error (pixels) moving frames may have; infinity: no such floor.
+  void SetMaximumEstimatedPixels(double pixels);
   /// The render scale for the next moving frame (1 until a slow moving frame lowers it).
   double Scale() const { return this->RenderScale; }
   double TargetFramesPerSecond() const { return 1.0 / this->TargetSeconds; }
@@ -88,11 +112,16 @@ public:
 
 private:
   double Coarsen(double factor, const CutRange& same);
+  /// The largest tolerance the estimated-error floor allows, from the frame's cut.
+  double EstimateLimit(const CutRange& same) const;
   double Refine(double factor, const CutRange& same);
 
   double TargetSeconds = 0.1;
   double Pixels = 1;
   double Ceiling = MaximumPixels;
+  double EstimateCeiling = std::numeric_limits<double>::infinity();
+  double EstimateBlock = MaximumPixels; ///< coarsening stays below it (see the contract)
+  double LastGoodCoarsenAt = 0;         ///< coarsenAt of the last complete cut within the floor
   double Floor = DefaultScaleFloor;
   double RenderScale = 1;
 };

@@ -84,6 +84,59 @@ double ProjectedError(const RegionRecord& record, const ViewParameters& view)
   return d > 0 ? error * view.pixelsPerUnit / d : std::numeric_limits<double>::infinity();
 }
 
+/// The region's typical error (its own where the file has none) at the box's centre.
+double EstimatedError(const RegionRecord& record, const ViewParameters& view)
+{
+  const double error = record.typicalError >= 0 ? record.typicalError : record.ownError;
+  if (!(error > 0))
+  {
+    return 0;
+  }
+  if (view.parallel)
+  {
+    return error * view.pixelsPerUnit;
+  }
+  const auto& b = record.bounds;
+  const double centre[3] = { 0.5 * (double(b[0]) + b[3]), 0.5 * (double(b[1]) + b[4]), -0.5 * (double(b[2]) + b[5]) };
+  double squared = 0;
+  for (int a = 0; a < 3; ++a)
+  {
+    squared += (centre[a] - view.eye[a]) * (centre[a] - view.eye[a]);
+  }
+  const double d = std::max({ std::sqrt(squared), Distance(record, view.eye), view.nearDistance, 0.0 });
+  return d > 0 ? error * view.pixelsPerUnit / d : std::numeric_limits<double>::infinity();
+}
+
+/// The share of the viewport the box's screen rectangle covers, in [0, 1]; 1 for a box reaching
+/// behind the eye (it may fill the view).
+double ScreenShare(const Box& corners, const std::array<double, 16>& m)
+{
+  double low[2] = { 1, 1 }, high[2] = { -1, -1 };
+  for (const auto& p : corners)
+  {
+    double clip[4];
+    for (int r = 0; r < 4; ++r)
+    {
+      clip[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
+    }
+    if (!(clip[3] > 0))
+    {
+      return 1;
+    }
+    for (int a = 0; a < 2; ++a)
+    {
+      low[a] = std::min(low[a], clip[a] / clip[3]);
+      high[a] = std::max(high[a], clip[a] / clip[3]);
+    }
+  }
+  double share = 1;
+  for (int a = 0; a < 2; ++a)
+  {
+    share *= std::max(0.0, std::min(high[a], 1.0) - std::max(low[a], -1.0)) / 2;
+  }
+  return share;
+}
+
 /// Sort key of the loading order within a level: nearest first.
 double Nearness(const RegionRecord& record, const Box& corners, const ViewParameters& view)
 {
@@ -341,6 +394,11 @@ double ProjectedErrorPixels(const RegionRecord& region, const ViewParameters& vi
   return ProjectedError(region, view);
 }
 
+double EstimatedErrorPixels(const RegionRecord& region, const ViewParameters& view)
+{
+  return EstimatedError(region, view);
+}
+
 ViewSelection ViewSelector::Select(const ViewParameters& view, const std::function<bool(std::size_t)>& resident) const
 {
   const auto& regions = this->File->Regions();
@@ -374,6 +432,7 @@ ViewSelection ViewSelector::Select(const ViewParameters& view, const std::functi
     nearFirst.emplace_back(Nearness(regions[r], Corners(regions[r]), view), r);
   }
   std::sort(nearFirst.begin(), nearFirst.end());
+  double estimateSum = 0, shareSum = 0;
   for (const auto& entry : nearFirst)
   {
     const std::size_t r = entry.second;
@@ -382,6 +441,10 @@ ViewSelection ViewSelector::Select(const ViewParameters& view, const std::functi
     DrawnRegion drawn;
     drawn.region = r;
     drawn.projectedError = ProjectedError(record, view);
+    drawn.estimatedError = EstimatedError(record, view);
+    drawn.screenShare = ScreenShare(corners, view.worldToClip);
+    estimateSum += drawn.screenShare * drawn.estimatedError;
+    shareSum += drawn.screenShare;
     drawn.top = record.topCone[3] > -1.5f && !BackFacing(record.topCone, corners, view);
     drawn.bottom = record.bottomCone[3] > -1.5f && !BackFacing(record.bottomCone, corners, view);
     selection.drawn.push_back(drawn);
@@ -390,6 +453,7 @@ ViewSelection ViewSelector::Select(const ViewParameters& view, const std::functi
       ++selection.substituted;
     }
   }
+  selection.estimatedErrorPixels = shareSum > 0 ? estimateSum / shareSum : 0;
   // The loading order: the ideal cut and its ancestors, level by level, nearest first.
   for (const auto& level : ideal.visibleByLevel)
   {

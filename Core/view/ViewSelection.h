@@ -12,6 +12,14 @@
 //   point of the diamond's bounding box nearest the eye: pixels = e * PixelsPerUnit / d,
 //   d = that distance but at least nearDistance, since nothing nearer than the near plane is
 //   drawn (perspective; infinite when both are 0), or e * PixelsPerUnit (parallel).
+// - Estimated error of a region (ours): the bound is a poor guide to what the picture shows
+//   (it takes the largest error at the box's nearest point; a 64 px frame still puts 96% of its
+//   pixels within 8 px of the exact one), so each drawn region also gets its typical error
+//   (RegionRecord::typicalError; its own error in files that lack it) seen at the box's centre
+//   (no nearer than its nearest point or the near plane). The frame's estimate is their mean
+//   weighted by the share of the view each region's box covers (so a coarse region far off
+//   counts for the little it shows); the frame-rate controller steers by it
+//   (FrameRateController.h).
 // - Conformity: a diamond is split only when every triangle of it is in the cut and all of
 //   their children (absent regions are empty and count as resident) are resident. Bounding
 //   boxes enclose every descendant, so projected errors never grow down the tree and the cut
@@ -53,6 +61,8 @@ struct DrawnRegion
   std::size_t region = 0;                      ///< index into MultiresolutionFile::Regions()
   bool top = true, bottom = true, side = true; ///< surfaces not culled by their normal cones
   double projectedError = 0;                   ///< the region's error in pixels this frame (Lindstrom's bound)
+  double estimatedError = 0;                   ///< the region's estimated error in pixels (see the contract)
+  double screenShare = 0;                      ///< share of the viewport its box's screen rectangle covers
 };
 
 struct ViewSelection
@@ -62,6 +72,9 @@ struct ViewSelection
   /// Largest projected error (pixels) of a drawn region's diamond; what the tolerance holds
   /// once everything wanted is resident.
   double largestProjectedError = 0;
+  /// The picture's estimated real error (pixels): the drawn regions' estimates, weighted by the
+  /// share of the view they cover (see the contract).
+  double estimatedErrorPixels = 0;
   /// The tolerances between which this frame's cut stays the same, for the frame-rate
   /// controller: a tolerance below `refineBelowPixels` splits a diamond drawn whole now (0:
   /// none can split, being leaves or waiting on loads), one at or above `coarsenAtPixels`
@@ -110,6 +123,9 @@ bool SurfaceCulled(const std::array<float, 4>& cone, const RegionRecord& region,
 
 /// A region's error in pixels seen from `view` (Lindstrom's bound, as Select splits by it).
 double ProjectedErrorPixels(const RegionRecord& region, const ViewParameters& view);
+
+/// A region's estimated error in pixels seen from `view` (see the contract).
+double EstimatedErrorPixels(const RegionRecord& region, const ViewParameters& view);
 
 /// Where the camera will probably be a frame ahead: the last two views extrapolated linearly
 /// (eye and clip matrix), for loading ahead of need.

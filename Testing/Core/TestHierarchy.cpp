@@ -4,6 +4,7 @@
 // rejection of corrupt and truncated files, and MAPAXES carried in the header (older versions
 // read as none, unknown ones refused).
 #include "CoreTesting.h"
+#include "FuzzResmrRepair.h"
 
 #include "BuildSchedule.h"
 #include "ColumnMesh.h"
@@ -1072,10 +1073,20 @@ void TestMapAxesInFile()
     out.write(content.data(), static_cast<std::streamsize>(content.size()));
   };
   const auto withVersion = [&](uint32_t version) {
-    std::string b = bytes;
+    std::vector<uint8_t> b(bytes.begin(), bytes.end());
     std::memcpy(&b[8], &version, 4);
-    std::fill(b.begin() + 184, b.begin() + 252, '\0');
-    return WithHeaderCrc(b);
+    std::fill(b.begin() + 184, b.begin() + 252, 0);
+    if (version < MultiresolutionHeader::TypicalErrorVersion)
+    {
+      // The typical error's bytes were reserved (zero) before; the index CRC follows them.
+      const auto index = resmr_fuzz::Load<uint64_t>(b, b.size() - IndexTrailerBytes);
+      for (std::size_t r = 0; r < file.Regions().size(); ++r)
+      {
+        resmr_fuzz::Store<float>(b, static_cast<std::size_t>(index) + r * 192 + 4, 0.f);
+      }
+    }
+    b = resmr_fuzz::Repair(b.data(), b.size(), resmr_fuzz::ResmrLayout(), false);
+    return std::string(b.begin(), b.end());
   };
   writeBytes(withVersion(3));
   {
@@ -1083,11 +1094,14 @@ void TestMapAxesInFile()
     CHECK(old.Header().version == 3 && !old.Header().map.hasMapAxes && old.Header().map.mapUnits.empty());
     CHECK(!CornerPointGeometry::PlacementTransform(old.Header().map, transform));
     CHECK(old.Regions().size() == file.Regions().size() && old.Header().geometryId == file.Header().geometryId);
+    // Its regions' typical errors are unknown (the view estimates from their own errors).
+    CHECK(std::all_of(
+      old.Regions().begin(), old.Regions().end(), [](const RegionRecord& r) { return r.typicalError < 0; }));
   }
   // Versions this build does not know are refused by number.
   writeBytes(withVersion(2));
   resmr_testing::ExpectError<FileFormatError>("version 2", [&] { MultiresolutionFile f(damaged); },
-    { damaged, "format version 2", "versions 3 to 7", "resmr build" });
+    { damaged, "format version 2", "versions 3 to 8", "resmr build" });
   const std::string newer = std::to_string(MultiresolutionHeader::Version + 1);
   writeBytes(withVersion(MultiresolutionHeader::Version + 1));
   resmr_testing::ExpectError<FileFormatError>(

@@ -130,7 +130,7 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
   const auto& h = file.Header();
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
 
-  ExpectGeometryRefused("version 8", valid, "format version 8", Set<uint32_t>(Version, 8));
+  ExpectGeometryRefused("version 9", valid, "format version 9", Set<uint32_t>(Version, 9));
   ExpectGeometryRefused("version 2", valid, "format version 2", Set<uint32_t>(Version, 2));
   ExpectGeometryRefused("header size", valid, "'header size'", Set<uint32_t>(HeaderSize, 255));
   ExpectGeometryRefused("nx 0", valid, "'dimensions (nx)' is 0", Set<int64_t>(Dims, 0));
@@ -181,10 +181,15 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
   ExpectGeometryRefused(
     "trailer reserved", valid, "(reserved) are not zero", {}, [](Bytes& f) { Store<uint32_t>(f, f.size() - 12, 1); });
 
-  // Index records: level 4, reserved 4, index 8, columns 8, active cells 8, vertices 8,
+  // Index records: level 4, typical error 4, index 8, columns 8, active cells 8, vertices 8,
   // bounds 6 floats, error, own error, two cones of 4 floats, four chunk references.
   ExpectGeometryRefused("record level", valid, "level or region index", SetRecord<int32_t>(0, 0, 2));
-  ExpectGeometryRefused("record reserved", valid, "reserved bytes", SetRecord<int32_t>(0, 4, 7));
+  ExpectGeometryRefused("record typical error NaN", valid, "typical error nan", SetRecord<float>(0, 4, NAN));
+  ExpectGeometryRefused("record typical error -1", valid, "typical error -1", SetRecord<float>(0, 4, -1.0f));
+  ExpectGeometryRefused("record typical error > own", valid, "not between 0 and the own error", [](Bytes& f) {
+    const std::size_t at = static_cast<std::size_t>(IndexAt(f)) + 2 * 192;
+    Store<float>(f, at + 4, 2 * Load<float>(f, at + 68) + 1);
+  });
   ExpectGeometryRefused("record padding", valid, "reserved bytes", SetRecord<uint8_t>(0, 190, 1));
   ExpectGeometryRefused("record index", valid, "level or region index", SetRecord<int64_t>(0, 8, 4));
   ExpectGeometryRefused("record columns 0", valid, "0 columns", SetRecord<int64_t>(0, 16, 0));

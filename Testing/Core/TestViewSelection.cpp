@@ -314,15 +314,47 @@ void TestExtremes(const Model& model)
     const auto selection = model.selector->Select(view, AllResident);
     const auto expected = SelectByError(*model.file, tolerance / view.pixelsPerUnit);
     CHECK(DrawnSet(selection) == expected);
-    double largest = 0;
+    double largest = 0, sum = 0, shares = 0;
     for (const auto& d : selection.drawn)
+    {
       largest = std::max(largest, regions[d.region].error * view.pixelsPerUnit);
+      CHECK(d.estimatedError == regions[d.region].typicalError * view.pixelsPerUnit);
+      CHECK(d.screenShare >= 0 && d.screenShare <= 1);
+      sum += d.screenShare * d.estimatedError;
+      shares += d.screenShare;
+    }
     CHECK(selection.largestProjectedError == largest);
+    // The estimate: the regions' typical errors (parallel: at any distance) weighted by the
+    // view they cover, never past the bound.
+    CHECK(shares > 0 && std::abs(selection.estimatedErrorPixels - sum / shares) <= 1e-9 * (1 + sum / shares));
+    CHECK(selection.estimatedErrorPixels <= largest * (1 + 1e-9));
     distinct += expected.size() != previous;
     previous = expected.size();
     CheckConformity(model, selection, true, AllResident, "parallel");
   }
   CHECK(distinct >= 3);
+  // Typical errors: a mean, so at most the region's own error, and below it where the
+  // simplification removed anything (a region whose every vertex moved as far is unlikely).
+  int below = 0;
+  for (const auto& r : regions)
+  {
+    CHECK(r.typicalError >= 0 && r.typicalError <= r.ownError);
+    below += r.typicalError < 0.9 * r.ownError;
+  }
+  CHECK(below > 0);
+  // Perspective: a region's estimate is at most its bound (a smaller error, seen farther).
+  view.parallel = false;
+  view.pixelsPerUnit = 1000;
+  view.eye = { model.low[0], model.low[1], model.high[2] + 0.05 * model.radius };
+  view.tolerancePixels = 8;
+  const auto low = model.selector->Select(view, AllResident);
+  double estimated = 0;
+  for (const auto& d : low.drawn)
+  {
+    CHECK(d.estimatedError <= d.projectedError && d.estimatedError == EstimatedErrorPixels(regions[d.region], view));
+    estimated = std::max(estimated, d.estimatedError);
+  }
+  CHECK(low.estimatedErrorPixels <= estimated * (1 + 1e-9));
 }
 
 void TestConformity(const Model& model)
@@ -1489,6 +1521,56 @@ void TestFrameRateController()
     CHECK(floor.Tolerance() > 32);
     floor.SetMaximumPixels(8);
     CHECK(floor.Tolerance() == 8 && floor.MaximumTolerance() == 8);
+  }
+  // The floor on the estimated error: a renderer slow at any tolerance, a cut whose bound is
+  // the tolerance and whose estimate a tenth of it. With an estimate floor of 2 px the
+  // tolerance stops at 16 px, where the estimate reaches the aim (0.8 of the floor), under a
+  // bound ceiling far above; a view where the estimate is a half of the bound (coming closer
+  // to what was simplified, 0.6 of the bound) refines to 8/3 px, the aim, in two frames (a
+  // quarter at most each) although every frame is slow; the bound's ceiling still holds where the estimate allows more.
+  {
+    FrameRateController steer;
+    steer.SetTargetFramesPerSecond(10);
+    steer.SetMaximumEstimatedPixels(2);
+    steer.Reset(1);
+    const auto cut = [&](double share) {
+      CutRange same;
+      same.bound = steer.Tolerance();
+      same.estimate = share * steer.Tolerance();
+      return same;
+    };
+    for (int f = 0; f < 100; ++f)
+    {
+      steer.Update(0.3, true, cut(0.1), true);
+      CHECK(steer.Tolerance() <= 16 * (1 + 1e-9));
+    }
+    CHECK(std::abs(steer.Tolerance() - 16) < 1e-9);
+    int frames = 0;
+    while (0.6 * steer.Tolerance() > 2 && frames < 10)
+    {
+      steer.Update(0.3, true, cut(0.6), true);
+      ++frames;
+    }
+    CHECK(frames == 2 && std::abs(steer.Tolerance() - 8.0 / 3) < 1e-9);
+    steer.Update(0.3, true, cut(0.6), true); // at the aim, slow: it stays
+    CHECK(std::abs(steer.Tolerance() - 8.0 / 3) < 1e-9);
+    // A frame still loading (complete = false) does not refine on its estimate.
+    steer.Reset(16);
+    steer.Update(0.3, false, cut(0.5), true);
+    CHECK(steer.Tolerance() >= 16);
+    steer.SetMaximumPixels(12);
+    steer.Reset(1);
+    for (int f = 0; f < 100; ++f)
+    {
+      steer.Update(0.3, true, cut(0.01), true);
+    }
+    CHECK(steer.Tolerance() == 12);
+    // No estimate (a cut of leaves, or 0 as the floor): the bound alone.
+    steer.SetMaximumPixels(FrameRateController::MaximumPixels);
+    steer.SetMaximumEstimatedPixels(0);
+    steer.Reset(20);
+    steer.Update(0.3, true, cut(0.5), false);
+    CHECK(steer.Tolerance() > 20);
   }
 
   // Fill-bound (a software rasterizer at the roots of a billion-cell model): a moving frame

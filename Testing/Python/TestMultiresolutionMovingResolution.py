@@ -119,8 +119,9 @@ def moving_and_still(tag):
     second = orbit(view, display, 1)
     check(first == [1] and second == [0.5],
           f"{tag}: the first moving frame lowers the scale to the floor: {first + second}")
-    check(tolerance_of(display) == tolerance_first,
-          f"{tag}: the tolerance waits for the scale: {tolerance_first} px, then {tolerance_of(display)} px")
+    check(tolerance_of(display) <= tolerance_first,
+          f"{tag}: the tolerance waits for the scale (it may refine to the estimated-error floor, never coarsen): "
+          f"{tolerance_first} px, then {tolerance_of(display)} px")
     moving = drawn_pixels(view)
     display.PixelTolerance = tolerance_of(display)
     display.TargetFrameRate = 0

@@ -3,7 +3,12 @@ surface cannot hold (1000 FPS, so every frame is slow) and full resolution kept 
 (Moving Resolution Floor 1, so the controller can only coarsen the geometry), on the faulted
 synthetic model:
 - the quality floor: over 40 moving frames the tolerance rises to Maximum Pixel Tolerance
-  (16 px here) and never past it; raised to 65536, the same frames go past it;
+  (16 px here, with no floor on the estimated error) and never past it; raised to 65536, the
+  same frames go past it;
+- the floor on the estimated error: with Maximum Pixel Tolerance at 65536 and Maximum
+  Estimated Error at a quarter of the estimate those unbounded frames reached, the same slow
+  frames keep their estimate (CurrentEstimatedError) within it, all but the frames that step
+  back under it, and their tolerance below the unbounded frames';
 - a still frame (the camera stopped) is drawn at the user's Pixel Tolerance whatever the
   controller chose, and the controller resumes where it was on the next moving frame;
 - reproducible: a moving frame drawn whole (no region standing in for one still loading) at
@@ -33,7 +38,7 @@ def check(condition, message):
 def readout(display):
     display.UpdatePropertyInformation()
     return {name: display.GetPropertyValue(name) for name in
-            ("CurrentTolerance", "TrianglesDrawn", "RegionsDrawn", "RegionsSubstituted", "LoadsPending",
+            ("CurrentTolerance", "CurrentEstimatedError", "TrianglesDrawn", "RegionsDrawn", "RegionsSubstituted", "LoadsPending",
              "CurrentFrameMoving")}
 
 
@@ -70,6 +75,7 @@ display.WaitForDetailMs = 0
 
 display.MovingResolutionFloor = 1.0
 display.MaximumPixelTolerance = 16
+display.MaximumEstimatedError = 0
 display.TargetFrameRate = 1000
 frames = moving_frames(view, display, 40)
 tolerances = [f["CurrentTolerance"] for f in frames]
@@ -85,8 +91,26 @@ resumed = moving_frames(view, display, 1)[0]["CurrentTolerance"]
 check(resumed == 16, f"the next moving frame resumes at the controller's 16 px: {resumed:g} px")
 
 display.MaximumPixelTolerance = 65536
-beyond = [f["CurrentTolerance"] for f in moving_frames(view, display, 20)]
+unbounded = moving_frames(view, display, 20)
+beyond = [f["CurrentTolerance"] for f in unbounded]
 check(max(beyond) > 16, f"with the floor at 65536 the same frames coarsen past 16 px: up to {max(beyond):g} px")
+reached = max(f["CurrentEstimatedError"] for f in unbounded)
+check(reached > 0, f"coarse frames have an estimated error: up to {reached:.2f} px")
+
+# The floor on the estimated error, the bound's lifted: the same slow frames, from the
+# controller's tolerance where the unbounded frames left it.
+floor = reached / 4
+display.MaximumEstimatedError = floor
+steered = moving_frames(view, display, 40)
+whole_frames = [f for f in steered[10:] if f["RegionsSubstituted"] == 0]
+within = [f for f in whole_frames if f["CurrentEstimatedError"] <= floor * 1.0001]
+check(len(whole_frames) >= 10 and len(within) >= 0.8 * len(whole_frames),
+      f"with Maximum Estimated Error {floor:.2f} px, {len(within)} of the last {len(whole_frames)} whole moving "
+      f"frames keep their estimate within it (up to {max(f['CurrentEstimatedError'] for f in steered[10:]):.2f} px)")
+check(max(f["CurrentTolerance"] for f in steered[10:]) < max(beyond),
+      f"the estimate holds the tolerance back: up to {max(f['CurrentTolerance'] for f in steered[10:]):g} px, "
+      f"{max(beyond):g} px without it")
+display.MaximumEstimatedError = 0
 
 # Reproducible: a whole moving frame at the controller's tolerance, then the same camera with
 # that tolerance typed in. A reachable rate lets the tolerance come down from where the slow
