@@ -135,7 +135,9 @@ def summary(samples):
             "drawn_hole_pixels_max": max(s.get("drawn_hole_pixels", 0) for s in samples),
             "drawn_hole_depth_max_px": max(s.get("drawn_hole_depth_px", 0) for s in samples),
             "sampled_tolerance_p50": float(np.percentile([s["tolerance"] for s in samples], 50)),
-            "sampled_tolerance_p90": float(np.percentile([s["tolerance"] for s in samples], 90))}
+            "sampled_tolerance_p90": float(np.percentile([s["tolerance"] for s in samples], 90)),
+            "sampled_estimate_p50": float(np.percentile([s.get("estimated_px", 0) for s in samples], 50)),
+            "sampled_estimate_p90": float(np.percentile([s.get("estimated_px", 0) for s in samples], 90))}
 
 
 def report_lines(models, out_name):
@@ -150,14 +152,15 @@ def report_lines(models, out_name):
              "(see-through gaps); NaN pixels are painted in the lookup table's NaN colour. 'As drawn': the same holes in "
              "the frame the user saw on the path (meshes still loading stood in for by coarser ones, a moving frame's "
              "reduced resolution).", "",
-             "| model | load | samples | tolerance p50 / p90 px | within 2 px: min / p10 / p50 | frames >= 95% | "
+             "| model | load | samples | tolerance p50 / p90 px | estimated error p50 / p90 px | within 2 px: min / p10 / p50 | frames >= 95% | "
              "same cell p50 / min | frames with holes | largest hole px (depth) | as drawn: frames with holes | "
              "as drawn: largest hole px (depth) | NaN px max | silhouette px max |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for e in rows:
         lines.append(
             f"| {e['model']} | {e.get('load', 'idle')} | {e['quality_samples']} | "
             f"{e['sampled_tolerance_p50']:.0f} / {e['sampled_tolerance_p90']:.0f} | "
+            f"{e.get('sampled_estimate_p50', 0):.2f} / {e.get('sampled_estimate_p90', 0):.2f} | "
             f"{100 * e['within_2px_min']:.1f}% / {100 * e['within_2px_p10']:.1f}% / {100 * e['within_2px_p50']:.1f}% | "
             f"{100 * e['frames_within_2px_95']:.0f}% | {100 * e['cell_agreement_p50']:.1f}% / "
             f"{100 * e['cell_agreement_min']:.1f}% | {e['frames_with_holes']} | {e['hole_pixels_max']} "
