@@ -108,9 +108,9 @@ lines = [f"# Picture quality against tolerance (generated faulted model {args.mo
          "the same camera in the Cell Id colouring: 'within 2 px' is the share of pixels whose cell (or the "
          "background) the exact frame has within 2 pixels; 'missed below layer 1' is the share of the other "
          "pixels whose exact cell lies below the first layer (walls: the outside and the faults, where every "
-         "layer shows). 'estimated px' is the frame's estimated error (the largest typical error of a drawn "
-         "region, seen at its centre; CurrentEstimatedError), what the frame rate steers by beside the "
-         "tolerance, a bound.", "",
+         "layer shows). 'estimated px' is the frame's estimated error (the typical errors of the drawn regions "
+         "seen at their centres, averaged over the view by the share each covers; CurrentEstimatedError), what "
+         "the frame rate steers by beside the tolerance, a bound.", "",
          "| camera | tolerance px | estimated px | within 2 px | missed below layer 1 | same cell | hole px | silhouette px | "
          "triangles (0 px: all) |",
          "|---|---|---|---|---|---|---|---|---|"]
