@@ -44,7 +44,7 @@ public:
   /// MaximumPixelTolerance's default (see docs/user-guide.md for the measurements behind it).
   static constexpr double DefaultMaximumPixelTolerance = 128.0;
   /// MaximumEstimatedError's default (see docs/user-guide.md for the measurements behind it).
-  static constexpr double DefaultMaximumEstimatedError = 1.0;
+  static constexpr double DefaultMaximumEstimatedError = 1.5;
 
   enum ColorModes
   {

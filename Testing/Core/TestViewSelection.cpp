@@ -1522,57 +1522,6 @@ void TestFrameRateController()
     floor.SetMaximumPixels(8);
     CHECK(floor.Tolerance() == 8 && floor.MaximumTolerance() == 8);
   }
-  // The floor on the estimated error: a renderer slow at any tolerance, a cut whose bound is
-  // the tolerance and whose estimate a tenth of it. With an estimate floor of 2 px the
-  // tolerance stops at 16 px, where the estimate reaches the aim (0.8 of the floor), under a
-  // bound ceiling far above; a view where the estimate is a half of the bound (coming closer
-  // to what was simplified, 0.6 of the bound) refines to 8/3 px, the aim, in two frames (a
-  // quarter at most each) although every frame is slow; the bound's ceiling still holds where the estimate allows more.
-  {
-    FrameRateController steer;
-    steer.SetTargetFramesPerSecond(10);
-    steer.SetMaximumEstimatedPixels(2);
-    steer.Reset(1);
-    const auto cut = [&](double share) {
-      CutRange same;
-      same.bound = steer.Tolerance();
-      same.estimate = share * steer.Tolerance();
-      return same;
-    };
-    for (int f = 0; f < 100; ++f)
-    {
-      steer.Update(0.3, true, cut(0.1), true);
-      CHECK(steer.Tolerance() <= 16 * (1 + 1e-9));
-    }
-    CHECK(std::abs(steer.Tolerance() - 16) < 1e-9);
-    int frames = 0;
-    while (0.6 * steer.Tolerance() > 2 && frames < 10)
-    {
-      steer.Update(0.3, true, cut(0.6), true);
-      ++frames;
-    }
-    CHECK(frames == 2 && std::abs(steer.Tolerance() - 8.0 / 3) < 1e-9);
-    steer.Update(0.3, true, cut(0.6), true); // at the aim, slow: it stays
-    CHECK(std::abs(steer.Tolerance() - 8.0 / 3) < 1e-9);
-    // A frame still loading (complete = false) does not refine on its estimate.
-    steer.Reset(16);
-    steer.Update(0.3, false, cut(0.5), true);
-    CHECK(steer.Tolerance() >= 16);
-    steer.SetMaximumPixels(12);
-    steer.Reset(1);
-    for (int f = 0; f < 100; ++f)
-    {
-      steer.Update(0.3, true, cut(0.01), true);
-    }
-    CHECK(steer.Tolerance() == 12);
-    // No estimate (a cut of leaves, or 0 as the floor): the bound alone.
-    steer.SetMaximumPixels(FrameRateController::MaximumPixels);
-    steer.SetMaximumEstimatedPixels(0);
-    steer.Reset(20);
-    steer.Update(0.3, true, cut(0.5), false);
-    CHECK(steer.Tolerance() > 20);
-  }
-
   // Fill-bound (a software rasterizer at the roots of a billion-cell model): a moving frame
   // costs 10 ms + 120 ms x scale^2 whatever the tolerance. The scale goes first and the
   // tolerance stays; frames settle inside the band; still frames leave the scale alone.
@@ -1706,6 +1655,61 @@ void TestFrameRateController()
     CHECK(fastest >= 0.5 * FrameRateController::LowFraction * 0.1);
   }
 }
+
+void TestEstimateSteering()
+{
+  // The floor on the estimated error: a renderer slow at any tolerance, a cut whose bound is
+  // the tolerance and whose estimate a tenth of it. With an estimate floor of 2 px the
+  // tolerance stops at 16 px, where the estimate reaches the aim (0.8 of the floor), under a
+  // bound ceiling far above; a view where the estimate is a half of the bound (coming closer
+  // to what was simplified, 0.6 of the bound) refines to 8/3 px, the aim, in two frames (a
+  // quarter at most each) although every frame is slow; the bound's ceiling still holds where the estimate allows more.
+  {
+    FrameRateController steer;
+    steer.SetTargetFramesPerSecond(10);
+    steer.SetMaximumEstimatedPixels(2);
+    steer.Reset(1);
+    const auto cut = [&](double share) {
+      CutRange same;
+      same.bound = steer.Tolerance();
+      same.estimate = share * steer.Tolerance();
+      return same;
+    };
+    for (int f = 0; f < 100; ++f)
+    {
+      steer.Update(0.3, true, cut(0.1), true);
+      CHECK(steer.Tolerance() <= 16 * (1 + 1e-9));
+    }
+    CHECK(std::abs(steer.Tolerance() - 16) < 1e-9);
+    int frames = 0;
+    while (0.6 * steer.Tolerance() > 2 && frames < 10)
+    {
+      steer.Update(0.3, true, cut(0.6), true);
+      ++frames;
+    }
+    CHECK(frames == 2 && std::abs(steer.Tolerance() - 8.0 / 3) < 1e-9);
+    steer.Update(0.3, true, cut(0.6), true); // at the aim, slow: it stays
+    CHECK(std::abs(steer.Tolerance() - 8.0 / 3) < 1e-9);
+    // A frame still loading (complete = false) does not refine on its estimate.
+    steer.Reset(16);
+    steer.Update(0.3, false, cut(0.5), true);
+    CHECK(steer.Tolerance() >= 16);
+    steer.SetMaximumPixels(12);
+    steer.Reset(1);
+    for (int f = 0; f < 100; ++f)
+    {
+      steer.Update(0.3, true, cut(0.01), true);
+    }
+    CHECK(steer.Tolerance() == 12);
+    // No estimate (a cut of leaves, or 0 as the floor): the bound alone.
+    steer.SetMaximumPixels(FrameRateController::MaximumPixels);
+    steer.SetMaximumEstimatedPixels(0);
+    steer.Reset(20);
+    steer.Update(0.3, true, cut(0.5), false);
+    CHECK(steer.Tolerance() > 20);
+  }
+}
+
 } // namespace
 
 void TestUploadPacer()
@@ -1810,6 +1814,7 @@ int main(int argc, char** argv)
       } },
     { "Prediction", [&] { TestPrediction(); } },
     { "FrameRateController", [&] { TestFrameRateController(); } },
+    { "EstimateSteering", [&] { TestEstimateSteering(); } },
     { "UploadPacer", [&] { TestUploadPacer(); } },
     { "DrawBuffers",
       [&] {
