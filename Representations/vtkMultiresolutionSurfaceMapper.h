@@ -64,9 +64,10 @@ public:
   vtkSetClampMacro(PixelTolerance, double, 0.0, 65536.0);
   vtkGetMacro(PixelTolerance, double);
 
-  /// The quality floor: the coarsest tolerance, in pixels, the frame-rate controller may use
-  /// while the camera moves (never below PixelTolerance); a frame still too slow there is late
-  /// rather than coarser. 65536 lets the controller coarsen as far as it likes.
+  /// The backstop of the quality floor: the coarsest tolerance, in pixels, the frame-rate
+  /// controller may use while the camera moves (never below PixelTolerance), whatever
+  /// MaximumEstimatedError allows; a frame still too slow there is late rather than coarser.
+  /// 65536 (with MaximumEstimatedError 0) lets the controller coarsen as far as it likes.
   vtkSetClampMacro(MaximumPixelTolerance, double, 0.5, 65536.0);
   vtkGetMacro(MaximumPixelTolerance, double);
 
