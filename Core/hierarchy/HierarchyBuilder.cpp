@@ -958,6 +958,9 @@ private:
   void WriteBuildManifest(const MultiresolutionHeader& header, const HierarchyReport& report) const;
   void FinishBoundsAndErrors(int leafLevel);
   void BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& report, std::vector<ModelChunk>& model);
+  /// The wall depth table of the leaves' wall faces (emptied), or why it was left out.
+  void AddWallDepths(std::vector<WallFace>& walls, const MultiresolutionHeader& header, HierarchyReport& report,
+    std::vector<ModelChunk>& model);
 
   LayerSource& Source;
   std::string Output;
@@ -1687,7 +1690,13 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
   std::vector<std::atomic<uint64_t>>().swap(touched);
   this->Chunks->AddModelArray(ModelChunk::CellNormals, slotNormals.data(), slotNormals.size() * 4, model);
   std::vector<std::array<uint16_t, 2>>().swap(slotNormals);
+  this->AddWallDepths(walls, header, report, model);
+}
 
+void Builder::AddWallDepths(std::vector<WallFace>& walls, const MultiresolutionHeader& header, HierarchyReport& report,
+  std::vector<ModelChunk>& model)
+{
+  const int64_t nx = header.dims[0], ny = header.dims[1], nz = header.dims[2];
   // Wall depths (ours, WallDepthTable.h), in a fixed order whatever the threads did; keys of
   // (j nx + i) 4 + face + 1 fit 32 bits below 2^30 columns.
   // The table is an aid to painting: a model it cannot be made for keeps the rest of the build.
