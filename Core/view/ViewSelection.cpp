@@ -84,7 +84,8 @@ double ProjectedError(const RegionRecord& record, const ViewParameters& view)
   return d > 0 ? error * view.pixelsPerUnit / d : std::numeric_limits<double>::infinity();
 }
 
-/// The region's typical error (its own where the file has none) at the box's centre.
+/// The region's typical error (its own where the file has none) at the box's centre (no
+/// nearer than the near plane).
 double EstimatedError(const RegionRecord& record, const ViewParameters& view)
 {
   const double error = record.typicalError >= 0 ? record.typicalError : record.ownError;
@@ -103,7 +104,7 @@ double EstimatedError(const RegionRecord& record, const ViewParameters& view)
   {
     squared += (centre[a] - view.eye[a]) * (centre[a] - view.eye[a]);
   }
-  const double d = std::max({ std::sqrt(squared), Distance(record, view.eye), view.nearDistance, 0.0 });
+  const double d = std::max({ std::sqrt(squared), view.nearDistance, 0.0 }); // never below the nearest point's
   return d > 0 ? error * view.pixelsPerUnit / d : std::numeric_limits<double>::infinity();
 }
 
