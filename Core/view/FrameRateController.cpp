@@ -58,22 +58,7 @@ double FrameRateController::Update(double frameSeconds, bool complete, const Cut
   const double ratio = frameSeconds / this->TargetSeconds;
   if (complete && same.estimate > this->EstimateCeiling && this->Pixels > MinimumPixels)
   {
-    // Past the estimated-error floor (the view came closer to what this cut simplified, or a
-    // step coarsened more than the estimate's proportion foretold): refine, and coarsen no
-    // more up to where the last cut within the floor began to change.
-    this->EstimateBlock =
-      this->LastGoodCoarsenAt > 0 && this->LastGoodCoarsenAt <= this->Pixels ? this->LastGoodCoarsenAt : this->Pixels;
-    this->LastGoodCoarsenAt = 0;
-    const double limit = this->EstimateLimit(same);
-    const double from = same.refineBelow < this->Pixels && same.refineBelow > 0 ? same.refineBelow : this->Pixels;
-    this->Pixels =
-      std::clamp(std::max(std::min(from, limit), this->Pixels * MaxRefineStep), MinimumPixels, this->Ceiling);
-    if (ratio > HighFraction && moving)
-    {
-      // Slow as well: the pixels pay for the detail the floor wants.
-      this->RenderScale = std::max(this->Floor, this->RenderScale / std::min(4.0, std::sqrt(ratio / AimFraction)));
-    }
-    return this->Pixels;
+    return this->RefineToEstimateFloor(same, ratio, moving);
   }
   if (complete && same.estimate <= this->EstimateCeiling)
   {
@@ -105,6 +90,26 @@ double FrameRateController::Update(double frameSeconds, bool complete, const Cut
       return this->Pixels;
     }
     return this->Refine(factor, same);
+  }
+  return this->Pixels;
+}
+
+double FrameRateController::RefineToEstimateFloor(const CutRange& same, double ratio, bool moving)
+{
+  // Past the estimated-error floor (the view came closer to what this cut simplified, or a
+  // step coarsened more than the estimate's proportion foretold): refine, and coarsen no more
+  // up to where the last cut within the floor began to change.
+  this->EstimateBlock =
+    this->LastGoodCoarsenAt > 0 && this->LastGoodCoarsenAt <= this->Pixels ? this->LastGoodCoarsenAt : this->Pixels;
+  this->LastGoodCoarsenAt = 0;
+  const double limit = this->EstimateLimit(same);
+  const double from = same.refineBelow < this->Pixels && same.refineBelow > 0 ? same.refineBelow : this->Pixels;
+  this->Pixels =
+    std::clamp(std::max(std::min(from, limit), this->Pixels * MaxRefineStep), MinimumPixels, this->Ceiling);
+  if (ratio > HighFraction && moving)
+  {
+    // Slow as well: the pixels pay for the detail the floor wants.
+    this->RenderScale = std::max(this->Floor, this->RenderScale / std::min(4.0, std::sqrt(ratio / AimFraction)));
   }
   return this->Pixels;
 }

@@ -112,6 +112,8 @@ public:
 
 private:
   double Coarsen(double factor, const CutRange& same);
+  /// A complete frame past the estimated-error floor: refine to it, whatever the frame's time.
+  double RefineToEstimateFloor(const CutRange& same, double ratio, bool moving);
   /// The largest tolerance the estimated-error floor allows, from the frame's cut.
   double EstimateLimit(const CutRange& same) const;
   double Refine(double factor, const CutRange& same);
