@@ -288,8 +288,8 @@ def write_report(results):
     if all("cpu_render_ms" in f for e in results["models"] for f in e["frames"]):
         lines += ["", "CPU time a frame by thread (ms, schedstat), the median over all frames and over the frames "
                   "over the target: the render thread (ParaView, the selection, uploads), llvmpipe's rasterizer "
-                  "threads (one a core: at most twice the frame time) and the mesh loader (SCHED_IDLE, so it "
-                  "takes only what the frame leaves idle).", "",
+                  "threads (one a core: at most twice the frame time) and the mesh loader (nice 19, so it "
+                  "takes little of what the frame needs).", "",
                   "| model | render | rasterizer | loader | over target: render | rasterizer | loader |",
                   "|---|---|---|---|---|---|---|"]
         for e in results["models"]:

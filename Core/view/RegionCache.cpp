@@ -4,7 +4,6 @@
 
 #ifdef __linux__
 #include <pthread.h>
-#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -991,21 +990,19 @@ void RegionCache::Run(Role role)
   if (role == Role::Idle)
   {
     // Below the render thread: decompression must not take the cores a frame (or a software
-    // rasterizer's threads) needs; it uses what the frames leave. At nice 10 it still took a
-    // whole core in frames of a 2-core machine (the scheduler counts a core running it as
-    // busy, so a waking rasterizer thread queued behind a frame's other work); a SCHED_IDLE
-    // core counts as idle, and the waking thread takes it at once.
-    sched_param none{};
-    if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &none) != 0)
-    {
-      setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
-    }
+    // rasterizer's threads) needs; it uses what the frames leave. Nice 19, not SCHED_IDLE: this
+    // thread takes the cache's mutex for its bookkeeping, and a SCHED_IDLE thread preempted
+    // while holding it, on cores the machine's other work keeps busy, did not run again for up
+    // to 1.8 s while the render thread waited on that mutex (a priority inversion; at nice 19
+    // the scheduler's fairness bounds the wait). At nice 10 it took a whole core in frames of a
+    // 2-core machine, queuing a waking rasterizer thread behind it.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
   }
   else if (standby)
   {
     // The standby only loads while the idle loader is starved (see RescueIfStarvedLocked): an
-    // ordinary thread, below the render thread. (An unprivileged thread cannot leave
-    // SCHED_IDLE, so the idle loader cannot be raised instead.)
+    // ordinary thread, below the render thread. (An unprivileged thread cannot lower its nice
+    // value, so the idle loader cannot be raised instead.)
     setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
   }
   // So profilers and the view bench can tell them apart.

@@ -36,8 +36,8 @@
 //   most of a coarse region's bytes, and a region whose error shows draws the simplified one.
 // - Property tables (Sec. 5.4: one value a hash slot) load the same way, off the render
 //   thread; the previous table stays current until the new one is ready.
-// - Loading runs on a thread below the render thread (SCHED_IDLE on Linux: it takes only
-//   cores the frames leave idle). When the machine's other work keeps every core busy, that
+// - Loading runs on a thread below the render thread (nice 19 on Linux: it takes little of
+//   the cores the frames need). When the machine's other work keeps every core busy, that
 //   thread gets almost nothing; then (work waiting 300 ms, under a tenth of it used, checked
 //   by Request, Pending and WaitIdle) a standby thread at nice 10 loads until nothing is
 //   pending: detail still arrives, a share slower.
@@ -243,7 +243,7 @@ private:
   int32_t LayerOf(Key key) const { return static_cast<int32_t>(key % this->LayerSlots) - 1; }
   enum class Role
   {
-    Idle,     ///< below every other thread (SCHED_IDLE on Linux)
+    Idle,     ///< below every other thread (nice 19 on Linux)
     Standby,  ///< nice 10, only while the idle loader is starved
     Essential ///< the process's priority, only what the picture cannot do without
   };
