@@ -1001,6 +1001,91 @@ void TestDrawPieces(const std::string& path)
   }
 }
 
+/// Loading on a core kept busy: the standby rescues the starved idle loader, and the essential
+/// loader alone brings the tables.
+void TestCacheOnBusyCore(const std::shared_ptr<const MultiresolutionFile>& file, const std::vector<std::size_t>& leaves,
+  const std::vector<std::size_t>& roots)
+{
+  using namespace std::chrono;
+  // A core kept busy by an ordinary thread: the idle loader gets almost nothing there, and
+  // the standby loads in its place (Linux, where the loader runs at nice 19). The loaders
+  // inherit this thread's CPU set, pinned to one core with the spinners: on free cores the
+  // few ms this model's leaves take could slip through (a clean-clone run loaded them in
+  // 10 ms with every core "busy").
+#ifdef __linux__
+  cpu_set_t saved, one;
+  const bool pinned = sched_getaffinity(0, sizeof(saved), &saved) == 0;
+  const int core = sched_getcpu();
+  CPU_ZERO(&one);
+  CPU_SET(core >= 0 ? core : 0, &one);
+  const bool isolated = pinned && sched_setaffinity(0, sizeof(one), &one) == 0;
+#endif
+  // Eight spinners: at this test's nice 10 (make test) one spinner weighs 110 to the nice 19
+  // loader's 15, which leaves the loader an eighth of the core, over the starvation line;
+  // eight leave it under 2%, so it cannot finish this model's leaves within a window.
+  std::atomic<bool> spin{ true };
+  std::atomic<int> spinning{ 0 };
+  std::vector<std::thread> spinners;
+  for (int s = 0; s < 8; ++s)
+    spinners.emplace_back([&] {
+      volatile uint64_t n = 0;
+      ++spinning;
+      while (spin.load(std::memory_order_relaxed))
+        n = n + 1;
+    });
+  while (spinning < 8)
+    std::this_thread::yield();
+  const auto start = steady_clock::now();
+  uint64_t rescues = 0;
+  bool loaded = false;
+  {
+    RegionCache cache(file, nullptr, SIZE_MAX);
+    cache.SetStarvationWindow(std::chrono::milliseconds(10));
+    CHECK(cache.WaitIdle(seconds(30)));
+    cache.Request(leaves);
+    loaded = cache.WaitIdle(seconds(30));
+    loaded = loaded && cache.ResidentCount() == roots.size() + leaves.size() && cache.LastError().empty();
+    rescues = cache.StandbyRescues();
+  }
+  const double took = duration<double>(steady_clock::now() - start).count();
+  // What the picture needs (the roots, the hash and normal tables) is read by the essential
+  // loader alone, at this thread's priority, even while the idle loader is starved and no
+  // standby rescues it: an idle loader that took the tables held them, and the colours,
+  // for as long as it starved (minutes on a busy 2-core machine).
+  double tablesSeconds = -1;
+  {
+    RegionCache cache(file, nullptr, SIZE_MAX);
+    cache.SetStarvationWindow(std::chrono::hours(1));
+    const auto opened = steady_clock::now();
+    while (!cache.Tables() && steady_clock::now() - opened < seconds(30))
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    if (cache.Tables())
+      tablesSeconds = duration<double>(steady_clock::now() - opened).count();
+  }
+  spin = false;
+  for (std::thread& spinner : spinners)
+    spinner.join();
+  std::printf("  tables on a core kept busy, no rescue: %.3f s\n", tablesSeconds);
+  CHECK(tablesSeconds >= 0 && tablesSeconds < 0.2); // starved, the idle loader took about 0.5 s
+#ifdef __linux__
+  if (pinned)
+    sched_setaffinity(0, sizeof(saved), &saved);
+#endif
+  CHECK(loaded);
+  std::printf("  cache on a core kept busy: all loaded in %.2f s, standby rescues %llu\n", took,
+    static_cast<unsigned long long>(rescues));
+#ifdef __linux__
+  // Spinners above nice 10 weigh too little against the nice 19 loader for it to starve:
+  // only an ordinary priority makes the core busy enough.
+  errno = 0;
+  const int niceness = getpriority(PRIO_PROCESS, 0);
+  if (errno == 0 && niceness > 10)
+    std::printf("  (run at nice %d: the rescue is not required)\n", niceness);
+  else
+    CHECK(!isolated || rescues > 0);
+#endif
+}
+
 void TestCache(const std::string& path)
 {
   using namespace std::chrono;
@@ -1040,85 +1125,7 @@ void TestCache(const std::string& path)
     std::printf("  cache: %zu leaves (%zu bytes) + %zu roots (%zu bytes) loaded in %.3f s\n", leaves.size(), leafBytes,
       roots.size(), rootBytes, seconds);
   }
-  {
-    // A core kept busy by an ordinary thread: the idle loader gets almost nothing there, and
-    // the standby loads in its place (Linux, where the loader runs at nice 19). The loaders
-    // inherit this thread's CPU set, pinned to one core with the spinners: on free cores the
-    // few ms this model's leaves take could slip through (a clean-clone run loaded them in
-    // 10 ms with every core "busy").
-#ifdef __linux__
-    cpu_set_t saved, one;
-    const bool pinned = sched_getaffinity(0, sizeof(saved), &saved) == 0;
-    const int core = sched_getcpu();
-    CPU_ZERO(&one);
-    CPU_SET(core >= 0 ? core : 0, &one);
-    const bool isolated = pinned && sched_setaffinity(0, sizeof(one), &one) == 0;
-#endif
-    // Eight spinners: at this test's nice 10 (make test) one spinner weighs 110 to the nice 19
-    // loader's 15, which leaves the loader an eighth of the core, over the starvation line;
-    // eight leave it under 2%, so it cannot finish this model's leaves within a window.
-    std::atomic<bool> spin{ true };
-    std::atomic<int> spinning{ 0 };
-    std::vector<std::thread> spinners;
-    for (int s = 0; s < 8; ++s)
-      spinners.emplace_back([&] {
-        volatile uint64_t n = 0;
-        ++spinning;
-        while (spin.load(std::memory_order_relaxed))
-          n = n + 1;
-      });
-    while (spinning < 8)
-      std::this_thread::yield();
-    const auto start = steady_clock::now();
-    uint64_t rescues = 0;
-    bool loaded = false;
-    {
-      RegionCache cache(file, nullptr, SIZE_MAX);
-      cache.SetStarvationWindow(std::chrono::milliseconds(10));
-      CHECK(cache.WaitIdle(seconds(30)));
-      cache.Request(leaves);
-      loaded = cache.WaitIdle(seconds(30));
-      loaded = loaded && cache.ResidentCount() == roots.size() + leaves.size() && cache.LastError().empty();
-      rescues = cache.StandbyRescues();
-    }
-    const double took = duration<double>(steady_clock::now() - start).count();
-    // What the picture needs (the roots, the hash and normal tables) is read by the essential
-    // loader alone, at this thread's priority, even while the idle loader is starved and no
-    // standby rescues it: an idle loader that took the tables held them, and the colours,
-    // for as long as it starved (minutes on a busy 2-core machine).
-    double tablesSeconds = -1;
-    {
-      RegionCache cache(file, nullptr, SIZE_MAX);
-      cache.SetStarvationWindow(std::chrono::hours(1));
-      const auto opened = steady_clock::now();
-      while (!cache.Tables() && steady_clock::now() - opened < seconds(30))
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      if (cache.Tables())
-        tablesSeconds = duration<double>(steady_clock::now() - opened).count();
-    }
-    spin = false;
-    for (std::thread& spinner : spinners)
-      spinner.join();
-    std::printf("  tables on a core kept busy, no rescue: %.3f s\n", tablesSeconds);
-    CHECK(tablesSeconds >= 0 && tablesSeconds < 0.2); // starved, the idle loader took about 0.5 s
-#ifdef __linux__
-    if (pinned)
-      sched_setaffinity(0, sizeof(saved), &saved);
-#endif
-    CHECK(loaded);
-    std::printf("  cache on a core kept busy: all loaded in %.2f s, standby rescues %llu\n", took,
-      static_cast<unsigned long long>(rescues));
-#ifdef __linux__
-    // Spinners above nice 10 weigh too little against the nice 19 loader for it to starve:
-    // only an ordinary priority makes the core busy enough.
-    errno = 0;
-    const int niceness = getpriority(PRIO_PROCESS, 0);
-    if (errno == 0 && niceness > 10)
-      std::printf("  (run at nice %d: the rescue is not required)\n", niceness);
-    else
-      CHECK(!isolated || rescues > 0);
-#endif
-  }
+  TestCacheOnBusyCore(file, leaves, roots);
   {
     // A budget for the roots and the first n leaves: loading stops at leaf n.
     const std::size_t n = leaves.size() / 3;
