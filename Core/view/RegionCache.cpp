@@ -992,10 +992,9 @@ void RegionCache::Run(Role role)
     // Below the render thread: decompression must not take the cores a frame (or a software
     // rasterizer's threads) needs; it uses what the frames leave. Nice 19, not SCHED_IDLE: this
     // thread takes the cache's mutex for its bookkeeping, and a SCHED_IDLE thread preempted
-    // while holding it, on cores the machine's other work keeps busy, did not run again for up
-    // to 1.8 s while the render thread waited on that mutex (a priority inversion; at nice 19
-    // the scheduler's fairness bounds the wait). At nice 10 it took a whole core in frames of a
-    // 2-core machine, queuing a waking rasterizer thread behind it.
+    // while holding it on cores the machine's other work keeps busy waits for an idle core,
+    // the render thread waiting on the mutex with it; at nice 19 the scheduler's fairness
+    // bounds that wait. Nearer nice 0 it would take cores a frame's rasterizer threads need.
     setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
   }
   else if (standby)
