@@ -95,7 +95,7 @@ for camera in cameras:
         row = {"camera": camera, "tolerance": tolerance, "estimated_px": estimated, "triangles": triangles,
                "exact_triangles": exact_triangles}
         row.update(image_metrics.compare(got, exact))
-        row["within_2px_fine"] = image_metrics.within_pixels_fine(got, fine, FINE_SCALE)
+        row["within_2px_fine"] = image_metrics.within_pixels(got, fine, scale=FINE_SCALE)
         if layers_known:
             missed = image_metrics.missed_pixels(got, exact)
             row["missed_below_first_layer"] = int((missed & (exact > nx * ny)).sum())
@@ -116,7 +116,7 @@ lines = [f"# Picture quality against tolerance (generated faulted model {args.mo
          "background) the exact frame has within 2 pixels; 'missed below layer 1' is the share of the other "
          "pixels whose exact cell lies below the first layer (walls: the outside and the faults, where every "
          "layer shows). 'of the 3x frame': the same against the exact frame drawn at 3x the resolution, where "
-         "cells thinner than a pixel all show (image_metrics.within_pixels_fine; the 1x exact frame is its centre "
+         "cells thinner than a pixel all show (image_metrics.within_pixels(scale=3); the 1x exact frame is its centre "
          "samples and scores 100% by it). 'estimated px' is the frame's estimated error (the typical errors of the drawn regions "
          "seen at their centres, averaged over the view by the share each covers; CurrentEstimatedError), what "
          "the frame rate steers by beside the tolerance, a bound.", "",

@@ -98,7 +98,7 @@ def measure(view, display, samples, budget_mb, folder):
         fine_png = os.path.join(folder, f"{tag}-0px-x{FINE_SCALE}-cellid.png")
         fine = resmr_testing.cell_ids(shot(0, "Cell Id", os.path.basename(fine_png), FINE_SCALE))
         os.remove(fine_png)  # 8 MPixel a sample; the 1x exact frame is its centre samples
-        sample["within_2px_fine"] = image_metrics.within_pixels_fine(got, fine, FINE_SCALE)
+        sample["within_2px_fine"] = image_metrics.within_pixels(got, fine, scale=FINE_SCALE)
         covered = sample.pop("drawn_covered", None)
         drawn = sample.pop("drawn_pixels", None)
         if covered is not None:
@@ -130,7 +130,7 @@ def summary(samples):
     if not samples:
         return {}
     within = [s["within_2px"] for s in samples]
-    fine = [s.get("within_2px_fine", float("nan")) for s in samples]
+    fine = [s["within_2px_fine"] for s in samples]
     return {"quality_samples": len(samples),
             "within_2px_min": min(within), "within_2px_p10": float(np.percentile(within, 10)),
             "within_2px_p50": float(np.percentile(within, 50)),

@@ -88,7 +88,7 @@ def count_holes(expected, got, tolerance):
 
 
 def check_fine_measure(ours, bounds, failures):
-    """image_metrics.within_pixels_fine, the view benchmark's measure against the exact frame
+    """image_metrics.within_pixels(scale=3), the view benchmark's measure against the exact frame
     drawn at 3x, on our 0 px frame (shown): the 3x frame's centre samples are the 1x frame,
     which scores 100% by it, as do the samples a third of a pixel aside; a frame moved 6 px
     does not."""
@@ -101,7 +101,7 @@ def check_fine_measure(ours, bounds, failures):
     aside = np.ascontiguousarray(fine[0::3, 0::3])
     moved = np.zeros_like(exact)
     moved[:, 6:] = exact[:, :-6]
-    exact_score, aside_score, moved_score = (im.within_pixels_fine(frame, fine, 3) for frame in (exact, aside, moved))
+    exact_score, aside_score, moved_score = (im.within_pixels(frame, fine, scale=3) for frame in (exact, aside, moved))
     print(f"3x exact frame: centre samples equal the 1x frame on {100 * centre:.3f}% of the pixels; within 2 px of "
           f"it: the 1x frame {100 * exact_score:.3f}%, a third of a pixel aside {100 * aside_score:.3f}%, "
           f"moved 6 px {100 * moved_score:.2f}%")

@@ -20,54 +20,41 @@ def cell_agreement(got, exact):
     return float(np.mean(got[both] == exact[both])) if both.any() else 0.0
 
 
-def missed_pixels(got, exact, reach=2):
+def missed_pixels(got, exact, reach=2, scale=1):
     """The pixels either covers whose content (a cell, or the background) the other image has
     nowhere within `reach` pixels (a square): a cell drawn up to `reach` pixels from where
     the exact image has it is not missed, a cell or a hole the exact image has nowhere near
-    is."""
-    found_got = np.zeros(got.shape, bool)    # got's pixel has its match in exact nearby
-    found_exact = np.zeros(got.shape, bool)  # exact's pixel has its match in got nearby
-    for dy in range(-reach, reach + 1):
-        for dx in range(-reach, reach + 1):
-            found_got |= _shifted(exact, dy, dx, -1) == got
-            found_exact |= _shifted(got, dy, dx, -1) == exact
-    return ((got > 0) | (exact > 0)) & ~(found_got & found_exact)
-
-
-def within_pixels(got, exact, reach=2):
-    """Share of the pixels either covers that missed_pixels does not count."""
-    covered = (got > 0) | (exact > 0)
-    if not covered.any():
-        return 1.0
-    return 1.0 - float(missed_pixels(got, exact, reach).sum()) / float(covered.sum())
-
-
-def within_pixels_fine(got, fine, scale, reach=2):
-    """within_pixels against an exact frame drawn at `scale` (odd) times the resolution, so
-    that cells thinner than a pixel all appear in it: a pixel of `got` is not missed when its
-    content is in `fine` within `reach` pixels of the pixel's footprint, and the exact side
-    when one of the `scale` x `scale` samples under the pixel has its content in `got` within
-    `reach`. At 1x a cell thinner than a pixel shows only where a pixel's centre happens to
-    fall in it, so a drawing that names a neighbouring sub-pixel cell counts as missed (the
-    exact frame drawn a sixth of a pixel aside scores so too); the 1x frame is `fine`'s centre
-    samples, which this measure finds all within reach."""
+    is. `exact` may be drawn at `scale` (odd) times the resolution, so that cells thinner than
+    a pixel all appear in it: then a pixel of `got` is not missed when its content is in
+    `exact` within `reach` pixels of the pixel's footprint, and the exact side when one of the
+    `scale` x `scale` samples under the pixel has its content in `got` within `reach`. At 1x a
+    cell thinner than a pixel shows only where a pixel's centre falls in it, so a frame naming
+    a neighbouring sub-pixel cell counts as missed (the exact frame sampled a third of a pixel
+    aside scores so too); the 1x frame is the 3x frame's centre samples."""
     height, width = got.shape
-    assert fine.shape == (height * scale, width * scale) and scale % 2 == 1
-    found_got = np.zeros(got.shape, bool)
-    found_exact = np.zeros(got.shape, bool)
+    assert exact.shape == (height * scale, width * scale) and scale % 2 == 1
+    found_got = np.zeros(got.shape, bool)    # got's pixel has its match in exact nearby
+    found_exact = np.zeros(got.shape, bool)  # one exact sample under the pixel has its match in got nearby
     for u in range(scale):
         for v in range(scale):
-            sample = np.ascontiguousarray(fine[u::scale, v::scale])
+            sample = np.ascontiguousarray(exact[u::scale, v::scale])
             sample_found = np.zeros(got.shape, bool)
             for dy in range(-reach, reach + 1):
                 for dx in range(-reach, reach + 1):
                     found_got |= _shifted(sample, dy, dx, -1) == got
                     sample_found |= _shifted(got, dy, dx, -1) == sample
             found_exact |= sample_found
-    covered = (got > 0) | (fine.reshape(height, scale, width, scale) > 0).any(axis=(1, 3))
+    exact_covered = (exact.reshape(height, scale, width, scale) > 0).any(axis=(1, 3))
+    return ((got > 0) | exact_covered) & ~(found_got & found_exact)
+
+
+def within_pixels(got, exact, reach=2, scale=1):
+    """Share of the pixels either covers that missed_pixels does not count."""
+    height, width = got.shape
+    covered = (got > 0) | (exact.reshape(height, scale, width, scale) > 0).any(axis=(1, 3))
     if not covered.any():
         return 1.0
-    return 1.0 - float((covered & ~(found_got & found_exact)).sum()) / float(covered.sum())
+    return 1.0 - float(missed_pixels(got, exact, reach, scale).sum()) / float(covered.sum())
 
 
 def _dilate(mask):
