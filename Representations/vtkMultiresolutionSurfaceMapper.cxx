@@ -624,7 +624,11 @@ void vtkMultiresolutionSurfaceMapper::SelectRegions(Frame& frame)
     const std::set<std::size_t> wanted(frame.selection.wanted.begin(), frame.selection.wanted.end());
     std::copy_if(simplified.begin(), simplified.end(), std::back_inserter(lean),
       [&](std::size_t r) { return !wanted.count(r); }); // this frame's choice first
-    cache.Request(frame.selection.wanted, predicted, lean);
+    // Stand-ins that take the picture past its quality floor make the wanted regions as
+    // urgent as the roots: read at this thread's priority, not only with what frames leave.
+    const bool urgent = frame.selection.substituted > 0 && this->MaximumEstimatedError > 0 &&
+      frame.selection.estimatedErrorPixels > this->MaximumEstimatedError;
+    cache.Request(frame.selection.wanted, predicted, lean, urgent);
   };
   request();
   // The roots stand in for everything, so a frame missing them (the first of a file or a

@@ -548,10 +548,11 @@ bool RegionCache::IsResident(std::size_t region) const
 }
 
 void RegionCache::Request(const std::vector<std::size_t>& wanted, const std::vector<std::size_t>& predicted,
-  const std::vector<std::size_t>& simplified)
+  const std::vector<std::size_t>& simplified, bool urgent)
 {
   {
     std::lock_guard<std::mutex> lock(this->Lock);
+    this->WantedUrgent = urgent;
     this->Wanted.clear();
     this->Predicted.clear();
     this->InWanted.clear();
@@ -1050,7 +1051,36 @@ bool RegionCache::EssentialPendingLocked() const
   {
     return true;
   }
-  return this->PropertyWanted && this->TablesTried && !this->PropertyLoading && !this->StandsInLocked();
+  if (this->PropertyWanted && this->TablesTried && !this->PropertyLoading && !this->StandsInLocked())
+  {
+    return true;
+  }
+  return !rootMissing && this->NextUrgentLocked() >= 0;
+}
+
+int64_t RegionCache::NextUrgentLocked() const
+{
+  if (!this->WantedUrgent || this->WantedBlocked)
+  {
+    return -1;
+  }
+  int64_t held = -1;
+  for (Key key : this->Wanted)
+  {
+    if (!this->MissingLocked(key))
+    {
+      continue;
+    }
+    if (!this->Loading.count(key))
+    {
+      return static_cast<int64_t>(key);
+    }
+    if (held < 0 && this->IdleLoading.count(key) && !this->ReadAgain.count(key))
+    {
+      held = static_cast<int64_t>(key);
+    }
+  }
+  return held;
 }
 
 void RegionCache::RescueIfStarvedLocked() const
@@ -1127,8 +1157,12 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock, Role role)
   }
   else
   {
-    const int64_t next = this->NextRegionLocked(essentialOnly);
-    if (next < 0 || (essentialOnly && !this->IsPinnedLocked(static_cast<Key>(next))))
+    int64_t next = this->NextRegionLocked(essentialOnly);
+    if (essentialOnly && (next < 0 || !this->IsPinnedLocked(static_cast<Key>(next))))
+    {
+      next = rootMissing ? -1 : this->NextUrgentLocked();
+    }
+    if (next < 0)
     {
       return false;
     }
@@ -1256,7 +1290,10 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, 
   const std::size_t region = this->RegionOf(key);
   const int32_t layer = this->LayerOf(key);
   const int handedness = this->Handedness;
-  this->Loading.insert(key);
+  // The essential loader may read again what the starved idle loader holds (NextUrgentLocked):
+  // whichever read ends first goes in.
+  const bool again = this->Loading.count(key) != 0;
+  (again ? this->ReadAgain : this->Loading).insert(key);
   if (role == Role::Idle)
   {
     this->IdleLoading.insert(key);
@@ -1282,16 +1319,23 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, 
   // standby and essential loaders waiting on it brought in almost nothing (a 100 s flight of
   // the 100M model with two cores busy held under 60 MB of 512); the earlier region, when it
   // comes, evicts later ones to fit (InsertLocked).
-  while (!this->Stopping && this->EarlierWantedLoadingLocked(key, role != Role::Idle))
+  while (!again && !this->Stopping && this->EarlierWantedLoadingLocked(key, role != Role::Idle))
   {
     this->Idle.wait(lock);
   }
-  this->Loading.erase(key);
-  this->IdleLoading.erase(key);
-  this->Idle.notify_all();
-  if (this->Stopping)
+  if (again)
   {
-    return;
+    this->ReadAgain.erase(key);
+  }
+  else
+  {
+    this->Loading.erase(key);
+    this->IdleLoading.erase(key);
+  }
+  this->Idle.notify_all();
+  if (this->Stopping || !this->MissingLocked(key))
+  {
+    return; // the other read of it went in first
   }
   if (!error.empty())
   {

@@ -45,7 +45,11 @@
 //   thread that does nothing else (ours): the topology's handedness, the roots, the model's
 //   tables and a property no earlier step of it stands in for. Without them a frame draws
 //   nothing or the solid colour; with two other processes keeping both cores busy, the nice
-//   10 standby took about 30 s to bring a 100M-cell model's colours.
+//   10 standby took about 30 s to bring a 100M-cell model's colours. So are the wanted
+//   regions of an urgent request (a frame that stood in for them past its quality floor): on
+//   a 300M-cell model the frames of the first seconds, drawn back to back, left the nice 19
+//   loader so little that they showed the roots' stand-ins for 2.4 s and the coarse ones
+//   past the floor for 5 s.
 // - Errors reading the file (damaged chunk) are kept, not thrown on the render thread:
 //   LastError() names the file and the region; the region is never resident.
 #pragma once
@@ -196,8 +200,11 @@ public:
   /// exact side unless they are resident with it; the roots always are (they stand in for
   /// everything, and their exact side is most of their bytes); the rest are wanted whole, and
   /// Get returns them without their exact side until they are.
+  /// With `urgent` (ours), the wanted regions are work the picture cannot do without, as the
+  /// roots are: the caller's frame stood in for them past its quality floor, and the
+  /// essential loader reads them too, in order, beside the idle one, until a request without.
   void Request(const std::vector<std::size_t>& wanted, const std::vector<std::size_t>& predicted = {},
-    const std::vector<std::size_t>& simplified = {});
+    const std::vector<std::size_t>& simplified = {}, bool urgent = false);
   /// Asks for a property table (name, step): the packed table, or the 2D table of `layer`
   /// (0-based); Property() keeps the previous one until it loads.
   void RequestProperty(const std::string& name, int32_t step, int32_t layer = -1);
@@ -259,8 +266,12 @@ private:
   void LoadTablesLocked(std::unique_lock<std::mutex>& lock);
   void LoadPropertyLocked(std::unique_lock<std::mutex>& lock);
   void LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, Role role);
+  /// For the essential loader, an urgent request's next wanted region: one nobody reads, else
+  /// one the idle loader reads and nobody reads again; -1 if none. Lock held.
+  int64_t NextUrgentLocked() const;
   /// Work the picture cannot do without is waiting, not being read: the handedness, a root,
-  /// the tables, or a property table with no earlier step of it standing in. Lock held.
+  /// the tables, a property table with no earlier step of it standing in, or an urgent
+  /// request's wanted region. Lock held.
   bool EssentialPendingLocked() const;
   /// The current property table is an earlier step of the one wanted, which stands in for
   /// it meanwhile. Lock held.
@@ -306,6 +317,9 @@ private:
   std::thread Loader, Standby, Essential;
   std::unordered_set<Key> Loading;     ///< being read by a loader
   std::unordered_set<Key> IdleLoading; ///< of those, by the idle loader
+  /// Of those, read again by the essential loader for an urgent request: the idle loader may
+  /// hold one for seconds on a busy machine, the picture past its floor meanwhile.
+  std::unordered_set<Key> ReadAgain;
   bool HandednessKnown = false, TablesLoading = false, PropertyLoading = false;
   // Starvation of the idle loader (see RescueIfStarvedLocked).
   mutable bool Rescuing = false;
@@ -331,6 +345,7 @@ private:
   std::vector<Key> Wanted, Predicted;
   std::unordered_set<Key> InWanted, InPredicted;
   bool WantedBlocked = false, PredictedBlocked = false; ///< loading stopped for the budget
+  bool WantedUrgent = false;                            ///< the newest request was urgent
   std::size_t WantedBlockedAt = 0;                      ///< where in Wanted, while WantedBlocked
   /// A key's place in Wanted (its size if absent). Lock held.
   std::size_t WantedIndexLocked(Key key) const;

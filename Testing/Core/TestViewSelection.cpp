@@ -1062,11 +1062,37 @@ void TestCacheOnBusyCore(const std::shared_ptr<const MultiresolutionFile>& file,
     if (cache.Tables())
       tablesSeconds = duration<double>(steady_clock::now() - opened).count();
   }
+  // An urgent request's wanted regions are read by the essential loader too; the same
+  // request not urgent waits on the starved idle loader (no rescue either).
+  double urgentSeconds = -1;
+  std::size_t plainLoaded = 0;
+  const std::size_t all = roots.size() + leaves.size();
+  for (const bool urgent : { true, false })
+  {
+    RegionCache cache(file, nullptr, SIZE_MAX);
+    cache.SetStarvationWindow(std::chrono::hours(1));
+    const auto opened = steady_clock::now();
+    while ((!cache.Tables() || cache.RootsMissing()) && steady_clock::now() - opened < seconds(30))
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const auto asked = steady_clock::now();
+    cache.Request(leaves, {}, {}, urgent);
+    // The plain request gets as long as the urgent one took.
+    const auto limit = urgent ? seconds(30) : duration_cast<steady_clock::duration>(duration<double>(urgentSeconds));
+    while (cache.ResidentCount() < all && steady_clock::now() - asked < limit)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    if (urgent && cache.ResidentCount() == all)
+      urgentSeconds = duration<double>(steady_clock::now() - asked).count();
+    if (!urgent)
+      plainLoaded = cache.ResidentCount() - roots.size();
+  }
   spin = false;
   for (std::thread& spinner : spinners)
     spinner.join();
   std::printf("  tables on a core kept busy, no rescue: %.3f s\n", tablesSeconds);
   CHECK(tablesSeconds >= 0 && tablesSeconds < 0.2); // starved, the idle loader took about 0.5 s
+  std::printf("  %zu leaves on a core kept busy, no rescue: urgent %.3f s; not urgent, %zu loaded meanwhile\n",
+    leaves.size(), urgentSeconds, plainLoaded);
+  CHECK(urgentSeconds >= 0);
 #ifdef __linux__
   if (pinned)
     sched_setaffinity(0, sizeof(saved), &saved);
@@ -1082,7 +1108,10 @@ void TestCacheOnBusyCore(const std::shared_ptr<const MultiresolutionFile>& file,
   if (errno == 0 && niceness > 10)
     std::printf("  (run at nice %d: the rescue is not required)\n", niceness);
   else
+  {
     CHECK(!isolated || rescues > 0);
+    CHECK(!isolated || plainLoaded < leaves.size());
+  }
 #endif
 }
 
