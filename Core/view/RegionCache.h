@@ -46,10 +46,9 @@
 //   tables and a property no earlier step of it stands in for. Without them a frame draws
 //   nothing or the solid colour; with two other processes keeping both cores busy, the nice
 //   10 standby took about 30 s to bring a 100M-cell model's colours. So are the wanted
-//   regions of an urgent request (a frame that stood in for them past its quality floor): on
-//   a 300M-cell model the frames of the first seconds, drawn back to back, left the nice 19
-//   loader so little that they showed the roots' stand-ins for 2.4 s and the coarse ones
-//   past the floor for 5 s.
+//   regions of an urgent request (a frame that stood in for them past its quality floor):
+//   frames drawn back to back leave a nice 19 loader little, and the picture stayed past
+//   the floor for as long as it starved.
 // - Errors reading the file (damaged chunk) are kept, not thrown on the render thread:
 //   LastError() names the file and the region; the region is never resident.
 #pragma once
