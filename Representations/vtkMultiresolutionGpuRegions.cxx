@@ -257,6 +257,7 @@ std::size_t vtkMultiresolutionGpuRegions::Draw(
       if (part.shown && end > begin)
       {
         program->SetUniformi("faceKind", part.kind);
+        program->SetUniformi("sideOneLayer", part.oneLayer ? 1 : 0);
         glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(end - begin), GL_UNSIGNED_INT,
           reinterpret_cast<const void*>(std::size_t(begin - piece->first) * sizeof(uint32_t)));
         triangles += (end - begin) / 3;

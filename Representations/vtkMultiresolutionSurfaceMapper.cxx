@@ -824,6 +824,9 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
     state->vtkglDisable(GL_CULL_FACE);
   }
   state->vtkglDisable(GL_BLEND);
+  // A side triangle's flat attributes come from its last vertex (RegionDrawBuffers::indices),
+  // OpenGL's default, which vtkOpenGLState does not track.
+  glProvokingVertex(GL_LAST_VERTEX_CONVENTION);
 
   // Lit tops and bottoms take their normals from the table, once it is loaded: they are
   // drawn first with a program that computes no facet normal, then the sides with one that

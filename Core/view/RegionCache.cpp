@@ -341,15 +341,22 @@ void AddSideTriangles(const RegionMesh& mesh, const std::vector<std::array<uint3
     {
       CheckSideCell(mesh, { t0, t1, t2 }, columns, offset);
     }
-    const uint32_t first = static_cast<uint32_t>(out.vertices.size() / 6);
+    // The vertex of largest k goes last, the turn kept (RegionDrawBuffers::indices).
+    std::array<Vector, 3> cells{ t0, t1, t2 };
+    int last = 0;
     for (int v = 0; v < 3; ++v)
     {
-      Vector cell = Topological(mesh, t[v]);
       for (int a = 0; a < 3; ++a)
       {
-        cell[a] += offset[a];
+        cells[v][a] += offset[a];
       }
-      PushVertex(out, ZUp(mesh, t[v]), origin, cell);
+      last = cells[v][2] > cells[last][2] ? v : last;
+    }
+    const uint32_t first = static_cast<uint32_t>(out.vertices.size() / 6);
+    for (int n = 1; n <= 3; ++n)
+    {
+      const int v = (last + n) % 3;
+      PushVertex(out, ZUp(mesh, t[v]), origin, cells[v]);
     }
     out.indices.insert(out.indices.end(), { first, first + 1, first + 2 });
   }

@@ -75,8 +75,12 @@ namespace resmr
 
 struct RegionDrawBuffers
 {
-  std::vector<float> vertices;                                 ///< per vertex: x, y, z, ci, cj, ck
-  std::vector<uint32_t> indices;                               ///< triangles: top, bottom, side, coarse side
+  std::vector<float> vertices; ///< per vertex: x, y, z, ci, cj, ck
+  /// Triangles: top, bottom, side, coarse side. A side triangle has its own three vertices,
+  /// the one of largest k last: drawn, that vertex provokes the triangle's flat attributes, so
+  /// a fragment knows the lowest layer its triangle reaches. An edge-on sliver's interpolated
+  /// k strays past its interfaces, to a cell no face shows (and the hash does not hold).
+  std::vector<uint32_t> indices;
   uint32_t topIndices = 0, bottomIndices = 0, sideIndices = 0; ///< index counts of each part
   /// The file's simplified side (Sec. 4.3), after the exact one: far fewer triangles on models
   /// of many layers, within the region's error, but its layer boundaries are interpolated

@@ -114,7 +114,7 @@ std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers, const Draw
   const bool coarseSide = buffers.coarseSideIndices > 0 &&
     (DrawsSimplifiedSide(fileVersion, drawn.projectedError, view) || !buffers.exactSides);
   const uint32_t exactSide = buffers.topIndices + buffers.bottomIndices;
-  DrawPart side{ drawn.side, exactSide, buffers.sideIndices, 2 };
+  DrawPart side{ drawn.side, exactSide, buffers.sideIndices, 2, true };
   if (coarseSide)
   {
     side = DrawPart{ drawn.side, exactSide + buffers.sideIndices, buffers.coarseSideIndices, 2 };

@@ -85,6 +85,7 @@ struct DrawPart
   bool shown = false;
   uint32_t first = 0, count = 0;
   int kind = 0;
+  bool oneLayer = false; ///< a side whose triangles each span one layer (the exact side)
 };
 
 /// The top, bottom and side index runs of `buffers` for a region drawn as `drawn`. The whole

@@ -24,8 +24,10 @@
 
 in vec3 cellCoord;
 in vec3 viewPosition;
+flat in float lastK; // a side triangle's largest k
 
 uniform int faceKind;     // 0: top, 1: bottom, 2: side
+uniform int sideOneLayer; // on sides, 1: each triangle spans one layer (the exact side)
 uniform ivec3 gridDims;   // nx, ny, nz
 uniform ivec3 tableSides; // m
 uniform ivec3 offsetSides; // r
@@ -252,13 +254,19 @@ void AddAnyLight(vec3 normal, vec3 toEye, vec3 position, vec3 lightColor, vec3 d
 void main()
 {
   ivec3 cell = clamp(ivec3(floor(cellCoord)), ivec3(0), gridDims - 1);
+  // Side faces span their interfaces: seen edge-on they are slivers on screen, where the
+  // interpolated k strays past either interface. Their cell is in the layers the triangle
+  // reaches; top and bottom faces keep the k their vertices give.
 #if LAYER_VIEW
   if (faceKind == 2)
   {
-    // A layer's side faces span its interfaces, k to k + 1: seen edge-on they are slivers
-    // on screen, where interpolation strays past either interface. Their cell is in the
-    // layer; top and bottom faces keep the k their vertices give.
     cell.z = layer;
+  }
+#else
+  if (faceKind == 2)
+  {
+    int lowest = max(int(ceil(lastK)) - 1, 0);
+    cell.z = sideOneLayer == 1 ? lowest : min(cell.z, lowest);
   }
 #endif
 #if WALL_DEPTHS

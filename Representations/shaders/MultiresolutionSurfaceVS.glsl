@@ -16,6 +16,7 @@ uniform mat4 modelToView;
 out vec3 cellCoord;
 out vec3 viewPosition;
 out float modelDepth; // depth below the origin: the wall depth table's frame
+flat out float lastK; // a side triangle's largest k, from its last vertex (RegionCache)
 
 void main()
 {
@@ -23,4 +24,5 @@ void main()
   viewPosition = (modelToView * vec4(vertexPosition, 1.0)).xyz;
   cellCoord = cellCoordinate;
   modelDepth = -vertexPosition.z;
+  lastK = cellCoordinate.z;
 }

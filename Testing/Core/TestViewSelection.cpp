@@ -852,6 +852,23 @@ void TestCoarseSides(const std::string& path)
     const std::size_t vertexCount = buffers.vertices.size() / 6;
     for (std::size_t i = buffers.indices.size() - buffers.coarseSideIndices; i < buffers.indices.size(); ++i)
       CHECK(buffers.indices[i] < vertexCount);
+    // Every side triangle's last vertex has its largest k (the fragment stage's lowest layer
+    // reached); an exact side triangle spans one layer, the one above that vertex.
+    const std::size_t sides = buffers.topIndices + buffers.bottomIndices;
+    for (std::size_t t = sides; t + 3 <= buffers.indices.size(); t += 3)
+    {
+      float k[3];
+      for (int v = 0; v < 3; ++v)
+        k[v] = buffers.vertices[std::size_t(buffers.indices[t + v]) * 6 + 5];
+      CHECK(k[2] >= k[0] && k[2] >= k[1]);
+      if (t < sides + buffers.sideIndices)
+      {
+        const bool oneLayer = k[2] == std::floor(k[2]) && std::min(k[0], k[1]) == k[2] - 1;
+        if (!oneLayer)
+          std::printf("region %zu exact side triangle at k %g %g %g\n", r, k[0], k[1], k[2]);
+        CHECK(oneLayer);
+      }
+    }
     if (file.Regions()[r].level < file.Header().leafLevel)
     {
       exact += buffers.sideIndices;
