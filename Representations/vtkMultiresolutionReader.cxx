@@ -83,6 +83,7 @@ int vtkMultiresolutionReader::RequestInformation(
   try
   {
     const resmr::MultiresolutionFile geometry(this->FileName); // checks header, index and trailer
+    this->WarnOfUnreachableRegions(geometry);
     this->ResolvedPropertyFile = this->PropertyPathFor();
     this->PropertyFileStamp = FileStamp(this->ResolvedPropertyFile);
     if (this->ResolvedPropertyFile.empty())
@@ -244,6 +245,23 @@ std::size_t vtkMultiresolutionReader::StepIndex(double time) const
 int vtkMultiresolutionReader::GetStepNumber(double time) const
 {
   return this->StepNumbers.empty() ? 0 : this->StepNumbers[this->StepIndex(time)];
+}
+
+void vtkMultiresolutionReader::WarnOfUnreachableRegions(const resmr::MultiresolutionFile& geometry)
+{
+  const std::vector<std::size_t> unreachable = resmr::UnreachableRegions(geometry);
+  if (unreachable.empty())
+  {
+    return;
+  }
+  int64_t cells = 0;
+  for (std::size_t r : unreachable)
+  {
+    cells += geometry.Regions()[r].activeCells;
+  }
+  vtkWarningMacro(<< this->FileName << ": " << unreachable.size() << " region(s) of the hierarchy (" << cells
+                  << " active cells) have no parent region and are never drawn, so the view shows holes "
+                     "there; the file was built by an earlier resmr: build it again (resmr build)");
 }
 
 int vtkMultiresolutionReader::Fail(const std::string& message)

@@ -21,6 +21,11 @@
 #include <string>
 #include <vector>
 
+namespace resmr
+{
+class MultiresolutionFile;
+}
+
 class RESMRREPRESENTATIONS_EXPORT vtkMultiresolutionReader : public vtkPolyDataAlgorithm
 {
 public:
@@ -72,6 +77,8 @@ private:
   std::string PropertyPathFor() const;
   std::size_t StepIndex(double time) const;
   int Fail(const std::string& message);
+  /// A warning naming the regions no cut reaches (resmr::UnreachableRegions), if any.
+  void WarnOfUnreachableRegions(const resmr::MultiresolutionFile& geometry);
 
   std::string FileName;
   std::string PropertyFileName;

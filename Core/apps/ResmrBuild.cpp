@@ -324,6 +324,8 @@ int MultiresolutionInfo(const char* path, bool listRegions)
   {
     std::printf(",\n \"map_axes\": null");
   }
+  // Regions no cut reaches (built by an earlier version): holes in the view until rebuilt.
+  std::printf(",\n \"unreachable_regions\": %zu", resmr::UnreachableRegions(file).size());
   if (listRegions)
   {
     std::printf(",\n \"region_list\": [");

@@ -1126,6 +1126,25 @@ MultiresolutionFile::~MultiresolutionFile()
   CloseDescriptor(this->Descriptor);
 }
 
+std::vector<std::size_t> UnreachableRegions(const MultiresolutionFile& file)
+{
+  std::set<std::pair<int32_t, int64_t>> present;
+  for (const RegionRecord& r : file.Regions())
+  {
+    present.insert({ r.level, r.index });
+  }
+  std::vector<std::size_t> out;
+  for (std::size_t n = 0; n < file.Regions().size(); ++n)
+  {
+    const RegionRecord& r = file.Regions()[n];
+    if (r.level > 0 && !present.count({ r.level - 1, r.index / 2 }))
+    {
+      out.push_back(n);
+    }
+  }
+  return out;
+}
+
 const RegionRecord* MultiresolutionFile::Find(int32_t level, int64_t index) const
 {
   for (const RegionRecord& r : this->Records)

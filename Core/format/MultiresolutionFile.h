@@ -267,4 +267,10 @@ private:
   std::vector<ModelChunk> Model;
 };
 
+/// Regions (indices into Regions()) whose parent, (level - 1, index / 2), the file lacks: the
+/// view reaches a region only through its parent, so these and all below them are never drawn.
+/// Files built by earlier versions can hold a few (a triangle whose columns all went to its
+/// diamond partner); rebuilding the file removes them.
+std::vector<std::size_t> UnreachableRegions(const MultiresolutionFile& file);
+
 } // namespace resmr

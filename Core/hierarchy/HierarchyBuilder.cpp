@@ -922,10 +922,11 @@ private:
   };
   void BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns, std::vector<Emitted>& out);
   void BuildDiamond(const DiamondHierarchy::Diamond& diamond, std::vector<Emitted>& out);
-  std::vector<ScratchRegion> LoadChildren(const DiamondHierarchy::Diamond& diamond) const;
+  /// `owners`: for each child, the triangle of the diamond it is a child of (1: first, 2: second).
+  std::vector<ScratchRegion> LoadChildren(const DiamondHierarchy::Diamond& diamond, std::vector<uint8_t>& owners) const;
   void SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const ColumnMesh& mesh,
-    const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides, double weldError,
-    std::vector<Emitted>& out);
+    const std::vector<uint8_t>& origin, const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides,
+    double weldError, std::vector<Emitted>& out);
   /// Saves the region's scratch file (for the level above) and encodes it.
   void Prepare(int level, int64_t index, const ScratchRegion& region, bool keepScratch, std::vector<Emitted>& out);
   /// Appends a task's regions to the chunk file and records them; with `task` (a one-process
@@ -1359,10 +1360,12 @@ void Builder::BuildLeaf(int64_t leaf, const std::vector<int64_t>& columns, std::
 }
 
 /// The finished regions of a diamond's children (level + 1), read back from scratch.
-std::vector<ScratchRegion> Builder::LoadChildren(const DiamondHierarchy::Diamond& diamond) const
+std::vector<ScratchRegion> Builder::LoadChildren(
+  const DiamondHierarchy::Diamond& diamond, std::vector<uint8_t>& owners) const
 {
   const int childLevel = diamond.level + 1;
   std::vector<ScratchRegion> children;
+  owners.clear();
   for (int64_t triangle : { diamond.first, diamond.second })
   {
     if (triangle < 0)
@@ -1376,40 +1379,105 @@ std::vector<ScratchRegion> Builder::LoadChildren(const DiamondHierarchy::Diamond
       if (LoadRegion(path, region)) // removed once the level is finished (resuming needs it)
       {
         children.push_back(std::move(region));
+        owners.push_back(triangle == diamond.first ? 1 : 2);
       }
     }
   }
   return children;
 }
 
+/// Ours: split by column centre alone, a simplified diamond's columns can all fall on one side
+/// of its hypotenuse (the other triangle's collapsed into columns centred across it). That
+/// triangle would have no region, and the view, which reaches a region only through its
+/// parent, could never draw its children: a hole in every finer cut. So a triangle whose
+/// children hold columns (`origin`: per column slot, the triangle whose children it came
+/// from) takes back the columns that came from them, or else the column centred nearest its
+/// own centre, as long as the other triangle keeps one if it needs one. `side`: per slot, 0
+/// (not alive), 1 or 2.
+void KeepEveryTriangleFed(const std::vector<uint8_t>& origin, const std::vector<glm::dvec2>& centres,
+  const std::array<glm::dvec2, 2>& triangleCentres, std::vector<uint8_t>& side)
+{
+  std::array<int64_t, 3> count{ 0, 0, 0 };
+  std::array<bool, 3> fed{ false, false, false };
+  for (std::size_t c = 0; c < side.size(); ++c)
+  {
+    ++count[side[c]];
+    fed[origin[c]] = true;
+  }
+  for (uint8_t which : { uint8_t(1), uint8_t(2) })
+  {
+    const uint8_t other = static_cast<uint8_t>(3 - which);
+    if (count[which] > 0 || !fed[which])
+    {
+      continue;
+    }
+    const int64_t keep = fed[other] ? 1 : 0;
+    for (std::size_t c = 0; c < side.size() && count[other] > keep; ++c)
+    {
+      if (side[c] == other && origin[c] == which)
+      {
+        side[c] = which;
+        --count[other];
+        ++count[which];
+      }
+    }
+    std::size_t nearest = side.size();
+    for (std::size_t c = 0; c < side.size() && count[which] == 0 && count[other] > keep; ++c)
+    {
+      const auto distance = [&](std::size_t n) { return glm::length(centres[n] - triangleCentres[which - 1]); };
+      if (side[c] == other && (nearest == side.size() || distance(c) < distance(nearest)))
+      {
+        nearest = c;
+      }
+    }
+    if (nearest < side.size())
+    {
+      side[nearest] = which;
+      --count[other];
+      ++count[which];
+    }
+  }
+}
+
 /// Splits the simplified diamond along its hypotenuse by column centre and emits each
 /// triangle's region with the edges cut towards the other triangle and other diamonds.
 void Builder::SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const ColumnMesh& mesh,
-  const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides, double weldError,
-  std::vector<Emitted>& out)
+  const std::vector<uint8_t>& origin, const std::vector<uint8_t>& childCut, const std::vector<uint8_t>& openSides,
+  double weldError, std::vector<Emitted>& out)
 {
   const int32_t slots = mesh.ColumnSlots();
   const int32_t layers = mesh.Layers();
   const std::size_t interfaces = static_cast<std::size_t>(layers) + 1;
   const int triangles = diamond.second >= 0 ? 2 : 1;
   std::vector<uint8_t> side(static_cast<std::size_t>(slots), 0);
+  std::vector<glm::dvec2> centres(static_cast<std::size_t>(slots), glm::dvec2(0.0));
   for (int32_t c = 0; c < slots; ++c)
   {
     if (!mesh.IsColumnAlive(c))
     {
       continue;
     }
-    double x = 0, y = 0;
     for (int32_t node : mesh.ColumnCorners(c))
     {
       for (int32_t k : { 0, layers })
       {
         const glm::dvec3 p = mesh.Position(node, k);
-        x += p.x / 8;
-        y += p.y / 8;
+        centres[c] += glm::dvec2(p.x, p.y) / 8.0;
       }
     }
-    side[c] = this->Tree.OnFirstSide(diamond, x, y) ? 1 : 2;
+    side[c] = this->Tree.OnFirstSide(diamond, centres[c].x, centres[c].y) ? 1 : 2;
+  }
+  if (triangles == 2)
+  {
+    std::array<glm::dvec2, 2> triangleCentres;
+    for (int which = 0; which < 2; ++which)
+    {
+      const auto t = this->Tree.ModelTriangle(diamond.level, which == 0 ? diamond.first : diamond.second);
+      triangleCentres[which] = glm::dvec2(t.apex[0] + t.left[0] + t.right[0], t.apex[1] + t.left[1] + t.right[1]) / 3.0;
+    }
+    std::vector<uint8_t> from = origin;
+    from.resize(side.size(), 0); // columns made after the merge (none today) came from no child
+    KeepEveryTriangleFed(from, centres, triangleCentres, side);
   }
   const FaultSides faults(mesh);
   for (int which = 1; which <= triangles; ++which)
@@ -1456,17 +1524,29 @@ void Builder::SplitAndEmit(const DiamondHierarchy::Diamond& diamond, const Colum
 
 void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond, std::vector<Emitted>& out)
 {
-  const std::vector<ScratchRegion> children = this->LoadChildren(diamond);
+  std::vector<uint8_t> owners;
+  const std::vector<ScratchRegion> children = this->LoadChildren(diamond, owners);
   if (children.empty())
   {
     return;
   }
+  // Per column slot of the merged mesh (the children's columns in order), the triangle whose
+  // children it came from.
+  std::vector<uint8_t> origin;
+  for (std::size_t n = 0; n < children.size(); ++n)
+  {
+    origin.insert(origin.end(), children[n].mesh.corners.size(), owners[n]);
+  }
+  const bool bothFed = std::find(owners.begin(), owners.end(), 1) != owners.end() &&
+    std::find(owners.begin(), owners.end(), 2) != owners.end();
   std::vector<uint8_t> childCut, openSides;
   int64_t inputColumns = 0;
   ColumnMesh mesh = MergeRegions(children, childCut, openSides, inputColumns);
   LockCutColumns(mesh, childCut);
   const int triangles = diamond.second >= 0 ? 2 : 1;
-  const int64_t target = std::min<int64_t>(this->Options.cmax * triangles, (inputColumns + 1) / 2);
+  // At least a column for each triangle whose children have some (KeepEveryTriangleFed).
+  const int64_t target =
+    std::max<int64_t>(std::min<int64_t>(this->Options.cmax * triangles, (inputColumns + 1) / 2), bothFed ? 2 : 1);
   // Faults too long to keep whole here weld instead of parting (FaultWelding.h).
   double weldError = 0;
   const int64_t faultColumns =
@@ -1485,7 +1565,7 @@ void Builder::BuildDiamond(const DiamondHierarchy::Diamond& diamond, std::vector
   }
   // Cut edges left are on the diamond's boundary, where columns are locked and unchanged.
   UpdateOpenSides(mesh, childCut, openSides);
-  this->SplitAndEmit(diamond, mesh, childCut, openSides, weldError, out);
+  this->SplitAndEmit(diamond, mesh, origin, childCut, openSides, weldError, out);
   this->WorkDone += inputColumns;
   this->Report(this->Phase, this->WorkStart + this->WorkSpan * static_cast<double>(this->WorkDone) / this->WorkTotal);
 }

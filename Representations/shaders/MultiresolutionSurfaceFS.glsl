@@ -282,7 +282,9 @@ void main()
 #endif
 #if COLOR_MODE == 2
   {
-    int id = cell.x + gridDims.x * (cell.y + gridDims.y * cell.z) + 1;
+    // 1 + the natural index, in 24 bits: past 2^24 - 1 cells it wraps to 1, never to the
+    // background's 0 (a cell painted black reads as a hole).
+    int id = (cell.x + gridDims.x * (cell.y + gridDims.y * cell.z)) % 16777215 + 1;
     gl_FragData[0] = vec4(float(id & 255), float((id >> 8) & 255), float((id >> 16) & 255), 255.0) / 255.0;
   }
 #else
