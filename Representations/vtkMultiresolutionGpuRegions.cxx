@@ -6,6 +6,7 @@
 
 #include "vtkNew.h"
 #include "vtkOpenGLBufferObject.h"
+#include "vtkOpenGLState.h"
 #include "vtkOpenGLVertexArrayObject.h"
 #include "vtkShaderProgram.h"
 #include "vtk_glew.h"
@@ -241,8 +242,8 @@ const resmr::RegionDrawBuffers* vtkMultiresolutionGpuRegions::Prepare(
   return gpu.Buffers.get();
 }
 
-std::size_t vtkMultiresolutionGpuRegions::Draw(
-  std::size_t region, const std::array<resmr::DrawPart, 3>& parts, vtkShaderProgram* program)
+std::size_t vtkMultiresolutionGpuRegions::Draw(std::size_t region, const std::array<resmr::DrawPart, 3>& parts,
+  vtkShaderProgram* program, vtkOpenGLState* state, bool cull)
 {
   std::size_t triangles = 0;
   for (const auto& piece : this->Regions.at(region)->Pieces)
@@ -256,6 +257,14 @@ std::size_t vtkMultiresolutionGpuRegions::Draw(
       const uint32_t end = std::min(part.first + part.count, piece->first + piece->count);
       if (part.shown && end > begin)
       {
+        if (cull && part.cullBackFaces)
+        {
+          state->vtkglEnable(GL_CULL_FACE);
+        }
+        else
+        {
+          state->vtkglDisable(GL_CULL_FACE);
+        }
         program->SetUniformi("faceKind", part.kind);
         program->SetUniformi("sideOneLayer", part.oneLayer ? 1 : 0);
         glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(end - begin), GL_UNSIGNED_INT,

@@ -16,6 +16,7 @@
 #include <memory>
 #include <vector>
 
+class vtkOpenGLState;
 class vtkShaderProgram;
 
 namespace resmr
@@ -52,9 +53,11 @@ public:
   /// unfinished; null when the cache no longer has it.
   const resmr::RegionDrawBuffers* Prepare(
     std::size_t region, const resmr::RegionCache& cache, vtkShaderProgram* program);
-  /// Draws the shown parts of a Prepare'd region piece by piece, setting `faceKind` for each;
+  /// Draws the shown parts of a Prepare'd region piece by piece, setting `faceKind` for each,
+  /// with back faces culled where `cull` and the part allows it (DrawPart::cullBackFaces);
   /// the triangles drawn.
-  std::size_t Draw(std::size_t region, const std::array<resmr::DrawPart, 3>& parts, vtkShaderProgram* program);
+  std::size_t Draw(std::size_t region, const std::array<resmr::DrawPart, 3>& parts, vtkShaderProgram* program,
+    vtkOpenGLState* state, bool cull);
 
   /// Frees every GL buffer.
   void ReleaseGraphicsResources();

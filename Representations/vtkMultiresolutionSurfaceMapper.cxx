@@ -230,6 +230,7 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   int colorMode = SolidColor;
   bool lit = false;            ///< the last program readied lights the surface
   bool clockwiseFront = false; ///< glFrontFace is GL_CW (a mirroring transform, back faces culled)
+  bool cullBackFaces = false;  ///< back faces may be culled this frame (ViewSelection::backFacesHidden, no layer)
 };
 
 vtkMultiresolutionSurfaceMapper::vtkMultiresolutionSurfaceMapper()
@@ -810,10 +811,11 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
   state->vtkglEnable(GL_DEPTH_TEST);
   state->vtkglDepthMask(GL_TRUE);
   // Back faces of the closed surface, hidden from outside, are culled (the bottom seen from
-  // above is about a third of the triangles); a mirroring transform turns the winding.
-  if (frame.selection.backFacesHidden && frame.layer < 0)
+  // above is about a third of the triangles), part by part (DrawPart::cullBackFaces); a
+  // mirroring transform turns the winding.
+  frame.cullBackFaces = frame.selection.backFacesHidden && frame.layer < 0;
+  if (frame.cullBackFaces)
   {
-    state->vtkglEnable(GL_CULL_FACE);
     state->vtkglCullFace(GL_BACK);
     // Restored after drawing (vtkOpenGLState does not track it).
     frame.clockwiseFront = resmr::LinearDeterminant(frame.modelToWorld) < 0;
@@ -891,7 +893,8 @@ int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bo
     // A leaf's sides are the original faces: their coordinates name the layer exactly.
     const bool leaf = in.File->Regions()[drawn.region].level == in.File->Header().leafLevel;
     frame.program->SetUniformi("wallLookup", leaf ? 0 : 1);
-    in.Triangles += static_cast<vtkIdType>(in.Regions.Draw(drawn.region, parts, frame.program));
+    in.Triangles += static_cast<vtkIdType>(
+      in.Regions.Draw(drawn.region, parts, frame.program, frame.window->GetState(), frame.cullBackFaces));
     ++regions;
   }
   return regions;

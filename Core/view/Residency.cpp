@@ -119,8 +119,13 @@ std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers, const Draw
   {
     side = DrawPart{ drawn.side, exactSide + buffers.sideIndices, buffers.coarseSideIndices, 2 };
   }
-  return { DrawPart{ top, 0, buffers.topIndices, 0 }, DrawPart{ bottom, buffers.topIndices, buffers.bottomIndices, 1 },
-    side };
+  // Parallel views look from below when their direction points up.
+  const bool eyeBelow = view.parallel ? view.direction[2] > 0 : view.eye[2] < -static_cast<double>(region.bounds[5]);
+  const bool eyeAbove = view.parallel ? view.direction[2] < 0 : view.eye[2] > -static_cast<double>(region.bounds[2]);
+  DrawPart topPart{ top, 0, buffers.topIndices, 0 }, bottomPart{ bottom, buffers.topIndices, buffers.bottomIndices, 1 };
+  topPart.cullBackFaces = eyeBelow;
+  bottomPart.cullBackFaces = eyeAbove;
+  return { topPart, bottomPart, side };
 }
 
 } // namespace resmr

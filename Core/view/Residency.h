@@ -86,6 +86,9 @@ struct DrawPart
   uint32_t first = 0, count = 0;
   int kind = 0;
   bool oneLayer = false; ///< a side whose triangles each span one layer (the exact side)
+  /// Whether the renderer may cull the run's back faces, where it culls at all (the eye
+  /// outside the model: ViewSelection::backFacesHidden); see PartsToDraw.
+  bool cullBackFaces = true;
 };
 
 /// The top, bottom and side index runs of `buffers` for a region drawn as `drawn`. The whole
@@ -94,6 +97,12 @@ struct DrawPart
 /// where DrawsSimplifiedSide says so (a file of `fileVersion`), when the region has one: on
 /// models of many layers the exact side is most of the triangles. Buffers loaded without
 /// their exact side draw the simplified one whatever the error.
+/// The top seen from above (the eye not below the region's box) and the bottom seen from
+/// below keep their back faces (cullBackFaces false): nearly every triangle of them faces the
+/// eye, and those that do not are folds of the visible sheet seen edge-on, where a rasterizer
+/// that decides a triangle's facing before snapping it to its sub-pixel grid (llvmpipe) can
+/// cull a sliver its neighbours left the only cover of a sample: a pin-hole. The sides and the
+/// surface facing away, most of the back faces, may be culled.
 std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers, const DrawnRegion& drawn, bool layerView,
   const RegionRecord& region, const ViewParameters& view, uint32_t fileVersion);
 

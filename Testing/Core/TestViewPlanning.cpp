@@ -335,6 +335,21 @@ void TestResidency()
   below.eye = { 0.5, 0.5, -10 };
   parts = PartsToDraw(buffers, drawn, true, box, below, now);
   CHECK(!parts[0].shown);
+  // Back faces: the top seen from above and the bottom seen from below keep theirs (folds of
+  // the visible sheet, seen edge-on); the sides and the surface facing away may lose them.
+  parts = PartsToDraw(buffers, drawn, false, box, above, now);
+  CHECK(!parts[0].cullBackFaces && parts[1].cullBackFaces && parts[2].cullBackFaces);
+  parts = PartsToDraw(buffers, drawn, false, box, below, now);
+  CHECK(parts[0].cullBackFaces && !parts[1].cullBackFaces && parts[2].cullBackFaces);
+  ViewParameters level; // the eye level with the box: neither surface faces away as a whole
+  level.eye = { 5, 0.5, -0.5 };
+  parts = PartsToDraw(buffers, drawn, false, box, level, now);
+  CHECK(!parts[0].cullBackFaces && !parts[1].cullBackFaces && parts[2].cullBackFaces);
+  ViewParameters up; // parallel, looking up
+  up.parallel = true;
+  up.direction = { 0, 0, 1 };
+  parts = PartsToDraw(buffers, drawn, false, box, up, now);
+  CHECK(parts[0].cullBackFaces && !parts[1].cullBackFaces);
 }
 
 int Run(const std::string& command)

@@ -66,24 +66,35 @@ def _dilate(mask):
     return out
 
 
-def hole_mask(got, exact):
+def _within(mask, reach):
+    """Pixels within `reach` pixels (a square) of `mask`."""
+    out = mask.copy()
+    for dy in range(-reach, reach + 1):
+        for dx in range(-reach, reach + 1):
+            out |= _shifted(mask, dy, dx, False)
+    return out
+
+
+def hole_mask(got, exact, reach=1):
     """Background pixels of `got` that no background of the exact image reaches through
-    `got`'s background (4-connected): gaps in the surface one sees through, not a silhouette
-    drawn a little inside the exact one."""
+    `got`'s background: gaps in the surface one sees through, not a silhouette drawn a little
+    inside the exact one. The reach steps 4-connected (`reach` 1), or up to `reach` pixels (a
+    square): a background wedge thinner than a pixel, where the coarse outline of a real gap
+    strays past the exact one, samples as pixels that far apart."""
     open_ = got == 0
     reached = open_ & (exact == 0)
     while True:
-        grown = _dilate(reached) & open_
+        grown = (_dilate(reached) if reach == 1 else _within(reached, reach)) & open_
         if np.array_equal(grown, reached):
             break
         reached = grown
     return open_ & ~reached
 
 
-def see_through_holes(got, exact):
+def see_through_holes(got, exact, reach=1):
     """The pixels of hole_mask (see-through gaps) and the deepest: the largest distance in
     pixels from a hole pixel to the hole's edge."""
-    holes = hole_mask(got, exact)
+    holes = hole_mask(got, exact, reach)
     count = int(holes.sum())
     depth = 0
     remaining = holes
@@ -128,9 +139,9 @@ def nan_pixels(rgb, nan_color):
     return int(np.sum(np.all(rgb == target, axis=-1)))
 
 
-def compare(got, exact):
-    """All of the above for one frame: a dict."""
-    holes, deepest = see_through_holes(got, exact)
+def compare(got, exact, hole_reach=1):
+    """All of the above for one frame: a dict (holes as see_through_holes with `hole_reach`)."""
+    holes, deepest = see_through_holes(got, exact, hole_reach)
     return {"cell_agreement": cell_agreement(got, exact), "within_2px": within_pixels(got, exact, 2),
             "hole_pixels": holes, "hole_depth_px": deepest,
             "silhouette_px": silhouette_distance(got, exact)}

@@ -165,11 +165,23 @@ def drawn_pixels(view):
     return pixels.reshape(height, width, 3)
 
 
+def keep_whole_depth(view):
+    """Stops the view's corner renderers (the orientation axes') from drawing: hidden or not,
+    they clear the depth of their corner, where drawn_covered could then go by colour alone.
+    For measuring views only."""
+    renderers = view.GetRenderWindow().GetRenderers()
+    renderers.InitTraversal()
+    for _ in range(renderers.GetNumberOfItems()):
+        renderer = renderers.GetNextItem()
+        if renderer.GetLayer() > 0 and renderer.GetErase() and tuple(renderer.GetViewport()) != (0.0, 0.0, 1.0, 1.0):
+            renderer.DrawOff()
+
+
 def drawn_covered(view, background):
     """The pixels the view's last frame covered, without rendering it again, (height, width)
     bool: those not in the `background` colour (RGB 0-255) or nearer than the far plane. The
     colour alone cannot tell (a lit surface may take the background's exact colour), nor the
-    depth alone (the orientation axes' corner clears it)."""
+    depth alone where a corner renderer cleared it (keep_whole_depth stops that)."""
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
     grab = vtkWindowToImageFilter()
