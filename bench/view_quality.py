@@ -177,10 +177,13 @@ def report_lines(models, out_name):
              "resolution, whose samples show every cell thinner than a pixel (a pixel is not missed when its cell is "
              "within 2 px of it there, and one of the exact cells under it is within 2 px in the frame; the 1x exact "
              "frame, its centre samples, scores 100% by it, and a third of a pixel aside 100% too, where it scores under "
-             "20% by the 1x measure on the 100M model seen whole); holes are background pixels no background of the exact image reaches "
-             "(see-through gaps); NaN pixels are painted in the lookup table's NaN colour. 'As drawn': the same holes in "
-             "the frame the user saw on the path (meshes still loading stood in for by coarser ones, a moving frame's "
-             "reduced resolution).", "",
+             "20% by the 1x measure on the 100M model seen whole); holes are background pixels the exact image's background "
+             f"does not reach through the frame's background in steps of up to {HOLE_REACH} px (see-through gaps; the "
+             "steps cross a wedge thinner than a pixel where a coarse outline of a real gap strays past the exact one); "
+             "NaN pixels are painted in the lookup table's NaN colour. 'As drawn': the same holes in the frame the user "
+             "saw on the path (meshes still loading stood in for by coarser ones, a moving frame's reduced resolution), a "
+             "pixel uncovered where its depth is the far plane's and its colour the background's (the view's corner "
+             "renderers kept from clearing the depth).", "",
              "| model | load | samples | tolerance p50 / p90 px | estimated error p50 / p90 px | within 2 px: min / p10 / p50 | frames >= 95% | "
              "of the 3x frame: min / p50, frames >= 95% | same cell p50 / min | frames with holes | largest hole px (depth) | as drawn: frames with holes | "
              "as drawn: largest hole px (depth) | NaN px max | silhouette px max |",
