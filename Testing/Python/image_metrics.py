@@ -123,12 +123,7 @@ def silhouette_distance(got, exact, limit=256):
         grown, steps = target.copy(), 0
         while (source & ~grown).any() and steps < limit:
             steps += 1
-            stepped = _dilate(grown)
-            stepped[1:, 1:] |= grown[:-1, :-1]
-            stepped[1:, :-1] |= grown[:-1, 1:]
-            stepped[:-1, 1:] |= grown[1:, :-1]
-            stepped[:-1, :-1] |= grown[1:, 1:]
-            grown = stepped
+            grown = _within(grown, 1)
         worst = max(worst, steps)
     return worst
 
