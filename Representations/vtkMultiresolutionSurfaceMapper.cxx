@@ -610,7 +610,16 @@ void vtkMultiresolutionSurfaceMapper::SelectRegions(Frame& frame)
   resmr::RegionCache& cache = *in.Cache;
   // Select, and ask for what is missing and what the next frame will probably want.
   const auto resident = [&cache](std::size_t region) { return cache.IsResident(region); };
-  frame.selection = in.Selector->Select(frame.view, resident);
+  if (frame.controlled)
+  {
+    // Refined before it is drawn when the cut, once loaded, would be past the quality floor.
+    frame.selection = resmr::SelectWithinFloor(*in.Selector, in.Controller, frame.view, resident);
+    in.Tolerance = frame.view.tolerancePixels;
+  }
+  else
+  {
+    frame.selection = in.Selector->Select(frame.view, resident);
+  }
   // Regions whose error shows draw their simplified side: their exact one is not loaded.
   std::vector<std::size_t> predicted, simplified;
   if (in.HavePreviousView)

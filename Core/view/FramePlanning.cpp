@@ -59,6 +59,27 @@ double ControllerStartTolerance(double pixelTolerance)
   return std::max(pixelTolerance, ControllerStartPixels);
 }
 
+ViewSelection SelectWithinFloor(const ViewSelector& selector, FrameRateController& controller, ViewParameters& view,
+  const std::function<bool(std::size_t)>& resident)
+{
+  ViewSelection selection = selector.Select(view, resident);
+  for (int pass = 0; pass < FloorPasses; ++pass)
+  {
+    CutRange ideal;
+    ideal.refineBelow = selection.ideal.refineBelowPixels;
+    ideal.bound = selection.ideal.largestProjectedError;
+    ideal.estimate = selection.ideal.estimatedErrorPixels;
+    const double tolerance = controller.HoldEstimateFloor(ideal);
+    if (!(tolerance < view.tolerancePixels))
+    {
+      break;
+    }
+    view.tolerancePixels = tolerance;
+    selection = selector.Select(view, resident);
+  }
+  return selection;
+}
+
 double MeasuredFrameMs(
   double frameMs, double rendererMs, double intervalMs, double targetFramesPerSecond, bool afterAllocation)
 {

@@ -6,8 +6,10 @@
 // frame-rate controller is told.
 #pragma once
 
+#include "FrameRateController.h"
 #include "RegionCache.h"
 #include "UploadPacer.h"
+#include "ViewSelection.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -69,6 +71,16 @@ bool MayCopyPiece(bool bounded, bool root, const UploadPacer& pacer, std::size_t
 constexpr double ControllerStartPixels = 64.0;
 /// The controller's starting tolerance for a user tolerance of `pixelTolerance`.
 double ControllerStartTolerance(double pixelTolerance);
+
+/// Most selections of one frame held within the estimated-error floor (SelectWithinFloor).
+constexpr int FloorPasses = 3;
+/// Selects a moving frame under a target frame rate (ours): while the ideal cut at the view's
+/// tolerance (the controller's) is past the controller's estimated-error floor, the controller
+/// lowers the tolerance (FrameRateController::HoldEstimateFloor) and the view is selected
+/// again, FloorPasses times at most, since the estimate follows the bound only roughly.
+/// `view.tolerancePixels` becomes the tolerance selected at.
+ViewSelection SelectWithinFloor(const ViewSelector& selector, FrameRateController& controller, ViewParameters& view,
+  const std::function<bool(std::size_t)>& resident);
 
 /// The frame time (ms) the frame-rate controller is told. The whole frame is what the user
 /// waits for: the frame's own time (`frameMs`), the renderer's time for it (`rendererMs`) and,

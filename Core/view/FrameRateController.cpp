@@ -97,21 +97,34 @@ double FrameRateController::Update(double frameSeconds, bool complete, const Cut
 double FrameRateController::RefineToEstimateFloor(const CutRange& same, double ratio, bool moving)
 {
   // Past the estimated-error floor (the view came closer to what this cut simplified, or a
-  // step coarsened more than the estimate's proportion foretold): refine, and coarsen no more
-  // up to where the last cut within the floor began to change.
-  this->EstimateBlock =
-    this->LastGoodCoarsenAt > 0 && this->LastGoodCoarsenAt <= this->Pixels ? this->LastGoodCoarsenAt : this->Pixels;
-  this->LastGoodCoarsenAt = 0;
-  const double limit = this->EstimateLimit(same);
-  const double from = same.refineBelow < this->Pixels && same.refineBelow > 0 ? same.refineBelow : this->Pixels;
-  this->Pixels =
-    std::clamp(std::max(std::min(from, limit), this->Pixels * MaxRefineStep), MinimumPixels, this->Ceiling);
+  // step coarsened more than the estimate's proportion foretold): refine.
+  this->Pixels = this->FloorTolerance(same, MaxRefineStep);
   if (ratio > HighFraction && moving)
   {
     // Slow as well: the pixels pay for the detail the floor wants.
     this->RenderScale = std::max(this->Floor, this->RenderScale / std::min(4.0, std::sqrt(ratio / AimFraction)));
   }
   return this->Pixels;
+}
+
+double FrameRateController::HoldEstimateFloor(const CutRange& ideal)
+{
+  if (ideal.estimate > this->EstimateCeiling && this->Pixels > MinimumPixels)
+  {
+    this->Pixels = this->FloorTolerance(ideal, 0);
+  }
+  return this->Pixels;
+}
+
+double FrameRateController::FloorTolerance(const CutRange& cut, double step)
+{
+  // Coarsen no more up to where the last cut within the floor began to change.
+  this->EstimateBlock =
+    this->LastGoodCoarsenAt > 0 && this->LastGoodCoarsenAt <= this->Pixels ? this->LastGoodCoarsenAt : this->Pixels;
+  this->LastGoodCoarsenAt = 0;
+  const double limit = this->EstimateLimit(cut);
+  const double from = cut.refineBelow < this->Pixels && cut.refineBelow > 0 ? cut.refineBelow : this->Pixels;
+  return std::clamp(std::max(std::min(from, limit), this->Pixels * step), MinimumPixels, this->Ceiling);
 }
 
 double FrameRateController::Coarsen(double factor, const CutRange& same)

@@ -51,6 +51,12 @@
 //   frames flipped between the two cuts every other frame. The block rises by BlockRelease a
 //   frame, as the view moves on. Ceiling still holds, so the bound limits what an estimate can
 //   let through.
+// - The floor before the frame (ours): HoldEstimateFloor takes the frame's ideal cut (what it
+//   will draw once its wanted meshes are in, ViewSelection::ideal) before it is drawn, and
+//   refines past the floor at once, with no quarter-a-frame limit, since the view is the one
+//   about to be drawn. Without it a frame still loading kept its tolerance, so while a large
+//   model's first meshes came in (seconds) the loader fetched a cut already known to be too
+//   coarse, and the controller's starting tolerance stayed what the frames were drawn at.
 #pragma once
 
 #include <limits>
@@ -109,11 +115,17 @@ public:
   /// the detail the tolerance selected, the tolerances that draw the same cut, and whether the
   /// camera moved since the frame before (only moving frames change the scale).
   double Update(double frameSeconds, bool complete = true, const CutRange& same = CutRange(), bool moving = false);
+  /// The tolerance for the frame about to be drawn, given its ideal cut at the current one
+  /// (see the contract): lower when that cut's estimate is past the floor, else unchanged.
+  double HoldEstimateFloor(const CutRange& ideal);
 
 private:
   double Coarsen(double factor, const CutRange& same);
   /// A complete frame past the estimated-error floor: refine to it, whatever the frame's time.
   double RefineToEstimateFloor(const CutRange& same, double ratio, bool moving);
+  /// The tolerance within the estimated-error floor from `cut`, lowering by at most the factor
+  /// `step` (0: no limit); blocks coarsening back to the cut that broke it.
+  double FloorTolerance(const CutRange& cut, double step);
   /// The largest tolerance the estimated-error floor allows, from the frame's cut.
   double EstimateLimit(const CutRange& same) const;
   double Refine(double factor, const CutRange& same);

@@ -13,6 +13,7 @@ void UploadPacer::BeginFrame(double budgetMs, std::size_t byteCap)
   this->ByteCap = byteCap;
   this->FrameMs = 0;
   this->FrameBytes = 0;
+  this->CopiedBytes = 0;
 }
 
 void UploadPacer::Spend(std::size_t bytes, double ms)
@@ -23,7 +24,7 @@ void UploadPacer::Spend(std::size_t bytes, double ms)
 
 bool UploadPacer::Admit(std::size_t bytes) const
 {
-  if (this->FrameBytes == 0)
+  if (this->CopiedBytes == 0)
   {
     return true;
   }
@@ -34,6 +35,7 @@ bool UploadPacer::Admit(std::size_t bytes) const
 void UploadPacer::Record(std::size_t bytes, double ms)
 {
   this->Spend(bytes, ms);
+  this->CopiedBytes += bytes;
   if (bytes < SmallestTimedBytes || !std::isfinite(ms) || ms < 0)
   {
     return;

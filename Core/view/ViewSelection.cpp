@@ -194,6 +194,20 @@ struct Visit
 };
 
 /// What the traversal leaves: the regions it shows and the regions it split.
+/// The regions' estimated errors, weighted by the share of the view each one's box covers.
+double WeightedEstimate(
+  const std::vector<RegionRecord>& regions, const std::vector<std::size_t>& shown, const ViewParameters& view)
+{
+  double estimateSum = 0, shareSum = 0;
+  for (std::size_t r : shown)
+  {
+    const double share = ScreenShare(Corners(regions[r]), view.worldToClip);
+    estimateSum += share * EstimatedError(regions[r], view);
+    shareSum += share;
+  }
+  return shareSum > 0 ? estimateSum / shareSum : 0;
+}
+
 struct Traversal
 {
   std::vector<std::size_t> shown;
@@ -455,6 +469,9 @@ ViewSelection ViewSelector::Select(const ViewParameters& view, const std::functi
     }
   }
   selection.estimatedErrorPixels = shareSum > 0 ? estimateSum / shareSum : 0;
+  selection.ideal.largestProjectedError = ideal.largest;
+  selection.ideal.refineBelowPixels = ideal.refineBelow;
+  selection.ideal.estimatedErrorPixels = WeightedEstimate(regions, ideal.shown, view);
   // The loading order: the ideal cut and its ancestors, level by level, nearest first.
   for (const auto& level : ideal.visibleByLevel)
   {

@@ -28,6 +28,9 @@
 // - `drawn` is ordered nearest first, so early depth rejection spares hidden fragments.
 // - `wanted` lists the regions of the ideal cut (as if everything were resident) and the
 //   ancestors leading to them, coarse before fine and near before far: the loading order.
+// - `ideal` (ours): the figures below of that ideal cut, what the frame will show once its
+//   wanted meshes are in; a frame still loading can tell from them whether its tolerance is
+//   fine enough.
 #pragma once
 
 #include "MultiresolutionFile.h"
@@ -83,6 +86,14 @@ struct ViewSelection
   double coarsenAtPixels = std::numeric_limits<double>::infinity();
   /// Drawn regions standing in for wanted descendants that are not resident.
   std::size_t substituted = 0;
+  /// The same figures of the ideal cut (every region resident): largest projected error,
+  /// estimated error and refineBelowPixels.
+  struct Ideal
+  {
+    double largestProjectedError = 0;
+    double estimatedErrorPixels = 0;
+    double refineBelowPixels = 0;
+  } ideal;
   /// The model's surface is closed and faces outward, so seen from outside its back faces are
   /// hidden and the renderer may cull them: true when the eye (perspective) is farther from the
   /// box of every region than twice the near plane (which then cuts no part of the model at

@@ -568,8 +568,52 @@ void TestFallback(const Model& model)
       loaded.insert(r);
   }
   CHECK(frames <= 2);
+  // A frame drawing stand-ins tells what its ideal cut will show: the figures of the frame
+  // with everything resident.
+  CHECK(std::abs(selection.ideal.estimatedErrorPixels - ideal.estimatedErrorPixels) <=
+    1e-9 * std::max(1.0, ideal.estimatedErrorPixels));
+  CHECK(selection.ideal.largestProjectedError == ideal.largestProjectedError);
+  CHECK(selection.ideal.refineBelowPixels == ideal.refineBelowPixels);
+  CHECK(ideal.ideal.largestProjectedError == ideal.largestProjectedError);
+  CHECK(selection.estimatedErrorPixels > ideal.estimatedErrorPixels);
   std::printf("  fallback: roots drawn for %zu wanted, ideal cut %zu after %d frames\n", selection.wanted.size(),
     ideal.drawn.size(), frames);
+}
+
+/// A moving frame selected within the estimated-error floor: from the controller's coarse
+/// start, with only the roots resident, one selection puts the ideal cut within the floor.
+void TestSelectWithinFloor(const Model& model)
+{
+  const auto onlyRoots = [&](std::size_t r) { return model.file->Regions()[r].level == 0; };
+  const Vec eye{ model.centre[0] + model.radius, model.centre[1], model.high[2] + 0.5 * model.radius };
+  const ViewParameters start = Perspective(eye, model.centre, { 0, 0, 1 }, 30, 1, 10 * model.radius, 64);
+  const ViewSelection coarse = model.selector->Select(start, onlyRoots);
+  const double floor = coarse.ideal.estimatedErrorPixels / 4;
+  if (!(floor > 0))
+  {
+    return; // nothing simplified in view
+  }
+  FrameRateController controller;
+  controller.SetTargetFramesPerSecond(10);
+  controller.SetMaximumEstimatedPixels(floor);
+  controller.Reset(64);
+  ViewParameters view = start;
+  const ViewSelection held = SelectWithinFloor(*model.selector, controller, view, onlyRoots);
+  CHECK(view.tolerancePixels < 64 && view.tolerancePixels == controller.Tolerance());
+  CHECK(held.ideal.estimatedErrorPixels <= floor || view.tolerancePixels == FrameRateController::MinimumPixels);
+  // The frame draws what is resident either way; what it wants is finer.
+  CHECK(DrawnSet(held) == DrawnSet(coarse));
+  CHECK(held.wanted.size() > coarse.wanted.size());
+  // Within the floor (or without one) the tolerance stays.
+  FrameRateController loose;
+  loose.SetTargetFramesPerSecond(10);
+  loose.SetMaximumEstimatedPixels(2 * coarse.ideal.estimatedErrorPixels);
+  loose.Reset(64);
+  ViewParameters same = start;
+  CHECK(SelectWithinFloor(*model.selector, loose, same, onlyRoots).wanted == coarse.wanted);
+  CHECK(same.tolerancePixels == 64 && loose.Tolerance() == 64);
+  std::printf("  within the floor: %.2f px estimated at 64 px, floor %.2f px: %.2f px at %.2f px\n",
+    coarse.ideal.estimatedErrorPixels, floor, held.ideal.estimatedErrorPixels, view.tolerancePixels);
 }
 
 /// Back faces may be culled only from outside the model, with the near plane clear of it.
@@ -1755,6 +1799,13 @@ void TestEstimateSteering()
     steer.Reset(16);
     steer.Update(0.3, false, cut(0.5), true);
     CHECK(steer.Tolerance() >= 16);
+    // Before a frame is drawn its ideal cut refines it at once, past the quarter a frame
+    // (64 to 12.8 px, the aim).
+    steer.Reset(64);
+    steer.HoldEstimateFloor(cut(0.125));
+    CHECK(std::abs(steer.Tolerance() - 12.8) < 1e-9);
+    steer.Reset(64);
+    CHECK(steer.HoldEstimateFloor(cut(0.025)) == 64); // 1.6 px: within the floor
     steer.SetMaximumPixels(12);
     steer.Reset(1);
     for (int f = 0; f < 100; ++f)
@@ -1800,17 +1851,23 @@ void TestUploadPacer()
   }
   CHECK(pacer.MsPerMB() < 0.2);
   CHECK(pacer.Admit(7 * MB) && !pacer.Admit(7 * MB + 1));
-  // Work already charged to the frame (the model's tables) counts against both bounds, and a
-  // frame that spent its time admits nothing more; tiny copies and bad timings teach nothing.
+  // Work already charged to the frame (the model's tables) counts against both bounds, but
+  // the frame's first mesh still goes, however slow the estimate (else nothing would teach it
+  // otherwise while the tables stream); after it, a frame that spent its time admits nothing
+  // more. Tiny copies and bad timings teach nothing.
   pacer.BeginFrame(10, 8 * MB);
   pacer.Spend(4 * MB, 9.95);
-  CHECK(!pacer.Admit(1 * MB) && !pacer.Admit(5 * MB));
+  CHECK(pacer.Admit(1 * MB));
+  pacer.BeginFrame(10, 8 * MB);
+  pacer.Spend(4 * MB, 9.95);
+  pacer.Record(2 * MB, 0.5);
+  CHECK(!pacer.Admit(MB / 8) && !pacer.Admit(2 * MB));
   const double before = pacer.MsPerMB();
   pacer.Record(1024, 500);
   pacer.Record(2 * MB, std::numeric_limits<double>::quiet_NaN());
   pacer.Record(2 * MB, -1);
   CHECK(pacer.MsPerMB() == before);
-  CHECK(pacer.SpentBytes() == 4 * MB + 1024 + 4 * MB);
+  CHECK(pacer.SpentBytes() == 4 * MB + 2 * MB + 1024 + 4 * MB);
   // A new frame starts a new account: its first mesh goes again.
   pacer.BeginFrame(10, 8 * MB);
   CHECK(pacer.SpentBytes() == 0 && pacer.SpentMs() == 0 && pacer.Admit(100 * MB));
@@ -1867,6 +1924,11 @@ int main(int argc, char** argv)
       [&] {
         for (const auto& m : models)
           TestFallback(*m);
+      } },
+    { "SelectWithinFloor",
+      [&] {
+        for (const auto& m : models)
+          TestSelectWithinFloor(*m);
       } },
     { "BackFaces",
       [&] {
