@@ -193,7 +193,6 @@ struct Visit
   bool culled;
 };
 
-/// What the traversal leaves: the regions it shows and the regions it split.
 /// The regions' estimated errors, weighted by the share of the view each one's box covers.
 double WeightedEstimate(
   const std::vector<RegionRecord>& regions, const std::vector<std::size_t>& shown, const ViewParameters& view)
@@ -208,6 +207,7 @@ double WeightedEstimate(
   return shareSum > 0 ? estimateSum / shareSum : 0;
 }
 
+/// What the traversal leaves: the regions it shows and the regions it split.
 struct Traversal
 {
   std::vector<std::size_t> shown;
