@@ -1,10 +1,12 @@
 #include "vtkMultiresolutionSurfaceMapper.h"
 
+#include "vtkMultiresolutionCellPicker.h"
 #include "vtkMultiresolutionGpuRegions.h"
 #include "vtkMultiresolutionReducedResolution.h"
 #include "vtkMultiresolutionShaderVariants.h"
 #include "vtkMultiresolutionTableTextures.h"
 
+#include "CellInspection.h"
 #include "CornerPointGeometry.h"
 #include "FramePlanning.h"
 #include "FrameRateController.h"
@@ -43,6 +45,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iterator>
 #include <limits>
 #include <set>
@@ -149,6 +152,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   vtkMultiresolutionTableTextures Tables;
   vtkMultiresolutionShaderVariants Shaders;
   vtkMultiresolutionReducedResolution Reduced;
+  vtkMultiresolutionCellPicker Picker;
   GpuTimer Timer;
 
   // View state and readout.
@@ -171,6 +175,18 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   std::chrono::steady_clock::time_point FrameStart;
   bool HaveFrameStart = false;
 
+  // Picking: what PickAt asked for, and what the last pick found.
+  bool PickPending = false;
+  std::array<double, 2> PickPixel{};
+  struct Picked
+  {
+    std::array<int, 3> cell{ 0, 0, 0 }; ///< I, J, K from 1; 0: nothing
+    int active = -1;
+    std::array<double, 3> point{};
+    std::array<double, 24> corners{};
+    std::string values;
+  } Pick;
+
   void Close()
   {
     this->ControllerRunning = false;
@@ -186,6 +202,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
 
   void ReleaseGpu()
   {
+    this->Picker.ReleaseGraphicsResources(this->Window);
     this->Reduced.ReleaseGraphicsResources(this->Window);
     this->Regions.ReleaseGraphicsResources();
     this->Tables.ForgetAll(this->Window);
@@ -289,6 +306,33 @@ bool vtkMultiresolutionSurfaceMapper::GetLoadsPending() const
 {
   return this->Internal->Pending;
 }
+void vtkMultiresolutionSurfaceMapper::PickAt(double x, double y)
+{
+  this->Internal->PickPending = x >= 0 && y >= 0;
+  this->Internal->PickPixel = { x, y };
+  this->Modified();
+}
+const int* vtkMultiresolutionSurfaceMapper::GetPickedCell() const
+{
+  return this->Internal->Pick.cell.data();
+}
+int vtkMultiresolutionSurfaceMapper::GetPickedActive() const
+{
+  return this->Internal->Pick.active;
+}
+const double* vtkMultiresolutionSurfaceMapper::GetPickedPoint() const
+{
+  return this->Internal->Pick.point.data();
+}
+const double* vtkMultiresolutionSurfaceMapper::GetPickedCorners() const
+{
+  return this->Internal->Pick.corners.data();
+}
+const char* vtkMultiresolutionSurfaceMapper::GetPickedValues() const
+{
+  return this->Internal->Pick.values.c_str();
+}
+
 const char* vtkMultiresolutionSurfaceMapper::GetLastError() const
 {
   if (this->Internal->Error.empty() && !this->Internal->LayerError.empty())
@@ -410,6 +454,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   {
     in.Reduced.End(frame.window);
   }
+  this->PickCell(frame);
   this->FinishFrame(frame);
 }
 
@@ -674,10 +719,11 @@ vtkShaderProgram* vtkMultiresolutionSurfaceMapper::ReadyProgram(Frame& frame, in
   painting.colorMode = colorMode;
   painting.layerView = frame.layer >= 0;
   painting.logScale = colorMode == PropertyColors && table && table->UsingLogScale() != 0;
-  painting.gridLines = this->GridLines && colorMode != CellIdColors;
-  // The renderer's lights as stock surfaces use them; an actor with lighting off is unlit.
+  painting.gridLines = this->GridLines && colorMode < CellIdColors;
+  // The renderer's lights as stock surfaces use them; an actor with lighting off is unlit, and
+  // so are the cell id colours.
   vtkOpenGLRenderer* lights = vtkOpenGLRenderer::SafeDownCast(frame.renderer);
-  painting.lighting = look->GetLighting() && lights ? lights->GetLightingComplexity() : 0;
+  painting.lighting = look->GetLighting() && lights && colorMode < CellIdColors ? lights->GetLightingComplexity() : 0;
   painting.lightCount = painting.lighting > 0 ? lights->GetLightingCount() : 0;
   painting.lighting = painting.lightCount > 0 ? painting.lighting : 0;
   painting.specular = painting.lighting > 0 && look->GetSpecular() > 0;
@@ -812,11 +858,9 @@ void vtkMultiresolutionSurfaceMapper::SetUniforms(Frame& frame)
   SetMaterialUniforms(program, look, frame.view.parallel);
 }
 
-void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
+void vtkMultiresolutionSurfaceMapper::BeginDrawing(Frame& frame)
 {
-  Internals& in = *this->Internal;
   vtkOpenGLState* state = frame.window->GetState();
-  in.Timer.Begin();
   state->vtkglEnable(GL_DEPTH_TEST);
   state->vtkglDepthMask(GL_TRUE);
   // Back faces of the closed surface, hidden from outside, are culled (the bottom seen from
@@ -838,11 +882,24 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
   // A side triangle's flat attributes come from its last vertex (RegionDrawBuffers::indices),
   // OpenGL's default, which vtkOpenGLState does not track.
   glProvokingVertex(GL_LAST_VERTEX_CONVENTION);
+}
 
+void vtkMultiresolutionSurfaceMapper::EndDrawing(Frame& frame)
+{
+  glFrontFace(GL_CCW);
+  frame.window->GetState()->vtkglDisable(GL_CULL_FACE);
+  this->Internal->Tables.Unbind();
+}
+
+void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
+{
+  Internals& in = *this->Internal;
+  in.Timer.Begin();
+  this->BeginDrawing(frame);
   // Lit tops and bottoms take their normals from the table, once it is loaded: they are
   // drawn first with a program that computes no facet normal, then the sides with one that
   // does; otherwise one program draws every face.
-  if (frame.lit && frame.colorMode != CellIdColors && frame.layer < 0 && in.Tables.NormalsReady())
+  if (frame.lit && frame.layer < 0 && in.Tables.NormalsReady())
   {
     vtkShaderProgram* sides = frame.program;
     frame.program = this->ReadyProgram(frame, frame.colorMode, true);
@@ -856,10 +913,8 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
     in.Drawn = this->DrawFaces(frame, { true, true, true });
   }
 
-  glFrontFace(GL_CCW);
-  state->vtkglDisable(GL_CULL_FACE);
   in.Substituted = static_cast<int>(frame.selection.substituted + this->SidesStandingIn(frame));
-  in.Tables.Unbind();
+  this->EndDrawing(frame);
   in.Timer.End();
   vtkOpenGLCheckErrorMacro("after drawing the multiresolution surface");
 }
@@ -907,6 +962,96 @@ int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bo
     ++regions;
   }
   return regions;
+}
+
+namespace
+{
+/// "NAME=value" lines of a cell's values (%.9g, "nan" for none).
+std::string ValueLines(const std::vector<resmr::CellValue>& values)
+{
+  std::string lines;
+  for (const resmr::CellValue& v : values)
+  {
+    char number[32];
+    std::snprintf(number, sizeof(number), "%.9g", static_cast<double>(v.value));
+    lines += v.name + "=" + (std::isnan(v.value) ? std::string("nan") : std::string(number)) + "\n";
+  }
+  return lines;
+}
+} // namespace
+
+void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
+{
+  Internals& in = *this->Internal;
+  if (!in.PickPending)
+  {
+    return;
+  }
+  in.PickPending = false;
+  in.Pick = Internals::Picked();
+  int width = 0, height = 0, x0 = 0, y0 = 0;
+  frame.renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+  const double x = std::floor(in.PickPixel[0]) - x0, y = std::floor(in.PickPixel[1]) - y0;
+  if (x < 0 || y < 0 || x >= width || y >= height)
+  {
+    return;
+  }
+  // The frame's cut once more, through a matrix that makes the picked pixel the whole
+  // viewport of a one-pixel target; the readout keeps the frame's own counts.
+  const resmr::Matrix4 clip = frame.modelToClip;
+  const vtkIdType triangles = in.Triangles;
+  frame.modelToClip = resmr::Multiply(resmr::PickPixelMatrix(x, y, width, height), clip);
+  frame.colorMode = PickColors;
+  frame.scale = 1;
+  frame.program = this->ReadyProgram(frame, PickColors);
+  std::array<float, 4> rgba{ 0, 0, 0, 0 };
+  float depth = 1;
+  if (frame.program && in.Picker.Begin(frame.window))
+  {
+    this->BeginDrawing(frame);
+    this->DrawFaces(frame, { true, true, true });
+    this->EndDrawing(frame);
+    in.Picker.End(frame.window, rgba, depth);
+  }
+  frame.modelToClip = clip;
+  in.Triangles = triangles;
+  std::array<int64_t, 3> cell{};
+  if (!resmr::CellFromPickPixel(rgba, in.File->Header().dims, cell))
+  {
+    return;
+  }
+  // The point hit: the pixel's centre at its depth, back through the frame's transforms.
+  resmr::Matrix4 toModel;
+  resmr::Invert(clip, toModel);
+  std::array<double, 4> model = resmr::Transform(
+    toModel, { 2 * (x + 0.5) / width - 1, 2 * (y + 0.5) / height - 1, 2 * static_cast<double>(depth) - 1, 1 });
+  for (double& c : model)
+  {
+    c /= model[3];
+  }
+  const std::array<double, 4> world = resmr::Transform(frame.modelToWorld, model);
+  in.Pick.cell = { int(cell[0] + 1), int(cell[1] + 1), int(cell[2] + 1) };
+  in.Pick.point = { world[0], world[1], world[2] };
+  try
+  {
+    const std::array<double, 3> near{ model[0], model[1], model[2] };
+    const resmr::CellGeometry geometry = resmr::InspectCellGeometry(*in.File, cell, &near);
+    in.Pick.active = geometry.found ? (geometry.active ? 1 : 0) : -1;
+    for (std::size_t c = 0; geometry.found && c < 8; ++c)
+    {
+      const auto& p = geometry.corners[c];
+      const std::array<double, 4> w = resmr::Transform(frame.modelToWorld, { p[0], p[1], p[2], 1 });
+      std::copy(w.begin(), w.begin() + 3, in.Pick.corners.begin() + 3 * static_cast<std::ptrdiff_t>(c));
+    }
+    if (in.Properties)
+    {
+      in.Pick.values = ValueLines(resmr::CellValues(*in.Properties, cell, frame.step));
+    }
+  }
+  catch (const std::exception& error)
+  {
+    in.Pick.values += std::string("error=") + error.what() + "\n";
+  }
 }
 
 void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)

@@ -50,7 +50,8 @@ public:
   {
     SolidColor = 0,
     PropertyColors = 1,
-    CellIdColors = 2 ///< debug: RGB = 1 + i + nx (j + ny k), unlit, for image comparisons
+    CellIdColors = 2, ///< debug: RGB = 1 + i + nx (j + ny k), unlit, for image comparisons
+    PickColors = 3    ///< internal: the pick pass's (i, j, k) as floats (not a user setting)
   };
 
   /// What paints the surface (ColorModes). Property colours need a property (ColorArrayName,
@@ -141,6 +142,29 @@ public:
   /// Why the files could not be used, empty if they could.
   const char* GetLastError() const;
 
+  ///@{
+  /// Picking (ours): PickAt asks the next render to name the original cell whose colour shows
+  /// at display pixel (x, y) (VTK's display coordinates: pixels from the render window's lower
+  /// left corner; the pixel holding (x, y)). That render draws its own cut once more into
+  /// one pixel (resmr::CellFromPickPixel), so the answer is the cell painted there at whatever
+  /// level is drawn; the files then give its corners (the finest level's), whether it is
+  /// active and its values (resmr::CellInspection). A negative x asks for nothing.
+  void PickAt(double x, double y);
+  /// ECLIPSE's I, J, K (from 1) of the cell picked last; 0, 0, 0 when the pick hit nothing.
+  const int* GetPickedCell() const;
+  /// 1: the picked cell is active, 0: inactive, -1: unknown (nothing picked, or its column not
+  /// found).
+  int GetPickedActive() const;
+  /// The world point the pick hit on the surface.
+  const double* GetPickedPoint() const;
+  /// The picked cell's eight corners, world coordinates, ECLIPSE's order (24 values).
+  const double* GetPickedCorners() const;
+  /// The picked cell's values at the descriptor's step, one "NAME=value" a line (static arrays
+  /// first; "nan" where the cell has none); empty without a property file. An error reading the
+  /// files is a line "error=...".
+  const char* GetPickedValues() const;
+  ///@}
+
   void Render(vtkRenderer* renderer, vtkActor* actor) override;
   void ReleaseGraphicsResources(vtkWindow* window) override;
   double* GetBounds() override;
@@ -198,6 +222,13 @@ private:
   int DrawFaces(Frame& frame, const std::array<bool, 3>& kinds);
   /// Drawn regions showing their simplified side while their exact one loads.
   std::size_t SidesStandingIn(const Frame& frame) const;
+  /// The GL state every pass of the surface draws with (depth test, culling, provoking
+  /// vertex), and its undoing.
+  void BeginDrawing(Frame& frame);
+  void EndDrawing(Frame& frame);
+  /// The pick PickAt asked for: the frame's cut drawn again into the picked pixel, then the
+  /// cell read from the files.
+  void PickCell(Frame& frame);
   /// Loads pending, errors, readout and the frame-rate controller.
   void FinishFrame(Frame& frame);
 };

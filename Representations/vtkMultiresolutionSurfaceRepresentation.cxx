@@ -19,6 +19,7 @@
 #include "vtkScalarsToColors.h"
 #include "vtkStringArray.h"
 
+#include <algorithm>
 #include <exception>
 #include <string>
 
@@ -314,6 +315,34 @@ int vtkMultiresolutionSurfaceRepresentation::GetLoadsPending()
 const char* vtkMultiresolutionSurfaceRepresentation::GetLastError()
 {
   return this->Error.empty() ? this->Mapper->GetLastError() : this->Error.c_str();
+}
+
+void vtkMultiresolutionSurfaceRepresentation::PickAt(double x, double y)
+{
+  this->Mapper->PickAt(x, y);
+}
+int* vtkMultiresolutionSurfaceRepresentation::GetPickedCell()
+{
+  std::copy(this->Mapper->GetPickedCell(), this->Mapper->GetPickedCell() + 3, this->PickedCell);
+  return this->PickedCell;
+}
+int vtkMultiresolutionSurfaceRepresentation::GetPickedActive()
+{
+  return this->Mapper->GetPickedActive();
+}
+double* vtkMultiresolutionSurfaceRepresentation::GetPickedPoint()
+{
+  std::copy(this->Mapper->GetPickedPoint(), this->Mapper->GetPickedPoint() + 3, this->PickedPoint);
+  return this->PickedPoint;
+}
+double* vtkMultiresolutionSurfaceRepresentation::GetPickedCorners()
+{
+  std::copy(this->Mapper->GetPickedCorners(), this->Mapper->GetPickedCorners() + 24, this->PickedCorners);
+  return this->PickedCorners;
+}
+const char* vtkMultiresolutionSurfaceRepresentation::GetPickedValues()
+{
+  return this->Mapper->GetPickedValues();
 }
 
 void vtkMultiresolutionSurfaceRepresentation::PrintSelf(ostream& os, vtkIndent indent)

@@ -94,6 +94,14 @@ public:
   double GetLastFrameMs();
   int GetLoadsPending();
   const char* GetLastError();
+  /// Picking: display pixel (x, y) picked at the next render (see the mapper), and what the
+  /// last pick found. The copies are the representation's, so the server's pull reads them.
+  void PickAt(double x, double y);
+  int* GetPickedCell() VTK_SIZEHINT(3);
+  int GetPickedActive();
+  double* GetPickedPoint() VTK_SIZEHINT(3);
+  double* GetPickedCorners() VTK_SIZEHINT(24);
+  const char* GetPickedValues();
   ///@}
 
   vtkMultiresolutionSurfaceMapper* GetMapper() { return this->Mapper; }
@@ -123,6 +131,9 @@ private:
   std::string Error;
   int LayerRange[2] = { 0, 0 };
   std::string LayerRangeFile; ///< the file LayerRange was read from
+  int PickedCell[3] = { 0, 0, 0 };
+  double PickedPoint[3] = { 0, 0, 0 };
+  double PickedCorners[24] = {};
 };
 
 #endif

@@ -13,7 +13,7 @@
 // renderer's lights adds a diffuse and a specular term.
 //
 // The mapper compiles one variant per painting mode, with these defined (0 or 1):
-// COLOR_MODE (0: solid colour, 1: property, 2: cell id), LAYER_VIEW (one layer drawn),
+// COLOR_MODE (0: solid colour, 1: property, 2: cell id, 3: the pick pass's cell (i, j, k)), LAYER_VIEW (one layer drawn),
 // LOG_SCALE, GRID_LINES, SPECULAR, TABLE_NORMALS (tops and bottoms lit by the normal
 // table), WALL_DEPTHS (side fragments find their layer from their depth, below), and LIGHTING (0: unlit, 1: headlight, 2: directional
 // lights, 3: positional lights, as vtkOpenGLRenderer's lighting complexity), with the
@@ -287,6 +287,9 @@ void main()
     int id = (cell.x + gridDims.x * (cell.y + gridDims.y * cell.z)) % 16777215 + 1;
     gl_FragData[0] = vec4(float(id & 255), float((id >> 8) & 255), float((id >> 16) & 255), 255.0) / 255.0;
   }
+#elif COLOR_MODE == 3
+  // The pick pass (a float target): the same cell, exact at any grid size.
+  gl_FragData[0] = vec4(vec3(cell), 1.0);
 #else
 #if !LAYER_VIEW
   ivec3 slot = HashSlot(cell);

@@ -1,0 +1,72 @@
+// Inspecting one original cell (ours; what makes it possible is the paper's Sec. 5.1: every
+// fragment of every level knows its original cell through its topological coordinate). A
+// pick names the cell whose colour shows under a pixel: a pick pass draws the frame's own cut
+// into one pixel, each fragment painting its cell as the Cell Id colouring finds it, so the
+// answer is exact at whatever level is drawn, with no search structure. What is then said of
+// the cell comes from the files, never from a whole-model array:
+// - its values: one layer chunk of each table of the property file, static arrays and the
+//   tables of the step (the layer tables hold NaN where a cell has no value);
+// - its eight corners and whether it is active: the column of the leaf region (the finest
+//   level, which keeps the original grid's corners) that holds it, found by the model point
+//   the pick hit or, without one, by the leaves' boxes around the column's place in a coarse
+//   region (GoTo needs no pixel).
+//
+// Contract:
+// - Cells are 0-based (i, j, k) here; the viewer shows ECLIPSE's I, J, K, from 1.
+// - Corners are model coordinates (x, y, z up: z = -depth), in ECLIPSE's order: (i, j),
+//   (i + 1, j), (i, j + 1), (i + 1, j + 1) on the cell's top, then the same on its bottom.
+// - Failures to read a file throw FileFormatError naming it (the caller reports them); a cell
+//   outside the grid is std::out_of_range.
+#pragma once
+
+#include "MultiresolutionFile.h"
+#include "PropertyFile.h"
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace resmr
+{
+
+struct CellValue
+{
+  std::string name;
+  int32_t step = -1; ///< -1: a static array
+  float value = 0;   ///< NaN: no value (an inactive cell, or none in the run)
+};
+
+struct CellGeometry
+{
+  bool found = false;  ///< the cell's column was found in a leaf region
+  bool active = false; ///< the cell is active in the grid
+  std::array<std::array<double, 3>, 8> corners{};
+  std::size_t leafRegion = 0;
+  /// The mean of the corners (model coordinates), what a camera goes to.
+  std::array<double, 3> Centre() const;
+};
+
+/// Every table of `properties` for `cell` at report step `step` (static arrays first, then
+/// the step's, in file order). Reads one layer chunk a table.
+std::vector<CellValue> CellValues(const PropertyFile& properties, const std::array<int64_t, 3>& cell, int32_t step);
+
+/// Most leaf regions read to find a column: the nearest boxes to where it stands.
+constexpr std::size_t MaxLeavesSearched = 16;
+
+/// The corners and activity of `cell` from the leaf region that holds its column. `near`,
+/// when given (a model point the pick hit), says where to look first; without it the column
+/// is placed from the coarsest region that holds it.
+CellGeometry InspectCellGeometry(
+  const MultiresolutionFile& file, const std::array<int64_t, 3>& cell, const std::array<double, 3>* near = nullptr);
+
+/// The cell a pick pass painted in a pixel: its RGB holds i, j, k (0-based) as floats, its
+/// alpha 1; alpha 0 (nothing drawn there) or a value off the grid gives false.
+bool CellFromPickPixel(
+  const std::array<float, 4>& rgba, const std::array<int64_t, 3>& dims, std::array<int64_t, 3>& cell);
+
+/// The row-major matrix that turns a clip transform into one whose 1 x 1 viewport shows pixel
+/// (x, y) of a `width` x `height` viewport (pixel centres at + 0.5), so one pixel is drawn.
+std::array<double, 16> PickPixelMatrix(double x, double y, double width, double height);
+
+} // namespace resmr
