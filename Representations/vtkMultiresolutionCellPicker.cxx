@@ -4,7 +4,7 @@
 #include "vtkOpenGLState.h"
 #include "vtk_glew.h"
 
-bool vtkMultiresolutionCellPicker::Begin(vtkOpenGLRenderWindow* window)
+bool vtkMultiresolutionCellPicker::Begin(vtkOpenGLRenderWindow* window, int x, int y, int width, int height)
 {
   vtkOpenGLState* state = window->GetState();
   if (!this->Framebuffer)
@@ -36,7 +36,7 @@ bool vtkMultiresolutionCellPicker::Begin(vtkOpenGLRenderWindow* window)
   state->vtkglBindFramebuffer(GL_FRAMEBUFFER, this->Framebuffer);
   const GLenum target = GL_COLOR_ATTACHMENT0;
   glDrawBuffers(1, &target);
-  state->vtkglViewport(0, 0, 1, 1);
+  state->vtkglViewport(-x, -y, width, height);
   state->vtkglScissor(0, 0, 1, 1);
   state->vtkglClearColor(0, 0, 0, 0);
   state->vtkglClearDepth(1);

@@ -996,24 +996,20 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
   {
     return;
   }
-  // The frame's cut once more, through a matrix that makes the picked pixel the whole
-  // viewport of a one-pixel target; the readout keeps the frame's own counts.
-  const resmr::Matrix4 clip = frame.modelToClip;
+  // The frame's cut once more, into the one pixel; the readout keeps the frame's own counts.
   const vtkIdType triangles = in.Triangles;
-  frame.modelToClip = resmr::Multiply(resmr::PickPixelMatrix(x, y, width, height), clip);
   frame.colorMode = PickColors;
   frame.scale = 1;
   frame.program = this->ReadyProgram(frame, PickColors);
   std::array<float, 4> rgba{ 0, 0, 0, 0 };
   float depth = 1;
-  if (frame.program && in.Picker.Begin(frame.window))
+  if (frame.program && in.Picker.Begin(frame.window, int(x), int(y), width, height))
   {
     this->BeginDrawing(frame);
     this->DrawFaces(frame, { true, true, true });
     this->EndDrawing(frame);
     in.Picker.End(frame.window, rgba, depth);
   }
-  frame.modelToClip = clip;
   in.Triangles = triangles;
   std::array<int64_t, 3> cell{};
   if (!resmr::CellFromPickPixel(rgba, in.File->Header().dims, cell))
@@ -1022,7 +1018,7 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
   }
   // The point hit: the pixel's centre at its depth, back through the frame's transforms.
   resmr::Matrix4 toModel;
-  resmr::Invert(clip, toModel);
+  resmr::Invert(frame.modelToClip, toModel);
   std::array<double, 4> model = resmr::Transform(
     toModel, { 2 * (x + 0.5) / width - 1, 2 * (y + 0.5) / height - 1, 2 * static_cast<double>(depth) - 1, 1 });
   for (double& c : model)
@@ -1037,6 +1033,7 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
     const std::array<double, 3> near{ model[0], model[1], model[2] };
     const resmr::CellGeometry geometry = resmr::InspectCellGeometry(*in.File, cell, &near);
     in.Pick.active = geometry.found ? (geometry.active ? 1 : 0) : -1;
+    in.Pick.corners.fill(std::numeric_limits<double>::quiet_NaN());
     for (std::size_t c = 0; geometry.found && c < 8; ++c)
     {
       const auto& p = geometry.corners[c];

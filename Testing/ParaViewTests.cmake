@@ -128,3 +128,6 @@ set_property(TEST Multiresolution.GUI APPEND PROPERTY ENVIRONMENT
   "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>" "PARAVIEW_EXECUTABLE=${PARAVIEW_EXECUTABLE}")
 set_property(TEST Multiresolution.GUI PROPERTY SKIP_RETURN_CODE 125)
 
+# Picking a cell: the frame's own cell at any level, stock's at 0 px, EGRIDReader's values and corners.
+resmr_add_pvpython_test(Multiresolution.Pick TestMultiresolutionPick.py)
+set_property(TEST Multiresolution.Pick APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")

@@ -203,12 +203,4 @@ bool CellFromPickPixel(
   return true;
 }
 
-std::array<double, 16> PickPixelMatrix(double x, double y, double width, double height)
-{
-  // The pixel's centre in normalised device coordinates; a pixel is 2 / size wide there, so
-  // ndc' = (ndc - centre) * size makes it span [-1, 1].
-  const double cx = 2 * (x + 0.5) / width - 1, cy = 2 * (y + 0.5) / height - 1;
-  return { width, 0, 0, -cx * width, 0, height, 0, -cy * height, 0, 0, 1, 0, 0, 0, 0, 1 };
-}
-
 } // namespace resmr

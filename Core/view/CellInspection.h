@@ -65,8 +65,4 @@ CellGeometry InspectCellGeometry(
 bool CellFromPickPixel(
   const std::array<float, 4>& rgba, const std::array<int64_t, 3>& dims, std::array<int64_t, 3>& cell);
 
-/// The row-major matrix that turns a clip transform into one whose 1 x 1 viewport shows pixel
-/// (x, y) of a `width` x `height` viewport (pixel centres at + 0.5), so one pixel is drawn.
-std::array<double, 16> PickPixelMatrix(double x, double y, double width, double height);
-
 } // namespace resmr
