@@ -1,5 +1,6 @@
 #include "pqMultiresolutionReadoutDock.h"
 
+#include "pqMultiresolutionInspectActions.h"
 #include "pqMultiresolutionReadout.h"
 
 #include "pqActiveObjects.h"
@@ -50,6 +51,11 @@ pqMultiresolutionReadoutDock::pqMultiresolutionReadoutDock(QWidget* parent)
   this->Error->setStyleSheet("color: #c0392b;");
   this->Error->setTextInteractionFlags(Qt::TextSelectableByMouse);
   layout->addWidget(this->Error);
+  this->Selected = new QLabel(body);
+  this->Selected->setWordWrap(true);
+  this->Selected->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  this->Selected->setToolTip(tr("The cell last selected with Inspect Cells (toolbar Reservoir Inspect)"));
+  layout->addWidget(this->Selected);
   layout->addStretch(1);
   this->setWidget(body);
 
@@ -112,6 +118,7 @@ void pqMultiresolutionReadoutDock::updateReadout()
   {
     this->Source->setText(tr("No Multiresolution Surface in the active view."));
     this->Values->setVisible(false);
+    this->Selected->setVisible(false);
     this->Error->setVisible(false);
     return;
   }
@@ -134,6 +141,9 @@ void pqMultiresolutionReadoutDock::updateReadout()
   this->Frame->setText(tr("%1 ms").arg(readout.FrameMs, 0, 'f', 1));
   this->Loads->setText(readout.LoadsPending ? tr("pending") : tr("idle"));
   this->Error->setText(readout.Error);
+  const QString selected = pqMultiresolutionInspectActions::SelectedText();
+  this->Selected->setText(selected.isEmpty() ? QString() : tr("Selected: %1").arg(selected));
+  this->Selected->setVisible(!selected.isEmpty());
   this->Values->setVisible(true);
   this->Error->setVisible(!readout.Error.isEmpty());
   vtkLogF(TRACE, "multiresolution readout: %.2f px, %.1f MB, %.0f triangles, %d regions, %d substituted, %s",

@@ -37,6 +37,7 @@ private:
   QLabel* Frame;
   QLabel* Loads;
   QLabel* Error;
+  QLabel* Selected; ///< the cell the Inspect Cells action last selected
   QWidget* Values;
 };
 

@@ -178,6 +178,8 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   // Picking: what PickAt asked for, and what the last pick found.
   bool PickPending = false;
   std::array<double, 2> PickPixel{};
+  bool InspectPending = false;
+  std::array<int64_t, 3> Inspect{}; ///< I, J, K from 1
   struct Picked
   {
     std::array<int, 3> cell{ 0, 0, 0 }; ///< I, J, K from 1; 0: nothing
@@ -310,6 +312,12 @@ void vtkMultiresolutionSurfaceMapper::PickAt(double x, double y)
 {
   this->Internal->PickPending = x >= 0 && y >= 0;
   this->Internal->PickPixel = { x, y };
+  this->Modified();
+}
+void vtkMultiresolutionSurfaceMapper::InspectCell(int i, int j, int k)
+{
+  this->Internal->InspectPending = i > 0 && j > 0 && k > 0;
+  this->Internal->Inspect = { i, j, k };
   this->Modified();
 }
 const int* vtkMultiresolutionSurfaceMapper::GetPickedCell() const
@@ -983,6 +991,19 @@ std::string ValueLines(const std::vector<resmr::CellValue>& values)
 void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
 {
   Internals& in = *this->Internal;
+  if (in.InspectPending)
+  {
+    // A cell named by I, J, K: no pixel, no drawing.
+    in.InspectPending = false;
+    in.Pick = Internals::Picked();
+    const resmr::MultiresolutionHeader& header = in.File->Header();
+    const std::array<int64_t, 3> cell{ in.Inspect[0] - 1, in.Inspect[1] - 1, in.Inspect[2] - 1 };
+    if (cell[0] >= 0 && cell[1] >= 0 && cell[2] >= 0 && cell[0] < header.dims[0] && cell[1] < header.dims[1] &&
+      cell[2] < header.dims[2])
+    {
+      this->DescribeCell(frame, cell, nullptr);
+    }
+  }
   if (!in.PickPending)
   {
     return;
@@ -1025,20 +1046,36 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
   {
     c /= model[3];
   }
-  const std::array<double, 4> world = resmr::Transform(frame.modelToWorld, model);
+  const std::array<double, 3> near{ model[0], model[1], model[2] };
+  this->DescribeCell(frame, cell, &near);
+}
+
+void vtkMultiresolutionSurfaceMapper::DescribeCell(
+  Frame& frame, const std::array<int64_t, 3>& cell, const std::array<double, 3>* near)
+{
+  Internals& in = *this->Internal;
+  const auto toWorld = [&frame](const std::array<double, 3>& p) {
+    const std::array<double, 4> w = resmr::Transform(frame.modelToWorld, { p[0], p[1], p[2], 1 });
+    return std::array<double, 3>{ w[0], w[1], w[2] };
+  };
   in.Pick.cell = { int(cell[0] + 1), int(cell[1] + 1), int(cell[2] + 1) };
-  in.Pick.point = { world[0], world[1], world[2] };
+  in.Pick.corners.fill(std::numeric_limits<double>::quiet_NaN());
   try
   {
-    const std::array<double, 3> near{ model[0], model[1], model[2] };
-    const resmr::CellGeometry geometry = resmr::InspectCellGeometry(*in.File, cell, &near);
+    const resmr::CellGeometry geometry = resmr::InspectCellGeometry(*in.File, cell, near);
     in.Pick.active = geometry.found ? (geometry.active ? 1 : 0) : -1;
-    in.Pick.corners.fill(std::numeric_limits<double>::quiet_NaN());
     for (std::size_t c = 0; geometry.found && c < 8; ++c)
     {
-      const auto& p = geometry.corners[c];
-      const std::array<double, 4> w = resmr::Transform(frame.modelToWorld, { p[0], p[1], p[2], 1 });
-      std::copy(w.begin(), w.begin() + 3, in.Pick.corners.begin() + 3 * static_cast<std::ptrdiff_t>(c));
+      const std::array<double, 3> w = toWorld(geometry.corners[c]);
+      std::copy(w.begin(), w.end(), in.Pick.corners.begin() + 3 * static_cast<std::ptrdiff_t>(c));
+    }
+    if (near)
+    {
+      in.Pick.point = toWorld(*near);
+    }
+    else if (geometry.found)
+    {
+      in.Pick.point = toWorld(geometry.Centre());
     }
     if (in.Properties)
     {

@@ -150,6 +150,9 @@ public:
   /// level is drawn; the files then give its corners (the finest level's), whether it is
   /// active and its values (resmr::CellInspection). A negative x asks for nothing.
   void PickAt(double x, double y);
+  /// Asks the next render to describe cell (I, J, K) (from 1) the same way, with no pixel: the
+  /// Picked* readouts then hold it, PickedPoint its centre. Any index below 1 asks for nothing.
+  void InspectCell(int i, int j, int k);
   /// ECLIPSE's I, J, K (from 1) of the cell picked last; 0, 0, 0 when the pick hit nothing.
   const int* GetPickedCell() const;
   /// 1: the picked cell is active, 0: inactive, -1: unknown (nothing picked, or its column not
@@ -157,7 +160,8 @@ public:
   int GetPickedActive() const;
   /// The world point the pick hit on the surface.
   const double* GetPickedPoint() const;
-  /// The picked cell's eight corners, world coordinates, ECLIPSE's order (24 values).
+  /// The picked cell's eight corners, world coordinates, ECLIPSE's order (24 values; NaN when
+  /// no leaf region holds its column, which then has no active cell).
   const double* GetPickedCorners() const;
   /// The picked cell's values at the descriptor's step, one "NAME=value" a line (static arrays
   /// first; "nan" where the cell has none); empty without a property file. An error reading the
@@ -229,6 +233,8 @@ private:
   /// The pick PickAt asked for: the frame's cut drawn again into the picked pixel, then the
   /// cell read from the files.
   void PickCell(Frame& frame);
+  /// The Picked* readouts for `cell` (0-based), from the files; `near`: the model point picked.
+  void DescribeCell(Frame& frame, const std::array<int64_t, 3>& cell, const std::array<double, 3>* near);
   /// Loads pending, errors, readout and the frame-rate controller.
   void FinishFrame(Frame& frame);
 };

@@ -321,6 +321,10 @@ void vtkMultiresolutionSurfaceRepresentation::PickAt(double x, double y)
 {
   this->Mapper->PickAt(x, y);
 }
+void vtkMultiresolutionSurfaceRepresentation::InspectCell(int i, int j, int k)
+{
+  this->Mapper->InspectCell(i, j, k);
+}
 int* vtkMultiresolutionSurfaceRepresentation::GetPickedCell()
 {
   std::copy(this->Mapper->GetPickedCell(), this->Mapper->GetPickedCell() + 3, this->PickedCell);

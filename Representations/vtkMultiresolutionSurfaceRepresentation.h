@@ -97,6 +97,7 @@ public:
   /// Picking: display pixel (x, y) picked at the next render (see the mapper), and what the
   /// last pick found. The copies are the representation's, so the server's pull reads them.
   void PickAt(double x, double y);
+  void InspectCell(int i, int j, int k);
   int* GetPickedCell() VTK_SIZEHINT(3);
   int GetPickedActive();
   double* GetPickedPoint() VTK_SIZEHINT(3);

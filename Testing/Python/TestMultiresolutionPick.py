@@ -14,7 +14,10 @@ from the side, 100 random covered pixels a camera (200 a model and tolerance):
 - its corners are EGRIDReader's corners of that cell within a millionth of the model's extent
   (the finest level's, whatever is drawn), and the point picked at 0 px lies within them
   where stock shows the same cell;
-- a pick on the background names nothing.
+- a pick on the background names nothing;
+- resmr_inspect.InspectCell(I, J, K) gives EGRIDReader's corners and values for random top
+  cells, and GoToCell puts the cell at the view's centre (a pick there names it) and outlines
+  it (the 'Selected Cell' source).
 Images of failures are left in the temporary folder."""
 import os
 
@@ -26,6 +29,7 @@ import resmr_testing as rt
 
 args = rt.arguments()
 rt.load_plugin(args.plugin)
+import resmr_inspect  # noqa: E402 (the plugin carries it)
 temp = os.path.join(args.temp, "pick")
 os.makedirs(temp, exist_ok=True)
 WIDTH, HEIGHT = 640, 480
@@ -43,19 +47,14 @@ def models():
 
 
 def pick(display, view, x, y):
-    """PickAt (x, y), rendered; (I, J, K), active, point, corners (8, 3), {name: value}."""
-    display.PickAt = [x, y]
-    simple.Render(view)
-    display.PickAt = [-1, -1]  # so that the same pixel can be asked again
-    display.UpdatePropertyInformation()
-    cell = tuple(int(v) for v in display.GetPropertyValue("PickedCell"))
-    values = {}
-    for line in display.GetPropertyValue("PickedValues").splitlines():
-        name, value = line.split("=", 1)
-        values[name] = float(value)
-    return (cell, int(display.GetPropertyValue("PickedActive")),
-            np.array(display.GetPropertyValue("PickedPoint")),
-            np.array(display.GetPropertyValue("PickedCorners")).reshape(8, 3), values)
+    """resmr_inspect.PickCell: (I, J, K), active (-1 unknown), point, corners (8, 3; NaN when
+    unknown), {name: value}; (0, 0, 0) over the background."""
+    cell = resmr_inspect.PickCell(x, y, view, display)
+    if cell is None:
+        return (0, 0, 0), -1, None, None, {}
+    corners = np.full((8, 3), np.nan) if cell["corners"] is None else np.array(cell["corners"])
+    active = -1 if cell["active"] is None else int(cell["active"])
+    return (cell["I"], cell["J"], cell["K"]), active, np.array(cell["point"]), corners, cell["values"]
 
 
 def stock_cells(grid):
@@ -187,6 +186,35 @@ for name, grid_path in models():
               + (f", {same_as_stock} stock's" if tolerance == 0 else ""))
         if tolerance == 0 and same_as_stock < 0.99 * picked:
             failures.append(f"{name}: {same_as_stock} of {picked} picks at 0 px name stock's cell (< 99%)")
+    # resmr_inspect, as users call it: InspectCell by I, J, K; GoToCell puts the cell at the
+    # view's centre (a top cell, seen from above) and outlines it.
+    ours.PixelTolerance = 0
+    active_top = [c for c, n in rows.items() if c[2] == 1 and int(grid.GetCellData().GetArray("ACTNUM").GetTuple1(n))]
+    for choice in rng.choice(len(active_top), 3, replace=False):
+        i, j, k = active_top[int(choice)]
+        inspected = resmr_inspect.InspectCell(i, j, k, view, ours)
+        row = rows[(i, j, k)]
+        stock_corners = points[cells[row]]
+        if inspected is None or inspected["corners"] is None:
+            failures.append(f"{name}: InspectCell({i}, {j}, {k}) found nothing")
+            continue
+        corners = np.array(inspected["corners"])
+        distances = np.linalg.norm(stock_corners[None, :, :] - corners[:, None, :], axis=2)
+        if float(np.max(np.min(distances, axis=1))) > 1e-6 * extent or not inspected["active"]:
+            failures.append(f"{name}: InspectCell({i}, {j}, {k}) corners or activity differ from EGRIDReader's")
+        check_values(f"{name} InspectCell({i}, {j}, {k})", inspected["values"], grid, row, failures)
+        view.ResetCamera(False)
+        rt.place_camera(view, bounds, 1.0, [0.1, -0.2, 1.0], 1.0)
+        resmr_inspect.GoToCell(i, j, k, view, ours)
+        centre = resmr_inspect.PickCell(WIDTH // 2, HEIGHT // 2, view, ours)
+        outline = simple.FindSource("Selected Cell")
+        print(f"{name}: GoToCell({i}, {j}, {k}): the view's centre shows "
+              f"{None if centre is None else (centre['I'], centre['J'], centre['K'])}")
+        if centre is None or (centre["I"], centre["J"], centre["K"]) != (i, j, k):
+            failures.append(f"{name}: after GoToCell({i}, {j}, {k}) the view's centre is not the cell")
+        if outline is None or len(outline.Points) != 48:
+            failures.append(f"{name}: GoToCell({i}, {j}, {k}) left no outline of the cell")
+    simple.Delete(simple.FindSource("Selected Cell"))
     print(f"{name}: values compared with EGRIDReader on {valued} picks")
     if valued < 100:
         failures.append(f"{name}: values compared on {valued} picks only")
