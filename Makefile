@@ -17,8 +17,8 @@ DEBIAN_RELEASE ?= $(shell . /etc/os-release 2>/dev/null; \
   case "$$VERSION_ID:$$VERSION_CODENAME" in (12:*|*:bookworm) echo 12 ;; (*) echo 13 ;; esac)
 
 # The ParaView SDK and the -dev packages its CMake config needs; build tools; the test oracle
-# (OPM) and a virtual display for headless rendering.
-PACKAGES := paraview paraview-dev python3-paraview python3-numpy xvfb xauth \
+# (OPM), a virtual display for headless rendering and xdotool to drive the GUI in its test.
+PACKAGES := paraview paraview-dev python3-paraview python3-numpy xvfb xauth xdotool \
   cmake ninja-build g++ liblzo2-dev libglm-dev python3-opm-common
 ifeq ($(DEBIAN_RELEASE),12)
 PACKAGES += \

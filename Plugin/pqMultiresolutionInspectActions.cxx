@@ -17,6 +17,7 @@
 #include "vtkSMSourceProxy.h"
 #include "vtkSmartPointer.h"
 
+#include <QKeySequence>
 #include <QLocale>
 #include <QToolTip>
 #include <QWidget>
@@ -66,8 +67,10 @@ pqMultiresolutionInspectActions::pqMultiresolutionInspectActions(QObject* parent
   this->Inspect = this->addAction(tr("Inspect Cells"));
   this->Inspect->setCheckable(true);
   this->Inspect->setObjectName("actionInspectCells");
+  this->Inspect->setShortcut(QKeySequence(tr("Ctrl+Shift+I")));
+  this->Inspect->setShortcutContext(Qt::ApplicationShortcut);
   this->Inspect->setToolTip(tr("Multiresolution Surface: rest the cursor on a cell to see its I, J, K and values; "
-                               "click to select it"));
+                               "click to select it (Ctrl+Shift+I)"));
   QObject::connect(this->Inspect, &QAction::toggled, this, &pqMultiresolutionInspectActions::setOn);
   this->Hover.setSingleShot(true);
   this->Hover.setInterval(300);
@@ -173,58 +176,75 @@ QString pqMultiresolutionInspectActions::Pick(const QPoint& at, bool select)
   {
     return QString();
   }
+  // Answered at once from the frame on screen (no render), where the surface renders.
+  surface->UpdatePropertyInformation();
+  const int done = vtkSMPropertyHelper(surface, "PicksDone").GetAsInt();
   vtkSMPropertyHelper(surface, "PickAt").Set(0, at.x());
   vtkSMPropertyHelper(surface, "PickAt").Set(1, at.y());
   surface->UpdateVTKObjects();
-  this->View->forceRender();
+  surface->UpdatePropertyInformation();
+  if (vtkSMPropertyHelper(surface, "PicksDone").GetAsInt() == done)
+  {
+    this->View->forceRender(); // no frame drawn yet
+    surface->UpdatePropertyInformation();
+  }
   vtkSMPropertyHelper(surface, "PickAt").Set(0, -1);
   vtkSMPropertyHelper(surface, "PickAt").Set(1, -1);
   surface->UpdateVTKObjects();
-  surface->UpdatePropertyInformation();
+  std::vector<double> corners;
+  const QString text = Describe(surface, corners);
+  vtkLogF(TRACE, "multiresolution pick at (%d, %d): %s", at.x(), at.y(),
+    text.isEmpty() ? "nothing" : text.split('\n').first().toUtf8().constData());
+  if (select)
+  {
+    Select(this->View, text, corners);
+  }
+  return text;
+}
+
+QString pqMultiresolutionInspectActions::Describe(vtkSMProxy* surface, std::vector<double>& corners)
+{
+  corners.clear();
   int cell[3] = { 0, 0, 0 };
   vtkSMPropertyHelper(surface, "PickedCell").Get(cell, 3);
-  QString text;
-  std::vector<double> corners(24);
-  if (cell[0] > 0)
+  if (cell[0] <= 0)
   {
-    const int active = vtkSMPropertyHelper(surface, "PickedActive").GetAsInt();
+    return QString();
+  }
+  const int active = vtkSMPropertyHelper(surface, "PickedActive").GetAsInt();
+  QString text = tr("Cell I %1, J %2, K %3 (%4)")
+                   .arg(cell[0])
+                   .arg(cell[1])
+                   .arg(cell[2])
+                   .arg(active > 0   ? tr("active")
+                       : active == 0 ? tr("inactive")
+                                     : tr("no active cell in its column"));
+  if (active >= 0)
+  {
+    corners.resize(24);
     vtkSMPropertyHelper(surface, "PickedCorners").Get(corners.data(), 24);
     double depth = 0;
     for (int c = 0; c < 8; ++c)
     {
       depth -= corners[3 * c + 2] / 8;
     }
-    text = tr("Cell I %1, J %2, K %3 (%4)")
-             .arg(cell[0])
-             .arg(cell[1])
-             .arg(cell[2])
-             .arg(active > 0   ? tr("active")
-                 : active == 0 ? tr("inactive")
-                               : tr("no active cell in its column"));
-    if (active >= 0)
-    {
-      text += "\n" + tr("Depth %1").arg(depth, 0, 'f', 2);
-    }
-    for (const QString& line : ValueLines(surface))
-    {
-      text += "\n" + QString(line).replace("=", " = ");
-    }
+    text += "\n" + tr("Depth %1").arg(depth, 0, 'f', 2);
   }
-  vtkLogF(TRACE, "multiresolution pick at (%d, %d): %s", at.x(), at.y(),
-    text.isEmpty() ? "nothing" : text.split('\n').first().toUtf8().constData());
-  if (select)
+  for (const QString& line : ValueLines(surface))
   {
-    Selected = text;
-    this->Outline(cell[0] > 0 && std::isfinite(corners[0]) ? corners : std::vector<double>());
+    text += "\n" + QString(line).replace("=", " = ");
   }
   return text;
 }
 
-void pqMultiresolutionInspectActions::Outline(const std::vector<double>& corners)
+void pqMultiresolutionInspectActions::Select(
+  pqRenderView* view, const QString& text, const std::vector<double>& corners)
 {
+  vtkLogF(TRACE, "multiresolution selected: %s", text.isEmpty() ? "nothing" : text.toUtf8().constData());
+  Selected = text;
   // The selected cell's edges as a poly-line source, replaced at each selection.
   pqServer* server = pqActiveObjects::instance().activeServer();
-  if (!server || !this->View)
+  if (!server || !view)
   {
     return;
   }
@@ -234,9 +254,9 @@ void pqMultiresolutionInspectActions::Outline(const std::vector<double>& corners
   {
     controller->UnRegisterProxy(old);
   }
-  if (corners.empty())
+  if (corners.size() != 24 || !std::isfinite(corners[0]))
   {
-    this->View->render();
+    view->render();
     return;
   }
   static const int path[16] = { 0, 1, 3, 2, 0, 4, 5, 7, 6, 4, 5, 1, 3, 7, 6, 2 }; // every edge
@@ -256,7 +276,7 @@ void pqMultiresolutionInspectActions::Outline(const std::vector<double>& corners
   controller->PostInitializeProxy(line);
   controller->RegisterPipelineProxy(line, OutlineName);
   vtkSMProxy* shown =
-    controller->Show(vtkSMSourceProxy::SafeDownCast(line), 0, vtkSMViewProxy::SafeDownCast(this->View->getProxy()));
+    controller->Show(vtkSMSourceProxy::SafeDownCast(line), 0, vtkSMViewProxy::SafeDownCast(view->getProxy()));
   if (shown)
   {
     const double red[3] = { 1.0, 0.1, 0.1 };
@@ -265,5 +285,5 @@ void pqMultiresolutionInspectActions::Outline(const std::vector<double>& corners
     vtkSMPropertyHelper(shown, "LineWidth").Set(3.0);
     shown->UpdateVTKObjects();
   }
-  this->View->render();
+  view->render();
 }

@@ -32,6 +32,11 @@ public:
 
   /// The text the last click selected (empty: none), for the readout dock.
   static QString SelectedText();
+  /// The last pick or inspection of `surface` as text (empty: nothing picked), and the cell's
+  /// corners (24 values, world; empty when unknown).
+  static QString Describe(vtkSMProxy* surface, std::vector<double>& corners);
+  /// Selects: `text` becomes SelectedText, and `corners` (if any) are outlined in `view`.
+  static void Select(pqRenderView* view, const QString& text, const std::vector<double>& corners);
 
 private Q_SLOTS:
   void setOn(bool on);
@@ -44,7 +49,6 @@ private:
   void OnMouse(vtkObject* caller, unsigned long event, void*);
   /// Picks at display pixel `at` of the view; the tooltip text, empty over no cell.
   QString Pick(const QPoint& at, bool select);
-  void Outline(const std::vector<double>& corners);
 
   QAction* Inspect;
   QPointer<pqRenderView> View;

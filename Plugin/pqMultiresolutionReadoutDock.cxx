@@ -6,12 +6,22 @@
 #include "pqActiveObjects.h"
 #include "pqDataRepresentation.h"
 #include "pqPipelineSource.h"
+#include "pqRenderView.h"
 #include "pqView.h"
 #include "vtkLogger.h"
+#include "vtkSMPropertyHelper.h"
+#include "vtkSMProxy.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
 
 #include <QFormLayout>
+#include <QHBoxLayout>
 #include <QLabel>
 #include <QLocale>
+#include <QPushButton>
+#include <QSpinBox>
 #include <QVBoxLayout>
 
 pqMultiresolutionReadoutDock::pqMultiresolutionReadoutDock(QWidget* parent)
@@ -51,6 +61,25 @@ pqMultiresolutionReadoutDock::pqMultiresolutionReadoutDock(QWidget* parent)
   this->Error->setStyleSheet("color: #c0392b;");
   this->Error->setTextInteractionFlags(Qt::TextSelectableByMouse);
   layout->addWidget(this->Error);
+  // Go to cell: ECLIPSE's I, J, K.
+  auto* go = new QWidget(body);
+  auto* goRow = new QHBoxLayout(go);
+  goRow->setContentsMargins(0, 0, 0, 0);
+  const char* names[3] = { "I", "J", "K" };
+  for (int a = 0; a < 3; ++a)
+  {
+    goRow->addWidget(new QLabel(names[a], go));
+    this->Cell[a] = new QSpinBox(go);
+    this->Cell[a]->setRange(1, 1 << 30);
+    this->Cell[a]->setObjectName(QString("GoTo%1").arg(names[a]));
+    goRow->addWidget(this->Cell[a], 1);
+  }
+  auto* button = new QPushButton(tr("Go to cell"), go);
+  button->setObjectName("GoToCell");
+  button->setToolTip(tr("Fly the camera to cell I, J, K (ECLIPSE's, from 1) and select it"));
+  QObject::connect(button, &QPushButton::clicked, this, &pqMultiresolutionReadoutDock::goToCell);
+  goRow->addWidget(button);
+  layout->addWidget(go);
   this->Selected = new QLabel(body);
   this->Selected->setWordWrap(true);
   this->Selected->setTextInteractionFlags(Qt::TextSelectableByMouse);
@@ -149,4 +178,62 @@ void pqMultiresolutionReadoutDock::updateReadout()
   vtkLogF(TRACE, "multiresolution readout: %.2f px, %.1f MB, %.0f triangles, %d regions, %d substituted, %s",
     readout.Tolerance, readout.ResidentMB, readout.Triangles, readout.Regions, readout.Substituted,
     readout.LoadsPending ? "pending" : "idle");
+}
+
+void pqMultiresolutionReadoutDock::goToCell()
+{
+  auto* view = qobject_cast<pqRenderView*>(this->View.data());
+  vtkSMProxy* surface = nullptr;
+  for (int i = 0; view && !surface && i < view->getNumberOfRepresentations(); ++i)
+  {
+    surface = pqMultiresolutionReadout::Surface(view->getRepresentation(i), true);
+  }
+  if (!surface)
+  {
+    return;
+  }
+  // Described at once from the files (InspectCell), where the surface renders.
+  vtkSMPropertyHelper(surface, "InspectCell").Set(0, this->Cell[0]->value());
+  vtkSMPropertyHelper(surface, "InspectCell").Set(1, this->Cell[1]->value());
+  vtkSMPropertyHelper(surface, "InspectCell").Set(2, this->Cell[2]->value());
+  surface->UpdateVTKObjects();
+  surface->UpdatePropertyInformation();
+  const int zero[3] = { 0, 0, 0 };
+  vtkSMPropertyHelper(surface, "InspectCell").Set(zero, 3);
+  surface->UpdateVTKObjects();
+  std::vector<double> corners;
+  const QString text = pqMultiresolutionInspectActions::Describe(surface, corners);
+  if (corners.size() == 24 && std::isfinite(corners[0]))
+  {
+    // The cell's centre becomes the focal point, seen from the camera's direction at 25 times
+    // the cell's size.
+    double centre[3] = { 0, 0, 0 }, low[3], high[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      low[a] = high[a] = corners[a];
+      for (int c = 0; c < 8; ++c)
+      {
+        centre[a] += corners[3 * c + a] / 8;
+        low[a] = std::min(low[a], corners[3 * c + a]);
+        high[a] = std::max(high[a], corners[3 * c + a]);
+      }
+    }
+    const double size = std::max({ high[0] - low[0], high[1] - low[1], high[2] - low[2] });
+    vtkSMProxy* camera = view->getProxy();
+    double position[3], focal[3];
+    vtkSMPropertyHelper(camera, "CameraPosition").Get(position, 3);
+    vtkSMPropertyHelper(camera, "CameraFocalPoint").Get(focal, 3);
+    const double along[3] = { position[0] - focal[0], position[1] - focal[1], position[2] - focal[2] };
+    const double length = std::sqrt(along[0] * along[0] + along[1] * along[1] + along[2] * along[2]);
+    for (int a = 0; a < 3; ++a)
+    {
+      position[a] = centre[a] + (length > 0 ? along[a] / length : (a == 2 ? 1.0 : 0.0)) * 25 * size;
+    }
+    vtkSMPropertyHelper(camera, "CameraFocalPoint").Set(centre, 3);
+    vtkSMPropertyHelper(camera, "CameraPosition").Set(position, 3);
+    vtkSMPropertyHelper(camera, "CenterOfRotation").Set(centre, 3);
+    camera->UpdateVTKObjects();
+  }
+  pqMultiresolutionInspectActions::Select(view, text, corners);
+  this->Update.start();
 }

@@ -9,6 +9,7 @@
 #include <QTimer>
 
 class QLabel;
+class QSpinBox;
 class pqView;
 
 class pqMultiresolutionReadoutDock : public QDockWidget
@@ -23,6 +24,8 @@ public:
 private Q_SLOTS:
   void setView(pqView* view);
   void updateReadout();
+  /// The camera to the cell of the I, J, K boxes, which is selected (outlined, kept here).
+  void goToCell();
 
 private:
   Q_DISABLE_COPY(pqMultiresolutionReadoutDock)
@@ -37,7 +40,8 @@ private:
   QLabel* Frame;
   QLabel* Loads;
   QLabel* Error;
-  QLabel* Selected; ///< the cell the Inspect Cells action last selected
+  QLabel* Selected;  ///< the cell the Inspect Cells action last selected
+  QSpinBox* Cell[3]; ///< I, J, K for goToCell
   QWidget* Values;
 };
 

@@ -50,27 +50,35 @@ def _result(display):
             "point": point, "depth": -centre[2], "centre": centre, "corners": corners, "values": values}
 
 
+def _ask(view, display, name, value, nothing):
+    """Sets `name` to `value` (answered at once from the last frame drawn), then back to
+    `nothing`, so the same question can be asked again; renders once when no frame has been
+    drawn yet (PicksDone unchanged)."""
+    display.UpdatePropertyInformation()
+    done = display.GetPropertyValue("PicksDone")
+    setattr(display, name, value)
+    display.UpdatePropertyInformation()
+    if display.GetPropertyValue("PicksDone") == done:
+        simple.Render(view)
+    setattr(display, name, nothing)
+    return _result(display)
+
+
 def PickCell(x, y, view=None, display=None):
     """The original cell under display pixel (x, y) of `view` (the active view by default): a
     dict with I, J, K (from 1), active (None when unknown), point (the surface point picked),
     depth (of the cell's centre, positive down), centre, corners (eight (x, y, z), ECLIPSE's
     order, from the finest level) and values ({array: value} at the view's time; NaN where the
-    cell has none); None over the background. Renders the view once."""
+    cell has none); None over the background. The pick is made in the last frame drawn (what
+    the user sees), with no new render."""
     view, display = _surface(view, display)
-    display.PickAt = [x, y]
-    simple.Render(view)
-    display.PickAt = [-1, -1]  # so that the same pixel can be picked again
-    return _result(display)
+    return _ask(view, display, "PickAt", [x, y], [-1, -1])
 
 
 def InspectCell(i, j, k, view=None, display=None):
-    """What PickCell returns, for cell (I, J, K) (from 1), with no pixel: point is its centre.
-    Renders the view once."""
+    """What PickCell returns, for cell (I, J, K) (from 1), with no pixel: point is its centre."""
     view, display = _surface(view, display)
-    display.InspectCell = [i, j, k]
-    simple.Render(view)
-    display.InspectCell = [0, 0, 0]
-    return _result(display)
+    return _ask(view, display, "InspectCell", [i, j, k], [0, 0, 0])
 
 
 def SelectCell(i, j, k, view=None, display=None, color=(1.0, 0.1, 0.1)):
@@ -111,3 +119,23 @@ def GoToCell(i, j, k, view=None, display=None, distance=None):
     view.CenterOfRotation = list(centre)
     simple.Render(view)
     return cell
+
+
+def GoToPoint(x, y, depth, view=None, display=None, distance=None):
+    """Flies the camera to map point (x, y) at `depth` (positive down; world coordinates as the
+    view shows them), from the camera's direction at `distance` (default: the camera's
+    distance now), and selects the cell the view then shows at its centre: the surface's cell
+    there, in front of the point when the point lies inside the model. Returns that cell's
+    dict, or None when the centre shows the background."""
+    view, display = _surface(view, display)
+    camera = view.GetActiveCamera()
+    direction = camera.GetDirectionOfProjection()
+    distance = distance or camera.GetDistance()
+    focal = (x, y, -depth)
+    camera.SetFocalPoint(focal)
+    camera.SetPosition([focal[a] - distance * direction[a] for a in range(3)])
+    view.CenterOfRotation = list(focal)
+    simple.Render(view)
+    width, height = view.ViewSize
+    cell = PickCell(width // 2, height // 2, view, display)
+    return None if cell is None else SelectCell(cell["I"], cell["J"], cell["K"], view, display)

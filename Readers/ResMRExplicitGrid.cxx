@@ -76,7 +76,6 @@ CellOrder BuildExplicitGrid(const resmr::CornerPointGeometry& geometry, const st
   grid->SetExtent(0, static_cast<int>(nx), 0, static_cast<int>(ny), 0, static_cast<int>(nz));
   grid->SetPoints(points);
   grid->SetCells(cells);
-  grid->ComputeFacesConnectivityFlagsArray();
 
   vtkNew<vtkIntArray> iArray, jArray, kArray, actnumArray;
   iArray->SetName("I");
@@ -111,6 +110,9 @@ CellOrder BuildExplicitGrid(const resmr::CornerPointGeometry& geometry, const st
   {
     cellData->AddArray(ghosts);
   }
+  // After I, J, K: ParaView's hover and spreadsheet list a cell's arrays in this order, and an
+  // engineer reads ECLIPSE's I, J, K first.
+  grid->ComputeFacesConnectivityFlagsArray();
   return order;
 }
 

@@ -39,6 +39,7 @@
 #include "vtkScalarsToColors.h"
 #include "vtkShaderProgram.h"
 #include "vtkStringArray.h"
+#include "vtkWeakPointer.h"
 #include "vtk_glew.h"
 
 #include <algorithm>
@@ -48,6 +49,7 @@
 #include <cstdio>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
@@ -180,6 +182,11 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   std::array<double, 2> PickPixel{};
   bool InspectPending = false;
   std::array<int64_t, 3> Inspect{}; ///< I, J, K from 1
+  int PicksDone = 0;                ///< picks and inspections answered, for scripts
+  /// The last frame drawn, which a pick between frames draws again (PickFromLastFrame).
+  std::unique_ptr<Frame> Last;
+  vtkWeakPointer<vtkRenderer> LastRenderer;
+  vtkWeakPointer<vtkActor> LastActor;
   struct Picked
   {
     std::array<int, 3> cell{ 0, 0, 0 }; ///< I, J, K from 1; 0: nothing
@@ -312,13 +319,38 @@ void vtkMultiresolutionSurfaceMapper::PickAt(double x, double y)
 {
   this->Internal->PickPending = x >= 0 && y >= 0;
   this->Internal->PickPixel = { x, y };
-  this->Modified();
+  this->PickFromLastFrame();
 }
 void vtkMultiresolutionSurfaceMapper::InspectCell(int i, int j, int k)
 {
   this->Internal->InspectPending = i > 0 && j > 0 && k > 0;
   this->Internal->Inspect = { i, j, k };
-  this->Modified();
+  this->PickFromLastFrame();
+}
+int vtkMultiresolutionSurfaceMapper::GetPicksDone() const
+{
+  return this->Internal->PicksDone;
+}
+
+void vtkMultiresolutionSurfaceMapper::PickFromLastFrame()
+{
+  // A pick needs no new frame: the last one's cut, camera and window, drawn once more into one
+  // pixel (a hover over a large model would otherwise wait for a whole frame). Without a last
+  // frame (or its renderer gone) the next render picks.
+  Internals& in = *this->Internal;
+  if (!(in.PickPending || in.InspectPending) || !in.Last || !in.LastRenderer || !in.LastActor || !in.Window ||
+    !in.File || in.Last->window != in.Window)
+  {
+    return;
+  }
+  in.Window->MakeCurrent();
+  Frame frame = *in.Last;
+  this->PickCell(frame);
+}
+
+void vtkMultiresolutionSurfaceMapper::ForgetLastFrame()
+{
+  this->Internal->Last.reset();
 }
 const int* vtkMultiresolutionSurfaceMapper::GetPickedCell() const
 {
@@ -373,6 +405,7 @@ double* vtkMultiresolutionSurfaceMapper::GetBounds()
 void vtkMultiresolutionSurfaceMapper::ReleaseGraphicsResources(vtkWindow* window)
 {
   Internals& in = *this->Internal;
+  in.Last.reset();
   in.ReleaseGpu();
   in.Tables.ReleaseGraphicsResources(window);
   in.Timer.Release();
@@ -463,6 +496,9 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     in.Reduced.End(frame.window);
   }
   this->PickCell(frame);
+  in.Last = std::make_unique<Frame>(frame);
+  in.LastRenderer = frame.renderer;
+  in.LastActor = frame.actor;
   this->FinishFrame(frame);
 }
 
@@ -1003,6 +1039,7 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
     {
       this->DescribeCell(frame, cell, nullptr);
     }
+    ++in.PicksDone;
   }
   if (!in.PickPending)
   {
@@ -1010,6 +1047,7 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
   }
   in.PickPending = false;
   in.Pick = Internals::Picked();
+  ++in.PicksDone;
   int width = 0, height = 0, x0 = 0, y0 = 0;
   frame.renderer->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
   const double x = std::floor(in.PickPixel[0]) - x0, y = std::floor(in.PickPixel[1]) - y0;
@@ -1017,8 +1055,17 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
   {
     return;
   }
-  // The frame's cut once more, into the one pixel; the readout keeps the frame's own counts.
+  // The frame's cut once more, into the one pixel: only the regions whose boxes may cover it
+  // (a handful; the whole cut would cost a frame's vertex work). The readout keeps the frame's
+  // own counts.
   const vtkIdType triangles = in.Triangles;
+  const std::vector<resmr::DrawnRegion> drawn = frame.selection.drawn;
+  const auto beside = [&](const resmr::DrawnRegion& region) {
+    return !resmr::BoxMayCoverPixel(
+      in.File->Regions()[region.region].bounds, frame.modelToClip, x + 0.5, y + 0.5, width, height);
+  };
+  frame.selection.drawn.erase(
+    std::remove_if(frame.selection.drawn.begin(), frame.selection.drawn.end(), beside), frame.selection.drawn.end());
   frame.colorMode = PickColors;
   frame.scale = 1;
   frame.program = this->ReadyProgram(frame, PickColors);
@@ -1032,6 +1079,7 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
     in.Picker.End(frame.window, rgba, depth);
   }
   in.Triangles = triangles;
+  frame.selection.drawn = drawn;
   std::array<int64_t, 3> cell{};
   if (!resmr::CellFromPickPixel(rgba, in.File->Header().dims, cell))
   {

@@ -143,16 +143,21 @@ public:
   const char* GetLastError() const;
 
   ///@{
-  /// Picking (ours): PickAt asks the next render to name the original cell whose colour shows
-  /// at display pixel (x, y) (VTK's display coordinates: pixels from the render window's lower
-  /// left corner; the pixel holding (x, y)). That render draws its own cut once more into
-  /// one pixel (resmr::CellFromPickPixel), so the answer is the cell painted there at whatever
-  /// level is drawn; the files then give its corners (the finest level's), whether it is
-  /// active and its values (resmr::CellInspection). A negative x asks for nothing.
+  /// Picking (ours): PickAt names the original cell whose colour shows at display pixel (x, y)
+  /// (VTK's display coordinates: pixels from the render window's lower left corner; the pixel
+  /// holding (x, y)) in the last frame drawn: its cut is drawn once more into one pixel
+  /// (resmr::CellFromPickPixel), at once, with no new frame, so the answer is the cell painted
+  /// there at whatever level was drawn; the files then give its corners (the finest level's),
+  /// whether it is active and its values (resmr::CellInspection). Before any frame, the next
+  /// render picks. A negative x asks for nothing.
   void PickAt(double x, double y);
-  /// Asks the next render to describe cell (I, J, K) (from 1) the same way, with no pixel: the
-  /// Picked* readouts then hold it, PickedPoint its centre. Any index below 1 asks for nothing.
+  /// Describes cell (I, J, K) (from 1) the same way, with no pixel: the Picked* readouts then
+  /// hold it, PickedPoint its centre. Any index below 1 asks for nothing.
   void InspectCell(int i, int j, int k);
+  /// Picks and inspections answered so far: a script that sees it unchanged renders once.
+  int GetPicksDone() const;
+  /// Forgets the last frame (its renderer is going away): picks then wait for a render.
+  void ForgetLastFrame();
   /// ECLIPSE's I, J, K (from 1) of the cell picked last; 0, 0, 0 when the pick hit nothing.
   const int* GetPickedCell() const;
   /// 1: the picked cell is active, 0: inactive, -1: unknown (nothing picked, or its column not
@@ -233,6 +238,8 @@ private:
   /// The pick PickAt asked for: the frame's cut drawn again into the picked pixel, then the
   /// cell read from the files.
   void PickCell(Frame& frame);
+  /// PickCell on the last frame drawn, when there is one.
+  void PickFromLastFrame();
   /// The Picked* readouts for `cell` (0-based), from the files; `near`: the model point picked.
   void DescribeCell(Frame& frame, const std::array<int64_t, 3>& cell, const std::array<double, 3>* near);
   /// Loads pending, errors, readout and the frame-rate controller.

@@ -152,6 +152,7 @@ bool vtkMultiresolutionSurfaceRepresentation::RemoveFromView(vtkView* view)
   vtkPVRenderView* renderView = vtkPVRenderView::SafeDownCast(view);
   if (renderView)
   {
+    this->Mapper->ForgetLastFrame();
     renderView->GetRenderer()->RemoveActor(this->Actor);
     return this->Superclass::RemoveFromView(view);
   }
@@ -324,6 +325,10 @@ void vtkMultiresolutionSurfaceRepresentation::PickAt(double x, double y)
 void vtkMultiresolutionSurfaceRepresentation::InspectCell(int i, int j, int k)
 {
   this->Mapper->InspectCell(i, j, k);
+}
+int vtkMultiresolutionSurfaceRepresentation::GetPicksDone()
+{
+  return this->Mapper->GetPicksDone();
 }
 int* vtkMultiresolutionSurfaceRepresentation::GetPickedCell()
 {

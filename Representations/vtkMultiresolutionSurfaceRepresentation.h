@@ -98,6 +98,7 @@ public:
   /// last pick found. The copies are the representation's, so the server's pull reads them.
   void PickAt(double x, double y);
   void InspectCell(int i, int j, int k);
+  int GetPicksDone();
   int* GetPickedCell() VTK_SIZEHINT(3);
   int GetPickedActive();
   double* GetPickedPoint() VTK_SIZEHINT(3);

@@ -4,6 +4,7 @@
 
 #include <lzo/lzo1x.h>
 
+#include <algorithm>
 #include <array>
 
 #include <cerrno>
@@ -31,7 +32,7 @@ void InitialiseLzo()
   });
 }
 
-std::vector<uint8_t> Decompress(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
+void CheckChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
 {
   if (ref.offset > size || ref.stored > size - ref.offset)
   {
@@ -46,6 +47,11 @@ std::vector<uint8_t> Decompress(const uint8_t* data, uint64_t size, const ChunkR
     throw FileFormatError(place + ": " + std::to_string(ref.stored) + " bytes cannot decompress to " +
       std::to_string(ref.raw) + " (corrupt)");
   }
+}
+
+std::vector<uint8_t> Decompress(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
+{
+  CheckChunk(data, size, ref, place);
   std::vector<uint8_t> raw(ref.raw);
   lzo_uint length = ref.raw;
   const int status = lzo1x_decompress_safe(data + ref.offset, ref.stored, raw.data(), &length, nullptr);
@@ -80,6 +86,35 @@ std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const C
 {
   InitialiseLzo();
   return Decompress(data, size, ref, place);
+}
+
+std::vector<uint8_t> DecompressChunkPrefix(
+  const uint8_t* data, uint64_t size, const ChunkRef& ref, uint64_t bytes, const std::string& place)
+{
+  InitialiseLzo();
+  if (bytes >= ref.raw)
+  {
+    return Decompress(data, size, ref, place);
+  }
+  CheckChunk(data, size, ref, place);
+  // LZO stops before a run that would pass the output's end, leaving what it wrote whole; the
+  // margin lets the run holding the last byte wanted finish, most of the time.
+  std::vector<uint8_t> raw(std::min<uint64_t>(ref.raw, bytes + PrefixMarginBytes));
+  lzo_uint length = raw.size();
+  const int status = lzo1x_decompress_safe(data + ref.offset, ref.stored, raw.data(), &length, nullptr);
+  const bool whole = status == LZO_E_OK && length == ref.raw;
+  if (whole || (status == LZO_E_OUTPUT_OVERRUN && length >= bytes))
+  {
+    raw.resize(bytes);
+    return raw;
+  }
+  if (status != LZO_E_OUTPUT_OVERRUN)
+  {
+    throw FileFormatError(place + ": does not decompress to its " + std::to_string(ref.raw) + " bytes");
+  }
+  raw = Decompress(data, size, ref, place); // a run longer than the margin
+  raw.resize(bytes);
+  return raw;
 }
 
 const uint8_t* MapReadOnlyFile(const std::string& path, uint64_t& size, int* keep)
@@ -141,8 +176,8 @@ void CloseDescriptor(int& descriptor)
   }
 }
 
-const uint8_t* MapOwnFile(const std::string& path, uint64_t minimumBytes, const char (&magic)[8], const std::string& kind,
-  const std::string& extension, uint64_t& size, int& descriptor)
+const uint8_t* MapOwnFile(const std::string& path, uint64_t minimumBytes, const char (&magic)[8],
+  const std::string& kind, const std::string& extension, uint64_t& size, int& descriptor)
 {
   const uint8_t* data = MapReadOnlyFile(path, size, &descriptor);
   std::string problem;

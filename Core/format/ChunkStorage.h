@@ -35,6 +35,14 @@ std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw);
 /// throws FileFormatError naming `place`.
 std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place);
 
+/// The first `bytes` bytes of a chunk once decompressed, with DecompressChunk's checks (the CRC
+/// over the whole stored chunk): LZO decodes front to back, so one value costs the chunk up to
+/// it (a picked cell's value in a layer table). The output buffer reaches PrefixMarginBytes
+/// past the bytes wanted.
+constexpr uint64_t PrefixMarginBytes = 1 << 16;
+std::vector<uint8_t> DecompressChunkPrefix(
+  const uint8_t* data, uint64_t size, const ChunkRef& ref, uint64_t bytes, const std::string& place);
+
 /// Maps a whole regular file read-only (nullptr for an empty one); throws
 /// FileFormatError naming the file. Release with UnmapFile. With `keep`, the file
 /// stays open and its descriptor is stored there (-1 if none; release with CloseDescriptor),
@@ -44,8 +52,8 @@ void UnmapFile(const uint8_t* data, uint64_t size);
 /// Maps one of this project's files as MapReadOnlyFile does (kept open, for CheckMappedSize)
 /// and checks that it holds at least `minimumBytes` and starts with `magic`; throws
 /// FileFormatError naming the file and the `kind` of file (e.g. "property", ".resmrp").
-const uint8_t* MapOwnFile(const std::string& path, uint64_t minimumBytes, const char (&magic)[8], const std::string& kind,
-  const std::string& extension, uint64_t& size, int& descriptor);
+const uint8_t* MapOwnFile(const std::string& path, uint64_t minimumBytes, const char (&magic)[8],
+  const std::string& kind, const std::string& extension, uint64_t& size, int& descriptor);
 void CloseDescriptor(int& descriptor);
 /// Throws FileFormatError naming the file if the open file is now shorter than the
 /// `size` bytes mapped: reading a page past its end would kill the process (SIGBUS). Called

@@ -360,6 +360,33 @@ std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
       std::to_string(t.layers[static_cast<std::size_t>(k)].offset));
 }
 
+float PropertyFile::ReadCell(std::size_t table, const std::array<int64_t, 3>& cell) const
+{
+  const PropertyTable& t = this->Entries.at(table);
+  for (int a = 0; a < 3; ++a)
+  {
+    if (cell[a] < 0 || cell[a] >= this->Dims[a])
+    {
+      throw std::out_of_range(this->FilePath + ": no cell (" + std::to_string(cell[0] + 1) + ", " +
+        std::to_string(cell[1] + 1) + ", " + std::to_string(cell[2] + 1) + ")");
+    }
+  }
+  const ChunkRef& ref = t.layers[static_cast<std::size_t>(cell[2])];
+  const uint64_t at = static_cast<uint64_t>(cell[0] + this->Dims[0] * cell[1]);
+  CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
+  const std::string place = this->FilePath + ": layer " + std::to_string(cell[2] + 1) + " of " + TableName(t) +
+    " at byte " + std::to_string(ref.offset);
+  if (ref.raw != static_cast<uint64_t>(this->Dims[0] * this->Dims[1]) * 4)
+  {
+    throw FileFormatError(place + ": " + std::to_string(ref.raw) + " bytes, " +
+      std::to_string(this->Dims[0] * this->Dims[1] * 4) + " expected");
+  }
+  const auto raw = DecompressChunkPrefix(this->Data, this->Size, ref, (at + 1) * 4, place);
+  float value = 0;
+  std::memcpy(&value, raw.data() + at * 4, 4);
+  return value;
+}
+
 PropertyFileWriter::PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry)
   : Output(new AtomicOutputFile(path))
   , Geometry(geometry.Header().geometryId)

@@ -23,6 +23,7 @@
 
 #include "MultiresolutionFile.h"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -69,6 +70,8 @@ public:
   std::vector<float> ReadPacked(std::size_t table) const;
   /// Layer k of the table (nx ny values).
   std::vector<float> ReadLayer(std::size_t table, int64_t k) const;
+  /// The value of cell (i, j, k) in the table: its layer's chunk decoded up to it only.
+  float ReadCell(std::size_t table, const std::array<int64_t, 3>& cell) const;
   /// The stored bytes of a chunk (for copying into a new file).
   const uint8_t* ChunkBytes(const ChunkRef& ref) const { return this->Data + ref.offset; }
 

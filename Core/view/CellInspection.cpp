@@ -1,11 +1,14 @@
 #include "CellInspection.h"
 
 #include "RegionMesh.h"
+#include "ThreadGroup.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <thread>
 
 namespace resmr
 {
@@ -127,18 +130,44 @@ bool ReadCell(const RegionMesh& mesh, const std::array<int64_t, 3>& cell, CellGe
 std::vector<CellValue> CellValues(const PropertyFile& properties, const std::array<int64_t, 3>& cell, int32_t step)
 {
   CheckCell(properties.Dimensions(), cell);
-  const std::size_t at = static_cast<std::size_t>(cell[0] + properties.Dimensions()[0] * cell[1]);
-  std::vector<CellValue> values;
+  std::vector<std::size_t> tables;
   for (int pass = 0; pass < 2; ++pass)
   {
     for (std::size_t t = 0; t < properties.Tables().size(); ++t)
     {
-      const PropertyTable& table = properties.Tables()[t];
-      if (pass == 0 ? table.step >= 0 : table.step != step)
+      const int32_t tableStep = properties.Tables()[t].step;
+      if (pass == 0 ? tableStep < 0 : tableStep == step)
       {
-        continue;
+        tables.push_back(t);
       }
-      values.push_back({ table.name, table.step, properties.ReadLayer(t, cell[2])[at] });
+    }
+  }
+  // One chunk a table, each checked whole (CRC) and decoded up to the cell: the tables on
+  // every core, so a pick answers while the cursor rests.
+  std::vector<CellValue> values(tables.size());
+  std::vector<std::string> errors(tables.size());
+  std::atomic<std::size_t> next{ 0 };
+  RunOnThreads(
+    static_cast<int>(std::min<std::size_t>(tables.size(), std::max(1u, std::thread::hardware_concurrency()))), [&] {
+      for (std::size_t n = next++; n < tables.size(); n = next++)
+      {
+        const PropertyTable& table = properties.Tables()[tables[n]];
+        values[n] = { table.name, table.step, 0 };
+        try
+        {
+          values[n].value = properties.ReadCell(tables[n], cell);
+        }
+        catch (const std::exception& error)
+        {
+          errors[n] = error.what();
+        }
+      }
+    });
+  for (const std::string& error : errors)
+  {
+    if (!error.empty())
+    {
+      throw FileFormatError(error);
     }
   }
   return values;
@@ -182,6 +211,36 @@ CellGeometry InspectCellGeometry(
     }
   }
   return out;
+}
+
+bool BoxMayCoverPixel(const std::array<float, 6>& bounds, const std::array<double, 16>& modelToClip, double x, double y,
+  double width, double height)
+{
+  double low[2] = { std::numeric_limits<double>::max(), std::numeric_limits<double>::max() };
+  double high[2] = { std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest() };
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    const double p[4] = { bounds[corner & 1 ? 3 : 0], bounds[corner & 2 ? 4 : 1], -double(bounds[corner & 4 ? 5 : 2]),
+      1 };
+    double clip[4];
+    for (int r = 0; r < 4; ++r)
+    {
+      clip[r] = modelToClip[4 * r] * p[0] + modelToClip[4 * r + 1] * p[1] + modelToClip[4 * r + 2] * p[2] +
+        modelToClip[4 * r + 3] * p[3];
+    }
+    if (!(clip[3] > 0))
+    {
+      return true; // behind the eye: its projection wraps
+    }
+    const double window[2] = { (clip[0] / clip[3] + 1) * width / 2, (clip[1] / clip[3] + 1) * height / 2 };
+    for (int a = 0; a < 2; ++a)
+    {
+      low[a] = std::min(low[a], window[a]);
+      high[a] = std::max(high[a], window[a]);
+    }
+  }
+  // A pixel of margin: the rasterizer's snapping and the box's float corners.
+  return x >= low[0] - 1 && x <= high[0] + 1 && y >= low[1] - 1 && y <= high[1] + 1;
 }
 
 bool CellFromPickPixel(

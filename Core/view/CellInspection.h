@@ -4,8 +4,9 @@
 // into one pixel, each fragment painting its cell as the Cell Id colouring finds it, so the
 // answer is exact at whatever level is drawn, with no search structure. What is then said of
 // the cell comes from the files, never from a whole-model array:
-// - its values: one layer chunk of each table of the property file, static arrays and the
-//   tables of the step (the layer tables hold NaN where a cell has no value);
+// - its values: one layer chunk of each table of the property file, decoded up to the cell,
+//   static arrays and the tables of the step (the layer tables hold NaN where a cell has no
+//   value);
 // - its eight corners and whether it is active: the column of the leaf region (the finest
 //   level, which keeps the original grid's corners) that holds it, found by the model point
 //   the pick hit or, without one, by the leaves' boxes around the column's place in a coarse
@@ -48,7 +49,7 @@ struct CellGeometry
 };
 
 /// Every table of `properties` for `cell` at report step `step` (static arrays first, then
-/// the step's, in file order). Reads one layer chunk a table.
+/// the step's, in file order). Decodes one layer chunk a table, up to the cell.
 std::vector<CellValue> CellValues(const PropertyFile& properties, const std::array<int64_t, 3>& cell, int32_t step);
 
 /// Most leaf regions read to find a column: the nearest boxes to where it stands.
@@ -59,6 +60,14 @@ constexpr std::size_t MaxLeavesSearched = 16;
 /// is placed from the coarsest region that holds it.
 CellGeometry InspectCellGeometry(
   const MultiresolutionFile& file, const std::array<int64_t, 3>& cell, const std::array<double, 3>* near = nullptr);
+
+/// Whether a region's box (RegionRecord::bounds: x, y, depth minima then maxima) may cover the
+/// pixel centred at window point (x, y) of a `width` x `height` viewport seen through the
+/// row-major `modelToClip` (z up): false only when its projection lies wholly beside the pixel
+/// (a box reaching behind the eye may cover anything). The pick pass draws only such regions:
+/// a handful, where the frame drew the whole cut.
+bool BoxMayCoverPixel(const std::array<float, 6>& bounds, const std::array<double, 16>& modelToClip, double x, double y,
+  double width, double height);
 
 /// The cell a pick pass painted in a pixel: its RGB holds i, j, k (0-based) as floats, its
 /// alpha 1; alpha 0 (nothing drawn there) or a value off the grid gives false.

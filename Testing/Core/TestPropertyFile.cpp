@@ -158,6 +158,12 @@ int CheckTables(const MultiresolutionFile& geometry, const PropertyFile& propert
       {
         wrong += !SameValue(values[static_cast<std::size_t>(c)], expected[static_cast<std::size_t>(k * layer + c)]);
       }
+      // One cell alone (its layer decoded up to it, a pick's read): the first, a middle, the last.
+      for (const int64_t c : { int64_t(0), layer / 2, layer - 1 })
+      {
+        const std::array<int64_t, 3> cell{ c % dims[0], c / dims[0], k };
+        wrong += !SameValue(properties.ReadCell(t, cell), values[static_cast<std::size_t>(c)]);
+      }
     }
     if (wrong)
     {
@@ -384,6 +390,17 @@ int main(int argc, char** argv)
   writeBytes(flipped);
   {
     const PropertyFile f(damaged);
+    resmr_testing::ExpectError<FileFormatError>("flipped chunk, one cell read",
+      [&] {
+        for (std::size_t t = 0; t < f.Tables().size(); ++t)
+        {
+          for (int64_t k = 0; k < 15; ++k)
+          {
+            f.ReadCell(t, { 0, 0, k });
+          }
+        }
+      },
+      { damaged, "checksum" });
     resmr_testing::ExpectError<FileFormatError>("flipped chunk",
       [&] {
         for (std::size_t t = 0; t < f.Tables().size(); ++t)

@@ -5,7 +5,8 @@ colouring, and the server's log (TRACE) shows it drew as many triangles as built
 The readout pulled in pvpython is the server's (vtkSMMultiresolutionSurfaceRepresentationProxy):
 triangles and regions equal the server's TRACE log of the same frame, resident MB > 0, and the
 tolerance is the one set (fixed, no target frame rate), at 0 px and at 12 px; LayerRange is
-the model's (0 to nk = 8)."""
+the model's (0 to nk = 8). Picks (resmr_inspect.PickCell) at 12 covered pixels name the same
+cells and PORO values through pvserver as builtin, each the cell the image shows there."""
 import re
 import os
 import socket
@@ -29,6 +30,19 @@ grid = os.path.join(temp, "faulted.EGRID")
 if not os.path.exists(path):
     subprocess.run([resmr, "synth", "60", "50", "8", "-o", grid, "--quiet"], check=True, capture_output=True)
     subprocess.run([resmr, "build", grid, "-o", path, "--quiet"], check=True, capture_output=True)
+if not os.path.exists(path + "p"):
+    subprocess.run([resmr, "add-properties", path, grid], check=True, capture_output=True)
+PICKED = []  # display pixels picked in both modes: the builtin image's covered pixels
+
+
+def picks(view, display):
+    """resmr_inspect.PickCell at each of PICKED: ((I, J, K), PORO) a pixel."""
+    import resmr_inspect
+    found = []
+    for x, y in PICKED:
+        cell = resmr_inspect.PickCell(x, y, view, display)
+        found.append(None if cell is None else ((cell["I"], cell["J"], cell["K"]), cell["values"].get("PORO")))
+    return found
 
 
 def render(name):
@@ -56,18 +70,28 @@ def render(name):
     image = os.path.join(temp, name + ".png")
     simple.SaveScreenshot(image, view, ImageResolution=[480, 360], TransparentBackground=0)
     readouts = [readout(display)]
+    if not PICKED:
+        pixels = cell_id_pixels(image)
+        covered = np.nonzero(pixels > 0)[0]
+        PICKED.extend((int(n % 480), int(n // 480)) for n in covered[:: max(1, len(covered) // 12)][:12])
+    picked = picks(view, display)
     # A coarser frame (fewer triangles): the readout must follow the frame just drawn.
     display.PixelTolerance = 12
     simple.Render(view)
     readouts.append(readout(display))
     error = readouts[0]["LastError"]
+    simple.Delete(reader)
+    simple.Delete(view)
+    return cell_id_pixels(image), readouts, error, picked
+
+
+def cell_id_pixels(image):
+    """The cell-id colouring of a saved image, one value a pixel, rows from the bottom."""
     reader_png = vtkPNGReader()
     reader_png.SetFileName(image)
     reader_png.Update()
     pixels = vtk_to_numpy(reader_png.GetOutput().GetPointData().GetScalars())[:, :3].astype(np.int64)
-    simple.Delete(reader)
-    simple.Delete(view)
-    return pixels[:, 0] + 256 * pixels[:, 1] + 65536 * pixels[:, 2], readouts, error
+    return pixels[:, 0] + 256 * pixels[:, 1] + 65536 * pixels[:, 2]
 
 
 def readout(display):
@@ -78,7 +102,7 @@ def readout(display):
 
 
 simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
-builtin, builtin_readouts, _ = render("builtin")
+builtin, builtin_readouts, _, builtin_picks = render("builtin")
 builtin_triangles = builtin_readouts[0]["TrianglesDrawn"]
 print(f"builtin: {int(np.sum(builtin > 0))} pixels covered, {builtin_triangles:.0f} triangles")
 
@@ -108,7 +132,7 @@ try:
     simple.Connect("localhost", port)
     simple.LoadPlugin(args.plugin, remote=True, ns=vars(simple))
     simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
-    remote, remote_readouts, error = render("server")
+    remote, remote_readouts, error, remote_picks = render("server")
     simple.Disconnect()
 finally:
     server.terminate()
@@ -152,4 +176,11 @@ if not remote_readouts[1]["TrianglesDrawn"] < remote_readouts[0]["TrianglesDrawn
 for a, b in zip(builtin_readouts, remote_readouts):
     if a["TrianglesDrawn"] != b["TrianglesDrawn"] or a["RegionsDrawn"] != b["RegionsDrawn"]:
         rt.fail(f"server readout {b} differs from builtin {a}")
+# Picks: the same cells and values through pvserver as builtin, each the image's cell there.
+for (x, y), a, b in zip(PICKED, builtin_picks, remote_picks):
+    index = int(builtin[y * 480 + x]) - 1
+    shown = (index % 60 + 1, index // 60 % 50 + 1, index // 3000 + 1)
+    if a is None or b != a or a[0] != shown or a[1] is None:
+        rt.fail(f"pick at ({x}, {y}): builtin {a}, server {b}, the image shows {shown}")
+print(f"{len(PICKED)} picks name the same cells and values through pvserver as builtin")
 print("Multiresolution Surface renders through pvserver; its readout is the server's")

@@ -1,6 +1,6 @@
 """Multiresolution Surface in the ParaView GUI (issue 7, points 3 and 4). `paraview` opens a
-generated .resmr from a startup script that renders it once; nothing touches the GUI after
-that. The first frame draws the roots only and leaves meshes loading, so:
+generated .resmr from a startup script that renders it once; nothing touches the GUI until
+it settles. The first frame draws the roots only and leaves meshes loading, so:
 - the plugin's refresh manager must ask for another render and its timer must fire and bring
   a frame (no input);
 - the frames after the first must draw more regions (ParaView itself renders a few times
@@ -9,13 +9,17 @@ that. The first frame draws the roots only and leaves meshes loading, so:
 - the view must end complete (no region standing in for a finer one, loads idle) and the GUI
   idle: no frame for 3 s, so no render loop;
 - the Multiresolution Readout dock must show the last frame (its triangles and regions,
-  resident MB > 0, the fixed 1 px tolerance).
+  resident MB > 0, the fixed 1 px tolerance);
+- Inspect Cells (toolbar Reservoir Inspect, Ctrl+Shift+I), driven with xdotool: resting the
+  pointer on the model picks the cell under it (the tooltip's text, logged), and a click there
+  selects the same cell (outlined, kept in the dock).
 Frames, refreshes and dock updates are read from the GUI's TRACE log. A screenshot of the
 whole screen is kept (Temporary/gui/gui.png). Skipped without a paraview executable or an X
 display."""
 import ctypes
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -133,6 +137,43 @@ def screenshot(name):
     print(f"screenshot: {name}")
 
 
+PICKED = re.compile(r"multiresolution pick at \((\d+), (\d+)\): Cell I (\d+), J (\d+), K (\d+)")
+SELECTED = re.compile(r"multiresolution selected: Cell I (\d+), J (\d+), K (\d+)")
+
+
+def log_matches(pattern):
+    with open(trace, errors="replace") as log:
+        return [m for m in (pattern.search(line) for line in log) if m]
+
+
+def inspect_cells():
+    """Inspect Cells on (Ctrl+Shift+I, with the pointer over the window: no window manager, so
+    the focus follows it), the pointer rested on points of the screen until one shows a cell in
+    the tooltip's pick, then a click there: (hover picks, selections) from the log."""
+    xdotool = shutil.which("xdotool")
+    if not xdotool:
+        rt.fail("xdotool is needed to drive the GUI (make test installs it)")
+    run = lambda *a: subprocess.run([xdotool, *a], check=True, capture_output=True)  # noqa: E731
+    run("mousemove", "640", "400")
+    time.sleep(0.5)
+    run("key", "ctrl+shift+i")
+    time.sleep(0.5)
+    for x, y in ((640, 400), (600, 360), (700, 450), (520, 300), (760, 500), (450, 420), (820, 380)):
+        run("mousemove", str(x), str(y))
+        deadline = time.time() + 5
+        while time.time() < deadline and not [m for m in log_matches(PICKED)]:
+            time.sleep(0.2)
+        if log_matches(PICKED):
+            break
+    if log_matches(PICKED):
+        run("click", "1")
+        deadline = time.time() + 5
+        while time.time() < deadline and not log_matches(SELECTED):
+            time.sleep(0.2)
+        time.sleep(1.0)
+    return log_matches(PICKED), log_matches(SELECTED)
+
+
 try:
     # Until the dock shows an idle readout of the last frame and no frame comes for 3 s.
     deadline = time.time() + 120
@@ -152,6 +193,8 @@ try:
             rt.fail(f"the GUI did not settle in 120 s: {frames[-5:]}, {readouts[-3:]}")
         time.sleep(0.25)
     screenshot(os.path.join(temp, "gui.png"))
+    inspected = inspect_cells()
+    screenshot(os.path.join(temp, "gui-inspect.png"))
 finally:
     gui.send_signal(signal.SIGTERM)
     try:
@@ -188,3 +231,11 @@ if (readout[3], readout[4]) != (last[2], last[1]) or not readout[2] > 0 or reado
         or readout[5] != 0 or readout[6] != "idle":
     rt.fail(f"the dock does not show a complete last frame ({last[1]} regions, {last[2]} triangles): {readout}")
 print("the refresh manager rendered with no input; the GUI went idle and the dock shows the last frame")
+hovered, selected = inspected
+print(f"Inspect Cells: {len(hovered)} hover picks, the first at {hovered[0].group(1, 2) if hovered else None}: "
+      f"{hovered[0].group(3, 4, 5) if hovered else None}; selected {[m.group(1, 2, 3) for m in selected]}")
+if not hovered or not selected or selected[-1].group(1, 2, 3) != hovered[-1].group(3, 4, 5):
+    rt.fail("Inspect Cells: no hover pick named a cell, or the click did not select the cell hovered")
+after = [e for e in events() if e[0] == "readout"]
+if not after:
+    rt.fail("no readout after the selection")

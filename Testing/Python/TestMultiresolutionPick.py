@@ -15,9 +15,11 @@ from the side, 100 random covered pixels a camera (200 a model and tolerance):
   (the finest level's, whatever is drawn), and the point picked at 0 px lies within them
   where stock shows the same cell;
 - a pick on the background names nothing;
+- stock grids (EGRIDReader, GRDECLReader) list I, J, K first among their cell arrays, as
+  ParaView's hover shows them;
 - resmr_inspect.InspectCell(I, J, K) gives EGRIDReader's corners and values for random top
   cells, and GoToCell puts the cell at the view's centre (a pick there names it) and outlines
-  it (the 'Selected Cell' source).
+  it (the 'Selected Cell' source); GoToPoint on the middle of its top face selects it.
 Images of failures are left in the temporary folder."""
 import os
 
@@ -95,6 +97,9 @@ for name, grid_path in models():
     grid = servermanager.Fetch(stock_reader, arg1=None, arg2=None, idx=0)
     dims = tuple(int(vtk_to_numpy(grid.GetCellData().GetArray(a)).max()) for a in ("I", "J", "K"))
     rows, points, cells = stock_cells(grid)
+    first = [grid.GetCellData().GetArrayName(n) for n in range(3)]
+    if first != ["I", "J", "K"]:
+        failures.append(f"{name}: EGRIDReader's first cell arrays are {first}, not I, J, K (hover lists them so)")
     # The file keeps corners within a millionth of the model's extent (float32).
     extent = float(np.linalg.norm(np.ptp(points, axis=0)))
     ids = rt.stock_cell_id_filter(stock_reader, dims)
@@ -214,6 +219,12 @@ for name, grid_path in models():
             failures.append(f"{name}: after GoToCell({i}, {j}, {k}) the view's centre is not the cell")
         if outline is None or len(outline.Points) != 48:
             failures.append(f"{name}: GoToCell({i}, {j}, {k}) left no outline of the cell")
+        # GoToPoint: the middle of the cell's top face (map x, y and its depth) selects it.
+        top = np.array(inspected["corners"][:4]).mean(axis=0)
+        at = resmr_inspect.GoToPoint(float(top[0]), float(top[1]), float(-top[2]), view, ours)
+        if at is None or (at["I"], at["J"], at["K"]) != (i, j, k):
+            failures.append(f"{name}: GoToPoint on the top of ({i}, {j}, {k}) selected "
+                            f"{None if at is None else (at['I'], at['J'], at['K'])}")
     simple.Delete(simple.FindSource("Selected Cell"))
     print(f"{name}: values compared with EGRIDReader on {valued} picks")
     if valued < 100:
@@ -223,6 +234,13 @@ for name, grid_path in models():
     simple.Delete(stock)
     simple.Delete(ids)
     simple.Delete(stock_reader)
+
+# Stock grids: GRDECLReader's cells list I, J, K first too (ParaView's hover shows arrays in order).
+deck = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "Data", "demo_faulted_dome.grdecl")
+first = [rt.read_grid(deck)[1].GetCellData().GetArrayName(n) for n in range(3)]
+print(f"GRDECLReader's first cell arrays: {first}")
+if first != ["I", "J", "K"]:
+    failures.append(f"GRDECLReader's first cell arrays are {first}, not I, J, K")
 
 if failures:
     for failure in failures[:40]:
