@@ -3,6 +3,7 @@
 #include "pqMultiresolutionReadout.h"
 
 #include "pqActiveObjects.h"
+#include "pqPipelineSource.h"
 #include "pqRenderView.h"
 #include "pqServer.h"
 #include "vtkCommand.h"
@@ -91,6 +92,7 @@ QString pqMultiresolutionInspectActions::SelectedText()
 
 void pqMultiresolutionInspectActions::setOn(bool on)
 {
+  vtkLogF(TRACE, "multiresolution inspect cells: %s", on ? "on" : "off");
   this->Observe(false);
   this->View = on ? qobject_cast<pqRenderView*>(pqActiveObjects::instance().activeView()) : nullptr;
   this->Observe(on);
@@ -250,6 +252,9 @@ void pqMultiresolutionInspectActions::Select(
   }
   vtkSMSessionProxyManager* proxies = server->proxyManager();
   vtkNew<vtkSMParaViewPipelineControllerWithRendering> controller;
+  // The outline is no pipeline step of the user's: the active source stays what it was.
+  pqActiveObjects& active = pqActiveObjects::instance();
+  QPointer<pqPipelineSource> previous = active.activeSource();
   if (vtkSMProxy* old = proxies->GetProxy("sources", OutlineName))
   {
     controller->UnRegisterProxy(old);
@@ -284,6 +289,10 @@ void pqMultiresolutionInspectActions::Select(
     vtkSMPropertyHelper(shown, "DiffuseColor").Set(red, 3);
     vtkSMPropertyHelper(shown, "LineWidth").Set(3.0);
     shown->UpdateVTKObjects();
+  }
+  if (previous)
+  {
+    active.setActiveSource(previous);
   }
   view->render();
 }

@@ -1110,7 +1110,8 @@ void vtkMultiresolutionSurfaceMapper::DescribeCell(
   in.Pick.corners.fill(std::numeric_limits<double>::quiet_NaN());
   try
   {
-    const resmr::CellGeometry geometry = resmr::InspectCellGeometry(*in.File, cell, near);
+    const resmr::CellReport report = resmr::InspectCell(*in.File, in.Properties.get(), cell, frame.step, near);
+    const resmr::CellGeometry& geometry = report.geometry;
     in.Pick.active = geometry.found ? (geometry.active ? 1 : 0) : -1;
     for (std::size_t c = 0; geometry.found && c < 8; ++c)
     {
@@ -1125,10 +1126,7 @@ void vtkMultiresolutionSurfaceMapper::DescribeCell(
     {
       in.Pick.point = toWorld(geometry.Centre());
     }
-    if (in.Properties)
-    {
-      in.Pick.values = ValueLines(resmr::CellValues(*in.Properties, cell, frame.step));
-    }
+    in.Pick.values = ValueLines(report.values);
   }
   catch (const std::exception& error)
   {

@@ -32,13 +32,13 @@ void InitialiseLzo()
   });
 }
 
-void CheckChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place)
+void CheckChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place, bool verify = true)
 {
   if (ref.offset > size || ref.stored > size - ref.offset)
   {
     throw FileFormatError(place + ": lies outside the file");
   }
-  if (Crc32(data + ref.offset, ref.stored) != ref.crc)
+  if (verify && Crc32(data + ref.offset, ref.stored) != ref.crc)
   {
     throw FileFormatError(place + ": checksum mismatch (corrupt data)");
   }
@@ -89,30 +89,36 @@ std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const C
 }
 
 std::vector<uint8_t> DecompressChunkPrefix(
-  const uint8_t* data, uint64_t size, const ChunkRef& ref, uint64_t bytes, const std::string& place)
+  const uint8_t* data, uint64_t size, const ChunkRef& ref, uint64_t bytes, const std::string& place, bool verify)
 {
   InitialiseLzo();
-  if (bytes >= ref.raw)
+  if (bytes >= ref.raw && verify)
   {
     return Decompress(data, size, ref, place);
   }
-  CheckChunk(data, size, ref, place);
+  CheckChunk(data, size, ref, place, verify);
   // LZO stops before a run that would pass the output's end, leaving what it wrote whole; the
   // margin lets the run holding the last byte wanted finish, most of the time.
-  std::vector<uint8_t> raw(std::min<uint64_t>(ref.raw, bytes + PrefixMarginBytes));
+  std::vector<uint8_t> raw(std::min<uint64_t>(ref.raw, std::min<uint64_t>(bytes, ref.raw) + PrefixMarginBytes));
   lzo_uint length = raw.size();
   const int status = lzo1x_decompress_safe(data + ref.offset, ref.stored, raw.data(), &length, nullptr);
   const bool whole = status == LZO_E_OK && length == ref.raw;
   if (whole || (status == LZO_E_OUTPUT_OVERRUN && length >= bytes))
   {
-    raw.resize(bytes);
+    raw.resize(std::min<uint64_t>(bytes, ref.raw));
     return raw;
   }
   if (status != LZO_E_OUTPUT_OVERRUN)
   {
     throw FileFormatError(place + ": does not decompress to its " + std::to_string(ref.raw) + " bytes");
   }
-  raw = Decompress(data, size, ref, place); // a run longer than the margin
+  raw.assign(ref.raw, 0); // a run longer than the margin: the whole chunk
+  length = ref.raw;
+  if (lzo1x_decompress_safe(data + ref.offset, ref.stored, raw.data(), &length, nullptr) != LZO_E_OK ||
+    length != ref.raw)
+  {
+    throw FileFormatError(place + ": does not decompress to its " + std::to_string(ref.raw) + " bytes");
+  }
   raw.resize(bytes);
   return raw;
 }

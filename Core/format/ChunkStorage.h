@@ -36,12 +36,12 @@ std::vector<uint8_t> CompressChunk(const std::vector<uint8_t>& raw);
 std::vector<uint8_t> DecompressChunk(const uint8_t* data, uint64_t size, const ChunkRef& ref, const std::string& place);
 
 /// The first `bytes` bytes of a chunk once decompressed, with DecompressChunk's checks (the CRC
-/// over the whole stored chunk): LZO decodes front to back, so one value costs the chunk up to
-/// it (a picked cell's value in a layer table). The output buffer reaches PrefixMarginBytes
-/// past the bytes wanted.
+/// over the whole stored chunk, unless `verify` is false: a caller that checked this chunk
+/// already): LZO decodes front to back, so one value costs the chunk up to it (a picked cell's
+/// value in a layer table). The output buffer reaches PrefixMarginBytes past the bytes wanted.
 constexpr uint64_t PrefixMarginBytes = 1 << 16;
-std::vector<uint8_t> DecompressChunkPrefix(
-  const uint8_t* data, uint64_t size, const ChunkRef& ref, uint64_t bytes, const std::string& place);
+std::vector<uint8_t> DecompressChunkPrefix(const uint8_t* data, uint64_t size, const ChunkRef& ref, uint64_t bytes,
+  const std::string& place, bool verify = true);
 
 /// Maps a whole regular file read-only (nullptr for an empty one); throws
 /// FileFormatError naming the file. Release with UnmapFile. With `keep`, the file

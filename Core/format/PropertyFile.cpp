@@ -381,7 +381,17 @@ float PropertyFile::ReadCell(std::size_t table, const std::array<int64_t, 3>& ce
     throw FileFormatError(place + ": " + std::to_string(ref.raw) + " bytes, " +
       std::to_string(this->Dims[0] * this->Dims[1] * 4) + " expected");
   }
-  const auto raw = DecompressChunkPrefix(this->Data, this->Size, ref, (at + 1) * 4, place);
+  bool verified = false;
+  {
+    const std::lock_guard<std::mutex> lock(this->VerifiedLock);
+    verified = this->Verified.count(ref.offset) != 0;
+  }
+  const auto raw = DecompressChunkPrefix(this->Data, this->Size, ref, (at + 1) * 4, place, !verified);
+  if (!verified)
+  {
+    const std::lock_guard<std::mutex> lock(this->VerifiedLock);
+    this->Verified.insert(ref.offset);
+  }
   float value = 0;
   std::memcpy(&value, raw.data() + at * 4, 4);
   return value;

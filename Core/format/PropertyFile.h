@@ -26,7 +26,9 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -70,7 +72,9 @@ public:
   std::vector<float> ReadPacked(std::size_t table) const;
   /// Layer k of the table (nx ny values).
   std::vector<float> ReadLayer(std::size_t table, int64_t k) const;
-  /// The value of cell (i, j, k) in the table: its layer's chunk decoded up to it only.
+  /// The value of cell (i, j, k) in the table: its layer's chunk decoded up to it only, its CRC
+  /// checked the first time the chunk is read (later reads of it, a cursor resting on one
+  /// layer, decode only).
   float ReadCell(std::size_t table, const std::array<int64_t, 3>& cell) const;
   /// The stored bytes of a chunk (for copying into a new file).
   const uint8_t* ChunkBytes(const ChunkRef& ref) const { return this->Data + ref.offset; }
@@ -87,6 +91,8 @@ private:
   std::array<int64_t, 3> Dims{};
   std::array<uint32_t, 3> TableSides{};
   std::vector<PropertyTable> Entries;
+  mutable std::mutex VerifiedLock;
+  mutable std::unordered_set<uint64_t> Verified; ///< offsets of layer chunks whose CRC held (ReadCell)
 };
 
 /// Writes a .resmrp file for `geometry` under a temporary name; Commit() puts it in place.

@@ -6,9 +6,14 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <stdexcept>
 #include <thread>
+
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 namespace resmr
 {
@@ -211,6 +216,29 @@ CellGeometry InspectCellGeometry(
     }
   }
   return out;
+}
+
+CellReport InspectCell(const MultiresolutionFile& file, const PropertyFile* properties,
+  const std::array<int64_t, 3>& cell, int32_t step, const std::array<double, 3>* near)
+{
+  CellReport report;
+  {
+    std::future<std::vector<CellValue>> values;
+    if (properties)
+    {
+      values = std::async(std::launch::async, [&] { return CellValues(*properties, cell, step); });
+    }
+    report.geometry = InspectCellGeometry(file, cell, near); // the future joins if this throws
+    if (values.valid())
+    {
+      report.values = values.get();
+    }
+  }
+#ifdef __GLIBC__
+  // A layer chunk decoded is megabytes; freed, glibc keeps it in the threads' arenas.
+  malloc_trim(0);
+#endif
+  return report;
 }
 
 bool BoxMayCoverPixel(const std::array<float, 6>& bounds, const std::array<double, 16>& modelToClip, double x, double y,

@@ -52,6 +52,18 @@ struct CellGeometry
 /// the step's, in file order). Decodes one layer chunk a table, up to the cell.
 std::vector<CellValue> CellValues(const PropertyFile& properties, const std::array<int64_t, 3>& cell, int32_t step);
 
+/// What the viewer says of one cell: its geometry and, with a property file, its values.
+struct CellReport
+{
+  CellGeometry geometry;
+  std::vector<CellValue> values;
+};
+
+/// InspectCellGeometry and CellValues at once (the tables read on other threads while the leaf
+/// is), then the decoding buffers handed back to the system, so a pick leaves no memory behind.
+CellReport InspectCell(const MultiresolutionFile& file, const PropertyFile* properties,
+  const std::array<int64_t, 3>& cell, int32_t step, const std::array<double, 3>* near = nullptr);
+
 /// Most leaf regions read to find a column: the nearest boxes to where it stands.
 constexpr std::size_t MaxLeavesSearched = 16;
 

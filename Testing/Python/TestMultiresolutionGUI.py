@@ -147,18 +147,23 @@ def log_matches(pattern):
 
 
 def inspect_cells():
-    """Inspect Cells on (Ctrl+Shift+I, with the pointer over the window: no window manager, so
-    the focus follows it), the pointer rested on points of the screen until one shows a cell in
-    the tooltip's pick, then a click there: (hover picks, selections) from the log."""
+    """Inspect Cells on (Ctrl+Shift+I, the main window focused), the pointer rested on points
+    of the view until one shows a cell in the tooltip's pick, then a click there: (hover picks,
+    selections) from the log."""
     xdotool = shutil.which("xdotool")
     if not xdotool:
         rt.fail("xdotool is needed to drive the GUI (make test installs it)")
-    run = lambda *a: subprocess.run([xdotool, *a], check=True, capture_output=True)  # noqa: E731
-    run("mousemove", "640", "400")
+    run = lambda *a: subprocess.run([xdotool, *a], check=True, capture_output=True, text=True)  # noqa: E731
+    # The main window: focused by hand, as there is no window manager to do it.
+    window = run("search", "--onlyvisible", "--name", "ParaView").stdout.split()[0]
+    run("mousemove", "480", "450")
+    time.sleep(0.5)
+    run("windowfocus", "--sync", window)
     time.sleep(0.5)
     run("key", "ctrl+shift+i")
     time.sleep(0.5)
-    for x, y in ((640, 400), (600, 360), (700, 450), (520, 300), (760, 500), (450, 420), (820, 380)):
+    # Points of the view, which the default layout puts left of the readout dock.
+    for x, y in ((470, 440), (480, 470), (440, 420), (510, 400), (430, 490), (540, 460), (400, 380)):
         run("mousemove", str(x), str(y))
         deadline = time.time() + 5
         while time.time() < deadline and not [m for m in log_matches(PICKED)]:
