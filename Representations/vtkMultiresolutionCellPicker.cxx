@@ -30,19 +30,7 @@ bool vtkMultiresolutionCellPicker::Begin(vtkOpenGLRenderWindow* window, int x, i
       return false;
     }
   }
-  state->vtkglGetIntegerv(GL_VIEWPORT, this->SavedViewport.data());
-  state->vtkglGetIntegerv(GL_SCISSOR_BOX, this->SavedScissor.data());
-  state->PushFramebufferBindings();
-  state->vtkglBindFramebuffer(GL_FRAMEBUFFER, this->Framebuffer);
-  const GLenum target = GL_COLOR_ATTACHMENT0;
-  glDrawBuffers(1, &target);
-  state->vtkglViewport(-x, -y, width, height);
-  state->vtkglScissor(0, 0, 1, 1);
-  state->vtkglClearColor(0, 0, 0, 0);
-  state->vtkglClearDepth(1);
-  state->vtkglDepthMask(GL_TRUE);
-  state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  state->vtkglClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  this->Target.Bind(state, this->Framebuffer, { -x, -y, width, height }, { 0, 0, 1, 1 });
   return true;
 }
 
@@ -51,12 +39,7 @@ void vtkMultiresolutionCellPicker::End(vtkOpenGLRenderWindow* window, std::array
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   glReadPixels(0, 0, 1, 1, GL_RGBA, GL_FLOAT, rgba.data());
   glReadPixels(0, 0, 1, 1, GL_DEPTH_COMPONENT, GL_FLOAT, &depth);
-  vtkOpenGLState* state = window->GetState();
-  state->PopFramebufferBindings();
-  const auto& v = this->SavedViewport;
-  const auto& c = this->SavedScissor;
-  state->vtkglViewport(v[0], v[1], v[2], v[3]);
-  state->vtkglScissor(c[0], c[1], c[2], c[3]);
+  this->Target.Restore(window->GetState());
 }
 
 void vtkMultiresolutionCellPicker::ReleaseGraphicsResources(vtkWindow*)

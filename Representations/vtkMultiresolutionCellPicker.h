@@ -8,6 +8,8 @@
 #ifndef vtkMultiresolutionCellPicker_h
 #define vtkMultiresolutionCellPicker_h
 
+#include "vtkMultiresolutionOffscreenTarget.h"
+
 #include <array>
 
 class vtkOpenGLRenderWindow;
@@ -30,7 +32,7 @@ public:
 
 private:
   unsigned int Framebuffer = 0, Color = 0, Depth = 0; ///< GL names (renderbuffers), 0: none
-  std::array<int, 4> SavedViewport{}, SavedScissor{};
+  vtkMultiresolutionOffscreenTarget Target;
 };
 
 #endif

@@ -93,31 +93,15 @@ bool vtkMultiresolutionReducedResolution::Begin(vtkOpenGLRenderWindow* window, v
   }
   this->Drawn = { std::max(1, static_cast<int>(std::lround(width * scale))),
     std::max(1, static_cast<int>(std::lround(height * scale))) };
-  vtkOpenGLState* state = window->GetState();
-  state->vtkglGetIntegerv(GL_VIEWPORT, this->SavedViewport.data());
-  state->vtkglGetIntegerv(GL_SCISSOR_BOX, this->SavedScissor.data());
-  state->PushFramebufferBindings();
-  state->vtkglBindFramebuffer(GL_FRAMEBUFFER, this->Framebuffer);
-  const GLenum target = GL_COLOR_ATTACHMENT0;
-  glDrawBuffers(1, &target);
-  state->vtkglViewport(0, 0, this->Drawn[0], this->Drawn[1]);
-  state->vtkglScissor(0, 0, this->Drawn[0], this->Drawn[1]);
-  state->vtkglClearColor(0, 0, 0, 0);
-  state->vtkglClearDepth(1);
-  state->vtkglDepthMask(GL_TRUE);
-  state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  state->vtkglClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  this->Target.Bind(window->GetState(), this->Framebuffer, { 0, 0, this->Drawn[0], this->Drawn[1] },
+    { 0, 0, this->Drawn[0], this->Drawn[1] });
   return true;
 }
 
 void vtkMultiresolutionReducedResolution::End(vtkOpenGLRenderWindow* window)
 {
   vtkOpenGLState* state = window->GetState();
-  state->PopFramebufferBindings();
-  const auto& v = this->SavedViewport;
-  const auto& c = this->SavedScissor;
-  state->vtkglViewport(v[0], v[1], v[2], v[3]);
-  state->vtkglScissor(c[0], c[1], c[2], c[3]);
+  this->Target.Restore(state);
   // The program is the shader cache's (the window frees it); the quad's buffers are made for
   // each draw, so only the vertex array is ours.
   vtkShaderProgram* program = window->GetShaderCache()->ReadyShaderProgram(StretchVS, MultiresolutionStretchFS, "");

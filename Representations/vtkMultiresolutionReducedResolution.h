@@ -8,6 +8,7 @@
 #ifndef vtkMultiresolutionReducedResolution_h
 #define vtkMultiresolutionReducedResolution_h
 
+#include "vtkMultiresolutionOffscreenTarget.h"
 #include "vtkSmartPointer.h"
 
 #include <array>
@@ -37,8 +38,8 @@ private:
   unsigned int Framebuffer = 0, Color = 0, Depth = 0; ///< GL names, 0: none
   std::array<int, 2> Size{};                          ///< of the textures: the view's
   vtkSmartPointer<vtkOpenGLVertexArrayObject> Quad;
-  std::array<int, 2> Drawn{};                         ///< the reduced viewport's width and height
-  std::array<int, 4> SavedViewport{}, SavedScissor{}; ///< the view's, restored by End
+  std::array<int, 2> Drawn{};               ///< the reduced viewport's width and height
+  vtkMultiresolutionOffscreenTarget Target; ///< the view's bindings, restored by End
 };
 
 #endif

@@ -51,12 +51,7 @@ unlit = rt.unlit
 
 
 def models():
-    synthetic = rt.faulted_synthetic(temp)
-    return [
-        ("reek", os.path.join(args.data, "reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID")),
-        ("brugge", os.path.join(args.data, "brugge/Real0/BRUGGE_0000.EGRID")),
-        ("faulted", synthetic),
-    ]
+    return rt.image_models(args.data, temp)
 
 
 def capture(view, name):

@@ -276,6 +276,16 @@ def faulted_synthetic(temp):
     return path
 
 
+def image_models(data, temp):
+    """The models the image tests share: (name, grid file) for Reek, Brugge and the faulted
+    synthetic model."""
+    return [
+        ("reek", os.path.join(data, "reek/res2df_sim/eclipse/model/2_R001_REEK-0.EGRID")),
+        ("brugge", os.path.join(data, "brugge/Real0/BRUGGE_0000.EGRID")),
+        ("faulted", faulted_synthetic(temp)),
+    ]
+
+
 def unlit(display):
     """Ambient light only: colours come out as the lookup table or cell-id colouring gives them."""
     display.Ambient = 1.0
