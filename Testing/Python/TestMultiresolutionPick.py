@@ -15,6 +15,7 @@ from the side, 100 random covered pixels a camera (200 a model and tolerance):
   (the finest level's, whatever is drawn), and the point picked at 0 px lies within them
   where stock shows the same cell;
 - a pick on the background names nothing;
+- in the single-layer view (layer 2), 50 picks name the cell its frame shows, in layer 2;
 - stock grids (EGRIDReader, GRDECLReader) list I, J, K first among their cell arrays, as
   ParaView's hover shows them;
 - resmr_inspect.InspectCell(I, J, K) gives EGRIDReader's corners and values for random top
@@ -186,6 +187,23 @@ for name, grid_path in models():
               + (f", {same_as_stock} stock's" if tolerance == 0 else ""))
         if tolerance == 0 and same_as_stock < 0.99 * picked:
             failures.append(f"{name}: {same_as_stock} of {picked} picks at 0 px name stock's cell (< 99%)")
+    # The single-layer view: layer 2 alone, picks name its cells as its frame shows them.
+    ours.Layer = 2
+    ours.PixelTolerance = 0
+    view.ResetCamera(False)
+    rt.place_camera(view, bounds, 1.0, [0.3, -0.5, 0.8], 1.0)
+    got = rt.cell_ids(rt.capture_rgb(view, os.path.join(temp, f"{name}-layer2.png"), WIDTH, HEIGHT))
+    ys, xs = np.nonzero(got > 0)
+    layer_same, count = 0, 50 if len(xs) > 50 else len(xs)  # (pvpython's numpy_interface replaces min)
+    for n in rng.choice(len(xs), count, replace=False):
+        x, y = int(xs[n]), int(ys[n])
+        index = got[y, x] - 1
+        shown = (index % dims[0] + 1, index // dims[0] % dims[1] + 1, index // (dims[0] * dims[1]) + 1)
+        layer_same += pick(ours, view, x, y)[0] == shown and shown[2] == 2
+    print(f"{name} layer 2: {layer_same} of {count} picks name the frame's cell, in layer 2")
+    if not count or layer_same != count:
+        failures.append(f"{name} layer 2: {layer_same} of {count} picks name the frame's cell")
+    ours.Layer = 0
     # resmr_inspect, as users call it: InspectCell by I, J, K; GoToCell puts the cell at the
     # view's centre (a top cell, seen from above) and outlines it.
     ours.PixelTolerance = 0
