@@ -32,15 +32,15 @@ def _surface(view, display):
 
 def _result(display):
     display.UpdatePropertyInformation()
-    cell = tuple(int(v) for v in display.GetPropertyValue("PickedCell"))
-    if cell == (0, 0, 0):
-        return None
     values = {}
     for line in display.GetPropertyValue("PickedValues").splitlines():
         name, value = line.split("=", 1)
         if name == "error":
-            raise RuntimeError(value)
+            raise RuntimeError(value)  # a cell off the grid, a damaged file: named there
         values[name] = float(value)
+    cell = tuple(int(v) for v in display.GetPropertyValue("PickedCell"))
+    if cell == (0, 0, 0):
+        return None
     active = int(display.GetPropertyValue("PickedActive"))
     corners = list(display.GetPropertyValue("PickedCorners"))
     corners = [tuple(corners[3 * n:3 * n + 3]) for n in range(8)] if active >= 0 else None
@@ -76,7 +76,8 @@ def PickCell(x, y, view=None, display=None):
 
 
 def InspectCell(i, j, k, view=None, display=None):
-    """What PickCell returns, for cell (I, J, K) (from 1), with no pixel: point is its centre."""
+    """What PickCell returns, for cell (I, J, K) (from 1), with no pixel: point is its centre.
+    A cell off the grid raises RuntimeError naming the file and the grid's size."""
     view, display = _surface(view, display)
     return _ask(view, display, "InspectCell", [i, j, k], [0, 0, 0])
 

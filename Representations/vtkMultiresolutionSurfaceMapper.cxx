@@ -1039,6 +1039,13 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
     {
       this->DescribeCell(frame, cell, nullptr);
     }
+    else
+    {
+      in.Pick.values = "error=" + in.FilePath + ": no cell (" + std::to_string(in.Inspect[0]) + ", " +
+        std::to_string(in.Inspect[1]) + ", " + std::to_string(in.Inspect[2]) + "): the grid has " +
+        std::to_string(header.dims[0]) + " x " + std::to_string(header.dims[1]) + " x " +
+        std::to_string(header.dims[2]) + " cells (I, J, K from 1)\n";
+    }
     ++in.PicksDone;
   }
   if (!in.PickPending)

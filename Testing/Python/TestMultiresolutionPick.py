@@ -14,7 +14,8 @@ from the side, 100 random covered pixels a camera (200 a model and tolerance):
 - its corners are EGRIDReader's corners of that cell within a millionth of the model's extent
   (the finest level's, whatever is drawn), and the point picked at 0 px lies within them
   where stock shows the same cell;
-- a pick on the background names nothing;
+- a pick on the background names nothing; InspectCell off the grid raises an error naming the
+  file and the grid's size;
 - in the single-layer view (layer 2), 50 picks name the cell its frame shows, in layer 2;
 - stock grids (EGRIDReader, GRDECLReader) list I, J, K first among their cell arrays, as
   ParaView's hover shows them;
@@ -239,6 +240,13 @@ for name, grid_path in models():
             failures.append(f"{name}: GoToPoint on the top of ({i}, {j}, {k}) selected "
                             f"{None if at is None else (at['I'], at['J'], at['K'])}")
     simple.Delete(simple.FindSource("Selected Cell"))
+    # Bad input: a cell off the grid is refused with a message naming the file and the grid.
+    try:
+        resmr_inspect.InspectCell(dims[0] + 1, 1, 1, view, ours)
+        failures.append(f"{name}: InspectCell off the grid raised nothing")
+    except RuntimeError as error:
+        if os.path.basename(resmr_path) not in str(error) or f"{dims[0]} x {dims[1]} x {dims[2]}" not in str(error):
+            failures.append(f"{name}: InspectCell off the grid: {error}")
     print(f"{name}: values compared with EGRIDReader on {valued} picks")
     if valued < 100:
         failures.append(f"{name}: values compared on {valued} picks only")
