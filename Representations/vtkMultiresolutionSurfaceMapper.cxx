@@ -496,7 +496,14 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
     in.Reduced.End(frame.window);
   }
   this->PickCell(frame);
-  in.Last = std::make_unique<Frame>(frame);
+  if (in.Last)
+  {
+    *in.Last = frame; // reuses the selection's storage: no allocation a frame
+  }
+  else
+  {
+    in.Last = std::make_unique<Frame>(frame);
+  }
   in.LastRenderer = frame.renderer;
   in.LastActor = frame.actor;
   this->FinishFrame(frame);
