@@ -148,7 +148,7 @@ void pqMultiresolutionInspectActions::OnMouse(vtkObject* caller, unsigned long e
     this->ButtonDown = false;
     if (this->At == this->Pressed)
     {
-      this->Pick(this->At, true); // a click, not a drag
+      Pick(this->View, this->At, true); // a click, not a drag
     }
   }
   else if (!this->ButtonDown)
@@ -160,7 +160,7 @@ void pqMultiresolutionInspectActions::OnMouse(vtkObject* caller, unsigned long e
 
 void pqMultiresolutionInspectActions::pickHovered()
 {
-  const QString text = this->Pick(this->At, false);
+  const QString text = Pick(this->View, this->At, false);
   QWidget* widget = this->View ? this->View->widget() : nullptr;
   if (!widget || text.isEmpty())
   {
@@ -171,9 +171,9 @@ void pqMultiresolutionInspectActions::pickHovered()
   QToolTip::showText(widget->mapToGlobal(local), text, widget);
 }
 
-QString pqMultiresolutionInspectActions::Pick(const QPoint& at, bool select)
+QString pqMultiresolutionInspectActions::Pick(pqRenderView* view, const QPoint& at, bool select)
 {
-  vtkSMProxy* surface = SurfaceIn(this->View);
+  vtkSMProxy* surface = SurfaceIn(view);
   if (!surface)
   {
     return QString();
@@ -187,7 +187,7 @@ QString pqMultiresolutionInspectActions::Pick(const QPoint& at, bool select)
   surface->UpdatePropertyInformation();
   if (vtkSMPropertyHelper(surface, "PicksDone").GetAsInt() == done)
   {
-    this->View->forceRender(); // no frame drawn yet
+    view->forceRender(); // no frame drawn yet
     surface->UpdatePropertyInformation();
   }
   vtkSMPropertyHelper(surface, "PickAt").Set(0, -1);
@@ -199,7 +199,7 @@ QString pqMultiresolutionInspectActions::Pick(const QPoint& at, bool select)
     text.isEmpty() ? "nothing" : text.split('\n').first().toUtf8().constData());
   if (select)
   {
-    Select(this->View, text, corners);
+    Select(view, text, corners);
   }
   return text;
 }

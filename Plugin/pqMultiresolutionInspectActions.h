@@ -37,6 +37,9 @@ public:
   static QString Describe(vtkSMProxy* surface, std::vector<double>& corners);
   /// Selects: `text` becomes SelectedText, and `corners` (if any) are outlined in `view`.
   static void Select(pqRenderView* view, const QString& text, const std::vector<double>& corners);
+  /// Picks at display pixel `at` of `view` (from its lower left) in the frame on screen, and
+  /// selects the cell when `select`; the cell's text, empty over no cell.
+  static QString Pick(pqRenderView* view, const QPoint& at, bool select);
 
 private Q_SLOTS:
   void setOn(bool on);
@@ -47,8 +50,6 @@ private:
   Q_DISABLE_COPY(pqMultiresolutionInspectActions)
   void Observe(bool on);
   void OnMouse(vtkObject* caller, unsigned long event, void*);
-  /// Picks at display pixel `at` of the view; the tooltip text, empty over no cell.
-  QString Pick(const QPoint& at, bool select);
 
   QAction* Inspect;
   QPointer<pqRenderView> View;

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <vector>
 
+#include <QDoubleSpinBox>
 #include <QFormLayout>
 #include <QHBoxLayout>
 #include <QLabel>
@@ -29,6 +30,7 @@ pqMultiresolutionReadoutDock::pqMultiresolutionReadoutDock(QWidget* parent)
 {
   this->setWindowTitle(tr("Multiresolution Readout"));
   auto* body = new QWidget(this);
+  body->setObjectName("ReadoutBody"); // names for ParaView's test playback
   auto* layout = new QVBoxLayout(body);
   this->Source = new QLabel(body);
   this->Source->setWordWrap(true);
@@ -63,6 +65,7 @@ pqMultiresolutionReadoutDock::pqMultiresolutionReadoutDock(QWidget* parent)
   layout->addWidget(this->Error);
   // Go to cell: ECLIPSE's I, J, K.
   auto* go = new QWidget(body);
+  go->setObjectName("GoToCellRow");
   auto* goRow = new QHBoxLayout(go);
   goRow->setContentsMargins(0, 0, 0, 0);
   const char* names[3] = { "I", "J", "K" };
@@ -80,6 +83,28 @@ pqMultiresolutionReadoutDock::pqMultiresolutionReadoutDock(QWidget* parent)
   QObject::connect(button, &QPushButton::clicked, this, &pqMultiresolutionReadoutDock::goToCell);
   goRow->addWidget(button);
   layout->addWidget(go);
+  // Go to point: map x, y (the view's world coordinates) and depth (positive down).
+  auto* goPoint = new QWidget(body);
+  goPoint->setObjectName("GoToPointRow");
+  auto* pointRow = new QHBoxLayout(goPoint);
+  pointRow->setContentsMargins(0, 0, 0, 0);
+  const char* axes[3] = { "X", "Y", "Depth" };
+  for (int a = 0; a < 3; ++a)
+  {
+    pointRow->addWidget(new QLabel(axes[a], goPoint));
+    this->Point[a] = new QDoubleSpinBox(goPoint);
+    this->Point[a]->setRange(-1e12, 1e12);
+    this->Point[a]->setDecimals(2);
+    this->Point[a]->setObjectName(QString("GoTo%1").arg(axes[a]));
+    pointRow->addWidget(this->Point[a], 1);
+  }
+  auto* pointButton = new QPushButton(tr("Go to point"), goPoint);
+  pointButton->setObjectName("GoToPoint");
+  pointButton->setToolTip(tr("Fly the camera to map point X, Y at Depth (positive down) and select the cell shown "
+                             "there"));
+  QObject::connect(pointButton, &QPushButton::clicked, this, &pqMultiresolutionReadoutDock::goToPoint);
+  pointRow->addWidget(pointButton);
+  layout->addWidget(goPoint);
   this->Selected = new QLabel(body);
   this->Selected->setWordWrap(true);
   this->Selected->setTextInteractionFlags(Qt::TextSelectableByMouse);
@@ -235,5 +260,33 @@ void pqMultiresolutionReadoutDock::goToCell()
     camera->UpdateVTKObjects();
   }
   pqMultiresolutionInspectActions::Select(view, text, corners);
+  this->Update.start();
+}
+
+void pqMultiresolutionReadoutDock::goToPoint()
+{
+  auto* view = qobject_cast<pqRenderView*>(this->View.data());
+  if (!view)
+  {
+    return;
+  }
+  vtkSMProxy* camera = view->getProxy();
+  double position[3], focal[3];
+  vtkSMPropertyHelper(camera, "CameraPosition").Get(position, 3);
+  vtkSMPropertyHelper(camera, "CameraFocalPoint").Get(focal, 3);
+  const double point[3] = { this->Point[0]->value(), this->Point[1]->value(), -this->Point[2]->value() };
+  for (int a = 0; a < 3; ++a)
+  {
+    position[a] += point[a] - focal[a];
+  }
+  vtkSMPropertyHelper(camera, "CameraFocalPoint").Set(point, 3);
+  vtkSMPropertyHelper(camera, "CameraPosition").Set(position, 3);
+  vtkSMPropertyHelper(camera, "CenterOfRotation").Set(point, 3);
+  camera->UpdateVTKObjects();
+  view->forceRender(); // the pick below names what this frame shows at the centre
+  int size[2] = { 0, 0 };
+  vtkSMPropertyHelper(camera, "ViewSize").Get(size, 2);
+  vtkLogF(TRACE, "multiresolution go to point (%g, %g, depth %g)", point[0], point[1], -point[2]);
+  pqMultiresolutionInspectActions::Pick(view, QPoint(size[0] / 2, size[1] / 2), true);
   this->Update.start();
 }

@@ -9,6 +9,7 @@
 #include <QTimer>
 
 class QLabel;
+class QDoubleSpinBox;
 class QSpinBox;
 class pqView;
 
@@ -26,6 +27,9 @@ private Q_SLOTS:
   void updateReadout();
   /// The camera to the cell of the I, J, K boxes, which is selected (outlined, kept here).
   void goToCell();
+  /// The camera's focal point to the map point and depth of the X, Y, Depth boxes (its
+  /// direction and distance kept); the cell then shown at the view's centre is selected.
+  void goToPoint();
 
 private:
   Q_DISABLE_COPY(pqMultiresolutionReadoutDock)
@@ -40,8 +44,9 @@ private:
   QLabel* Frame;
   QLabel* Loads;
   QLabel* Error;
-  QLabel* Selected;  ///< the cell the Inspect Cells action last selected
-  QSpinBox* Cell[3]; ///< I, J, K for goToCell
+  QLabel* Selected;         ///< the cell the Inspect Cells action last selected
+  QSpinBox* Cell[3];        ///< I, J, K for goToCell
+  QDoubleSpinBox* Point[3]; ///< x, y, depth for goToPoint
   QWidget* Values;
 };
 

@@ -1,5 +1,6 @@
 #include "vtkMultiresolutionGpuRegions.h"
 
+#include "CellInspection.h"
 #include "FramePlanning.h"
 #include "RegionCache.h"
 #include "UploadPacer.h"
@@ -53,7 +54,8 @@ public:
 
   std::shared_ptr<const resmr::RegionDrawBuffers> Buffers;
   std::vector<std::unique_ptr<GpuPiece>> Pieces;
-  std::size_t Bytes = 0; ///< copied so far
+  std::size_t Bytes = 0;                        ///< copied so far
+  std::vector<std::array<float, 6>> ChunkBoxes; ///< made at the region's first pick
 
   bool Ready() const { return this->Cursor.Done(); }
   /// Bytes the next piece will copy.
@@ -242,7 +244,17 @@ const resmr::RegionDrawBuffers* vtkMultiresolutionGpuRegions::Prepare(
   return gpu.Buffers.get();
 }
 
-std::size_t vtkMultiresolutionGpuRegions::Draw(std::size_t region, const std::array<resmr::DrawPart, 3>& parts,
+const std::vector<std::array<float, 6>>& vtkMultiresolutionGpuRegions::ChunkBoxes(std::size_t region)
+{
+  Region& gpu = *this->Regions.at(region);
+  if (gpu.ChunkBoxes.empty())
+  {
+    gpu.ChunkBoxes = resmr::TriangleChunkBoxes(*gpu.Buffers);
+  }
+  return gpu.ChunkBoxes;
+}
+
+std::size_t vtkMultiresolutionGpuRegions::Draw(std::size_t region, const std::vector<resmr::DrawPart>& parts,
   vtkShaderProgram* program, vtkOpenGLState* state, bool cull)
 {
   std::size_t triangles = 0;

@@ -56,8 +56,11 @@ public:
   /// Draws the shown parts of a Prepare'd region piece by piece, setting `faceKind` for each,
   /// with back faces culled where `cull` and the part allows it (DrawPart::cullBackFaces);
   /// the triangles drawn.
-  std::size_t Draw(std::size_t region, const std::array<resmr::DrawPart, 3>& parts, vtkShaderProgram* program,
+  std::size_t Draw(std::size_t region, const std::vector<resmr::DrawPart>& parts, vtkShaderProgram* program,
     vtkOpenGLState* state, bool cull);
+  /// The boxes of a Prepare'd region's triangle chunks (resmr::TriangleChunkBoxes), made at its
+  /// first pick and kept with its copy.
+  const std::vector<std::array<float, 6>>& ChunkBoxes(std::size_t region);
 
   /// Frees every GL buffer.
   void ReleaseGraphicsResources();

@@ -257,6 +257,9 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   bool lit = false;            ///< the last program readied lights the surface
   bool clockwiseFront = false; ///< glFrontFace is GL_CW (a mirroring transform, back faces culled)
   bool cullBackFaces = false;  ///< back faces may be culled this frame (ViewSelection::backFacesHidden, no layer)
+  /// The pick pass's pixel centre and viewport (x, y, width, height); x < 0: no pick. Faces
+  /// are then drawn only in the triangle chunks that may cover the pixel.
+  std::array<double, 4> pickPixel{ -1, -1, 0, 0 };
 };
 
 vtkMultiresolutionSurfaceMapper::vtkMultiresolutionSurfaceMapper()
@@ -991,6 +994,23 @@ int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bo
     return 0;
   }
   this->SetUniforms(frame);
+  // A pick pass: of each part, the runs of triangle chunks that may cover its pixel (the
+  // buffers hold positions about the cache's origin).
+  const resmr::Matrix4 bufferToClip = resmr::Multiply(frame.modelToClip, resmr::TranslationMatrix(in.Cache->Origin()));
+  const auto coveringPixel = [&](std::size_t region, const std::vector<resmr::DrawPart>& parts) {
+    std::vector<resmr::DrawPart> runs;
+    for (const resmr::DrawPart& part : parts)
+    {
+      for (const auto& [first, count] : resmr::IndexRunsCoveringPixel(in.Regions.ChunkBoxes(region), part.first,
+             part.count, bufferToClip, frame.pickPixel[0], frame.pickPixel[1], frame.pickPixel[2], frame.pickPixel[3]))
+      {
+        runs.push_back(part);
+        runs.back().first = first;
+        runs.back().count = count;
+      }
+    }
+    return runs;
+  };
   int regions = 0;
   for (const resmr::DrawnRegion& drawn : frame.selection.drawn)
   {
@@ -999,11 +1019,19 @@ int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bo
     {
       continue;
     }
-    std::array<resmr::DrawPart, 3> parts = resmr::PartsToDraw(
+    const std::array<resmr::DrawPart, 3> all = resmr::PartsToDraw(
       *buffers, drawn, frame.layer >= 0, in.File->Regions()[drawn.region], frame.view, in.File->Header().version);
-    for (resmr::DrawPart& part : parts)
+    std::vector<resmr::DrawPart> parts;
+    for (const resmr::DrawPart& part : all)
     {
-      part.shown = part.shown && kinds[static_cast<std::size_t>(part.kind)];
+      if (part.shown && kinds[static_cast<std::size_t>(part.kind)])
+      {
+        parts.push_back(part);
+      }
+    }
+    if (frame.pickPixel[0] >= 0)
+    {
+      parts = coveringPixel(drawn.region, parts);
     }
     // A leaf's sides are the original faces: their coordinates name the layer exactly.
     const bool leaf = in.File->Regions()[drawn.region].level == in.File->Header().leafLevel;
@@ -1069,13 +1097,14 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
   {
     return;
   }
-  // The frame's cut once more, into the one pixel: only the regions whose boxes may cover it
-  // (a handful; the whole cut would cost a frame's vertex work). The readout keeps the frame's
+  // The frame's cut once more, into the one pixel: only the regions whose boxes may cover it,
+  // and of those only the triangle chunks that may (the whole cut would cost a frame's vertex
+  // work). Drawn in the frame's order, ties fall as in the frame. The readout keeps the frame's
   // own counts.
   const vtkIdType triangles = in.Triangles;
   const std::vector<resmr::DrawnRegion> drawn = frame.selection.drawn;
   const auto beside = [&](const resmr::DrawnRegion& region) {
-    return !resmr::BoxMayCoverPixel(
+    return !resmr::RegionMayCoverPixel(
       in.File->Regions()[region.region].bounds, frame.modelToClip, x + 0.5, y + 0.5, width, height);
   };
   frame.selection.drawn.erase(
@@ -1083,8 +1112,11 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
   frame.colorMode = PickColors;
   frame.scale = 1;
   frame.program = this->ReadyProgram(frame, PickColors);
+  frame.pickPixel = { x + 0.5, y + 0.5, double(width), double(height) };
   std::array<float, 4> rgba{ 0, 0, 0, 0 };
   float depth = 1;
+  const auto drawStart = std::chrono::steady_clock::now();
+  in.Triangles = 0;
   if (frame.program && in.Picker.Begin(frame.window, int(x), int(y), width, height))
   {
     this->BeginDrawing(frame);
@@ -1092,6 +1124,9 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
     this->EndDrawing(frame);
     in.Picker.End(frame.window, rgba, depth);
   }
+  vtkLogF(TRACE, "multiresolution pick pass: %zu regions, %lld triangles, %.1f ms", frame.selection.drawn.size(),
+    static_cast<long long>(in.Triangles), ElapsedMs(drawStart));
+  frame.pickPixel = { -1, -1, 0, 0 };
   in.Triangles = triangles;
   frame.selection.drawn = drawn;
   std::array<int64_t, 3> cell{};
@@ -1109,7 +1144,9 @@ void vtkMultiresolutionSurfaceMapper::PickCell(Frame& frame)
     c /= model[3];
   }
   const std::array<double, 3> near{ model[0], model[1], model[2] };
+  const auto describeStart = std::chrono::steady_clock::now();
   this->DescribeCell(frame, cell, &near);
+  vtkLogF(TRACE, "multiresolution pick described in %.1f ms", ElapsedMs(describeStart));
 }
 
 void vtkMultiresolutionSurfaceMapper::DescribeCell(

@@ -127,6 +127,11 @@ resmr_add_pvpython_test(Multiresolution.GUI TestMultiresolutionGUI.py)
 set_property(TEST Multiresolution.GUI APPEND PROPERTY ENVIRONMENT
   "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>" "PARAVIEW_EXECUTABLE=${PARAVIEW_EXECUTABLE}")
 set_property(TEST Multiresolution.GUI PROPERTY SKIP_RETURN_CODE 125)
+# The dock's Go to cell and Go to point, played by ParaView's test playback (skipped without paraview).
+resmr_add_pvpython_test(Multiresolution.GUIGoTo TestMultiresolutionGUIGoTo.py)
+set_property(TEST Multiresolution.GUIGoTo APPEND PROPERTY ENVIRONMENT
+  "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>" "PARAVIEW_EXECUTABLE=${PARAVIEW_EXECUTABLE}")
+set_property(TEST Multiresolution.GUIGoTo PROPERTY SKIP_RETURN_CODE 125)
 
 # Picking a cell: the frame's own cell at any level, stock's at 0 px, EGRIDReader's values and corners.
 resmr_add_pvpython_test(Multiresolution.Pick TestMultiresolutionPick.py)

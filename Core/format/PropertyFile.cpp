@@ -19,7 +19,8 @@ namespace
 {
 constexpr char Magic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'R', 'P' };
 constexpr char TrailerMagic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'I', 'X' };
-constexpr uint32_t Version = 2;
+constexpr uint32_t Version = 3;
+constexpr uint32_t OldestVersion = 2; ///< a chunk a layer: read as one band a layer
 constexpr std::size_t HeaderBytes = 128;
 constexpr std::size_t NameBytes = 32;
 
@@ -41,8 +42,8 @@ ChunkRef GetRef(ByteReader& in)
   return c;
 }
 
-std::vector<uint8_t> HeaderOf(
-  uint64_t geometry, const std::array<int64_t, 3>& dims, const std::array<uint32_t, 3>& tableSides, uint32_t tables)
+std::vector<uint8_t> HeaderOf(uint64_t geometry, const std::array<int64_t, 3>& dims,
+  const std::array<uint32_t, 3>& tableSides, uint32_t tables, int64_t bandRows)
 {
   ByteWriter head;
   head.PutBytes(Magic, 8);
@@ -51,6 +52,7 @@ std::vector<uint8_t> HeaderOf(
   head.Put(dims);
   head.Put(tableSides);
   head.Put(tables);
+  head.Put(static_cast<uint32_t>(bandRows));
   head.Bytes.resize(HeaderBytes - 4, 0);
   head.Put(Crc32(head.Bytes.data(), head.Bytes.size()));
   return std::move(head.Bytes);
@@ -127,10 +129,10 @@ void NearestActiveSources(std::vector<uint64_t>& slotCells, const std::vector<st
 }
 
 /// Index bytes a table takes: name, step, report, days, range, then the packed table's chunk
-/// and one chunk a layer.
-uint64_t TableRecordBytes(int64_t layers)
+/// and one chunk a band of every layer.
+uint64_t TableRecordBytes(uint64_t layerBands)
 {
-  return NameBytes + 4 + 4 + 8 + 4 + 4 + 20 * (static_cast<uint64_t>(layers) + 1);
+  return NameBytes + 4 + 4 + 8 + 4 + 4 + 20 * (layerBands + 1);
 }
 
 std::string TableName(const PropertyTable& t)
@@ -140,6 +142,11 @@ std::string TableName(const PropertyTable& t)
     : t.name + " of step " + std::to_string(t.step) + " (report " + std::to_string(t.reportNumber) + ")";
 }
 } // namespace
+
+int64_t LayerBandRows(int64_t nx, int64_t ny)
+{
+  return std::clamp<int64_t>(LayerBandValues / std::max<int64_t>(nx, 1), 1, std::max<int64_t>(ny, 1));
+}
 
 PropertyFile::PropertyFile(const std::string& path)
   : FilePath(path)
@@ -156,17 +163,18 @@ PropertyFile::PropertyFile(const std::string& path)
     }
     ByteReader head(this->Data + 8, HeaderBytes - 12, path + ": header");
     const uint32_t version = head.Get<uint32_t>();
-    if (version != Version)
+    if (version < OldestVersion || version > Version)
     {
-      throw FileFormatError(
-        path + ": format version " + std::to_string(version) + "; this build reads version " + std::to_string(Version));
+      throw FileFormatError(path + ": format version " + std::to_string(version) + "; this build reads versions " +
+        std::to_string(OldestVersion) + " to " + std::to_string(Version));
     }
     this->Geometry = head.Get<uint64_t>();
     head.Get(this->Dims);
     head.Get(this->TableSides);
     const uint32_t tables = head.Get<uint32_t>();
+    const uint32_t bandRows = version >= 3 ? head.Get<uint32_t>() : 0;
     const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
-    this->CheckHeader(tables, indexSize);
+    this->CheckHeader(tables, indexSize, version, bandRows);
     ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
     std::set<std::pair<std::string, int32_t>> seen;
     for (uint32_t t = 0; t < tables; ++t)
@@ -188,8 +196,9 @@ PropertyFile::PropertyFile(const std::string& path)
   }
 }
 
-void PropertyFile::CheckHeader(uint32_t tables, uint64_t indexSize) const
+void PropertyFile::CheckHeader(uint32_t tables, uint64_t indexSize, uint32_t version, uint32_t bandRows)
 {
+  // Sets RowsInBand, which the index's size depends on.
   const auto bad = [&](const std::string& field, const std::string& value, const std::string& must) {
     throw FileFormatError(
       this->FilePath + ": header field '" + field + "' is " + value + ", must be " + must + " (corrupt)");
@@ -223,15 +232,20 @@ void PropertyFile::CheckHeader(uint32_t tables, uint64_t indexSize) const
         std::to_string(this->TableSides[2]),
       "at most 2^30 slots");
   }
-  for (std::size_t at = 60; at < HeaderBytes - 4; ++at)
+  if (version >= 3 && (bandRows < 1 || bandRows > this->Dims[1]))
+  {
+    bad("rows a band", std::to_string(bandRows), "1 to ny (" + std::to_string(this->Dims[1]) + ")");
+  }
+  this->RowsInBand = version >= 3 ? static_cast<int64_t>(bandRows) : this->Dims[1];
+  for (std::size_t at = version >= 3 ? 64 : 60; at < HeaderBytes - 4; ++at)
   {
     if (this->Data[at] != 0)
     {
       bad("reserved bytes", "byte " + std::to_string(at) + " = " + std::to_string(this->Data[at]), "zero");
     }
   }
-  const uint64_t recordBytes = TableRecordBytes(this->Dims[2]);
-  if (indexSize != tables * recordBytes)
+  const uint64_t recordBytes = TableRecordBytes(static_cast<uint64_t>(this->Dims[2] * this->Bands()));
+  if (indexSize % recordBytes != 0 || indexSize / recordBytes != tables)
   {
     bad("table count", std::to_string(tables),
       "what the index of " + std::to_string(indexSize) + " bytes holds (" + std::to_string(recordBytes) +
@@ -251,10 +265,11 @@ PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t in
   table.minimum = index.Get<float>();
   table.maximum = index.Get<float>();
   table.packed = GetRef(index);
-  table.layers.resize(static_cast<std::size_t>(this->Dims[2]));
-  for (ChunkRef& layer : table.layers)
+  const int64_t bands = this->Bands();
+  table.layerBands.resize(static_cast<std::size_t>(this->Dims[2] * bands));
+  for (ChunkRef& band : table.layerBands)
   {
-    layer = GetRef(index);
+    band = GetRef(index);
   }
   const std::string place = this->FilePath + ": index table " + std::to_string(t) + " (" + TableName(table) + ")";
   const auto fail = [&](const std::string& what) { throw FileFormatError(place + ": " + what + " (corrupt)"); };
@@ -278,20 +293,21 @@ PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t in
     fail("value range " + std::to_string(table.minimum) + " to " + std::to_string(table.maximum) + " impossible");
   }
   const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
-  const uint64_t layerValues = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
-  for (int64_t k = -1; k < this->Dims[2]; ++k)
+  for (int64_t n = -1; n < static_cast<int64_t>(table.layerBands.size()); ++n)
   {
-    const ChunkRef& c = k < 0 ? table.packed : table.layers[static_cast<std::size_t>(k)];
-    const std::string what = k < 0 ? std::string("packed table") : "layer " + std::to_string(k + 1);
+    const ChunkRef& c = n < 0 ? table.packed : table.layerBands[static_cast<std::size_t>(n)];
+    const std::string what = n < 0
+      ? std::string("packed table")
+      : "layer " + std::to_string(n / bands + 1) + (bands > 1 ? " band " + std::to_string(n % bands + 1) : "");
     if (c.offset < HeaderBytes || c.offset > indexOffset || c.stored > indexOffset - c.offset)
     {
       fail(what + " at byte " + std::to_string(c.offset) + " of " + std::to_string(c.stored) +
         " bytes lies outside the file");
     }
-    if (c.raw != (k < 0 ? slots : layerValues) * 4)
+    const uint64_t values = n < 0 ? slots : static_cast<uint64_t>(this->Dims[0] * this->RowsIn(n % bands));
+    if (c.raw != values * 4)
     {
-      fail(what + " of " + std::to_string(c.raw) + " bytes for " + std::to_string(k < 0 ? slots : layerValues) +
-        " values");
+      fail(what + " of " + std::to_string(c.raw) + " bytes for " + std::to_string(values) + " values");
     }
   }
   return table;
@@ -348,6 +364,20 @@ std::vector<float> PropertyFile::ReadPacked(std::size_t table) const
     this->FilePath + ": packed table of " + TableName(t) + " at byte " + std::to_string(t.packed.offset));
 }
 
+int64_t PropertyFile::RowsIn(int64_t band) const
+{
+  return std::min(this->RowsInBand, this->Dims[1] - band * this->RowsInBand);
+}
+
+const ChunkRef& PropertyFile::Band(const PropertyTable& t, int64_t k, int64_t band, std::string& place) const
+{
+  const ChunkRef& ref = t.layerBands[static_cast<std::size_t>(k * this->Bands() + band)];
+  place = this->FilePath + ": layer " + std::to_string(k + 1) + " of " + TableName(t) +
+    (this->Bands() > 1 ? " (band " + std::to_string(band + 1) + ")" : std::string()) + " at byte " +
+    std::to_string(ref.offset);
+  return ref;
+}
+
 std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
 {
   const PropertyTable& t = this->Entries.at(table);
@@ -355,9 +385,16 @@ std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
   {
     throw std::out_of_range(this->FilePath + ": no layer " + std::to_string(k + 1));
   }
-  return this->ReadValues(t.layers[static_cast<std::size_t>(k)], static_cast<uint64_t>(this->Dims[0] * this->Dims[1]),
-    this->FilePath + ": layer " + std::to_string(k + 1) + " of " + TableName(t) + " at byte " +
-      std::to_string(t.layers[static_cast<std::size_t>(k)].offset));
+  std::vector<float> layer;
+  layer.reserve(static_cast<std::size_t>(this->Dims[0] * this->Dims[1]));
+  for (int64_t b = 0; b < this->Bands(); ++b)
+  {
+    std::string place;
+    const ChunkRef& ref = this->Band(t, k, b, place);
+    const auto values = this->ReadValues(ref, static_cast<uint64_t>(this->Dims[0] * this->RowsIn(b)), place);
+    layer.insert(layer.end(), values.begin(), values.end());
+  }
+  return layer;
 }
 
 float PropertyFile::ReadCell(std::size_t table, const std::array<int64_t, 3>& cell) const
@@ -371,16 +408,11 @@ float PropertyFile::ReadCell(std::size_t table, const std::array<int64_t, 3>& ce
         std::to_string(cell[1] + 1) + ", " + std::to_string(cell[2] + 1) + ")");
     }
   }
-  const ChunkRef& ref = t.layers[static_cast<std::size_t>(cell[2])];
-  const uint64_t at = static_cast<uint64_t>(cell[0] + this->Dims[0] * cell[1]);
+  const int64_t band = cell[1] / this->RowsInBand;
+  std::string place;
+  const ChunkRef& ref = this->Band(t, cell[2], band, place);
+  const uint64_t at = static_cast<uint64_t>(cell[0] + this->Dims[0] * (cell[1] - band * this->RowsInBand));
   CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
-  const std::string place = this->FilePath + ": layer " + std::to_string(cell[2] + 1) + " of " + TableName(t) +
-    " at byte " + std::to_string(ref.offset);
-  if (ref.raw != static_cast<uint64_t>(this->Dims[0] * this->Dims[1]) * 4)
-  {
-    throw FileFormatError(place + ": " + std::to_string(ref.raw) + " bytes, " +
-      std::to_string(this->Dims[0] * this->Dims[1] * 4) + " expected");
-  }
   bool verified = false;
   {
     const std::lock_guard<std::mutex> lock(this->VerifiedLock);
@@ -397,11 +429,13 @@ float PropertyFile::ReadCell(std::size_t table, const std::array<int64_t, 3>& ce
   return value;
 }
 
-PropertyFileWriter::PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry)
+PropertyFileWriter::PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry, int64_t bandRows)
   : Output(new AtomicOutputFile(path))
   , Geometry(geometry.Header().geometryId)
   , Dims(geometry.Header().dims)
   , TableSides(geometry.Header().hashTableSides)
+  , RowsInBand(bandRows > 0 ? std::min(bandRows, geometry.Header().dims[1])
+                            : LayerBandRows(geometry.Header().dims[0], geometry.Header().dims[1]))
 {
   const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
   const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
@@ -467,7 +501,7 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
     }
   }
   // The table count is patched in at Commit.
-  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, 0);
+  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, 0, this->RowsInBand);
   this->Write(head.data(), head.size(), "header");
 }
 
@@ -493,6 +527,19 @@ ChunkRef PropertyFileWriter::PutChunk(const std::vector<uint8_t>& raw, const std
   ref.crc = Crc32(stored.data(), stored.size());
   this->Write(stored.data(), stored.size(), what);
   return ref;
+}
+
+void PropertyFileWriter::PutLayerBands(PropertyTable& table, const std::vector<uint8_t>& raw, int64_t k)
+{
+  const std::size_t bandBytes = static_cast<std::size_t>(this->Dims[0] * this->RowsInBand) * 4;
+  std::vector<uint8_t> band;
+  for (std::size_t at = 0; at < raw.size(); at += bandBytes)
+  {
+    band.assign(raw.begin() + static_cast<std::ptrdiff_t>(at),
+      raw.begin() + static_cast<std::ptrdiff_t>(std::min(raw.size(), at + bandBytes)));
+    table.layerBands.push_back(this->PutChunk(
+      band, TableName(table) + " layer " + std::to_string(k + 1) + " band " + std::to_string(at / bandBytes + 1)));
+  }
 }
 
 ChunkRef PropertyFileWriter::CopyChunk(const PropertyFile& from, const ChunkRef& ref)
@@ -541,7 +588,7 @@ std::size_t PropertyFileWriter::BeginTable(PropertyTable table)
   }
   OpenTable opened;
   opened.table = std::move(table);
-  opened.table.layers.clear();
+  opened.table.layerBands.clear();
   opened.low = std::numeric_limits<float>::infinity();
   opened.high = -opened.low;
   // Slots without a source (empty, or inactive in a layer with no active cell) stay NaN.
@@ -576,7 +623,7 @@ PropertyFileWriter::OpenTable& PropertyFileWriter::Opened(std::size_t handle)
 void PropertyFileWriter::AddLayer(std::size_t handle, const float* layerValues)
 {
   OpenTable& t = this->Opened(handle);
-  const int64_t k = static_cast<int64_t>(t.table.layers.size());
+  const int64_t k = t.layers;
   if (k >= this->Dims[2])
   {
     throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) + " given more than its " +
@@ -596,7 +643,8 @@ void PropertyFileWriter::AddLayer(std::size_t handle, const float* layerValues)
     }
     std::memcpy(&raw[static_cast<std::size_t>(c) * 4], &v, 4);
   }
-  t.table.layers.push_back(this->PutChunk(raw, TableName(t.table) + " layer " + std::to_string(k + 1)));
+  this->PutLayerBands(t.table, raw, k);
+  ++t.layers;
   for (uint64_t at = this->LayerSlotStart[static_cast<std::size_t>(k)];
        at < this->LayerSlotStart[static_cast<std::size_t>(k) + 1]; ++at)
   {
@@ -609,10 +657,10 @@ void PropertyFileWriter::AddLayer(std::size_t handle, const float* layerValues)
 void PropertyFileWriter::EndTable(std::size_t handle)
 {
   OpenTable& t = this->Opened(handle);
-  if (static_cast<int64_t>(t.table.layers.size()) != this->Dims[2])
+  if (t.layers != this->Dims[2])
   {
     throw std::invalid_argument(this->Output->Path() + ": " + TableName(t.table) + " ended after " +
-      std::to_string(t.table.layers.size()) + " of its " + std::to_string(this->Dims[2]) + " layers");
+      std::to_string(t.layers) + " of its " + std::to_string(this->Dims[2]) + " layers");
   }
   const float none = std::numeric_limits<float>::quiet_NaN();
   PropertyTable table = std::move(t.table);
@@ -648,9 +696,24 @@ void PropertyFileWriter::CopyFrom(const PropertyFile& older)
     }
     PropertyTable copy = table;
     copy.packed = this->CopyChunk(older, table.packed);
-    for (ChunkRef& layer : copy.layers)
+    if (older.BandRows() == this->RowsInBand)
     {
-      layer = this->CopyChunk(older, layer);
+      for (ChunkRef& band : copy.layerBands)
+      {
+        band = this->CopyChunk(older, band);
+      }
+    }
+    else // an older version's layers: cut into this file's bands
+    {
+      copy.layerBands.clear();
+      const std::size_t t = static_cast<std::size_t>(&table - older.Tables().data());
+      for (int64_t k = 0; k < this->Dims[2]; ++k)
+      {
+        const std::vector<float> layer = older.ReadLayer(t, k);
+        std::vector<uint8_t> raw(layer.size() * 4);
+        std::memcpy(raw.data(), layer.data(), raw.size());
+        this->PutLayerBands(copy, raw, k);
+      }
     }
     this->Entries.push_back(std::move(copy));
   }
@@ -677,9 +740,9 @@ void PropertyFileWriter::Commit()
     index.Put(t.minimum);
     index.Put(t.maximum);
     PutRef(index, t.packed);
-    for (const ChunkRef& layer : t.layers)
+    for (const ChunkRef& band : t.layerBands)
     {
-      PutRef(index, layer);
+      PutRef(index, band);
     }
   }
   const uint64_t indexOffset = this->Offset;
@@ -687,7 +750,8 @@ void PropertyFileWriter::Commit()
   const auto trailer = IndexTrailer(indexOffset, index.Bytes, TrailerMagic);
   this->Write(trailer.data(), trailer.size(), "trailer");
   // The table count goes in the header, which was written first: rewrite it in place.
-  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, static_cast<uint32_t>(this->Entries.size()));
+  const auto head = HeaderOf(
+    this->Geometry, this->Dims, this->TableSides, static_cast<uint32_t>(this->Entries.size()), this->RowsInBand);
   if (!this->Output->WriteAt(head.data(), head.size(), 0))
   {
     throw FileFormatError(this->Output->Path() + ": rewriting the header failed: " + std::strerror(errno));

@@ -8,12 +8,15 @@
 //   cell is inactive in the geometry or has no value. Each table is stored twice, LZO-
 //   compressed with a CRC-32 a chunk: packed through the geometry's perfect spatial hash
 //   (m^3 values, slot s holding the cell the geometry's HashCells names; the whole-model
-//   view's 3D texture, Sec. 5.4) and one chunk a layer (nx ny values, i fastest; the single-
-//   layer view's 2D texture, Sec. 5.2).
+//   view's 3D texture, Sec. 5.4) and layer by layer (nx ny values, i fastest; the single-
+//   layer view's 2D texture, Sec. 5.2), each layer cut into bands of whole rows of at most
+//   LayerBandValues values, a chunk a band (ours: reading one cell's value, a pick, decodes one
+//   band instead of a whole layer).
 // - Layout (little-endian): header (128 bytes, CRC-32 at its end: magic, version, the
-//   geometry id of the .resmr file, grid dimensions, hash table side, table count), chunks,
-//   index (per table: name, step, report number, days, value range, packed chunk, nz layer
-//   chunks), trailer (index offset and size, index CRC, magic "RESMRPIX").
+//   geometry id of the .resmr file, grid dimensions, hash table side, table count, rows a
+//   band), chunks, index (per table: name, step, report number, days, value range, packed
+//   chunk, then nz times the bands of a layer), trailer (index offset and size, index CRC,
+//   magic "RESMRPIX"). Version 2 files (a chunk a layer, no band rows) are read as one band.
 // - A file is written under a temporary name and renamed; one that names another geometry
 //   is refused (CheckGeometry). Every header and index field is checked when the file is
 //   opened (dimensions, sides, the table count against the index size, names, steps, value
@@ -45,8 +48,13 @@ struct PropertyTable
   double days = 0;                ///< simulated time of the step
   float minimum = 0, maximum = 0; ///< over the cells with a value (NaN if none)
   ChunkRef packed;
-  std::vector<ChunkRef> layers;
+  std::vector<ChunkRef> layerBands; ///< nz times the bands of a layer: layer k's band b at k * bands + b
 };
+
+/// Most values in a band of a layer's rows (1 MB of floats); a band holds at least one row.
+constexpr int64_t LayerBandValues = int64_t(1) << 18;
+/// Rows of nx cells in each band of a layer (the last band of a layer may hold fewer).
+int64_t LayerBandRows(int64_t nx, int64_t ny);
 
 /// A .resmrp file opened for reading (memory-mapped).
 class PropertyFile
@@ -62,6 +70,9 @@ public:
   /// Grid dimensions and hash table sides of the geometry the file was made for.
   const std::array<int64_t, 3>& Dimensions() const { return this->Dims; }
   const std::array<uint32_t, 3>& HashTableSides() const { return this->TableSides; }
+  /// Rows in each band of a layer, and bands in a layer.
+  int64_t BandRows() const { return this->RowsInBand; }
+  int64_t Bands() const { return (this->Dims[1] + this->RowsInBand - 1) / this->RowsInBand; }
   const std::vector<PropertyTable>& Tables() const { return this->Entries; }
   /// Index of table (name, step) or -1.
   int Find(const std::string& name, int32_t step) const;
@@ -72,15 +83,19 @@ public:
   std::vector<float> ReadPacked(std::size_t table) const;
   /// Layer k of the table (nx ny values).
   std::vector<float> ReadLayer(std::size_t table, int64_t k) const;
-  /// The value of cell (i, j, k) in the table: its layer's chunk decoded up to it only, its CRC
-  /// checked the first time the chunk is read (later reads of it, a cursor resting on one
-  /// layer, decode only).
+  /// The value of cell (i, j, k) in the table: the band of its layer that holds it decoded up to
+  /// it only, the band's CRC checked the first time it is read (later reads of it, a cursor
+  /// resting on one place, decode only).
   float ReadCell(std::size_t table, const std::array<int64_t, 3>& cell) const;
   /// The stored bytes of a chunk (for copying into a new file).
   const uint8_t* ChunkBytes(const ChunkRef& ref) const { return this->Data + ref.offset; }
 
 private:
-  void CheckHeader(uint32_t tables, uint64_t indexSize) const;
+  void CheckHeader(uint32_t tables, uint64_t indexSize, uint32_t version, uint32_t bandRows);
+  /// Rows of band `band` of a layer.
+  int64_t RowsIn(int64_t band) const;
+  /// Band `band` of layer k of table t, and where it lies, in words for errors.
+  const ChunkRef& Band(const PropertyTable& t, int64_t k, int64_t band, std::string& place) const;
   PropertyTable ReadTable(ByteReader& index, uint32_t t, uint64_t indexOffset) const;
   std::vector<float> ReadValues(const ChunkRef& ref, uint64_t count, const std::string& place) const;
   std::string FilePath;
@@ -90,6 +105,7 @@ private:
   uint64_t Geometry = 0;
   std::array<int64_t, 3> Dims{};
   std::array<uint32_t, 3> TableSides{};
+  int64_t RowsInBand = 1;
   std::vector<PropertyTable> Entries;
   mutable std::mutex VerifiedLock;
   mutable std::unordered_set<uint64_t> Verified; ///< offsets of layer chunks whose CRC held (ReadCell)
@@ -99,7 +115,8 @@ private:
 class PropertyFileWriter
 {
 public:
-  PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry);
+  /// `bandRows`: rows a band of each layer (0: LayerBandRows, what files are written with).
+  PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry, int64_t bandRows = 0);
   ~PropertyFileWriter();
 
   /// Adds a table from one value a cell (nx ny nz, ECLIPSE order; NaN: no value); cells
@@ -116,7 +133,8 @@ public:
   /// The next layer of open table `handle`: nx ny values, i fastest.
   void AddLayer(std::size_t handle, const float* layerValues);
   void EndTable(std::size_t handle);
-  /// Copies every table of `older` (same geometry) that this writer does not hold yet.
+  /// Copies every table of `older` (same geometry) that this writer does not hold yet; the
+  /// layers of a file cut into other bands (an older version's) are cut into this file's.
   void CopyFrom(const PropertyFile& older);
   /// Writes the index and trailer and renames the file into place.
   void Commit();
@@ -128,17 +146,21 @@ private:
     PropertyTable table;
     std::vector<uint8_t> packed; ///< m0 m1 m2 floats, filled as the layers come
     float low = 0, high = 0;     ///< value range so far
+    int64_t layers = 0;          ///< layers added so far
     bool open = false;
   };
   OpenTable& Opened(std::size_t handle);
   ChunkRef PutChunk(const std::vector<uint8_t>& raw, const std::string& what);
   ChunkRef CopyChunk(const PropertyFile& from, const ChunkRef& ref);
+  /// Layer values (nx ny floats as bytes) stored as this file's bands.
+  void PutLayerBands(PropertyTable& table, const std::vector<uint8_t>& raw, int64_t k);
   void Write(const void* data, std::size_t size, const std::string& what);
   std::unique_ptr<AtomicOutputFile> Output;
   uint64_t Offset = 0;
   uint64_t Geometry = 0;
   std::array<int64_t, 3> Dims{};
   std::array<uint32_t, 3> TableSides{};
+  int64_t RowsInBand = 1;
   uint64_t SlotCount = 0;                    ///< of the packed tables
   std::vector<std::vector<uint64_t>> Active; ///< per layer, a bit a cell
   std::vector<uint64_t> LayerSlotStart;      ///< nz + 1: where each layer's slots start below

@@ -1,7 +1,9 @@
 #include "CellInspection.h"
 
+#include "DiamondHierarchy.h"
 #include "RegionMesh.h"
 #include "ThreadGroup.h"
+#include "ViewTransforms.h"
 
 #include <algorithm>
 #include <atomic>
@@ -105,6 +107,28 @@ bool PlaceFromRoots(const MultiresolutionFile& file, int64_t i, int64_t j, std::
   return false;
 }
 
+/// Squared distance from p to the triangle (0 inside): leaves hold the columns whose centres
+/// their triangles hold (Sec. 4.2), so the column under a point is in the triangle holding it or
+/// in one beside it, where the leaves' boxes (a diamond's, both triangles) overlap by half.
+double DistanceToTriangle(const DiamondHierarchy::Triangle& t, const std::array<double, 2>& p)
+{
+  const DiamondHierarchy::Point* v[3] = { &t.apex, &t.left, &t.right };
+  double nearest = std::numeric_limits<double>::max();
+  int sides = 0;
+  for (int e = 0; e < 3; ++e)
+  {
+    const auto& a = *v[e];
+    const auto& b = *v[(e + 1) % 3];
+    const double ex = b[0] - a[0], ey = b[1] - a[1], px = p[0] - a[0], py = p[1] - a[1];
+    const double length = ex * ex + ey * ey;
+    const double s = length > 0 ? std::clamp((px * ex + py * ey) / length, 0.0, 1.0) : 0.0;
+    const double dx = px - s * ex, dy = py - s * ey;
+    nearest = std::min(nearest, dx * dx + dy * dy);
+    sides += ex * py - ey * px >= 0 ? 1 : -1;
+  }
+  return sides == 3 || sides == -3 ? 0.0 : nearest;
+}
+
 /// The cell's corners and activity from leaf `mesh`'s column (i, j); false if it has none.
 bool ReadCell(const RegionMesh& mesh, const std::array<int64_t, 3>& cell, CellGeometry& out)
 {
@@ -192,17 +216,16 @@ CellGeometry InspectCellGeometry(
   {
     return out; // no region covers the column: it holds no active cell
   }
-  // Leaves by how far their boxes lie from the place: the column is in one of the nearest.
+  // Leaves by how far their triangles lie from the place: the column is in one of the nearest.
+  const MultiresolutionHeader& header = file.Header();
+  const DiamondHierarchy tree(header.box[0], header.box[1], header.box[2], header.box[3], header.leafLevel);
   const auto& regions = file.Regions();
   std::vector<std::pair<double, std::size_t>> leaves;
   for (std::size_t r = 0; r < regions.size(); ++r)
   {
-    if (regions[r].level == file.Header().leafLevel)
+    if (regions[r].level == header.leafLevel)
     {
-      const auto& b = regions[r].bounds;
-      const double dx = std::max({ double(b[0]) - place[0], 0.0, place[0] - double(b[3]) });
-      const double dy = std::max({ double(b[1]) - place[1], 0.0, place[1] - double(b[4]) });
-      leaves.emplace_back(dx * dx + dy * dy, r);
+      leaves.emplace_back(DistanceToTriangle(tree.ModelTriangle(regions[r].level, regions[r].index), place), r);
     }
   }
   const std::size_t tries = std::min<std::size_t>(leaves.size(), MaxLeavesSearched);
@@ -241,20 +264,19 @@ CellReport InspectCell(const MultiresolutionFile& file, const PropertyFile* prop
   return report;
 }
 
-bool BoxMayCoverPixel(const std::array<float, 6>& bounds, const std::array<double, 16>& modelToClip, double x, double y,
-  double width, double height)
+bool BoxMayCoverPixel(const std::array<double, 3>& low, const std::array<double, 3>& high,
+  const std::array<double, 16>& toClip, double x, double y, double width, double height)
 {
-  double low[2] = { std::numeric_limits<double>::max(), std::numeric_limits<double>::max() };
-  double high[2] = { std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest() };
+  double least[2] = { std::numeric_limits<double>::max(), std::numeric_limits<double>::max() };
+  double most[2] = { std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest() };
   for (int corner = 0; corner < 8; ++corner)
   {
-    const double p[4] = { bounds[corner & 1 ? 3 : 0], bounds[corner & 2 ? 4 : 1], -double(bounds[corner & 4 ? 5 : 2]),
+    const double p[4] = { corner & 1 ? high[0] : low[0], corner & 2 ? high[1] : low[1], corner & 4 ? high[2] : low[2],
       1 };
     double clip[4];
     for (int r = 0; r < 4; ++r)
     {
-      clip[r] = modelToClip[4 * r] * p[0] + modelToClip[4 * r + 1] * p[1] + modelToClip[4 * r + 2] * p[2] +
-        modelToClip[4 * r + 3] * p[3];
+      clip[r] = toClip[4 * r] * p[0] + toClip[4 * r + 1] * p[1] + toClip[4 * r + 2] * p[2] + toClip[4 * r + 3] * p[3];
     }
     if (!(clip[3] > 0))
     {
@@ -263,12 +285,78 @@ bool BoxMayCoverPixel(const std::array<float, 6>& bounds, const std::array<doubl
     const double window[2] = { (clip[0] / clip[3] + 1) * width / 2, (clip[1] / clip[3] + 1) * height / 2 };
     for (int a = 0; a < 2; ++a)
     {
-      low[a] = std::min(low[a], window[a]);
-      high[a] = std::max(high[a], window[a]);
+      least[a] = std::min(least[a], window[a]);
+      most[a] = std::max(most[a], window[a]);
     }
   }
   // A pixel of margin: the rasterizer's snapping and the box's float corners.
-  return x >= low[0] - 1 && x <= high[0] + 1 && y >= low[1] - 1 && y <= high[1] + 1;
+  return x >= least[0] - 1 && x <= most[0] + 1 && y >= least[1] - 1 && y <= most[1] + 1;
+}
+
+bool RegionMayCoverPixel(const std::array<float, 6>& bounds, const std::array<double, 16>& modelToClip, double x,
+  double y, double width, double height)
+{
+  // z up: the box's z runs from -(deepest) to -(shallowest).
+  return BoxMayCoverPixel({ bounds[0], bounds[1], -double(bounds[5]) }, { bounds[3], bounds[4], -double(bounds[2]) },
+    modelToClip, x, y, width, height);
+}
+
+std::vector<std::array<float, 6>> TriangleChunkBoxes(const RegionDrawBuffers& buffers)
+{
+  const std::size_t chunkIndices = std::size_t(PickChunkTriangles) * 3;
+  const std::size_t vertexCount = buffers.vertices.size() / 6;
+  std::vector<std::array<float, 6>> boxes((buffers.indices.size() + chunkIndices - 1) / chunkIndices);
+  for (std::size_t c = 0; c < boxes.size(); ++c)
+  {
+    std::array<float, 6> box{ std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
+      std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest(), std::numeric_limits<float>::lowest(),
+      std::numeric_limits<float>::lowest() };
+    const std::size_t end = std::min(buffers.indices.size(), (c + 1) * chunkIndices);
+    for (std::size_t n = c * chunkIndices; n < end; ++n)
+    {
+      const uint32_t v = buffers.indices[n];
+      if (v >= vertexCount)
+      {
+        continue;
+      }
+      const float* p = &buffers.vertices[std::size_t(v) * 6];
+      for (std::size_t a = 0; a < 3; ++a)
+      {
+        box[a] = std::min(box[a], p[a]);
+        box[3 + a] = std::max(box[3 + a], p[a]);
+      }
+    }
+    boxes[c] = box;
+  }
+  return boxes;
+}
+
+std::vector<std::pair<uint32_t, uint32_t>> IndexRunsCoveringPixel(const std::vector<std::array<float, 6>>& boxes,
+  uint32_t first, uint32_t count, const std::array<double, 16>& toClip, double x, double y, double width, double height)
+{
+  std::vector<std::pair<uint32_t, uint32_t>> runs;
+  const uint32_t chunkIndices = PickChunkTriangles * 3, end = first + count;
+  for (uint32_t at = first; at < end;)
+  {
+    const std::size_t chunk = at / chunkIndices;
+    const uint32_t chunkEnd = std::min(end, static_cast<uint32_t>((chunk + 1) * chunkIndices));
+    const bool covers = chunk >= boxes.size() ||
+      BoxMayCoverPixel({ boxes[chunk][0], boxes[chunk][1], boxes[chunk][2] },
+        { boxes[chunk][3], boxes[chunk][4], boxes[chunk][5] }, toClip, x, y, width, height);
+    if (covers)
+    {
+      if (!runs.empty() && runs.back().first + runs.back().second == at)
+      {
+        runs.back().second += chunkEnd - at;
+      }
+      else
+      {
+        runs.emplace_back(at, chunkEnd - at);
+      }
+    }
+    at = chunkEnd;
+  }
+  return runs;
 }
 
 bool CellFromPickPixel(

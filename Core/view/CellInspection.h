@@ -22,10 +22,12 @@
 
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
+#include "RegionCache.h"
 
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace resmr
@@ -73,13 +75,32 @@ constexpr std::size_t MaxLeavesSearched = 16;
 CellGeometry InspectCellGeometry(
   const MultiresolutionFile& file, const std::array<int64_t, 3>& cell, const std::array<double, 3>* near = nullptr);
 
-/// Whether a region's box (RegionRecord::bounds: x, y, depth minima then maxima) may cover the
-/// pixel centred at window point (x, y) of a `width` x `height` viewport seen through the
-/// row-major `modelToClip` (z up): false only when its projection lies wholly beside the pixel
-/// (a box reaching behind the eye may cover anything). The pick pass draws only such regions:
-/// a handful, where the frame drew the whole cut.
-bool BoxMayCoverPixel(const std::array<float, 6>& bounds, const std::array<double, 16>& modelToClip, double x, double y,
-  double width, double height);
+/// Whether the box [low, high] (z up) may cover the pixel centred at window point (x, y) of a
+/// `width` x `height` viewport seen through the row-major `toClip`: false only when its
+/// projection lies wholly beside the pixel, a pixel of margin around it for the rasterizer's
+/// snapping (a box reaching behind the eye may cover anything).
+bool BoxMayCoverPixel(const std::array<double, 3>& low, const std::array<double, 3>& high,
+  const std::array<double, 16>& toClip, double x, double y, double width, double height);
+
+/// The same for a region's box (RegionRecord::bounds: x, y, depth minima then maxima). The pick
+/// pass draws only such regions: a handful, where the frame drew the whole cut.
+bool RegionMayCoverPixel(const std::array<float, 6>& bounds, const std::array<double, 16>& modelToClip, double x,
+  double y, double width, double height);
+
+/// Triangles a chunk box of TriangleChunkBoxes bounds: of the regions that may cover a pixel,
+/// the pick pass draws only the chunks that may (a few thousand triangles instead of hundreds
+/// of thousands); a box is 24 bytes, 0.1 byte a triangle, kept while the region is on the GPU.
+constexpr uint32_t PickChunkTriangles = 256;
+
+/// The boxes (x, y, z minima then maxima, the buffers' coordinates) of each run of
+/// PickChunkTriangles triangles of `buffers.indices`, from its start.
+std::vector<std::array<float, 6>> TriangleChunkBoxes(const RegionDrawBuffers& buffers);
+
+/// The runs (first index, index count) of indices [first, first + count) whose chunk boxes may
+/// cover the pixel (BoxMayCoverPixel, `toClip` taking the buffers' coordinates to clip space).
+std::vector<std::pair<uint32_t, uint32_t>> IndexRunsCoveringPixel(const std::vector<std::array<float, 6>>& boxes,
+  uint32_t first, uint32_t count, const std::array<double, 16>& toClip, double x, double y, double width,
+  double height);
 
 /// The cell a pick pass painted in a pixel: its RGB holds i, j, k (0-based) as floats, its
 /// alpha 1; alpha 0 (nothing drawn there) or a value off the grid gives false.

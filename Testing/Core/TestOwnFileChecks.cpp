@@ -279,7 +279,7 @@ void RegionContents(const Bytes& valid)
 }
 
 // .resmrp header fields (PropertyFile.cpp, HeaderOf).
-constexpr std::size_t PVersion = 8, PDims = 20, PSides = 44, PTables = 56;
+constexpr std::size_t PVersion = 8, PDims = 20, PSides = 44, PTables = 56, PBandRows = 60;
 
 void PropertyFields(const Bytes& valid, const std::string& validPath, const std::string& geometryPath)
 {
@@ -296,7 +296,31 @@ void PropertyFields(const Bytes& valid, const std::string& validPath, const std:
   const auto setTable = [&](std::size_t t, std::size_t field, auto value) -> Change {
     return [=](Bytes& f) { Store(f, static_cast<std::size_t>(index + t * table + field), value); };
   };
-  ExpectPropertiesRefused("version 3", valid, "format version 3", Set<uint32_t>(PVersion, 3));
+  ExpectPropertiesRefused("version 4", valid, "format version 4", Set<uint32_t>(PVersion, 4));
+  ExpectPropertiesRefused("version 1", valid, "format version 1", Set<uint32_t>(PVersion, 1));
+  ExpectPropertiesRefused("band rows 0", valid, "'rows a band' is 0", Set<uint32_t>(PBandRows, 0));
+  ExpectPropertiesRefused("band rows ny + 1", valid, "'rows a band'",
+    [](Bytes& f) { Store<uint32_t>(f, PBandRows, static_cast<uint32_t>(Load<int64_t>(f, PDims + 8) + 1)); });
+  {
+    // A version 2 file (a chunk a layer, no band rows) reads as one band a layer.
+    const std::string old = Temp + "/version2.resmrp";
+    Spill(old, Changed(valid, resmr_fuzz::ResmrpLayout(), [](Bytes& f) {
+      Store<uint32_t>(f, PVersion, 2);
+      Store<uint32_t>(f, PBandRows, 0);
+    }));
+    const PropertyFile now(validPath), before(old);
+    CHECK(before.Bands() == 1 && now.Bands() == 1 && before.BandRows() == now.BandRows());
+    CHECK(before.Tables().size() == now.Tables().size());
+    for (std::size_t t = 0; t < now.Tables().size(); ++t)
+    {
+      const auto a = now.ReadLayer(t, 1), b = before.ReadLayer(t, 1);
+      CHECK(std::memcmp(a.data(), b.data(), a.size() * 4) == 0 && a.size() == b.size());
+    }
+    ExpectPropertiesRefused("version 2 band rows", valid, "'reserved bytes'", [](Bytes& f) {
+      Store<uint32_t>(f, PVersion, 2);
+      Store<uint32_t>(f, PBandRows, 1);
+    });
+  }
   ExpectPropertiesRefused("0 tables", valid, "'table count' is 0", Set<uint32_t>(PTables, 0));
   ExpectPropertiesRefused("tables + 1", valid, "'table count'", Set<uint32_t>(PTables, tables + 1));
   ExpectPropertiesRefused("tables - 1", valid, "'table count'", Set<uint32_t>(PTables, tables - 1));

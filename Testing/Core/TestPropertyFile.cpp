@@ -345,6 +345,30 @@ int main(int argc, char** argv)
     const MultiresolutionFile geometry(reekGeometry);
     const PropertyFile properties(reekProperties);
     CHECK(CheckTables(geometry, properties, reekGrid, reekResults) == static_cast<int>(properties.Tables().size()));
+    CHECK(properties.Bands() == 1 && properties.BandRows() == reekGrid.deck.dims[1]);
+    // Layers cut into bands of 5 rows (the last of 4), then copied back into one band a layer
+    // (what copying an older version's file does): the same values either way.
+    const std::string banded = temp + "/reek-banded.resmrp", again = temp + "/reek-again.resmrp";
+    {
+      PropertyFileWriter writer(banded, geometry, 5);
+      writer.CopyFrom(properties);
+      writer.Commit();
+    }
+    {
+      const PropertyFile cut(banded);
+      CHECK(cut.BandRows() == 5 && cut.Bands() == (reekGrid.deck.dims[1] + 4) / 5 && cut.Bands() > 2);
+      CHECK(CheckTables(geometry, cut, reekGrid, reekResults) == static_cast<int>(properties.Tables().size()));
+      PropertyFileWriter writer(again, geometry);
+      writer.CopyFrom(cut);
+      writer.Commit();
+    }
+    {
+      const PropertyFile whole(again);
+      CHECK(whole.Bands() == 1);
+      CHECK(CheckTables(geometry, whole, reekGrid, reekResults) == static_cast<int>(properties.Tables().size()));
+    }
+    std::remove(banded.c_str());
+    std::remove(again.c_str());
     std::remove(reekProperties.c_str());
     GrowingRun(resmrTool, reek, reekGeometry, temp, reekGrid, reekResults);
     std::remove(reekProperties.c_str());

@@ -4,8 +4,11 @@
 // projection; the per-frame upload plan (time budget, table slabs, mesh pieces of given byte
 // counts, piece admission); the frame time the controller is told; the memory budget's
 // split, which GPU copies go when the mirror is full, which property table is asked for and
-// which may stand in, and which index runs of a region are drawn.
+// which may stand in, and which index runs of a region are drawn; which triangle chunks the
+// pick pass draws for a pixel.
 #include "CoreTesting.h"
+
+#include "CellInspection.h"
 
 #include "FramePlanning.h"
 #include "PropertyFile.h"
@@ -380,6 +383,50 @@ void TestPropertyRequests()
 }
 } // namespace
 
+/// Chunk boxes of 600 triangles in three clusters (x near 0, 100, 200): a pixel over the middle
+/// cluster keeps only its chunk; a part starting mid-chunk keeps its own indices only.
+void TestPickChunks()
+{
+  RegionDrawBuffers buffers;
+  for (int t = 0; t < 600; ++t)
+  {
+    const float x = t < 256 ? 0.f : t < 512 ? 100.f : 200.f;
+    for (int v = 0; v < 3; ++v)
+    {
+      const float corner[6] = { x + float(v == 1), float(v == 2), float(t % 7), 0, 0, 0 };
+      buffers.vertices.insert(buffers.vertices.end(), corner, corner + 6);
+      buffers.indices.push_back(static_cast<uint32_t>(3 * t + v));
+    }
+  }
+  const auto boxes = TriangleChunkBoxes(buffers);
+  CHECK(boxes.size() == 3);
+  CHECK(boxes[0][0] == 0.f && boxes[0][3] == 1.f && boxes[1][0] == 100.f && boxes[1][3] == 101.f);
+  CHECK(boxes[2][0] == 200.f && boxes[2][4] == 1.f && boxes[2][5] == 6.f);
+  // Orthographic: x from -10 to 210 and y from -10 to 10 across a 220 x 20 pixel viewport.
+  Matrix4 toClip{};
+  toClip[0] = 2.0 / 220;
+  toClip[3] = -200.0 / 220;
+  toClip[5] = 2.0 / 20;
+  toClip[10] = -0.01;
+  toClip[15] = 1;
+  const auto runs = IndexRunsCoveringPixel(boxes, 0, 1800, toClip, 110.5, 10.5, 220, 20);
+  CHECK(runs.size() == 1 && runs[0].first == 768 && runs[0].second == 768);
+  // The pixel a few pixels off the cluster's box: nothing.
+  CHECK(IndexRunsCoveringPixel(boxes, 0, 1800, toClip, 115.5, 10.5, 220, 20).empty());
+  // A part from triangle 300 to 550 over the last two clusters' pixels: its own indices only.
+  const auto late = IndexRunsCoveringPixel(boxes, 900, 750, toClip, 210.5, 10.5, 220, 20);
+  CHECK(late.size() == 1 && late[0].first == 1536 && late[0].second == 114);
+  const auto both = IndexRunsCoveringPixel(boxes, 900, 750, toClip, 110.5, 10.5, 220, 20);
+  CHECK(both.size() == 1 && both[0].first == 900 && both[0].second == 636);
+  // A box reaching behind the eye may cover anything.
+  Matrix4 perspective{};
+  perspective[0] = perspective[5] = 1;
+  perspective[10] = -1;
+  perspective[14] = -1; // w = -z: the eye at z = 0 looking down -z
+  CHECK(BoxMayCoverPixel({ -1, -1, -1 }, { 1, 1, 1 }, perspective, 0.5, 0.5, 10, 10));
+  CHECK(!BoxMayCoverPixel({ 5, 5, -2 }, { 6, 6, -1 }, perspective, 0.5, 0.5, 10, 10));
+}
+
 int main(int argc, char** argv)
 {
   if (argc != 3)
@@ -397,6 +444,7 @@ int main(int argc, char** argv)
     { "ControllerInputs", TestControllerInputs },
     { "Residency", TestResidency },
     { "PropertyRequests", TestPropertyRequests },
+    { "PickChunks", TestPickChunks },
   });
   return passed ? 0 : 1;
 }

@@ -257,18 +257,27 @@ inline FileLayout ResmrLayout()
   return layout;
 }
 
-/// The .resmrp layout (PropertyFile.cpp): 128-byte header with nz at byte 36 and the table
-/// count at 56; per table 56 bytes (name, step, report, days, range), then the packed
-/// table's reference and one a layer.
+/// The .resmrp layout (PropertyFile.cpp): 128-byte header with the version at byte 8, ny at 28,
+/// nz at 36, the table count at 56 and (version 3) the rows a band at 60; per table 56 bytes
+/// (name, step, report, days, range), then the packed table's reference and one a band of
+/// every layer (version 2: one a layer).
 inline FileLayout ResmrpLayout()
 {
-  constexpr std::size_t Header = 128, LayersAt = 36, TablesAt = 56, TableHead = 56;
+  constexpr std::size_t Header = 128, VersionAt = 8, RowsAt = 28, LayersAt = 36, TablesAt = 56, BandRowsAt = 60,
+                        TableHead = 56;
   FileLayout layout;
   layout.headerBytes = Header;
   std::memcpy(layout.trailerMagic, "RESMRPIX", 8);
   const auto tableBytes = [=](const std::vector<uint8_t>& file) -> uint64_t {
-    const int64_t layers = Load<int64_t>(file, LayersAt);
-    return layers > 0 && layers <= (int64_t(1) << 24) ? TableHead + 20 * (static_cast<uint64_t>(layers) + 1) : 0;
+    const int64_t limit = int64_t(1) << 24;
+    const int64_t layers = Load<int64_t>(file, LayersAt), rows = Load<int64_t>(file, RowsAt);
+    const int64_t bandRows = Load<uint32_t>(file, VersionAt) >= 3 ? Load<uint32_t>(file, BandRowsAt) : rows;
+    if (layers <= 0 || layers > limit || rows <= 0 || rows > limit || bandRows <= 0 || bandRows > rows)
+    {
+      return 0;
+    }
+    const uint64_t bands = static_cast<uint64_t>((rows + bandRows - 1) / bandRows);
+    return TableHead + 20 * (static_cast<uint64_t>(layers) * bands + 1);
   };
   layout.indexBytes = [=](const std::vector<uint8_t>& file) -> uint64_t {
     return Load<uint32_t>(file, TablesAt) * tableBytes(file);

@@ -59,7 +59,8 @@ void CheckIndex(const resmr::PropertyFile& file, const std::vector<uint8_t>& byt
   }
   const auto& dims = file.Dimensions();
   const uint64_t indexSize = resmr_fuzz::Load<uint64_t>(bytes, bytes.size() - resmr::IndexTrailerBytes + 8);
-  const uint64_t perTable = 56 + 20 * (static_cast<uint64_t>(dims[2]) + 1);
+  const int64_t bands = file.Bands();
+  const uint64_t perTable = 56 + 20 * (static_cast<uint64_t>(dims[2] * bands) + 1);
   if (indexSize != file.Tables().size() * perTable)
   {
     BrokenInvariant("opened with " + std::to_string(file.Tables().size()) + " tables in an index of " +
@@ -68,9 +69,11 @@ void CheckIndex(const resmr::PropertyFile& file, const std::vector<uint8_t>& byt
   for (const auto& table : file.Tables())
   {
     bool sized = table.packed.raw == slots * 4;
-    for (const auto& layer : table.layers)
+    for (std::size_t n = 0; n < table.layerBands.size(); ++n)
     {
-      sized = sized && layer.raw == static_cast<uint64_t>(dims[0] * dims[1]) * 4;
+      const int64_t b = static_cast<int64_t>(n) % bands;
+      const int64_t rows = std::min(file.BandRows(), dims[1] - b * file.BandRows());
+      sized = sized && table.layerBands[n].raw == static_cast<uint64_t>(dims[0] * rows) * 4;
     }
     if (!sized)
     {
@@ -87,9 +90,10 @@ int ReadEverything(
   for (std::size_t t = 0; t < file.Tables().size(); ++t)
   {
     const auto& table = file.Tables()[t];
-    if (resmr_fuzz::InvariantsChecked() && table.layers.size() != static_cast<std::size_t>(dims[2]))
+    if (resmr_fuzz::InvariantsChecked() && table.layerBands.size() != static_cast<std::size_t>(dims[2] * file.Bands()))
     {
-      BrokenInvariant("table " + std::to_string(t) + " has " + std::to_string(table.layers.size()) + " layers");
+      BrokenInvariant("table " + std::to_string(t) + " has " + std::to_string(table.layerBands.size()) +
+        " layer bands for " + std::to_string(dims[2]) + " layers of " + std::to_string(file.Bands()));
     }
     for (int64_t k = -1; k < dims[2]; ++k)
     {
