@@ -99,7 +99,10 @@ for path in args.models:
         named += cell is not None and bool(cell["values"])
     after, after_file = rss_mb(), rss_mb("RssFile")
     display.UpdatePropertyInformation()
+    cell = resmr_inspect.PickCell(int(covered[0] % WIDTH), int(covered[0] // WIDTH), view, display)
     row = {"model": os.path.basename(path), "triangles": int(display.GetPropertyValue("TrianglesDrawn")),
+           "regions": int(display.GetPropertyValue("RegionsDrawn")),
+           "tables_read": len(cell["values"]) if cell else 0,
            "picks": args.picks, "picks_with_values": named,
            "pick_p50_ms": round(percentile(latencies, 50), 1), "pick_p99_ms": round(percentile(latencies, 99), 1),
            "render_p50_ms": round(percentile(plain, 50), 1), "render_p99_ms": round(percentile(plain, 99), 1),
@@ -125,11 +128,12 @@ lines = ["# Pick latency", "",
          "rendered (what a pick that waited for a frame would cost). Memory: heap (RssAnon) before the first pick and "
          "after the last; the property file's pages the picks mapped (RssFile) are the page cache's." % (result["date"], result["machine"],
                                                                                 args.picks), "",
-         "| model | triangles | pick p50 / p99 ms | a render p50 / p99 ms | picks with values | heap added MB | "
-         "file pages added MB |", "|---|---|---|---|---|---|---|"]
+         "| model | regions, triangles | tables read a pick | pick p50 / p99 ms | a render p50 / p99 ms | "
+         "picks with values | heap added MB | file pages added MB |", "|---|---|---|---|---|---|---|---|"]
 for r in rows:
-    lines.append("| %s | %s | %.0f / %.0f | %.0f / %.0f | %d of %d | %.1f | %.1f |" % (
-        r["model"], format(r["triangles"], ","), r["pick_p50_ms"], r["pick_p99_ms"], r["render_p50_ms"],
-        r["render_p99_ms"], r["picks_with_values"], r["picks"], r["rss_added_mb"], r["file_pages_added_mb"]))
+    lines.append("| %s | %d, %s | %d | %.0f / %.0f | %.0f / %.0f | %d of %d | %.1f | %.1f |" % (
+        r["model"], r["regions"], format(r["triangles"], ","), r["tables_read"], r["pick_p50_ms"], r["pick_p99_ms"],
+        r["render_p50_ms"], r["render_p99_ms"], r["picks_with_values"], r["picks"], r["rss_added_mb"],
+        r["file_pages_added_mb"]))
 with open(args.out + ".md", "w") as f:
     f.write("\n".join(lines) + "\n")

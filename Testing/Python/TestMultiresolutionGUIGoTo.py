@@ -11,27 +11,12 @@ same file. Skipped without a paraview executable or an X display."""
 import os
 import re
 import subprocess
-import sys
 import time
 
 import resmr_testing as rt
 
-SKIP = 125
 args = rt.arguments()
-paraview = os.environ.get("PARAVIEW_EXECUTABLE", "")
-if not paraview or not os.path.exists(paraview) or not os.environ.get("DISPLAY"):
-    print(f"skipped: paraview {paraview!r}, DISPLAY {os.environ.get('DISPLAY')!r}")
-    sys.exit(SKIP)
-
-resmr = os.environ["RESMR_EXECUTABLE"]
-temp = os.path.join(args.temp, "gui-goto")
-os.makedirs(temp, exist_ok=True)
-grid = os.path.join(temp, "faulted.EGRID")
-path = os.path.join(temp, "faulted.resmr")
-if not os.path.exists(path + "p"):
-    subprocess.run([resmr, "synth", "120", "100", "16", "-o", grid, "--quiet"], check=True, capture_output=True)
-    subprocess.run([resmr, "build", grid, "-o", path, "--quiet"], check=True, capture_output=True)
-    subprocess.run([resmr, "add-properties", path, grid], check=True, capture_output=True)
+paraview, temp, path = rt.gui_model(args, "gui-goto")
 
 # Two active top cells and the middle of the second's top face, from pvpython.
 from paraview import simple  # noqa: E402

@@ -3,6 +3,7 @@ deck through the GRDECLReader proxy, and image comparison against a baseline."""
 import argparse
 import os
 import shutil
+import subprocess
 import sys
 
 import numpy as np
@@ -15,6 +16,26 @@ def arguments():
     parser.add_argument("--baselines", default="")
     parser.add_argument("--temp", default="/tmp")
     return parser.parse_args()
+
+
+def gui_model(args, folder):
+    """For the GUI tests: the paraview executable, TEMP/folder and a generated faulted model
+    with its properties there (120 x 100 x 16, built once); exits 125 (skipped) without a
+    paraview executable or an X display."""
+    paraview = os.environ.get("PARAVIEW_EXECUTABLE", "")
+    if not paraview or not os.path.exists(paraview) or not os.environ.get("DISPLAY"):
+        print(f"skipped: paraview {paraview!r}, DISPLAY {os.environ.get('DISPLAY')!r}")
+        sys.exit(125)
+    resmr = os.environ["RESMR_EXECUTABLE"]
+    temp = os.path.join(args.temp, folder)
+    os.makedirs(temp, exist_ok=True)
+    grid = os.path.join(temp, "faulted.EGRID")
+    path = os.path.join(temp, "faulted.resmr")
+    if not os.path.exists(path + "p"):
+        for command in (["synth", "120", "100", "16", "-o", grid, "--quiet"], ["build", grid, "-o", path, "--quiet"],
+                        ["add-properties", path, grid]):
+            subprocess.run([resmr, *command], check=True, capture_output=True)
+    return paraview, temp, path
 
 
 def load_plugin(path):
