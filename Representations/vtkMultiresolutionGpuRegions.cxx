@@ -124,6 +124,8 @@ bool vtkMultiresolutionGpuRegions::Ready(std::size_t region) const
 
 void vtkMultiresolutionGpuRegions::Erase(RegionMap::iterator entry)
 {
+  this->BoxBytes -= entry->second->ChunkBoxes.size() * sizeof(std::array<float, 6>);
+  this->Boxed.erase(std::remove(this->Boxed.begin(), this->Boxed.end(), entry->first), this->Boxed.end());
   this->GpuBytes -= entry->second->Bytes;
   entry->second->Release();
   this->Regions.erase(entry);
@@ -250,6 +252,15 @@ const std::vector<std::array<float, 6>>& vtkMultiresolutionGpuRegions::ChunkBoxe
   if (gpu.ChunkBoxes.empty())
   {
     gpu.ChunkBoxes = resmr::TriangleChunkBoxes(*gpu.Buffers);
+    this->BoxBytes += gpu.ChunkBoxes.size() * sizeof(std::array<float, 6>);
+    this->Boxed.push_back(region);
+    while (this->BoxBytes > resmr::MaxPickBoxBytes && this->Boxed.front() != region)
+    {
+      auto& boxes = this->Regions.at(this->Boxed.front())->ChunkBoxes;
+      this->BoxBytes -= boxes.size() * sizeof(std::array<float, 6>);
+      std::vector<std::array<float, 6>>().swap(boxes);
+      this->Boxed.erase(this->Boxed.begin());
+    }
   }
   return gpu.ChunkBoxes;
 }
@@ -297,5 +308,7 @@ void vtkMultiresolutionGpuRegions::ReleaseGraphicsResources()
     entry.second->Release();
   }
   this->Regions.clear();
+  this->Boxed.clear();
+  this->BoxBytes = 0;
   this->GpuBytes = 0;
 }

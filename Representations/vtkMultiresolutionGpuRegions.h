@@ -59,7 +59,8 @@ public:
   std::size_t Draw(std::size_t region, const std::vector<resmr::DrawPart>& parts, vtkShaderProgram* program,
     vtkOpenGLState* state, bool cull);
   /// The boxes of a Prepare'd region's triangle chunks (resmr::TriangleChunkBoxes), made at its
-  /// first pick and kept with its copy.
+  /// first pick and kept with its copy, those of the regions picked longest ago dropped past
+  /// resmr::MaxPickBoxBytes.
   const std::vector<std::array<float, 6>>& ChunkBoxes(std::size_t region);
 
   /// Frees every GL buffer.
@@ -79,6 +80,8 @@ private:
   RegionMap Regions;
   std::size_t GpuBytes = 0;
   std::vector<uint32_t> IndexScratch; ///< a piece's rebased indices, kept from piece to piece
+  std::vector<std::size_t> Boxed;     ///< regions holding chunk boxes, picked longest ago first
+  std::size_t BoxBytes = 0;
 };
 
 #endif

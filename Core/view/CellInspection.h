@@ -89,8 +89,11 @@ bool RegionMayCoverPixel(const std::array<float, 6>& bounds, const std::array<do
 
 /// Triangles a chunk box of TriangleChunkBoxes bounds: of the regions that may cover a pixel,
 /// the pick pass draws only the chunks that may (a few thousand triangles instead of hundreds
-/// of thousands); a box is 24 bytes, 0.1 byte a triangle, kept while the region is on the GPU.
+/// of thousands); a box is 24 bytes, 0.1 byte a triangle.
 constexpr uint32_t PickChunkTriangles = 256;
+/// Most bytes of chunk boxes kept between picks (those of the regions picked last): what
+/// picking adds to memory, whatever the model and the budget.
+constexpr std::size_t MaxPickBoxBytes = std::size_t(512) << 10;
 
 /// The boxes (x, y, z minima then maxima, the buffers' coordinates) of each run of
 /// PickChunkTriangles triangles of `buffers.indices`, from its start.
