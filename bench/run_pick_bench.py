@@ -26,6 +26,8 @@ parser.add_argument("--plugin", required=True)
 parser.add_argument("--models", nargs="+", required=True)
 parser.add_argument("--picks", type=int, default=100)
 parser.add_argument("--out", default="bench/results/pick")
+parser.add_argument("--drop-caches", action="store_true",
+                    help="empty the page cache before each model (root): its files' first picks read the disk")
 args = parser.parse_args()
 
 simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
@@ -52,6 +54,10 @@ def percentile(values, p):
 simple.Render(simple.CreateRenderView())  # paraview.simple resets the camera on its first render
 rows = []
 for path in args.models:
+    if args.drop_caches:
+        os.sync()
+        with open("/proc/sys/vm/drop_caches", "w") as caches:
+            caches.write("3\n")
     view = simple.CreateRenderView()
     view.ViewSize = [WIDTH, HEIGHT]
     view.OrientationAxesVisibility = 0
@@ -116,7 +122,7 @@ for path in args.models:
     simple.Delete(view)
 
 cpu = [l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")]
-result = {"date": time.strftime("%Y-%m-%d %H:%M"), "view": [WIDTH, HEIGHT],
+result = {"date": time.strftime("%Y-%m-%d %H:%M"), "view": [WIDTH, HEIGHT], "page_cache_dropped": args.drop_caches,
           "machine": "%s, %d cores, llvmpipe" % (cpu[0] if cpu else platform.processor(), os.cpu_count()),
           "rows": rows}
 with open(args.out + ".json", "w") as f:
@@ -126,8 +132,10 @@ lines = ["# Pick latency", "",
          "loaded; %d random covered pixels picked as the GUI's hover does (resmr_inspect.PickCell: the request, "
          "the pick pass drawn from the last frame, no new render, the answer pulled), beside the same view "
          "rendered (what a pick that waited for a frame would cost). Memory: heap (RssAnon) before the first pick and "
-         "after the last; the property file's pages the picks mapped (RssFile) are the page cache's." % (result["date"], result["machine"],
-                                                                                args.picks), "",
+         "after the last; the property file's pages the picks mapped (RssFile) are the page cache's.%s" % (
+             result["date"], result["machine"], args.picks,
+             " The page cache was emptied before each model: the files' pages come from the disk at their first read."
+             if args.drop_caches else ""), "",
          "| model | regions, triangles | tables read a pick | pick p50 / p99 ms | a render p50 / p99 ms | "
          "picks with values | heap added MB | file pages added MB |", "|---|---|---|---|---|---|---|---|"]
 for r in rows:

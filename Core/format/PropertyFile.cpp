@@ -12,6 +12,8 @@
 #include <limits>
 #include <set>
 #include <stdexcept>
+#include <sys/mman.h>
+#include <unistd.h>
 
 namespace resmr
 {
@@ -427,6 +429,21 @@ float PropertyFile::ReadCell(std::size_t table, const std::array<int64_t, 3>& ce
   float value = 0;
   std::memcpy(&value, raw.data() + at * 4, 4);
   return value;
+}
+
+void PropertyFile::PrefetchCell(std::size_t table, const std::array<int64_t, 3>& cell) const
+{
+  const PropertyTable& t = this->Entries.at(table);
+  if (cell[0] < 0 || cell[1] < 0 || cell[2] < 0 || cell[0] >= this->Dims[0] || cell[1] >= this->Dims[1] ||
+    cell[2] >= this->Dims[2])
+  {
+    return;
+  }
+  const ChunkRef& ref = t.layerBands[static_cast<std::size_t>(cell[2] * this->Bands() + cell[1] / this->RowsInBand)];
+  const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
+  const uintptr_t begin = reinterpret_cast<uintptr_t>(this->Data + ref.offset) & ~(page - 1);
+  const uintptr_t end = reinterpret_cast<uintptr_t>(this->Data + ref.offset + ref.stored);
+  posix_madvise(reinterpret_cast<void*>(begin), end - begin, POSIX_MADV_WILLNEED);
 }
 
 PropertyFileWriter::PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry, int64_t bandRows)

@@ -87,6 +87,9 @@ public:
   /// it only, the band's CRC checked the first time it is read (later reads of it, a cursor
   /// resting on one place, decode only).
   float ReadCell(std::size_t table, const std::array<int64_t, 3>& cell) const;
+  /// Asks the system to start reading the band ReadCell will decode (a cold file's pages come
+  /// from the disk all at once, not one table after the other); returns at once.
+  void PrefetchCell(std::size_t table, const std::array<int64_t, 3>& cell) const;
   /// The stored bytes of a chunk (for copying into a new file).
   const uint8_t* ChunkBytes(const ChunkRef& ref) const { return this->Data + ref.offset; }
 

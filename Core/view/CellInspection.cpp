@@ -171,8 +171,13 @@ std::vector<CellValue> CellValues(const PropertyFile& properties, const std::arr
       }
     }
   }
-  // One chunk a table, each checked whole (CRC) and decoded up to the cell: the tables on
-  // every core, so a pick answers while the cursor rests.
+  // One band a table, each checked whole (CRC) and decoded up to the cell: the tables on every
+  // core, so a pick answers while the cursor rests; a cold file's bands asked of the disk
+  // together first.
+  for (std::size_t t : tables)
+  {
+    properties.PrefetchCell(t, cell);
+  }
   std::vector<CellValue> values(tables.size());
   std::vector<std::string> errors(tables.size());
   std::atomic<std::size_t> next{ 0 };
