@@ -3,7 +3,6 @@
 #include "DiamondHierarchy.h"
 #include "RegionMesh.h"
 #include "ThreadGroup.h"
-#include "ViewTransforms.h"
 
 #include <algorithm>
 #include <atomic>
