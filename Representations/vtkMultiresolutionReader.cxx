@@ -75,6 +75,7 @@ int vtkMultiresolutionReader::RequestInformation(
   this->StepNumbers.clear();
   this->LastError.clear();
   this->InformationFailed.clear();
+  std::fill(this->Dimensions, this->Dimensions + 3, 0);
   if (this->FileName.empty())
   {
     this->InformationFailed = "no FileName: a .resmr file is needed";
@@ -83,6 +84,10 @@ int vtkMultiresolutionReader::RequestInformation(
   try
   {
     const resmr::MultiresolutionFile geometry(this->FileName); // checks header, index and trailer
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Dimensions[a] = static_cast<int>(geometry.Header().dims[a]);
+    }
     this->WarnOfUnreachableRegions(geometry);
     this->ResolvedPropertyFile = this->PropertyPathFor();
     this->PropertyFileStamp = FileStamp(this->ResolvedPropertyFile);

@@ -63,6 +63,10 @@ public:
   /// Why the last update failed; empty if it did not.
   const char* GetLastError() const { return this->LastError.c_str(); }
 
+  /// The grid's cells in I, J and K, after RequestInformation (0 before, or for a file that
+  /// did not open).
+  const int* GetDimensions() const { return this->Dimensions; }
+
 protected:
   vtkMultiresolutionReader();
   ~vtkMultiresolutionReader() override;
@@ -89,6 +93,7 @@ private:
   std::string InformationFailed;    ///< why RequestInformation failed (the file did not open)
   std::vector<double> StepDays;     ///< per report step, from the property file
   std::vector<int32_t> StepNumbers; ///< the property file's step of each
+  int Dimensions[3] = { 0, 0, 0 };
 };
 
 #endif

@@ -7,6 +7,7 @@
 #include "vtkMultiresolutionTableTextures.h"
 
 #include "CellInspection.h"
+#include "CellRange.h"
 #include "CornerPointGeometry.h"
 #include "FramePlanning.h"
 #include "FrameRateController.h"
@@ -41,6 +42,8 @@
 #include "vtkStringArray.h"
 #include "vtkWeakPointer.h"
 #include "vtk_glew.h"
+
+#include <sstream>
 
 #include <algorithm>
 #include <array>
@@ -240,7 +243,10 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   std::string filePath, propertyPath, propertyStamp;
   int32_t step = 0;
   bool applyMapAxes = false;
-  int32_t layer = -1; ///< 0-based; -1: the whole model
+  int32_t layer = -1;    ///< 0-based; -1: the whole model
+  std::string rangeText; ///< the descriptor's I/J/K range, from 1 (empty: none)
+  bool ranged = false;   ///< drawing the cells of `range` only
+  resmr::CellRange range;
   resmr::PropertyRequest property;
   /// The property table drawn: the requested one or one standing in; null: solid colour.
   std::shared_ptr<const resmr::PropertyTableData> drawnProperty;
@@ -419,9 +425,30 @@ void vtkMultiresolutionSurfaceMapper::ReleaseGraphicsResources(vtkWindow* window
 namespace
 {
 /// (.resmr path, .resmrp path, step, map axes) from the descriptor; false if it has none.
-bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties, int32_t& step, bool& mapAxes,
-  std::string& propertiesStamp)
+/// A range "I0 I1 J0 J1 K0 K1" (ECLIPSE's, from 1, inclusive) as a 0-based CellRange.
+bool ParseRange(const std::string& text, resmr::CellRange& range)
 {
+  std::istringstream in(text);
+  std::array<long long, 6> v{};
+  for (auto& value : v)
+  {
+    if (!(in >> value))
+    {
+      return false;
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    range.lo[a] = v[2 * a] - 1;
+    range.hi[a] = v[2 * a + 1] - 1;
+  }
+  return true;
+}
+} // namespace
+
+bool vtkMultiresolutionSurfaceMapper::ReadSource(Frame& frame)
+{
+  vtkDataObject* input = this->GetInputDataObject(0, 0);
   vtkFieldData* fields = input ? input->GetFieldData() : nullptr;
   vtkStringArray* source = fields
     ? vtkStringArray::SafeDownCast(fields->GetAbstractArray(vtkMultiresolutionSurfaceMapper::SourceArrayName()))
@@ -430,14 +457,14 @@ bool ReadSource(vtkDataObject* input, std::string& file, std::string& properties
   {
     return false;
   }
-  file = source->GetValue(0);
-  properties = source->GetValue(1);
-  step = static_cast<int32_t>(std::stol(source->GetValue(2)));
-  mapAxes = source->GetNumberOfValues() > 3 && source->GetValue(3) == "1";
-  propertiesStamp = source->GetNumberOfValues() > 4 ? source->GetValue(4) : std::string();
+  frame.filePath = source->GetValue(0);
+  frame.propertyPath = source->GetValue(1);
+  frame.step = static_cast<int32_t>(std::stol(source->GetValue(2)));
+  frame.applyMapAxes = source->GetNumberOfValues() > 3 && source->GetValue(3) == "1";
+  frame.propertyStamp = source->GetNumberOfValues() > 4 ? source->GetValue(4) : std::string();
+  frame.rangeText = source->GetNumberOfValues() > 5 ? source->GetValue(5) : std::string();
   return true;
 }
-} // namespace
 
 void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* actor)
 {
@@ -447,8 +474,7 @@ void vtkMultiresolutionSurfaceMapper::Render(vtkRenderer* renderer, vtkActor* ac
   {
     return; // hardware picking: the descriptor has no cells to name
   }
-  if (!ReadSource(this->GetInputDataObject(0, 0), frame.filePath, frame.propertyPath, frame.step, frame.applyMapAxes,
-        frame.propertyStamp))
+  if (!this->ReadSource(frame))
   {
     return; // an empty piece (another rank) or no file yet
   }
@@ -612,6 +638,52 @@ bool vtkMultiresolutionSurfaceMapper::SelectLayer(Frame& frame)
   in.LayerError.clear();
   frame.layer = this->Layer - 1;
   in.Cache->SetLayer(frame.layer);
+  return this->SelectRange(frame);
+}
+
+bool vtkMultiresolutionSurfaceMapper::SelectRange(Frame& frame)
+{
+  Internals& in = *this->Internal;
+  const auto& dims = in.File->Header().dims;
+  frame.ranged = !frame.rangeText.empty();
+  if (frame.ranged && !ParseRange(frame.rangeText, frame.range))
+  {
+    in.LayerError = "the I/J/K range '" + frame.rangeText + "' is not six whole numbers";
+    in.Pending = false;
+    return false;
+  }
+  if (frame.ranged && frame.layer >= 0)
+  {
+    // A layer shown within a range: the range's cells of that layer, painted as a range.
+    frame.range.lo[2] = std::max<int64_t>(frame.range.lo[2], frame.layer);
+    frame.range.hi[2] = std::min<int64_t>(frame.range.hi[2], frame.layer);
+    frame.layer = -1;
+  }
+  frame.ranged = frame.ranged && !frame.range.Whole({ dims[0], dims[1], dims[2] });
+  if (frame.ranged && frame.range.Empty({ dims[0], dims[1], dims[2] }))
+  {
+    in.Pending = false;
+    return false; // no cell in it: nothing to draw
+  }
+  in.Cache->SetRange(frame.ranged ? &frame.range : nullptr);
+  if (!frame.ranged)
+  {
+    in.Selector->SetRangeClassifier({});
+    return true;
+  }
+  // Where the range lies against a region is known once the region was decoded (its
+  // footprint comes with its buffers); ancestors are decoded before their children.
+  resmr::RegionCache* cache = in.Cache.get();
+  const resmr::CellRange range = frame.range;
+  const std::array<int64_t, 3> grid{ dims[0], dims[1], dims[2] };
+  in.Selector->SetRangeClassifier([cache, range, grid](std::vector<resmr::RangeClass>& classes) {
+    cache->VisitFootprints([&](std::size_t region, const std::array<float, 4>& footprint) {
+      if (region < classes.size())
+      {
+        classes[region] = resmr::ClassifyFootprint(footprint, range, grid);
+      }
+    });
+  });
   return true;
 }
 
@@ -881,8 +953,25 @@ void vtkMultiresolutionSurfaceMapper::SetUniforms(Frame& frame)
   program->SetUniformMatrix4x4("modelToView", packed.data());
   std::array<float, 9> normal = resmr::NormalMatrix(frame.modelToView);
   program->SetUniformMatrix3x3("normalToView", normal.data());
-  glUniform3i(glGetUniformLocation(static_cast<GLuint>(program->GetHandle()), "gridDims"), int(header.dims[0]),
-    int(header.dims[1]), int(header.dims[2]));
+  const GLuint handle = static_cast<GLuint>(program->GetHandle());
+  glUniform3i(glGetUniformLocation(handle, "gridDims"), int(header.dims[0]), int(header.dims[1]), int(header.dims[2]));
+  // Every face drawn is a face of a cell of the range (or of the grid).
+  std::array<int, 6> cells{ 0, int(header.dims[0]) - 1, 0, int(header.dims[1]) - 1, 0, int(header.dims[2]) - 1 };
+  for (int a = 0; frame.ranged && a < 3; ++a)
+  {
+    cells[2 * a] = std::max(cells[2 * a], int(frame.range.lo[a]));
+    cells[2 * a + 1] = std::min(cells[2 * a + 1], int(frame.range.hi[a]));
+  }
+  glUniform3i(glGetUniformLocation(handle, "cellLow"), cells[0], cells[2], cells[4]);
+  glUniform3i(glGetUniformLocation(handle, "cellHigh"), cells[1], cells[3], cells[5]);
+  std::array<int, 6> cuts{ -1, -1, -1, -1, -1, -1 }; // low and high cut cell an axis
+  for (int a = 0; frame.ranged && a < 3; ++a)
+  {
+    cuts[2 * a] = frame.range.lo[a] > 0 ? cells[2 * a] : -1;
+    cuts[2 * a + 1] = frame.range.hi[a] < header.dims[a] - 1 ? cells[2 * a + 1] : -1;
+  }
+  glUniform3i(glGetUniformLocation(handle, "cutLow"), cuts[0], cuts[2], cuts[4]);
+  glUniform3i(glGetUniformLocation(handle, "cutHigh"), cuts[1], cuts[3], cuts[5]);
   in.Tables.Bind(program, header);
   // The side a side fragment's cell lies on (RegionCache's offsets): by the handedness and
   // the triangle's turn on the screen, which gl_FrontFacing gives as glFrontFace sets it.
@@ -953,7 +1042,9 @@ void vtkMultiresolutionSurfaceMapper::DrawRegions(Frame& frame)
   // Lit tops and bottoms take their normals from the table, once it is loaded: they are
   // drawn first with a program that computes no facet normal, then the sides with one that
   // does; otherwise one program draws every face.
-  if (frame.lit && frame.layer < 0 && in.Tables.NormalsReady())
+  // A range's caps are inside the model, where the normal table (hashed for the model's
+  // external faces) has nothing: a range lights every face by its facet, as a layer does.
+  if (frame.lit && frame.layer < 0 && !frame.ranged && in.Tables.NormalsReady())
   {
     vtkShaderProgram* sides = frame.program;
     frame.program = this->ReadyProgram(frame, frame.colorMode, true);

@@ -215,6 +215,11 @@ private:
   void Fail(const Frame& frame, const std::string& message);
   /// The layer shown; false (nothing drawn, LastError says why) when out of range.
   bool SelectLayer(Frame& frame);
+  /// The I/J/K range the descriptor names, if any (with Layer set, that layer of it); false
+  /// (nothing drawn) when it holds no cell or cannot be read (LastError says why).
+  bool SelectRange(Frame& frame);
+  /// What the descriptor names; false without a descriptor (an empty piece, no file yet).
+  bool ReadSource(Frame& frame);
   void RequestProperty(Frame& frame);
   /// The camera in model coordinates, and the tolerance.
   void ComputeView(Frame& frame);

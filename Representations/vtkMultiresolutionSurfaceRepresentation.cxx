@@ -1,5 +1,6 @@
 #include "vtkMultiresolutionSurfaceRepresentation.h"
 
+#include "vtkMultiresolutionExtractSubset.h"
 #include "vtkMultiresolutionReader.h"
 #include "vtkMultiresolutionSurfaceMapper.h"
 
@@ -10,6 +11,7 @@
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
+#include "vtkIntArray.h"
 #include "vtkMatrix4x4.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVRenderView.h"
@@ -68,7 +70,7 @@ int vtkMultiresolutionSurfaceRepresentation::RequestData(
     else if (input && input->GetNumberOfPoints() > 0)
     {
       this->Delivered->ShallowCopy(input);
-      this->Delivered->GetFieldData()->Initialize();
+      this->Delivered->SetFieldData(vtkNew<vtkFieldData>()); // the input's stays as it is
       int step = 0;
       if (input->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP()))
       {
@@ -81,6 +83,15 @@ int vtkMultiresolutionSurfaceRepresentation::RequestData(
       source->InsertNextValue(std::to_string(step));
       source->InsertNextValue(reader->GetApplyMapAxes() ? "1" : "0");
       source->InsertNextValue(reader->GetPropertyFileStamp());
+      // An I/J/K range set upstream (Multiresolution Extract Subset), as "I0 I1 J0 J1 K0 K1".
+      vtkIntArray* range = vtkIntArray::SafeDownCast(
+        input->GetFieldData()->GetAbstractArray(vtkMultiresolutionExtractSubset::RangeArrayName()));
+      std::string rangeText;
+      for (vtkIdType n = 0; range && range->GetNumberOfValues() == 6 && n < 6; ++n)
+      {
+        rangeText += (n ? " " : "") + std::to_string(range->GetValue(n));
+      }
+      source->InsertNextValue(rangeText);
       this->Delivered->GetFieldData()->AddArray(source);
       // The Layer property's range: the header is read once a file (the mapper opens it again
       // where it draws, which may be another process).

@@ -136,3 +136,7 @@ set_property(TEST Multiresolution.GUIGoTo PROPERTY SKIP_RETURN_CODE 125)
 # Picking a cell: the frame's own cell at any level, stock's at 0 px, EGRIDReader's values and corners.
 resmr_add_pvpython_test(Multiresolution.Pick TestMultiresolutionPick.py)
 set_property(TEST Multiresolution.Pick APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+# The I/J/K range filter (Multiresolution Extract Subset) against stock ParaView's Threshold
+# on I, J, K and ACTNUM of the full grid, pixel by pixel; coarse tolerances stay in range.
+resmr_add_pvpython_test(Multiresolution.Range TestMultiresolutionRange.py)
+set_property(TEST Multiresolution.Range APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")

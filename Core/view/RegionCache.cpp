@@ -282,12 +282,15 @@ void UseOriginalSideFaces(RegionMesh& mesh)
 }
 
 RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
-  const std::array<double, 3>& origin, int handedness, int32_t layer, bool exactSides)
+  const std::array<double, 3>& origin, int handedness, int32_t layer, bool exactSides, const CellRange* range)
 {
   RegionMesh mesh = file.ReadRegion(region); // not ReadRegionSurfaces: the buffers need positions
+  const std::array<float, 4> footprint = RegionFootprint(mesh);
   if (layer >= 0)
   {
-    return PrepareLayerDrawBuffers(mesh, layer, origin, handedness);
+    RegionDrawBuffers out = PrepareLayerDrawBuffers(mesh, layer, origin, handedness);
+    out.footprint = footprint;
+    return out;
   }
   if (!(mesh.sealedPinchThickness > 0))
   {
@@ -295,6 +298,17 @@ RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::si
     // another inside the solid and hide nothing, but on models that pinch out they are most
     // of the leaves' top and bottom triangles.
     mesh.sealedPinchThickness = std::numeric_limits<double>::min();
+  }
+  if (range)
+  {
+    MaskToRange(mesh, *range);
+    UseOriginalSideFaces(mesh);
+    RegionDrawBuffers out = PrepareRegionDrawBuffers(mesh, origin, handedness);
+    out.ranged = true;
+    out.footprint = footprint;
+    out.topCone = mesh.top.cone; // the range's faces, not the region's stored surfaces
+    out.bottomCone = mesh.bottom.cone;
+    return out;
   }
   const std::vector<std::array<uint32_t, 3>> simplifiedSide = mesh.sideTriangles;
   UseOriginalSideFaces(mesh);
@@ -306,6 +320,7 @@ RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::si
   }
   RegionDrawBuffers out = PrepareRegionDrawBuffers(mesh, origin, handedness);
   out.exactSides = exact;
+  out.footprint = footprint;
   AddCoarseSide(mesh, simplifiedSide, origin, handedness, out);
   return out;
 }
@@ -445,7 +460,7 @@ RegionCache::RegionCache(std::shared_ptr<const MultiresolutionFile> file,
 {
   const auto& origin = this->File->Header().latticeOrigin;
   this->ModelOrigin = { origin[0], origin[1], -origin[2] };
-  this->LayerSlots = static_cast<uint64_t>(std::max<int64_t>(this->File->Header().dims[2], 0)) + 2;
+  this->LayerSlots = static_cast<uint64_t>(std::max<int64_t>(this->File->Header().dims[2], 0)) + 3;
   const std::size_t count = this->File->Regions().size();
   this->IsRoot.assign(count, 0);
   this->IsLeaf.assign(count, 0);
@@ -493,27 +508,72 @@ bool RegionCache::SetLayer(int32_t layer)
   }
   {
     std::lock_guard<std::mutex> lock(this->Lock);
-    if (layer == this->CurrentLayer)
+    this->ChosenLayer = layer;
+    if (this->CurrentLayer != this->RangeLayer())
     {
-      return true;
+      this->SwitchLayerLocked(layer);
     }
-    this->CurrentLayer = layer;
-    this->Pinned.clear();
-    for (std::size_t r : this->Roots)
-    {
-      this->Pinned.push_back(this->RequestKeyLocked(r, layer, true));
-    }
-    // The old layer's request is void: its regions become evictable, and none loads now.
-    this->Wanted.clear();
-    this->Predicted.clear();
-    this->InWanted.clear();
-    this->InPredicted.clear();
-    this->WantedBlocked = this->PredictedBlocked = false;
-    ++this->Changes; // what Get returns has changed
   }
   this->Wake.notify_all();
   this->StandbyWake.notify_all();
   return true;
+}
+
+void RegionCache::SetRange(const CellRange* range)
+{
+  {
+    std::lock_guard<std::mutex> lock(this->Lock);
+    const bool ranged = this->CurrentLayer == this->RangeLayer();
+    if (range && (!ranged || *range != this->CurrentRange))
+    {
+      this->CurrentRange = *range;
+      ++this->RangeGeneration;
+      this->CurrentLayer = -2; // switched below, whatever it was
+    }
+    this->SwitchLayerLocked(range ? this->RangeLayer() : this->ChosenLayer);
+  }
+  this->Wake.notify_all();
+  this->StandbyWake.notify_all();
+}
+
+bool RegionCache::Ranged() const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  return this->CurrentLayer == this->RangeLayer();
+}
+
+void RegionCache::VisitFootprints(const std::function<void(std::size_t, const std::array<float, 4>&)>& visit) const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  for (const auto& entry : this->Entries)
+  {
+    const std::size_t region = this->RegionOf(entry.first);
+    if (entry.second.buffers && entry.first == this->KeyOf(region, this->CurrentLayer))
+    {
+      visit(region, entry.second.buffers->footprint);
+    }
+  }
+}
+
+void RegionCache::SwitchLayerLocked(int32_t layer)
+{
+  if (layer == this->CurrentLayer)
+  {
+    return;
+  }
+  this->CurrentLayer = layer;
+  this->Pinned.clear();
+  for (std::size_t r : this->Roots)
+  {
+    this->Pinned.push_back(this->RequestKeyLocked(r, layer, true));
+  }
+  // The old layer's request is void: its regions become evictable, and none loads now.
+  this->Wanted.clear();
+  this->Predicted.clear();
+  this->InWanted.clear();
+  this->InPredicted.clear();
+  this->WantedBlocked = this->PredictedBlocked = false;
+  ++this->Changes; // what Get returns has changed
 }
 
 int32_t RegionCache::Layer() const
@@ -1297,6 +1357,13 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, 
   const std::size_t region = this->RegionOf(key);
   const int32_t layer = this->LayerOf(key);
   const int handedness = this->Handedness;
+  const bool ranged = layer == this->RangeLayer();
+  const CellRange range = this->CurrentRange;
+  if (ranged && key != this->KeyOf(region, layer))
+  {
+    this->Entries[key].failed = true; // an earlier range's: nothing asks for it any more
+    return;
+  }
   // The essential loader may read again what the starved idle loader holds (NextUrgentLocked):
   // whichever read ends first goes in.
   const bool again = this->Loading.count(key) != 0;
@@ -1312,8 +1379,8 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, 
   {
     // ReadRegion, not ReadRegionSurfaces: the buffers need the positions.
     const bool simplified = layer == this->SimplifiedLayer();
-    buffers = std::make_shared<RegionDrawBuffers>(
-      LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin, handedness, simplified ? -1 : layer, !simplified));
+    buffers = std::make_shared<RegionDrawBuffers>(LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin,
+      handedness, simplified || ranged ? -1 : layer, !simplified, ranged ? &range : nullptr));
   }
   catch (const std::exception& e)
   {

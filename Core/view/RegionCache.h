@@ -53,6 +53,7 @@
 //   LastError() names the file and the region; the region is never resident.
 #pragma once
 
+#include "CellRange.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
 
@@ -62,6 +63,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <ctime>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -90,7 +92,10 @@ struct RegionDrawBuffers
   /// false: the exact side was left out (sideIndices 0; RegionCache's simplified sides), the
   /// coarse side stands for it.
   bool exactSides = true;
-  int32_t layer = -1; ///< the layer drawn (0-based), -1: the whole model
+  int32_t layer = -1;  ///< the layer drawn (0-based), -1: the whole model
+  bool ranged = false; ///< the cells of a range (CellRange.h), not the whole model
+  /// The region's footprint in (i, j) (RegionFootprint): where a range lies against it.
+  std::array<float, 4> footprint{ 0.f, -1.f, 0.f, -1.f };
   /// Normal cones of the top and bottom parts (RegionSurface::cone). A layer's faces are not
   /// the region's stored surfaces, so their culling needs their own cones.
   std::array<float, 4> topCone{ 0.f, 0.f, 1.f, -2.f }, bottomCone{ 0.f, 0.f, 1.f, -2.f };
@@ -127,9 +132,12 @@ RegionDrawBuffers PrepareLayerDrawBuffers(
 /// What the cache loads for a region: its mesh read and checked, its own side faces, buffers;
 /// of one layer (0-based) when `layer` >= 0. Without `exactSides` (the whole model only) the
 /// region's own side faces are left out when the file has its simplified side: on models of
-/// many layers they are most of a coarse region's bytes.
+/// many layers they are most of a coarse region's bytes. With `range` (and `layer` -1), the
+/// cells in the range alone (MaskToRange), with their exact side faces and no simplified side
+/// (its triangles span every layer).
 RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
-  const std::array<double, 3>& origin, int handedness, int32_t layer = -1, bool exactSides = true);
+  const std::array<double, 3>& origin, int handedness, int32_t layer = -1, bool exactSides = true,
+  const CellRange* range = nullptr);
 
 /// A run of a region's triangles copied to the GPU as one piece: indices [first, end) and
 /// the vertices [lowVertex, highVertex] they use.
@@ -189,6 +197,15 @@ public:
   /// false, changing nothing, for a layer the model does not have. Never blocks on loading.
   bool SetLayer(int32_t layer);
   int32_t Layer() const;
+  /// The I/J/K range view (CellRange.h): with `range`, Get, IsResident and Request deal in the
+  /// buffers of the range's cells (the layer set by SetLayer is left); null goes back to the
+  /// whole model. A new range makes new buffers; those of an earlier one are evicted first as
+  /// nothing requests them. Never blocks on loading.
+  void SetRange(const CellRange* range);
+  bool Ranged() const;
+  /// Calls `visit(region, footprint)` for each region resident in the current layer or range
+  /// (RegionDrawBuffers::footprint), under the cache's lock: `visit` must not call the cache.
+  void VisitFootprints(const std::function<void(std::size_t, const std::array<float, 4>&)>& visit) const;
 
   /// The buffers of a resident region (of the current layer, or of `layer`), or null. Never
   /// blocks on loading. Of the whole model: with its exact side when resident so, else
@@ -242,15 +259,19 @@ public:
   void SetStarvationWindow(std::chrono::milliseconds window);
 
 private:
-  /// Entries are keyed by (region, layer): region * (nk + 2) + layer + 1, the whole model's
-  /// buffers without their exact side at layer nk.
+  /// Entries are keyed by (region, layer): region * (nk + 3) + layer + 1, the whole model's
+  /// buffers without their exact side at layer nk, a range's at nk + 1 with the range's
+  /// generation above bit RangeShift.
   using Key = uint64_t;
+  static constexpr int RangeShift = 44;
   Key KeyOf(std::size_t region, int32_t layer) const
   {
-    return static_cast<Key>(region) * this->LayerSlots + static_cast<Key>(layer + 1);
+    const Key generation = layer == this->RangeLayer() ? this->RangeGeneration << RangeShift : 0;
+    return generation | (static_cast<Key>(region) * this->LayerSlots + static_cast<Key>(layer + 1));
   }
-  std::size_t RegionOf(Key key) const { return static_cast<std::size_t>(key / this->LayerSlots); }
-  int32_t LayerOf(Key key) const { return static_cast<int32_t>(key % this->LayerSlots) - 1; }
+  static Key Unranged(Key key) { return key & ((Key(1) << RangeShift) - 1); }
+  std::size_t RegionOf(Key key) const { return static_cast<std::size_t>(Unranged(key) / this->LayerSlots); }
+  int32_t LayerOf(Key key) const { return static_cast<int32_t>(Unranged(key) % this->LayerSlots) - 1; }
   enum class Role
   {
     Idle,     ///< below every other thread (nice 19 on Linux)
@@ -305,13 +326,20 @@ private:
   std::shared_ptr<const PropertyFile> Properties;
   std::array<double, 3> ModelOrigin{};
   int Handedness = 1;
-  uint64_t LayerSlots = 1; ///< nk + 2
+  uint64_t LayerSlots = 1; ///< nk + 3
   int32_t CurrentLayer = -1;
+  int32_t ChosenLayer = -1; ///< SetLayer's, shown again when the range goes
+  CellRange CurrentRange;
+  Key RangeGeneration = 0;
+  /// Makes `layer` the one Get and Request deal in (SetLayer, SetRange). Lock held.
+  void SwitchLayerLocked(int32_t layer);
   bool SimplifiedSides = false;
   std::vector<std::size_t> Roots;
   std::vector<uint8_t> IsRoot, IsLeaf; ///< per region
   /// The layer a key of the whole model without its exact side has (nk).
-  int32_t SimplifiedLayer() const { return static_cast<int32_t>(this->LayerSlots) - 2; }
+  int32_t SimplifiedLayer() const { return static_cast<int32_t>(this->LayerSlots) - 3; }
+  /// The layer a key of the range view has (nk + 1).
+  int32_t RangeLayer() const { return static_cast<int32_t>(this->LayerSlots) - 2; }
   /// The key of `region` in `layer` as a request wants it (`simplified`: its exact side may
   /// be left out). Lock held.
   Key RequestKeyLocked(std::size_t region, int32_t layer, bool simplified) const;

@@ -109,8 +109,9 @@ std::vector<std::size_t> RegionsWithSimplifiedSide(
 std::array<DrawPart, 3> PartsToDraw(const RegionDrawBuffers& buffers, const DrawnRegion& drawn, bool layerView,
   const RegionRecord& region, const ViewParameters& view, uint32_t fileVersion)
 {
-  const bool top = !layerView ? drawn.top : !SurfaceCulled(buffers.topCone, region, view);
-  const bool bottom = !layerView ? drawn.bottom : !SurfaceCulled(buffers.bottomCone, region, view);
+  const bool ownCones = layerView || buffers.ranged; // faces that are not the stored surfaces
+  const bool top = !ownCones ? drawn.top : !SurfaceCulled(buffers.topCone, region, view);
+  const bool bottom = !ownCones ? drawn.bottom : !SurfaceCulled(buffers.bottomCone, region, view);
   const bool coarseSide = buffers.coarseSideIndices > 0 &&
     (DrawsSimplifiedSide(fileVersion, drawn.projectedError, view) || !buffers.exactSides);
   const uint32_t exactSide = buffers.topIndices + buffers.bottomIndices;

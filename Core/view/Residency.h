@@ -93,8 +93,8 @@ struct DrawPart
 
 /// The top, bottom and side index runs of `buffers` for a region drawn as `drawn`. The whole
 /// model's top and bottom are culled by the selection (`drawn`); a layer's own top and bottom
-/// (`layerView`) by their own cones against `region` and `view`. The simplified side is drawn
-/// where DrawsSimplifiedSide says so (a file of `fileVersion`), when the region has one: on
+/// (`layerView`) and a range's (RegionDrawBuffers::ranged) by their own cones against `region` and `view`. The
+/// simplified side is drawn where DrawsSimplifiedSide says so (a file of `fileVersion`), when the region has one: on
 /// models of many layers the exact side is most of the triangles. Buffers loaded without
 /// their exact side draw the simplified one whatever the error.
 /// The top seen from above (the eye not below the region's box) and the bottom seen from

@@ -256,6 +256,13 @@ ViewSelector::ViewSelector(const MultiresolutionFile& file)
     {
       this->Nodes[r].children = { find(regions[r].level + 1, 2 * regions[r].index),
         find(regions[r].level + 1, 2 * regions[r].index + 1) };
+      for (const int64_t child : this->Nodes[r].children)
+      {
+        if (child >= 0)
+        {
+          this->Nodes[static_cast<std::size_t>(child)].parent = static_cast<int64_t>(r);
+        }
+      }
     }
   }
   const DiamondHierarchy tree(header.box[0], header.box[1], header.box[2], header.box[3], header.leafLevel);
@@ -289,7 +296,8 @@ namespace
 /// resident (a culled child is never drawn, so it need not be).
 template<typename Nodes>
 Traversal Traverse(const MultiresolutionFile& file, const Nodes& nodes, const std::vector<std::size_t>& roots,
-  const ViewParameters& view, const std::function<bool(std::size_t)>& resident, bool ideal)
+  const ViewParameters& view, const std::function<bool(std::size_t)>& resident, const std::vector<RangeClass>& classes,
+  const std::vector<uint8_t>& forced, bool ideal)
 {
   const auto& regions = file.Regions();
   const int leaves = file.Header().leafLevel;
@@ -300,7 +308,8 @@ Traversal Traverse(const MultiresolutionFile& file, const Nodes& nodes, const st
   const auto isCulled = [&](std::size_t r) {
     if (culled[r] < 0)
     {
-      culled[r] = OutsideFrustum(Corners(regions[r]), view.worldToClip) ? 1 : 0;
+      const bool outside = !classes.empty() && classes[r] == RangeClass::Outside;
+      culled[r] = outside || OutsideFrustum(Corners(regions[r]), view.worldToClip) ? 1 : 0;
     }
     return culled[r] == 1;
   };
@@ -340,11 +349,12 @@ Traversal Traverse(const MultiresolutionFile& file, const Nodes& nodes, const st
           complete = false; // the partner's area is still covered by a coarser region
         }
       }
-      bool anyVisible = false, ready = true;
+      bool anyVisible = false, ready = true, crossed = false;
       double error = 0;
       for (std::size_t t : diamond)
       {
         error = std::max(error, ProjectedError(regions[t], view));
+        crossed = crossed || (!forced.empty() && forced[t]);
         if (isCulled(t))
         {
           continue;
@@ -362,13 +372,16 @@ Traversal Traverse(const MultiresolutionFile& file, const Nodes& nodes, const st
           }
         }
       }
-      const bool splittable = depth < leaves && complete && anyVisible && ready;
-      const bool split = splittable && error > view.tolerancePixels;
-      if (split)
+      // A range may need a diamond with no triangle in view split: a neighbour's is in the cut
+      // only once it is.
+      const bool splittable = depth < leaves && complete && (anyVisible || crossed) && ready;
+      const bool split = splittable && (error > view.tolerancePixels || crossed);
+      // A range's split is no tolerance's.
+      if (split && !crossed)
       {
         out.coarsenAt = std::min(out.coarsenAt, error);
       }
-      else if (splittable)
+      else if (splittable && !crossed)
       {
         out.refineBelow = std::max(out.refineBelow, error);
       }
@@ -414,11 +427,55 @@ double EstimatedErrorPixels(const RegionRecord& region, const ViewParameters& vi
   return EstimatedError(region, view);
 }
 
+std::vector<uint8_t> ViewSelector::ForcedSplits(const std::vector<RangeClass>& classes) const
+{
+  const int leaves = this->File->Header().leafLevel;
+  const auto& regions = this->File->Regions();
+  std::vector<uint8_t> forced(classes.size(), 0);
+  // Splitting a region needs its diamond in the cut: its parent and its partner's split.
+  std::vector<int64_t> work;
+  const auto need = [&](int64_t region) {
+    if (region >= 0 && this->Nodes[static_cast<std::size_t>(region)].parent >= 0)
+    {
+      work.push_back(this->Nodes[static_cast<std::size_t>(region)].parent);
+    }
+  };
+  for (std::size_t r = 0; r < classes.size(); ++r)
+  {
+    if (classes[r] == RangeClass::Crossed)
+    {
+      regions[r].level < leaves ? work.push_back(static_cast<int64_t>(r)) : need(static_cast<int64_t>(r));
+    }
+  }
+  while (!work.empty())
+  {
+    const std::size_t r = static_cast<std::size_t>(work.back());
+    work.pop_back();
+    if (forced[r])
+    {
+      continue;
+    }
+    forced[r] = 1;
+    need(static_cast<int64_t>(r));
+    need(this->Nodes[r].partner);
+  }
+  return forced;
+}
+
 ViewSelection ViewSelector::Select(const ViewParameters& view, const std::function<bool(std::size_t)>& resident) const
 {
   const auto& regions = this->File->Regions();
-  const Traversal actual = Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, false);
-  const Traversal ideal = Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, true);
+  std::vector<RangeClass> classes;
+  std::vector<uint8_t> forced;
+  if (this->Ranged)
+  {
+    classes.assign(regions.size(), RangeClass::Unknown);
+    this->Ranged(classes);
+    forced = this->ForcedSplits(classes);
+  }
+  const Traversal actual =
+    Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, classes, forced, false);
+  const Traversal ideal = Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, classes, forced, true);
 
   ViewSelection selection;
   selection.largestProjectedError = actual.largest;

@@ -28,11 +28,14 @@
 // - `drawn` is ordered nearest first, so early depth rejection spares hidden fragments.
 // - `wanted` lists the regions of the ideal cut (as if everything were resident) and the
 //   ancestors leading to them, coarse before fine and near before far: the loading order.
+// - Range view (ours): see Select; the forced splits set neither refineBelowPixels nor
+//   coarsenAtPixels, which no tolerance changes.
 // - `ideal` (ours): the figures below of that ideal cut, what the frame will show once its
 //   wanted meshes are in; a frame still loading can tell from them whether its tolerance is
 //   fine enough.
 #pragma once
 
+#include "CellRange.h"
 #include "MultiresolutionFile.h"
 
 #include <array>
@@ -111,6 +114,15 @@ public:
   /// Selects for `view`; `resident(region)` says whether a region's mesh is ready to draw.
   ViewSelection Select(const ViewParameters& view, const std::function<bool(std::size_t)>& resident) const;
 
+  /// The I/J/K range view (CellRange.h): `ranged(classes)` fills, per region (the vector comes
+  /// sized to the regions, every one Unknown), where the range lies against the regions known
+  /// so far. Regions Outside are culled; a region Crossed is split whatever its error, down to
+  /// the leaves, and so are the diamonds that must split for it to be in the cut (its parent,
+  /// its partner's parent, and theirs in turn); a region Unknown (not decoded yet) is decided
+  /// by its error until it is known. Empty: the whole model.
+  using RangeClassifier = std::function<void(std::vector<RangeClass>& classes)>;
+  void SetRangeClassifier(RangeClassifier ranged) { this->Ranged = std::move(ranged); }
+
   /// The root regions (level 0), which the caller keeps resident.
   const std::vector<std::size_t>& Roots() const { return this->RootRegions; }
 
@@ -119,11 +131,15 @@ private:
   {
     std::array<int64_t, 2> children{ -1, -1 }; ///< region indices, -1: absent (empty)
     int64_t partner = -1;                      ///< the other triangle of its diamond, -1: none
+    int64_t parent = -1;                       ///< -1: a root
   };
+  /// Per region, whether the range forces it to split (see SetRangeClassifier).
+  std::vector<uint8_t> ForcedSplits(const std::vector<RangeClass>& classes) const;
   const MultiresolutionFile* File = nullptr;
   std::vector<Node> Nodes;
   std::vector<std::size_t> RootRegions;
   std::array<double, 6> ModelBox{}; ///< every region's box: xmin, xmax, ymin, ymax, zmin, zmax (z up)
+  RangeClassifier Ranged;
 };
 
 /// Whether a surface of `region` whose normals lie in `cone` (RegionSurface::cone; cosine -2:

@@ -29,6 +29,10 @@ flat in float lastK; // a side triangle's largest k
 uniform int faceKind;     // 0: top, 1: bottom, 2: side
 uniform int sideOneLayer; // on sides, 1: each triangle spans one layer (the exact side)
 uniform ivec3 gridDims;   // nx, ny, nz
+uniform ivec3 cellLow;    // the lowest cell drawn: 0, or an I/J/K range's
+uniform ivec3 cellHigh;   // the highest: gridDims - 1, or a range's
+uniform ivec3 cutLow;     // an I/J/K range's lowest cells where it cuts the grid, -1: no cut
+uniform ivec3 cutHigh;    // its highest cells where it cuts the grid, -1: no cut
 uniform ivec3 tableSides; // m
 uniform ivec3 offsetSides; // r
 uniform usampler3D hashOffsets;  // r0 x r1 x r2, RGB16UI
@@ -253,7 +257,9 @@ void AddAnyLight(vec3 normal, vec3 toEye, vec3 position, vec3 lightColor, vec3 d
 
 void main()
 {
-  ivec3 cell = clamp(ivec3(floor(cellCoord)), ivec3(0), gridDims - 1);
+  // A fragment on a face's edge may interpolate a hair past it: every face drawn belongs to
+  // a cell of the grid, or of the range shown.
+  ivec3 cell = clamp(ivec3(floor(cellCoord)), cellLow, cellHigh);
   // Side faces span their interfaces: seen edge-on they are slivers on screen, where the
   // interpolated k strays past either interface. Their cell is in the layers the triangle
   // reaches; top and bottom faces keep the k their vertices give.
@@ -300,10 +306,14 @@ void main()
   {
 #if LAYER_VIEW
     float value = texelFetch(layerProperty, cell.xy, 0).r;
+    bool onCut = false;
 #else
     float value = texelFetch(propertyTable, slot, 0).r;
+    // The hash holds the cells of the model's outside: the cells a range's cut exposes have
+    // no value there, and are drawn in the NaN colour rather than in another cell's.
+    bool onCut = any(equal(cell, cutLow)) || any(equal(cell, cutHigh));
 #endif
-    if (isnan(value))
+    if (onCut || isnan(value))
     {
       color = nanColor.rgb;
     }

@@ -5,9 +5,11 @@
 // draw buffers whose cell coordinates land in the right active cell, and the region cache's
 // budget, LRU eviction, damaged chunks, prompt shutdown and property tables; single-layer
 // buffers (exactly the layer's active cells and the faces bounding them) and the cache's
-// layers (switching never waits, buffers kept per layer under the one budget).
+// layers (switching never waits, buffers kept per layer under the one budget); the I/J/K range
+// view's footprints, forced splits and masked leaves.
 #include "CoreTesting.h"
 
+#include "CellRange.h"
 #include "ConformalCut.h"
 #include "DiamondHierarchy.h"
 #include "FramePlanning.h"
@@ -1873,6 +1875,116 @@ void TestUploadPacer()
   CHECK(pacer.SpentBytes() == 0 && pacer.SpentMs() == 0 && pacer.Admit(100 * MB));
 }
 
+/// The I/J/K range view (CellRange.h): a region's footprint holds every leaf column below it;
+/// with everything resident and a tolerance no region splits by, every drawn region a side of
+/// a random range crosses is a leaf, none lies outside, and every leaf column in the range is
+/// drawn by itself or by an ancestor wholly inside; a leaf's masked mesh keeps exactly the
+/// active cells in the range, with their sides open towards the cells out of it.
+void TestRanges(const Model& model)
+{
+  const auto& regions = model.file->Regions();
+  const auto& header = model.file->Header();
+  const std::array<int64_t, 3> dims{ header.dims[0], header.dims[1], header.dims[2] };
+  std::vector<std::array<float, 4>> footprints(regions.size());
+  std::vector<std::array<float, 4>> columns(regions.size(), { 1e30f, -1e30f, 1e30f, -1e30f }); // raw, leaves
+  for (std::size_t r = 0; r < regions.size(); ++r)
+  {
+    const RegionMesh mesh = model.file->ReadRegion(r);
+    footprints[r] = RegionFootprint(mesh);
+    for (std::size_t c = 0; regions[r].level == header.leafLevel && c < mesh.corners.size(); ++c)
+    {
+      const auto cell = mesh.ColumnCell(c);
+      columns[r] = { std::min(columns[r][0], cell[0]), std::max(columns[r][1], cell[0] + 1),
+        std::min(columns[r][2], cell[1]), std::max(columns[r][3], cell[1] + 1) };
+    }
+  }
+  for (const std::size_t leaf : model.Leaves())
+  {
+    for (int64_t a = static_cast<int64_t>(leaf); a >= 0 && columns[leaf][0] <= columns[leaf][1];
+         a = model.Parent(static_cast<std::size_t>(a)))
+    {
+      const auto& f = footprints[static_cast<std::size_t>(a)];
+      CHECK(
+        f[0] <= columns[leaf][0] && f[1] >= columns[leaf][1] && f[2] <= columns[leaf][2] && f[3] >= columns[leaf][3]);
+    }
+  }
+  std::mt19937 random(7);
+  ViewParameters view;
+  view.worldToClip = Everything(1e-9);
+  view.parallel = true;
+  view.direction = { 0, 0, -1 };
+  view.tolerancePixels = 1e30; // only the range splits
+  for (int trial = 0; trial < 12; ++trial)
+  {
+    CellRange range;
+    for (int a = 0; a < 3; ++a)
+    {
+      std::uniform_int_distribution<int64_t> pick(0, dims[a] - 1);
+      int64_t lo = pick(random), hi = pick(random);
+      if (trial % 3 == 0 && a < 2)
+        hi = lo; // a slice
+      range.lo[a] = std::min(lo, hi);
+      range.hi[a] = std::max(lo, hi);
+    }
+    std::vector<RangeClass> classes(regions.size());
+    for (std::size_t r = 0; r < regions.size(); ++r)
+      classes[r] = ClassifyFootprint(footprints[r], range, dims);
+    ViewSelector selector(*model.file);
+    selector.SetRangeClassifier([&](std::vector<RangeClass>& out) { out = classes; });
+    const ViewSelection selection = selector.Select(view, AllResident);
+    std::set<std::size_t> drawn;
+    for (const auto& d : selection.drawn)
+    {
+      drawn.insert(d.region);
+      CHECK(classes[d.region] != RangeClass::Outside);
+      CHECK(classes[d.region] != RangeClass::Crossed || regions[d.region].level == header.leafLevel);
+    }
+    for (const std::size_t leaf : model.Leaves())
+    {
+      const auto& box = columns[leaf];
+      const bool touches =
+        box[0] < range.hi[0] + 1 && box[1] > range.lo[0] && box[2] < range.hi[1] + 1 && box[3] > range.lo[1];
+      if (!touches || drawn.count(leaf))
+        continue;
+      bool covered = false;
+      for (int64_t a = model.Parent(leaf); a >= 0 && !covered; a = model.Parent(static_cast<std::size_t>(a)))
+        covered =
+          drawn.count(static_cast<std::size_t>(a)) && classes[static_cast<std::size_t>(a)] == RangeClass::Inside;
+      CHECK(covered);
+    }
+    for (const std::size_t leaf : drawn)
+    {
+      if (regions[leaf].level != header.leafLevel)
+        continue;
+      const RegionMesh original = model.file->ReadRegion(leaf);
+      RegionMesh masked = original;
+      MaskToRange(masked, range);
+      const std::size_t layers = static_cast<std::size_t>(original.layers);
+      for (std::size_t c = 0; c < original.corners.size(); ++c)
+      {
+        const auto cell = original.ColumnCell(c);
+        for (std::size_t k = 0; k < layers; ++k)
+        {
+          const bool in = range.Contains(int64_t(cell[0]), int64_t(cell[1]), int64_t(k));
+          CHECK(masked.active[c * layers + k] == (original.active[c * layers + k] && in));
+          for (int e = 0; in && masked.active[c * layers + k] && e < 4; ++e)
+          {
+            // The edge's two corners in (i, j): on a side of the range, the side is open.
+            const auto& p = original.topology[original.corners[c][e]];
+            const auto& q = original.topology[original.corners[c][(e + 1) % 4]];
+            const bool onSide = (p[0] == q[0] && (p[0] == float(range.lo[0]) || p[0] == float(range.hi[0] + 1))) ||
+              (p[1] == q[1] && (p[1] == float(range.lo[1]) || p[1] == float(range.hi[1] + 1)));
+            const bool onGrid = (p[0] == q[0] && (p[0] == 0 || p[0] == float(dims[0]))) ||
+              (p[1] == q[1] && (p[1] == 0 || p[1] == float(dims[1])));
+            if (onSide && !onGrid)
+              CHECK(masked.openSides[c * layers + k] & (1u << e));
+          }
+        }
+      }
+    }
+  }
+}
+
 int main(int argc, char** argv)
 {
   if (argc < 4)
@@ -1904,6 +2016,11 @@ int main(int argc, char** argv)
       [&] {
         for (const auto& m : models)
           TestConformity(*m);
+      } },
+    { "Ranges",
+      [&] {
+        for (const auto& m : models)
+          TestRanges(*m);
       } },
     { "ToleranceInterval",
       [&] {

@@ -1,0 +1,159 @@
+// I/J/K range filter (ours, see CellRange.h): region classification and the masking of a
+// region's hexahedral mesh that ExtractSurfaces then closes.
+#include "CellRange.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace resmr
+{
+namespace
+{
+std::array<double, 2> ColumnCentre(const RegionMesh& mesh, std::size_t column)
+{
+  std::array<double, 2> sum{ 0, 0 };
+  for (const uint32_t node : mesh.corners[column])
+  {
+    sum[0] += mesh.topology[node][0];
+    sum[1] += mesh.topology[node][1];
+  }
+  return { sum[0] / 4, sum[1] / 4 };
+}
+
+bool InRangeIJ(const CellRange& range, const std::array<double, 2>& centre)
+{
+  const double i = std::floor(centre[0]), j = std::floor(centre[1]);
+  return i >= double(range.lo[0]) && i <= double(range.hi[0]) && j >= double(range.lo[1]) && j <= double(range.hi[1]);
+}
+} // namespace
+
+bool CellRange::Empty(const std::array<int64_t, 3>& dims) const
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    if (std::max<int64_t>(this->lo[a], 0) > std::min(this->hi[a], dims[a] - 1))
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+bool CellRange::Whole(const std::array<int64_t, 3>& dims) const
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    if (this->lo[a] > 0 || this->hi[a] < dims[a] - 1)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+std::string CellRange::Describe() const
+{
+  std::string out;
+  const char* names[3] = { "I", "J", "K" };
+  for (int a = 0; a < 3; ++a)
+  {
+    out += (a ? ", " : "") + std::string(names[a]) + " " + std::to_string(this->lo[a] + 1) + "-" +
+      std::to_string(this->hi[a] + 1);
+  }
+  return out;
+}
+
+std::array<float, 4> RegionFootprint(const RegionMesh& mesh)
+{
+  std::array<float, 4> box{ std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest(),
+    std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest() };
+  float widest = 0;
+  for (const auto& corners : mesh.corners)
+  {
+    const auto& first = mesh.topology[corners[0]];
+    std::array<float, 4> column{ first[0], first[0], first[1], first[1] };
+    for (const uint32_t node : corners)
+    {
+      column[0] = std::min(column[0], mesh.topology[node][0]);
+      column[1] = std::max(column[1], mesh.topology[node][0]);
+      column[2] = std::min(column[2], mesh.topology[node][1]);
+      column[3] = std::max(column[3], mesh.topology[node][1]);
+    }
+    widest = std::max({ widest, column[1] - column[0], column[3] - column[2] });
+    box = { std::min(box[0], column[0]), std::max(box[1], column[1]), std::min(box[2], column[2]),
+      std::max(box[3], column[3]) };
+  }
+  if (mesh.corners.empty())
+  {
+    return { 0.f, -1.f, 0.f, -1.f }; // lies nowhere
+  }
+  const float margin = std::ceil(widest) + 1;
+  return { box[0] - margin, box[1] + margin, box[2] - margin, box[3] + margin };
+}
+
+RangeClass ClassifyFootprint(
+  const std::array<float, 4>& footprint, const CellRange& range, const std::array<int64_t, 3>& dims)
+{
+  if (footprint[1] < footprint[0] || range.Empty(dims))
+  {
+    return RangeClass::Outside;
+  }
+  bool inside = true;
+  for (int a = 0; a < 2; ++a)
+  {
+    // The range's sides as topological coordinates; on the grid's own limits, no side at all.
+    const double low = range.lo[a] <= 0 ? -HUGE_VAL : double(range.lo[a]);
+    const double high = range.hi[a] >= dims[a] - 1 ? HUGE_VAL : double(range.hi[a] + 1);
+    const double from = footprint[2 * a], to = footprint[2 * a + 1];
+    if (to <= low || from >= high)
+    {
+      return RangeClass::Outside;
+    }
+    inside = inside && from >= low && to <= high;
+  }
+  return inside ? RangeClass::Inside : RangeClass::Crossed;
+}
+
+void MaskToRange(RegionMesh& mesh, const CellRange& range)
+{
+  const std::size_t layers = static_cast<std::size_t>(mesh.layers);
+  std::vector<uint8_t> cutOpen(mesh.corners.size(), 0); // cut edges whose column across is out
+  for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+  {
+    const std::array<double, 2> centre = ColumnCentre(mesh, c);
+    const bool in = InRangeIJ(range, centre);
+    for (std::size_t k = 0; k < layers; ++k)
+    {
+      uint8_t& active = mesh.active[c * layers + k];
+      active = active && in && int64_t(k) >= range.lo[2] && int64_t(k) <= range.hi[2];
+    }
+    for (int e = 0; in && e < 4; ++e)
+    {
+      if (!(mesh.cutEdges[c] & (1u << e)))
+      {
+        continue;
+      }
+      const auto& a = mesh.topology[mesh.corners[c][e]];
+      const auto& b = mesh.topology[mesh.corners[c][(e + 1) % 4]];
+      const std::array<double, 2> across{ double(a[0]) + double(b[0]) - centre[0],
+        double(a[1]) + double(b[1]) - centre[1] };
+      if (!InRangeIJ(range, across))
+      {
+        cutOpen[c] |= static_cast<uint8_t>(1u << e);
+      }
+    }
+  }
+  // Inside the region, from the masked cells; the cut edges keep what the file says of the
+  // cell across, unless that column is out of the range.
+  ComputeOpenSides(mesh);
+  for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+  {
+    for (std::size_t k = 0; cutOpen[c] && k < layers; ++k)
+    {
+      mesh.openSides[c * layers + k] |= cutOpen[c];
+    }
+  }
+}
+
+} // namespace resmr

@@ -1,0 +1,73 @@
+// I/J/K range filter on the multiresolution surface (ours; the paper's Sec. 8 leaves regions
+// of interest to future work, its Sec. 3 argues that keeping columns and hexahedra makes them
+// possible): only the cells with i, j, k in a box are drawn, and the faces where the box cuts
+// the model close the solid.
+//
+// Contract:
+// - A range is a box of cells, 0-based and inclusive on each axis: [lo, hi] in i, j and k.
+// - K is exact at every level: column collapse keeps every layer interface in every column
+//   (Sec. 4.1), so masking layers out of a coarse region leaves its top of layer lo[2] and
+//   bottom of layer hi[2] on the same interfaces as the original grid's, within the region's
+//   error.
+// - I and J are exact at the leaves (original columns, integer topology). A coarse column's
+//   topology is an average of the nodes it merged, so a box side through a coarse region has
+//   no exact place in it: such a region is split down to the leaves (ClassifyFootprint says
+//   which regions it crosses). The leaves along a box side are few: a side crosses a row of
+//   leaves, not an area.
+// - A region's footprint is the box of its nodes' topological coordinates, widened by its
+//   widest column and one cell: a region covers the area its descendants cover, its columns
+//   merge only their own nodes, and the widening keeps the neighbours across its border
+//   inside the box it is classified by (their faces on the border are its own).
+#pragma once
+
+#include "RegionMesh.h"
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+namespace resmr
+{
+
+struct CellRange
+{
+  std::array<int64_t, 3> lo{ 0, 0, 0 }, hi{ -1, -1, -1 }; ///< inclusive, 0-based
+  bool operator==(const CellRange& other) const { return this->lo == other.lo && this->hi == other.hi; }
+  bool operator!=(const CellRange& other) const { return !(*this == other); }
+  bool Contains(int64_t i, int64_t j, int64_t k) const
+  {
+    return i >= this->lo[0] && i <= this->hi[0] && j >= this->lo[1] && j <= this->hi[1] && k >= this->lo[2] &&
+      k <= this->hi[2];
+  }
+  /// Whether no cell of a grid of `dims` is in the range.
+  bool Empty(const std::array<int64_t, 3>& dims) const;
+  /// Whether every cell of a grid of `dims` is in the range.
+  bool Whole(const std::array<int64_t, 3>& dims) const;
+  /// The range as ECLIPSE writes it, from 1: "I 3-10, J 1-5, K 2-2".
+  std::string Describe() const;
+};
+
+/// Box of a region mesh's topology: (ti min, ti max, tj min, tj max), widened as the contract says.
+std::array<float, 4> RegionFootprint(const RegionMesh& mesh);
+
+enum class RangeClass : uint8_t
+{
+  Unknown, ///< footprint not known yet (region not decoded)
+  Outside, ///< no cell of the region or its descendants is in the range
+  Inside,  ///< every column of the region and its descendants is in the range in (i, j)
+  Crossed  ///< a side of the range in i or j may pass through: split to the leaves
+};
+
+/// Where a region of footprint `footprint` (RegionFootprint) lies against `range` in a grid of
+/// `dims`: range sides on the grid's own limits cut nothing.
+RangeClass ClassifyFootprint(
+  const std::array<float, 4>& footprint, const CellRange& range, const std::array<int64_t, 3>& dims);
+
+/// Leaves in `mesh` only the cells in `range` active, and opens their sides towards cells out of
+/// it: across an edge inside the region from the masked cells, across a cut edge (the region's
+/// border) from where the column across lies (its centre mirrored through the edge's midpoint;
+/// at the leaves, exactly the neighbour's cell). A column is in the range when its centre is.
+/// The mesh's surfaces must be extracted again (ExtractSurfaces) afterwards.
+void MaskToRange(RegionMesh& mesh, const CellRange& range);
+
+} // namespace resmr
