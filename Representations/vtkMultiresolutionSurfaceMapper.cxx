@@ -425,6 +425,34 @@ void vtkMultiresolutionSurfaceMapper::ReleaseGraphicsResources(vtkWindow* window
 namespace
 {
 /// (.resmr path, .resmrp path, step, map axes) from the descriptor; false if it has none.
+/// A plane along which a range cuts the grid, with its place in the shader's order (K low,
+/// K high, I low, I high, J low, J high).
+struct CutPlaneSlot
+{
+  int slot;
+  int axis;
+  int64_t index;
+};
+
+/// The planes along which `range` (if `ranged`) cuts a grid of `dims`.
+std::vector<CutPlaneSlot> CutPlaneSlots(bool ranged, const resmr::CellRange& range, const int64_t* dims)
+{
+  std::vector<CutPlaneSlot> slots;
+  for (int a = 0; ranged && a < 3; ++a)
+  {
+    const int first = a == 2 ? 0 : 2 * a + 2;
+    if (range.lo[a] > 0)
+    {
+      slots.push_back({ first, a, range.lo[a] });
+    }
+    if (range.hi[a] < dims[a] - 1)
+    {
+      slots.push_back({ first + 1, a, range.hi[a] });
+    }
+  }
+  return slots;
+}
+
 /// A range "I0 I1 J0 J1 K0 K1" (ECLIPSE's, from 1, inclusive) as a 0-based CellRange.
 bool ParseRange(const std::string& text, resmr::CellRange& range)
 {
@@ -696,6 +724,17 @@ void vtkMultiresolutionSurfaceMapper::RequestProperty(Frame& frame)
   {
     in.Cache->RequestProperty(frame.property.name, frame.property.step, frame.layer);
   }
+  // A range's cut faces show cells inside the model, which the packed table does not hold:
+  // their values come from the planes of cells along each cut.
+  std::vector<std::array<int64_t, 2>> planes;
+  for (const CutPlaneSlot& slot : CutPlaneSlots(frame.ranged, frame.range, in.File->Header().dims.data()))
+  {
+    planes.push_back({ slot.axis, slot.index });
+  }
+  if (frame.property.wanted && !planes.empty())
+  {
+    in.Cache->RequestCutPlanes(frame.property.name, frame.property.step, planes);
+  }
 }
 
 void vtkMultiresolutionSurfaceMapper::ComputeView(Frame& frame)
@@ -884,6 +923,14 @@ void vtkMultiresolutionSurfaceMapper::StreamTables(Frame& frame)
     loaded.reset(); // still the previous property
   }
   in.Tables.StreamProperty(frame.window, loaded, in.File->Header(), budget, !frame.bounded);
+  std::array<std::shared_ptr<const resmr::CutPlaneData>, 6> cuts;
+  for (const CutPlaneSlot& slot : CutPlaneSlots(frame.ranged, frame.range, in.File->Header().dims.data()))
+  {
+    cuts[static_cast<std::size_t>(slot.slot)] = frame.property.wanted
+      ? in.Cache->CutPlane(frame.property.name, frame.property.step, slot.axis, slot.index)
+      : nullptr;
+  }
+  in.Tables.UploadCutPlanes(frame.window, cuts, in.File->Header());
   in.Tables.StreamNormals(frame.window, budget, !frame.bounded);
   in.Tables.UploadWalls(frame.window, *in.Cache);
   const auto tables = in.Cache->Tables();

@@ -365,6 +365,70 @@ void vtkMultiresolutionTableTextures::UpdateColorMap(vtkOpenGLRenderWindow* wind
   this->ColorTableTime = table->GetMTime();
 }
 
+void vtkMultiresolutionTableTextures::UploadCutPlanes(vtkOpenGLRenderWindow* window,
+  const std::array<std::shared_ptr<const resmr::CutPlaneData>, 6>& planes, const resmr::MultiresolutionHeader& header)
+{
+  const auto create = [window](
+                        vtkTextureObject* texture, unsigned int width, unsigned int height, const float* values) {
+    window->GetState()->vtkglPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    texture->SetContext(window);
+    texture->ResetFormatAndType();
+    texture->SetMinificationFilter(vtkTextureObject::Nearest);
+    texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    texture->Create2DFromRaw(width, height, 1, VTK_FLOAT, const_cast<float*>(values));
+  };
+  const float none = std::numeric_limits<float>::quiet_NaN();
+  if (this->CutSidesTexture->GetHandle() == 0)
+  {
+    create(this->CutLowKTexture, 1, 1, &none);
+    create(this->CutHighKTexture, 1, 1, &none);
+    create(this->CutSidesTexture, 1, 1, &none);
+  }
+  const unsigned int nx = static_cast<unsigned int>(header.dims[0]), ny = static_cast<unsigned int>(header.dims[1]);
+  const unsigned int nk = static_cast<unsigned int>(header.dims[2]);
+  vtkTextureObject* layers[2] = { this->CutLowKTexture, this->CutHighKTexture };
+  for (int p = 0; p < 2; ++p)
+  {
+    if (planes[p] && planes[p] != this->UploadedCuts[p] && planes[p]->values.size() == std::size_t(nx) * ny)
+    {
+      create(layers[p], nx, ny, planes[p]->values.data());
+      this->UploadedCuts[p] = planes[p];
+    }
+  }
+  // I and J planes share one texture: row band p - 2 of nk rows, indexed (j or i, k).
+  bool sidesChanged = false;
+  for (int p = 2; p < 6; ++p)
+  {
+    sidesChanged = sidesChanged || (planes[p] && planes[p] != this->UploadedCuts[p]);
+  }
+  if (sidesChanged)
+  {
+    const unsigned int width = std::max(nx, ny);
+    std::vector<float> sides(std::size_t(width) * 4 * nk, none);
+    for (int p = 2; p < 6; ++p)
+    {
+      this->UploadedCuts[p] = planes[p];
+      const unsigned int along = p < 4 ? ny : nx;
+      if (!planes[p] || planes[p]->values.size() != std::size_t(along) * nk)
+      {
+        this->UploadedCuts[p].reset();
+        continue;
+      }
+      for (unsigned int k = 0; k < nk; ++k)
+      {
+        std::copy_n(planes[p]->values.begin() + std::ptrdiff_t(k) * along, along,
+          sides.begin() + (std::ptrdiff_t(p - 2) * nk + k) * width);
+      }
+    }
+    create(this->CutSidesTexture, width, 4 * nk, sides.data());
+  }
+  this->CutReady = 0;
+  for (int p = 0; p < 6; ++p)
+  {
+    this->CutReady |= planes[p] && planes[p] == this->UploadedCuts[p] ? 1 << p : 0;
+  }
+}
+
 void vtkMultiresolutionTableTextures::Bind(vtkShaderProgram* program, const resmr::MultiresolutionHeader& header)
 {
   const GLuint handle = static_cast<GLuint>(program->GetHandle());
@@ -383,6 +447,10 @@ void vtkMultiresolutionTableTextures::Bind(vtkShaderProgram* program, const resm
   bind(this->PropertyTexture, "propertyTable");
   bind(this->LayerPropertyTexture, "layerProperty");
   bind(this->ColorTexture, "colorMap");
+  bind(this->CutLowKTexture, "cutLowK");
+  bind(this->CutHighKTexture, "cutHighK");
+  bind(this->CutSidesTexture, "cutSides");
+  program->SetUniformi("cutReady", this->CutReady);
   if (this->WallsUploaded)
   {
     uniform3i("wallTableSides", this->WallTableSides);
@@ -401,6 +469,9 @@ void vtkMultiresolutionTableTextures::Unbind()
   this->PropertyTexture->Deactivate();
   this->LayerPropertyTexture->Deactivate();
   this->ColorTexture->Deactivate();
+  this->CutLowKTexture->Deactivate();
+  this->CutHighKTexture->Deactivate();
+  this->CutSidesTexture->Deactivate();
   this->OffsetTexture->Deactivate();
   this->NormalTexture->Deactivate();
   if (this->WallsUploaded)
@@ -430,6 +501,8 @@ void vtkMultiresolutionTableTextures::Forget(vtkWindow* window)
   this->WallsUploaded = false;
   this->WallsTried = false;
   this->Uploaded.reset();
+  this->UploadedCuts = {};
+  this->CutReady = 0;
   this->CancelUploads(window);
 }
 
@@ -445,6 +518,11 @@ void vtkMultiresolutionTableTextures::ReleaseGraphicsResources(vtkWindow* window
   this->NormalTexture->ReleaseGraphicsResources(window);
   this->PropertyTexture->ReleaseGraphicsResources(window);
   this->LayerPropertyTexture->ReleaseGraphicsResources(window);
+  this->CutLowKTexture->ReleaseGraphicsResources(window);
+  this->CutHighKTexture->ReleaseGraphicsResources(window);
+  this->CutSidesTexture->ReleaseGraphicsResources(window);
+  this->UploadedCuts = {};
+  this->CutReady = 0;
   this->ColorTexture->ReleaseGraphicsResources(window);
   this->WallOffsetTexture->ReleaseGraphicsResources(window);
   this->WallKeyTexture->ReleaseGraphicsResources(window);

@@ -30,6 +30,7 @@ namespace resmr
 class RegionCache;
 struct MultiresolutionHeader;
 struct PropertyTableData;
+struct CutPlaneData;
 }
 
 class vtkMultiresolutionTableTextures
@@ -55,6 +56,15 @@ public:
   /// Copies the wall depth table (WallDepthTable.h) once the normals are in, at once (a few
   /// MB to tens of MB); nothing for files without one.
   void UploadWalls(vtkOpenGLRenderWindow* window, const resmr::RegionCache& cache);
+  /// The planes an I/J/K range's cut faces are painted from (CellRange.h), in the order K low,
+  /// K high, I low, I high, J low, J high; null where the range does not cut the grid or the
+  /// plane is not loaded yet. A plane that changed is copied at once (K planes nx x ny, the
+  /// others a few MB together). Called every frame: the samplers need textures either way.
+  void UploadCutPlanes(vtkOpenGLRenderWindow* window,
+    const std::array<std::shared_ptr<const resmr::CutPlaneData>, 6>& planes,
+    const resmr::MultiresolutionHeader& header);
+  /// Bit p: plane p of the last UploadCutPlanes is on the GPU.
+  int CutPlanesReady() const { return this->CutReady; }
   /// Refills the colour map when the lookup table changed.
   void UpdateColorMap(vtkOpenGLRenderWindow* window, vtkScalarsToColors* table);
 
@@ -96,9 +106,14 @@ private:
   vtkSmartPointer<vtkTextureObject> PropertyTexture = vtkSmartPointer<vtkTextureObject>::New();
   vtkNew<vtkTextureObject> ColorTexture;
   vtkNew<vtkTextureObject> LayerPropertyTexture; ///< nx x ny R32F: one layer's table
-  vtkNew<vtkTextureObject> WallOffsetTexture;    ///< the wall hash's offsets, RGB16UI
-  vtkNew<vtkTextureObject> WallKeyTexture;       ///< rows x slabs RG32UI: each slot's key and row
-  vtkNew<vtkTextureObject> WallDepthTexture;     ///< (nk + 1) x rows x slabs RGB32F: the faces
+  vtkNew<vtkTextureObject> CutLowKTexture;       ///< nx x ny R32F: a range's K low plane
+  vtkNew<vtkTextureObject> CutHighKTexture;      ///< nx x ny R32F: its K high plane
+  vtkNew<vtkTextureObject> CutSidesTexture;      ///< max(nx, ny) x 4 nk R32F: its I and J planes
+  std::array<std::shared_ptr<const resmr::CutPlaneData>, 6> UploadedCuts;
+  int CutReady = 0;
+  vtkNew<vtkTextureObject> WallOffsetTexture; ///< the wall hash's offsets, RGB16UI
+  vtkNew<vtkTextureObject> WallKeyTexture;    ///< rows x slabs RG32UI: each slot's key and row
+  vtkNew<vtkTextureObject> WallDepthTexture;  ///< (nk + 1) x rows x slabs RGB32F: the faces
   bool WallsUploaded = false;
   bool WallsTried = false; ///< uploaded, or found none or too large for 3D textures
   std::array<uint32_t, 3> WallTableSides{ 1, 1, 1 }, WallOffsetSides{ 1, 1, 1 };

@@ -399,6 +399,49 @@ std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
   return layer;
 }
 
+std::vector<float> PropertyFile::ReadPlane(std::size_t table, int axis, int64_t index) const
+{
+  if (axis == 2)
+  {
+    return this->ReadLayer(table, index);
+  }
+  const PropertyTable& t = this->Entries.at(table);
+  if (axis < 0 || axis > 2 || index < 0 || index >= this->Dims[axis])
+  {
+    const char* names[3] = { "I", "J", "K" };
+    throw std::out_of_range(this->FilePath + ": no plane " +
+      (axis >= 0 && axis <= 2 ? std::string(names[axis]) + " = " : "along axis " + std::to_string(axis) + ", ") +
+      std::to_string(index + 1));
+  }
+  const int64_t nx = this->Dims[0], ny = this->Dims[1], nz = this->Dims[2];
+  std::vector<float> plane;
+  plane.reserve(static_cast<std::size_t>((axis == 0 ? ny : nx) * nz));
+  for (int64_t k = 0; k < nz; ++k)
+  {
+    if (axis == 0)
+    {
+      for (int64_t b = 0; b < this->Bands(); ++b)
+      {
+        std::string place;
+        const ChunkRef& ref = this->Band(t, k, b, place);
+        const auto values = this->ReadValues(ref, static_cast<uint64_t>(nx * this->RowsIn(b)), place);
+        for (int64_t row = 0; row < this->RowsIn(b); ++row)
+        {
+          plane.push_back(values[static_cast<std::size_t>(row * nx + index)]);
+        }
+      }
+      continue;
+    }
+    const int64_t band = index / this->RowsInBand;
+    std::string place;
+    const ChunkRef& ref = this->Band(t, k, band, place);
+    const auto values = this->ReadValues(ref, static_cast<uint64_t>(nx * this->RowsIn(band)), place);
+    const auto row = values.begin() + static_cast<std::ptrdiff_t>((index - band * this->RowsInBand) * nx);
+    plane.insert(plane.end(), row, row + nx);
+  }
+  return plane;
+}
+
 float PropertyFile::ReadCell(std::size_t table, const std::array<int64_t, 3>& cell) const
 {
   const PropertyTable& t = this->Entries.at(table);

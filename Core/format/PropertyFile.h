@@ -83,6 +83,11 @@ public:
   std::vector<float> ReadPacked(std::size_t table) const;
   /// Layer k of the table (nx ny values).
   std::vector<float> ReadLayer(std::size_t table, int64_t k) const;
+  /// A plane of cells of the table with one index fixed: `axis` 0, I = `index` (ny nz values,
+  /// j fastest); 1, J = `index` (nx nz values, i fastest); 2, a layer (ReadLayer). An I plane
+  /// decodes every band of every layer, a J plane one band a layer (ours: the cut faces of an
+  /// I/J/K range, CellRange.h).
+  std::vector<float> ReadPlane(std::size_t table, int axis, int64_t index) const;
   /// The value of cell (i, j, k) in the table: the band of its layer that holds it decoded up to
   /// it only, the band's CRC checked the first time it is read (later reads of it, a cursor
   /// resting on one place, decode only).

@@ -703,6 +703,92 @@ std::shared_ptr<const PropertyTableData> RegionCache::Property() const
   return this->CurrentProperty;
 }
 
+void RegionCache::RequestCutPlanes(
+  const std::string& name, int32_t step, const std::vector<std::array<int64_t, 2>>& planes)
+{
+  {
+    std::lock_guard<std::mutex> lock(this->Lock);
+    this->CutName = name;
+    this->CutStep = step;
+    this->CutWanted.assign(planes.begin(), planes.begin() + std::min(planes.size(), MaxCutPlanes));
+  }
+  this->Wake.notify_all();
+  this->StandbyWake.notify_all();
+}
+
+std::shared_ptr<const CutPlaneData> RegionCache::CutPlane(
+  const std::string& name, int32_t step, int axis, int64_t index) const
+{
+  std::lock_guard<std::mutex> lock(this->Lock);
+  for (const auto& plane : this->CutPlanes)
+  {
+    if (plane->name == name && plane->step == step && plane->axis == axis && plane->index == index)
+    {
+      return plane;
+    }
+  }
+  return nullptr;
+}
+
+int64_t RegionCache::NextCutPlaneLocked() const
+{
+  for (std::size_t n = 0; n < this->CutWanted.size(); ++n)
+  {
+    const int axis = static_cast<int>(this->CutWanted[n][0]);
+    const int64_t index = this->CutWanted[n][1];
+    const bool held = std::any_of(this->CutPlanes.begin(), this->CutPlanes.end(), [&](const auto& plane) {
+      return plane->name == this->CutName && plane->step == this->CutStep && plane->axis == axis &&
+        plane->index == index;
+    });
+    const std::string key = CutKey(this->CutName, this->CutStep, axis, index);
+    if (!held && std::find(this->CutFailed.begin(), this->CutFailed.end(), key) == this->CutFailed.end())
+    {
+      return static_cast<int64_t>(n);
+    }
+  }
+  return -1;
+}
+
+void RegionCache::LoadCutPlaneLocked(std::unique_lock<std::mutex>& lock, std::size_t wanted)
+{
+  auto plane = std::make_shared<CutPlaneData>();
+  plane->name = this->CutName;
+  plane->step = this->CutStep;
+  plane->axis = static_cast<int>(this->CutWanted[wanted][0]);
+  plane->index = this->CutWanted[wanted][1];
+  this->CutLoading = true;
+  lock.unlock();
+  std::string error;
+  try
+  {
+    const int table = this->Properties ? this->Properties->Find(plane->name, plane->step) : -1;
+    if (table < 0)
+    {
+      throw std::runtime_error((this->Properties ? this->Properties->Path() : std::string("no property file")) +
+        ": property " + plane->name + " step " + std::to_string(plane->step) + " not found");
+    }
+    plane->values = this->Properties->ReadPlane(static_cast<std::size_t>(table), plane->axis, plane->index);
+  }
+  catch (const std::exception& e)
+  {
+    error = e.what();
+  }
+  lock.lock();
+  this->CutLoading = false;
+  if (!error.empty())
+  {
+    this->CutFailed.push_back(CutKey(plane->name, plane->step, plane->axis, plane->index));
+    this->Error = error;
+    return;
+  }
+  this->CutPlanes.push_back(std::move(plane));
+  if (this->CutPlanes.size() > MaxCutPlanes)
+  {
+    this->CutPlanes.erase(this->CutPlanes.begin());
+  }
+  ++this->Changes;
+}
+
 std::shared_ptr<const ModelTables> RegionCache::Tables() const
 {
   std::lock_guard<std::mutex> lock(this->Lock);
@@ -717,7 +803,7 @@ bool RegionCache::MissingLocked(Key key) const
 
 bool RegionCache::PendingLocked() const
 {
-  if (this->PropertyWanted || !this->TablesTried)
+  if (this->PropertyWanted || !this->TablesTried || this->NextCutPlaneLocked() >= 0 || this->CutLoading)
   {
     return true;
   }
@@ -1221,6 +1307,10 @@ bool RegionCache::LoadNextLocked(std::unique_lock<std::mutex>& lock, Role role)
     essentialOnly != this->StandsInLocked())
   {
     this->LoadPropertyLocked(lock);
+  }
+  else if (!essentialOnly && !this->CutLoading && !rootMissing && this->NextCutPlaneLocked() >= 0)
+  {
+    this->LoadCutPlaneLocked(lock, static_cast<std::size_t>(this->NextCutPlaneLocked()));
   }
   else
   {

@@ -155,6 +155,17 @@ struct DrawPiece
 /// checks the total).
 DrawPiece NextDrawPiece(const RegionDrawBuffers& buffers, std::size_t first, std::size_t maxBytes);
 
+/// The property values of a plane of cells (PropertyFile::ReadPlane): where an I/J/K range
+/// cuts the grid, the cut faces' cells.
+struct CutPlaneData
+{
+  std::string name;
+  int32_t step = -1;
+  int axis = 0;      ///< 0: I, 1: J, 2: K
+  int64_t index = 0; ///< 0-based
+  std::vector<float> values;
+};
+
 struct PropertyTableData
 {
   std::string name;
@@ -229,6 +240,14 @@ public:
   /// (0-based); Property() keeps the previous one until it loads.
   void RequestProperty(const std::string& name, int32_t step, int32_t layer = -1);
   std::shared_ptr<const PropertyTableData> Property() const;
+  /// Asks for the values of property (name, step) on the planes `planes` ((axis, index), at
+  /// most MaxCutPlanes): the cells a range's cut faces show, which the packed table (the
+  /// model's outside) does not hold. Loaded after the property table, before regions; planes
+  /// of earlier requests stay until MaxCutPlanes newer ones push them out.
+  void RequestCutPlanes(const std::string& name, int32_t step, const std::vector<std::array<int64_t, 2>>& planes);
+  /// A plane's values once loaded (null before, or when it could not be read: LastError).
+  std::shared_ptr<const CutPlaneData> CutPlane(const std::string& name, int32_t step, int axis, int64_t index) const;
+  static constexpr std::size_t MaxCutPlanes = 12;
   /// The hash and normal tables, or null until the loader has read them (right after the
   /// roots: on a large model they are tens of MB to decompress, never the render thread's job).
   std::shared_ptr<const ModelTables> Tables() const;
@@ -289,6 +308,9 @@ private:
   void LoadHandednessLocked(std::unique_lock<std::mutex>& lock);
   void LoadTablesLocked(std::unique_lock<std::mutex>& lock);
   void LoadPropertyLocked(std::unique_lock<std::mutex>& lock);
+  /// The first requested cut plane neither held nor failed, or -1. Lock held.
+  int64_t NextCutPlaneLocked() const;
+  void LoadCutPlaneLocked(std::unique_lock<std::mutex>& lock, std::size_t wanted);
   void LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, Role role);
   /// For the essential loader, an urgent request's next wanted region: one nobody reads, else
   /// one the idle loader reads and nobody reads again; -1 if none. Lock held.
@@ -396,6 +418,17 @@ private:
   std::shared_ptr<const PropertyTableData> CurrentProperty;
   std::shared_ptr<const ModelTables> LoadedTables;
   bool TablesTried = false; ///< read once, loaded or failed
+  std::string CutName;
+  int32_t CutStep = -1;
+  std::vector<std::array<int64_t, 2>> CutWanted;
+  std::vector<std::shared_ptr<const CutPlaneData>> CutPlanes; ///< held, the newest last
+  std::vector<std::string> CutFailed;                         ///< planes that could not be read
+  bool CutLoading = false;
+  /// A cut plane's name in CutFailed.
+  static std::string CutKey(const std::string& name, int32_t step, int axis, int64_t index)
+  {
+    return name + "/" + std::to_string(step) + "/" + std::to_string(axis) + "/" + std::to_string(index);
+  }
 };
 
 } // namespace resmr

@@ -5,7 +5,8 @@
 // the perfect spatial hash (two texel fetches); the original grid lines are where the
 // coordinate crosses an integer, drawn a fixed width in pixels and faded out where cells
 // shrink below a few pixels. In the single-layer view (layer >= 0) the property comes from
-// that layer's 2D table, indexed by (i, j) without the hash.
+// that layer's 2D table, indexed by (i, j) without the hash; the cells an I/J/K range's cuts
+// expose (inside the model, not in the hash) from the planes of cells along each cut.
 //
 // Lit as VTK lights its surfaces (ours: the renderer's lights and the actor's material, so
 // the surface looks as ParaView's Surface of the full grid): a property's colour is both the
@@ -33,6 +34,10 @@ uniform ivec3 cellLow;    // the lowest cell drawn: 0, or an I/J/K range's
 uniform ivec3 cellHigh;   // the highest: gridDims - 1, or a range's
 uniform ivec3 cutLow;     // an I/J/K range's lowest cells where it cuts the grid, -1: no cut
 uniform ivec3 cutHigh;    // its highest cells where it cuts the grid, -1: no cut
+uniform sampler2D cutLowK;  // nx x ny, R32F: the values of the range's K low plane
+uniform sampler2D cutHighK; // nx x ny, R32F: of its K high plane
+uniform sampler2D cutSides; // max(nx, ny) x 4 nz, R32F: of its I low, I high, J low, J high planes
+uniform int cutReady;       // bit p: plane p (K low, K high, I low, ..., J high) is loaded
 uniform ivec3 tableSides; // m
 uniform ivec3 offsetSides; // r
 uniform usampler3D hashOffsets;  // r0 x r1 x r2, RGB16UI
@@ -217,6 +222,33 @@ bool WallCell(inout ivec3 cell, vec3 topoNormal, float depthPerPixel, out vec2 l
 }
 #endif
 
+// The plane of a range's cut a cell lies on (K low, K high, I low, I high, J low, J high), or
+// -1: the cells a cut exposes lie inside the model, where the hash has no value.
+int CutPlane(ivec3 cell)
+{
+  if (cell.z == cutLow.z)
+    return 0;
+  if (cell.z == cutHigh.z)
+    return 1;
+  if (cell.x == cutLow.x)
+    return 2;
+  if (cell.x == cutHigh.x)
+    return 3;
+  if (cell.y == cutLow.y)
+    return 4;
+  return cell.y == cutHigh.y ? 5 : -1;
+}
+
+float CutValue(int plane, ivec3 cell)
+{
+  if (plane == 0)
+    return texelFetch(cutLowK, cell.xy, 0).r;
+  if (plane == 1)
+    return texelFetch(cutHighK, cell.xy, 0).r;
+  int along = plane < 4 ? cell.y : cell.x;
+  return texelFetch(cutSides, ivec2(along, (plane - 2) * gridDims.z + cell.z), 0).r;
+}
+
 #if LIGHTING > 1
 // One light's diffuse and specular share at this fragment (`toLight` unit, from the fragment).
 void AddLight(vec3 normal, vec3 toEye, vec3 toLight, vec3 lightColor, float attenuation,
@@ -306,14 +338,16 @@ void main()
   {
 #if LAYER_VIEW
     float value = texelFetch(layerProperty, cell.xy, 0).r;
-    bool onCut = false;
+    bool waiting = false;
 #else
     float value = texelFetch(propertyTable, slot, 0).r;
-    // The hash holds the cells of the model's outside: the cells a range's cut exposes have
-    // no value there, and are drawn in the NaN colour rather than in another cell's.
-    bool onCut = any(equal(cell, cutLow)) || any(equal(cell, cutHigh));
+    // A cut's cells from its plane's values: in the NaN colour until they are loaded, never
+    // in the colour of the cell the hash would name.
+    int plane = CutPlane(cell);
+    bool waiting = plane >= 0 && (cutReady / (1 << max(plane, 0))) % 2 == 0;
+    value = plane >= 0 ? CutValue(plane, cell) : value;
 #endif
-    if (onCut || isnan(value))
+    if (waiting || isnan(value))
     {
       color = nanColor.rgb;
     }

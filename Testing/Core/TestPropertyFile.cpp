@@ -165,6 +165,40 @@ int CheckTables(const MultiresolutionFile& geometry, const PropertyFile& propert
         wrong += !SameValue(properties.ReadCell(t, cell), values[static_cast<std::size_t>(c)]);
       }
     }
+    // Planes of one I and one J (a range's cut faces): every value where the layers put it.
+    for (const int64_t i : { int64_t(0), dims[0] / 2, dims[0] - 1 })
+    {
+      const std::vector<float> plane = properties.ReadPlane(t, 0, i);
+      CHECK(plane.size() == std::size_t(dims[1] * dims[2]));
+      for (int64_t n = 0; n < int64_t(plane.size()); ++n)
+      {
+        const int64_t j = n % dims[1], k = n / dims[1];
+        wrong += !SameValue(plane[std::size_t(n)], expected[std::size_t(k * layer + j * dims[0] + i)]);
+      }
+    }
+    for (const std::array<int64_t, 2> bad : { std::array<int64_t, 2>{ 0, dims[0] }, { 1, -1 }, { 3, 0 } })
+    {
+      bool refused = false;
+      try
+      {
+        properties.ReadPlane(t, int(bad[0]), bad[1]);
+      }
+      catch (const std::out_of_range&)
+      {
+        refused = true;
+      }
+      CHECK(refused);
+    }
+    for (const int64_t j : { int64_t(0), dims[1] / 2, dims[1] - 1 })
+    {
+      const std::vector<float> plane = properties.ReadPlane(t, 1, j);
+      CHECK(plane.size() == std::size_t(dims[0] * dims[2]));
+      for (int64_t n = 0; n < int64_t(plane.size()); ++n)
+      {
+        const int64_t i = n % dims[0], k = n / dims[0];
+        wrong += !SameValue(plane[std::size_t(n)], expected[std::size_t(k * layer + j * dims[0] + i)]);
+      }
+    }
     if (wrong)
     {
       std::fprintf(
