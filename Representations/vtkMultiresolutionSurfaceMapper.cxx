@@ -148,6 +148,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   std::unique_ptr<resmr::RegionCache> Cache;
   std::string Error;
   std::string LayerError;   ///< why Layer cannot be drawn, empty if it can
+  std::string RangeShown;   ///< the I/J/K range drawn last (CellRange::Describe), for the log
   std::string Reported;     ///< the last error sent to vtkErrorMacro (each failure once)
   bool WallsWarned = false; ///< a damaged wall depth table was reported
 
@@ -694,6 +695,12 @@ bool vtkMultiresolutionSurfaceMapper::SelectRange(Frame& frame)
     return false; // no cell in it: nothing to draw
   }
   in.Cache->SetRange(frame.ranged ? &frame.range : nullptr);
+  const std::string shown = frame.ranged ? frame.range.Describe() : std::string("the whole grid");
+  if (shown != in.RangeShown)
+  {
+    vtkLogF(TRACE, "multiresolution range shown: %s of %s", shown.c_str(), in.FilePath.c_str());
+    in.RangeShown = shown;
+  }
   if (!frame.ranged)
   {
     in.Selector->SetRangeClassifier({});

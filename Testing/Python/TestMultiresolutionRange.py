@@ -13,6 +13,8 @@ of Multiresolution Extract Subset at tolerance 0 in its Cell Id mode, from 4 cam
 - at a tolerance of 8 px every pixel of ours still names a cell in the range (coarse regions
   never cross a side of the range);
 - an empty range draws nothing;
+- stock Slice, Clip and Threshold applied to the .resmr (directly or after the filter) warn once,
+  naming Multiresolution Extract Subset; on the full grid they do not;
 - Reek's PORO, and SWAT at the first and last report steps, on a box and an I slice through
   ParaView's lookup table (unlit): >= 99% of the pixels both cover within 3 levels a channel
   of stock's (the cut faces painted from the planes of cells along each cut).
@@ -121,6 +123,34 @@ def check_properties(subset, ours, stock_reader, bounds, dims):
     ours.PaintBy = "Cell Id"
 
 
+def warnings_while(make):
+    """The proxy `make()` returns, and the VTK warnings printed meanwhile."""
+    from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
+    window = vtkStringOutputWindow()
+    previous = vtkOutputWindow.GetInstance()
+    vtkOutputWindow.SetInstance(window)
+    try:
+        proxy = make()
+    finally:
+        vtkOutputWindow.SetInstance(previous)
+    return proxy, window.GetOutput()
+
+
+def check_stock_warnings(reader, subset, grid_reader):
+    """Stock filters on the descriptor warn, naming the filter to use; on the full grid not."""
+    cases = [("Slice", lambda: simple.Slice(Input=reader), True),
+             ("Clip", lambda: simple.Clip(Input=subset), True),
+             ("Threshold", lambda: simple.Threshold(Input=subset), True),
+             ("Slice of the full grid", lambda: simple.Slice(Input=grid_reader), False)]
+    for label, make, expected in cases:
+        proxy, text = warnings_while(make)
+        warned = "Multiresolution Extract Subset" in text
+        print(f"{label}: {'warned' if warned else 'no warning'} {text.strip()[:160]!r}")
+        if warned != expected or (expected and text.count("Multiresolution Extract Subset") != 1):
+            failures.append(f"{label}: warning {text!r}, expected {'one' if expected else 'none'}")
+        simple.Delete(proxy)
+
+
 view = rt.image_view(WIDTH, HEIGHT)
 view.EnableRenderOnInteraction = 0
 failures = []
@@ -148,6 +178,8 @@ for name, grid_path in models():
     print(f"{name}: {nx} x {ny} x {nk}; VOI default {list(subset.VOI)}, sliders {voi_range}")
     if voi_range != [1, nx, 1, nx, 1, ny, 1, ny, 1, nk, 1, nk]:
         failures.append(f"{name}: VOI sliders {voi_range}")
+    if name == "reek":
+        check_stock_warnings(reader, subset, stock_reader)
     ours = simple.Show(subset, view)
     ours.PaintBy = "Cell Id"
     ours.GridLines = 0
