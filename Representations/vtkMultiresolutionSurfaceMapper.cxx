@@ -147,8 +147,10 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   std::unique_ptr<resmr::ViewSelector> Selector;
   std::unique_ptr<resmr::RegionCache> Cache;
   std::string Error;
-  std::string LayerError;   ///< why Layer cannot be drawn, empty if it can
-  std::string RangeShown;   ///< the I/J/K range drawn last (CellRange::Describe), for the log
+  std::string LayerError; ///< why Layer cannot be drawn, empty if it can
+  std::string RangeShown; ///< the I/J/K range drawn last (CellRange::Describe), for the log
+  /// The file's region footprints (MultiresolutionFile::ReadFootprints), empty without them.
+  std::vector<std::array<float, 4>> Footprints;
   std::string Reported;     ///< the last error sent to vtkErrorMacro (each failure once)
   bool WallsWarned = false; ///< a damaged wall depth table was reported
 
@@ -205,6 +207,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
     this->ControllerRunning = false;
     this->Cache.reset();
     this->Selector.reset();
+    this->Footprints.clear();
     this->Properties.reset();
     this->File.reset();
     this->FilePath.clear();
@@ -624,6 +627,16 @@ bool vtkMultiresolutionSurfaceMapper::OpenFiles(Frame& frame)
         in.Properties = properties;
       }
       in.Selector.reset(new resmr::ViewSelector(*in.File));
+      in.Footprints.clear();
+      try
+      {
+        in.Footprints = in.File->ReadFootprints();
+      }
+      catch (const resmr::FileFormatError& error)
+      {
+        // Ranges still draw, deciding regions by their own widened boxes as they load.
+        vtkWarningMacro(<< error.what() << "; I/J/K ranges decide regions as they load");
+      }
       in.Cache.reset(
         new resmr::RegionCache(in.File, in.Properties, resmr::MainMemoryShare(this->MemoryBudgetMB), true));
       in.FilePath = frame.filePath;
@@ -711,6 +724,18 @@ bool vtkMultiresolutionSurfaceMapper::SelectRange(Frame& frame)
   resmr::RegionCache* cache = in.Cache.get();
   const resmr::CellRange range = frame.range;
   const std::array<int64_t, 3> grid{ dims[0], dims[1], dims[2] };
+  if (!in.Footprints.empty())
+  {
+    // The file's footprints: every region is classified before anything loads.
+    const std::vector<std::array<float, 4>>* footprints = &in.Footprints;
+    in.Selector->SetRangeClassifier([footprints, range, grid](std::vector<resmr::RangeClass>& classes) {
+      for (std::size_t r = 0; r < classes.size() && r < footprints->size(); ++r)
+      {
+        classes[r] = resmr::ClassifyFootprint((*footprints)[r], range, grid, 1);
+      }
+    });
+    return true;
+  }
   in.Selector->SetRangeClassifier([cache, range, grid](std::vector<resmr::RangeClass>& classes) {
     cache->VisitFootprints([&](std::size_t region, const std::array<float, 4>& footprint) {
       if (region < classes.size())
@@ -1181,6 +1206,10 @@ int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bo
     // A leaf's sides are the original faces: their coordinates name the layer exactly.
     const bool leaf = in.File->Regions()[drawn.region].level == in.File->Header().leafLevel;
     frame.program->SetUniformi("wallLookup", leaf ? 0 : 1);
+    if (getenv("RESMR_DEBUG_RANGE") && frame.ranged && !frame.pickPixel[0] >= 0)
+      fprintf(stderr, "DBG region %zu level %d tris top %u bottom %u side %u coarse %u bytes %zu exact %d\n",
+        drawn.region, in.File->Regions()[drawn.region].level, buffers->topIndices / 3, buffers->bottomIndices / 3,
+        buffers->sideIndices / 3, buffers->coarseSideIndices / 3, buffers->Bytes(), int(buffers->exactSides));
     in.Triangles += static_cast<vtkIdType>(
       in.Regions.Draw(drawn.region, parts, frame.program, frame.window->GetState(), frame.cullBackFaces));
     ++regions;

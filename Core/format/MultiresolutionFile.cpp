@@ -640,11 +640,11 @@ void CheckModelChunks(const std::vector<ModelChunk>& model, const Multiresolutio
   const uint64_t layer = static_cast<uint64_t>(h.dims[0] * h.dims[1]);
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
   const uint64_t offsets = uint64_t(h.hashOffsetSides[0]) * h.hashOffsetSides[1] * h.hashOffsetSides[2];
-  const uint64_t expected[6] = { 0, (layer + 7) / 8, offsets * 6, slots * 8, slots * 4, 0 };
-  const char* const names[6] = { "", "active flags", "hash offset table", "hash cell table", "cell normal table",
-    "wall depth table" };
+  const uint64_t expected[7] = { 0, (layer + 7) / 8, offsets * 6, slots * 8, slots * 4, 0, h.regionCount * 16 };
+  const char* const names[7] = { "", "active flags", "hash offset table", "hash cell table", "cell normal table",
+    "wall depth table", "region footprints" };
   std::vector<uint8_t> layerSeen(static_cast<std::size_t>(h.dims[2]), 0);
-  uint64_t total[6] = {}, pieces[6] = {};
+  uint64_t total[7] = {}, pieces[7] = {};
   for (const ModelChunk& m : model)
   {
     const std::string place = path + ": model chunk " + names[m.kind] + " part " + std::to_string(m.part);
@@ -686,6 +686,14 @@ void CheckModelChunks(const std::vector<ModelChunk>& model, const Multiresolutio
     throw FileFormatError(path + ": wall depth table of " + std::to_string(total[ModelChunk::WallDepths]) +
       " bytes in " + std::to_string(pieces[ModelChunk::WallDepths]) + " chunks (corrupt)");
   }
+  const uint32_t footprints = ModelChunk::Footprints;
+  if (pieces[footprints] > 0 &&
+    (total[footprints] != expected[footprints] || pieces[footprints] != ModelPieces(expected[footprints])))
+  {
+    throw FileFormatError(path + ": region footprints of " + std::to_string(total[footprints]) + " bytes in " +
+      std::to_string(pieces[footprints]) + " chunks, " + std::to_string(expected[footprints]) + " expected for " +
+      std::to_string(h.regionCount) + " regions (corrupt)");
+  }
 }
 
 } // namespace
@@ -701,6 +709,10 @@ void GeometryDigest::Add(const RegionRecord& region)
 
 void GeometryDigest::Add(const ModelChunk& chunk)
 {
+  if (chunk.kind == ModelChunk::Footprints)
+  {
+    return; // derived from the regions, which the id covers
+  }
   this->A = Crc32(&chunk.chunk.crc, 4, Crc32(&chunk.kind, 4, this->A));
   this->B = Crc32(&chunk.chunk.raw, 4, Crc32(&chunk.part, 4, this->B));
 }
@@ -1062,7 +1074,7 @@ void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
     const uint32_t reserved = index.Get<uint32_t>();
     const std::string place = path + ": model chunk record " + std::to_string(i) + " (kind " + std::to_string(m.kind) +
       ", part " + std::to_string(m.part) + ")";
-    if (m.kind < ModelChunk::ActiveLayer || m.kind > ModelChunk::WallDepths || reserved != 0)
+    if (m.kind < ModelChunk::ActiveLayer || m.kind > ModelChunk::Footprints || reserved != 0)
     {
       throw FileFormatError(place + ": unknown kind or reserved bytes set (corrupt)");
     }
@@ -1232,8 +1244,8 @@ std::vector<uint8_t> MultiresolutionFile::ReadModelArray(uint32_t kind) const
   std::sort(pieces.begin(), pieces.end(), [](const ModelChunk* a, const ModelChunk* b) { return a->part < b->part; });
   std::vector<uint8_t> out;
   const char* const names[] = { "model array", "active flags", "hash offset table", "hash cell table",
-    "cell normal table", "wall depth table" };
-  const std::string name = names[kind <= ModelChunk::WallDepths ? kind : 0];
+    "cell normal table", "wall depth table", "region footprints" };
+  const std::string name = names[kind <= ModelChunk::Footprints ? kind : 0];
   for (std::size_t p = 0; p < pieces.size(); ++p)
   {
     const std::string place = this->FilePath + ": " + name + " (model chunk kind " + std::to_string(kind) + ") piece " +
@@ -1256,6 +1268,30 @@ WallDepthTable MultiresolutionFile::ReadWallDepths() const
     return WallDepthTable{};
   }
   return DecodeWallDepthTable(bytes, this->Head.dims, this->FilePath + ": wall depth table");
+}
+
+std::vector<std::array<float, 4>> MultiresolutionFile::ReadFootprints() const
+{
+  const auto bytes = this->ReadModelArray(ModelChunk::Footprints);
+  std::vector<std::array<float, 4>> footprints(bytes.size() / 16);
+  if (!footprints.empty())
+  {
+    std::memcpy(footprints.data(), bytes.data(), footprints.size() * 16);
+  }
+  const float most = float(std::max(this->Head.dims[0], this->Head.dims[1]));
+  for (std::size_t r = 0; r < footprints.size(); ++r)
+  {
+    const auto& f = footprints[r];
+    const bool none = f[0] == 0 && f[1] == -1 && f[2] == 0 && f[3] == -1;
+    const bool box = f[0] >= 0 && f[0] <= f[1] && f[1] <= most && f[2] >= 0 && f[2] <= f[3] && f[3] <= most;
+    if (!none && !box)
+    {
+      throw FileFormatError(this->FilePath + ": region footprints: region " + std::to_string(r) + " spans i " +
+        std::to_string(f[0]) + " to " + std::to_string(f[1]) + ", j " + std::to_string(f[2]) + " to " +
+        std::to_string(f[3]) + ", not within the grid (corrupt)");
+    }
+  }
+  return footprints;
 }
 
 RegionMesh MultiresolutionFile::ReadRegion(std::size_t i) const

@@ -55,12 +55,14 @@ namespace resmr
 
 struct MultiresolutionHeader
 {
-  static constexpr uint32_t Version = 8;
+  static constexpr uint32_t Version = 9;
   static constexpr uint32_t OldestVersion = 3; ///< older files are refused
   /// The first version whose simplified sides paint every cell in place (see above).
   static constexpr uint32_t SidesInPlaceVersion = 6;
   /// From this version on a region record carries its typical error (RegionRecord::typicalError).
   static constexpr uint32_t TypicalErrorVersion = 8;
+  /// From this version on `resmr build` writes the regions' footprints (ModelChunk::Footprints).
+  static constexpr uint32_t FootprintsVersion = 9;
   uint32_t version = Version; ///< the file's, when read
   std::array<int64_t, 3> dims{};
   std::array<double, 4> box{};           ///< hierarchy box: xmin, ymin, xmax, ymax
@@ -121,7 +123,12 @@ struct ModelChunk
     HashOffsets = 2, ///< the offset table: r^3 x 3 uint16
     HashCells = 3,   ///< per slot, uint64 natural cell index i + nx (j + ny k); all ones if empty
     CellNormals = 4, ///< per slot, two uint16 (top, bottom face normal, NormalQuantization.h)
-    WallDepths = 5   ///< the wall depth table (WallDepthTable.h), from version 7 on; optional
+    WallDepths = 5,  ///< the wall depth table (WallDepthTable.h), from version 7 on; optional
+    /// Per region (the index's order), float32 ti min, ti max, tj min, tj max of the nodes of
+    /// the region and its descendants (0, -1, 0, -1: none): a coarse node is an average of the
+    /// nodes it merged, so a region's own box may fall short of its leaves'.
+    /// From version 9 on; optional; derived from the geometry, so left out of the geometry id.
+    Footprints = 6
   };
   uint32_t kind = 0;
   uint32_t part = 0; ///< layer, or piece of a long array (pieces of at most 2^28 bytes)
@@ -249,6 +256,9 @@ public:
   /// The wall depth table (WallDepthTable.h); empty when the file has none (before version 7,
   /// or a model without walls). Throws FileFormatError for a damaged one.
   WallDepthTable ReadWallDepths() const;
+  /// The regions' footprints in (i, j) (ModelChunk::Footprints), one a region; empty when the
+  /// file has none. Throws FileFormatError for a damaged table.
+  std::vector<std::array<float, 4>> ReadFootprints() const;
   /// The record of (level, index), or nullptr.
   const RegionRecord* Find(int32_t level, int64_t index) const;
 

@@ -959,6 +959,10 @@ private:
   void WriteBuildManifest(const MultiresolutionHeader& header, const HierarchyReport& report) const;
   void FinishBoundsAndErrors(int leafLevel);
   void BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& report, std::vector<ModelChunk>& model);
+  /// The regions' footprints (ModelChunk::Footprints) from each region's own topology box
+  /// (`hulls`, of `keys`), added to `model`.
+  void AddFootprints(const std::vector<std::pair<int, int64_t>>& keys, const std::vector<std::array<float, 4>>& hulls,
+    int leafLevel, std::vector<ModelChunk>& model);
   /// The wall depth table of the leaves' wall faces (emptied), or why it was left out.
   void AddWallDepths(std::vector<WallFace>& walls, const MultiresolutionHeader& header, HierarchyReport& report,
     std::vector<ModelChunk>& model);
@@ -1646,6 +1650,56 @@ void Builder::FinishBoundsAndErrors(int leafLevel)
   }
 }
 
+void Builder::AddFootprints(const std::vector<std::pair<int, int64_t>>& keys,
+  const std::vector<std::array<float, 4>>& hulls, int leafLevel, std::vector<ModelChunk>& model)
+{
+  // A region's footprint (ours, for the view's I/J/K ranges, CellRange.h) is its own and its
+  // descendants' node boxes together: a coarse column's topology is an average of the nodes
+  // it merged, so its own box may fall short of what it stands for. The deepest level first.
+  std::map<std::pair<int, int64_t>, std::array<float, 4>> footprint;
+  for (std::size_t n = 0; n < keys.size(); ++n)
+  {
+    footprint[keys[n]] = hulls[n];
+  }
+  const std::array<float, 4> none{ 0.f, -1.f, 0.f, -1.f };
+  const auto unite = [&](std::array<float, 4>& into, const std::array<float, 4>& box) {
+    if (box[1] < box[0])
+    {
+      return;
+    }
+    into = into[1] < into[0] ? box
+                             : std::array<float, 4>{ std::min(into[0], box[0]), std::max(into[1], box[1]),
+                                 std::min(into[2], box[2]), std::max(into[3], box[3]) };
+  };
+  for (int level = leafLevel - 1; level >= 0; --level)
+  {
+    for (auto& entry : footprint)
+    {
+      if (entry.first.first != level)
+      {
+        continue;
+      }
+      for (const int64_t child : { 2 * entry.first.second, 2 * entry.first.second + 1 })
+      {
+        const auto found = footprint.find({ level + 1, child });
+        if (found != footprint.end())
+        {
+          unite(entry.second, found->second);
+        }
+      }
+    }
+  }
+  std::vector<float> table;
+  table.reserve(this->Records.size() * 4);
+  for (const auto& entry : this->Records) // the index's order
+  {
+    const auto found = footprint.find(entry.first);
+    const auto& box = found != footprint.end() ? found->second : none;
+    table.insert(table.end(), box.begin(), box.end());
+  }
+  this->Chunks->AddModelArray(ModelChunk::Footprints, table.data(), table.size() * 4, model);
+}
+
 void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& report, std::vector<ModelChunk>& model)
 {
   const auto& dims = header.dims;
@@ -1672,9 +1726,11 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
   this->Phase = "property side";
   std::vector<WallFace> walls; // the leaves' wall faces, for the wall depth table
   std::mutex wallsMutex;
+  std::vector<std::array<float, 4>> hulls(keys.size()); // each region's own nodes' box in (i, j)
   ParallelFor(static_cast<int64_t>(keys.size()), threads, [&](int64_t n) {
     const auto& key = keys[static_cast<std::size_t>(n)];
     RegionMesh mesh = parts[static_cast<std::size_t>(this->Parts[key])]->ReadRegion(this->Records[key], header);
+    hulls[static_cast<std::size_t>(n)] = TopologyBox(mesh);
     ExtractSurfaces(mesh); // the exact side faces, which views draw for regions of small error
     MarkTouchedCells(mesh, dims, touched);
     if (key.first == header.leafLevel)
@@ -1687,6 +1743,7 @@ void Builder::BuildPropertySide(MultiresolutionHeader& header, HierarchyReport& 
     this->Report(this->Phase, 0.95 + 0.03 * static_cast<double>(n + 1) / static_cast<double>(keys.size()));
   });
   parts.clear();
+  this->AddFootprints(keys, hulls, header.leafLevel, model);
 
   // Perfect spatial hash over them (Lefebvre and Hoppe), the cell of each slot. The cell
   // list is the largest array of the build: made exactly once, freed before the tables.

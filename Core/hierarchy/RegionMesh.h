@@ -99,6 +99,10 @@ void ExtractSurfaces(RegionMesh& mesh);
 void ExtractLayerSurfaces(
   const RegionMesh& mesh, int32_t layer, RegionSurface& top, RegionSurface& bottom, RegionSurface& side);
 
+/// The box of the mesh's nodes' topological coordinates: ti min, ti max, tj min, tj max
+/// (0, -1, 0, -1 without columns).
+std::array<float, 4> TopologyBox(const RegionMesh& mesh);
+
 /// +1 if the columns turn counter-clockwise in (x, y) seen from above, -1 otherwise.
 int RegionOrientation(const RegionMesh& mesh);
 

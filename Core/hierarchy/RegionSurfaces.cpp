@@ -178,6 +178,24 @@ void ComputeOpenSides(RegionMesh& mesh)
   }
 }
 
+std::array<float, 4> TopologyBox(const RegionMesh& mesh)
+{
+  if (mesh.corners.empty())
+  {
+    return { 0.f, -1.f, 0.f, -1.f };
+  }
+  std::array<float, 4> box{ HUGE_VALF, -HUGE_VALF, HUGE_VALF, -HUGE_VALF };
+  for (const auto& corners : mesh.corners)
+  {
+    for (const uint32_t node : corners)
+    {
+      const auto& t = mesh.topology[node];
+      box = { std::min(box[0], t[0]), std::max(box[1], t[0]), std::min(box[2], t[1]), std::max(box[3], t[1]) };
+    }
+  }
+  return box;
+}
+
 int RegionOrientation(const RegionMesh& mesh)
 {
   double area = 0;

@@ -66,34 +66,31 @@ std::string CellRange::Describe() const
 
 std::array<float, 4> RegionFootprint(const RegionMesh& mesh)
 {
-  std::array<float, 4> box{ std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest(),
-    std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest() };
+  const std::array<float, 4> box = TopologyBox(mesh);
+  if (box[1] < box[0])
+  {
+    return box; // lies nowhere
+  }
   float widest = 0;
   for (const auto& corners : mesh.corners)
   {
-    const auto& first = mesh.topology[corners[0]];
-    std::array<float, 4> column{ first[0], first[0], first[1], first[1] };
+    std::array<float, 2> low = mesh.topology[corners[0]], high = low;
     for (const uint32_t node : corners)
     {
-      column[0] = std::min(column[0], mesh.topology[node][0]);
-      column[1] = std::max(column[1], mesh.topology[node][0]);
-      column[2] = std::min(column[2], mesh.topology[node][1]);
-      column[3] = std::max(column[3], mesh.topology[node][1]);
+      for (int a = 0; a < 2; ++a)
+      {
+        low[a] = std::min(low[a], mesh.topology[node][a]);
+        high[a] = std::max(high[a], mesh.topology[node][a]);
+      }
     }
-    widest = std::max({ widest, column[1] - column[0], column[3] - column[2] });
-    box = { std::min(box[0], column[0]), std::max(box[1], column[1]), std::min(box[2], column[2]),
-      std::max(box[3], column[3]) };
-  }
-  if (mesh.corners.empty())
-  {
-    return { 0.f, -1.f, 0.f, -1.f }; // lies nowhere
+    widest = std::max({ widest, high[0] - low[0], high[1] - low[1] });
   }
   const float margin = std::ceil(widest) + 1;
   return { box[0] - margin, box[1] + margin, box[2] - margin, box[3] + margin };
 }
 
 RangeClass ClassifyFootprint(
-  const std::array<float, 4>& footprint, const CellRange& range, const std::array<int64_t, 3>& dims)
+  const std::array<float, 4>& footprint, const CellRange& range, const std::array<int64_t, 3>& dims, float insideMargin)
 {
   if (footprint[1] < footprint[0] || range.Empty(dims))
   {
@@ -110,7 +107,7 @@ RangeClass ClassifyFootprint(
     {
       return RangeClass::Outside;
     }
-    inside = inside && from >= low && to <= high;
+    inside = inside && from >= low + insideMargin && to <= high - insideMargin;
   }
   return inside ? RangeClass::Inside : RangeClass::Crossed;
 }

@@ -14,10 +14,12 @@
 //   no exact place in it: such a region is split down to the leaves (ClassifyFootprint says
 //   which regions it crosses). The leaves along a box side are few: a side crosses a row of
 //   leaves, not an area.
-// - A region's footprint is the box of its nodes' topological coordinates, widened by its
-//   widest column and one cell: a region covers the area its descendants cover, its columns
-//   merge only their own nodes, and the widening keeps the neighbours across its border
-//   inside the box it is classified by (their faces on the border are its own).
+// - Where a range lies against a region is decided by the region's footprint in (i, j): the
+//   file's (ModelChunk::Footprints, exact: its leaves' node boxes together), or, in files
+//   without them, the box of the region's own nodes widened by its widest column and one cell
+//   (a coarse node is an average of the nodes it merged, so its box may fall short of its
+//   leaves'; measured: by at most its widest column). A region is Inside only with a cell to
+//   spare on each side of the range, so the cells across its border are in the range too.
 #pragma once
 
 #include "RegionMesh.h"
@@ -58,10 +60,11 @@ enum class RangeClass : uint8_t
   Crossed  ///< a side of the range in i or j may pass through: split to the leaves
 };
 
-/// Where a region of footprint `footprint` (RegionFootprint) lies against `range` in a grid of
-/// `dims`: range sides on the grid's own limits cut nothing.
-RangeClass ClassifyFootprint(
-  const std::array<float, 4>& footprint, const CellRange& range, const std::array<int64_t, 3>& dims);
+/// Where a region of footprint `footprint` lies against `range` in a grid of `dims`: range
+/// sides on the grid's own limits cut nothing. Inside needs `insideMargin` cells to spare on
+/// each side (1 for the file's exact footprints; 0 for RegionFootprint's, already widened).
+RangeClass ClassifyFootprint(const std::array<float, 4>& footprint, const CellRange& range,
+  const std::array<int64_t, 3>& dims, float insideMargin = 0);
 
 /// Leaves in `mesh` only the cells in `range` active, and opens their sides towards cells out of
 /// it: across an edge inside the region from the masked cells, across a cut edge (the region's

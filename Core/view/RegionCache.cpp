@@ -1469,6 +1469,8 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, 
   {
     // ReadRegion, not ReadRegionSurfaces: the buffers need the positions.
     const bool simplified = layer == this->SimplifiedLayer();
+    if (getenv("RESMR_DEBUG_RANGE"))
+      fprintf(stderr, "DBGLOAD region %zu level %d ranged %d\n", region, this->File->Regions()[region].level, int(ranged));
     buffers = std::make_shared<RegionDrawBuffers>(LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin,
       handedness, simplified || ranged ? -1 : layer, !simplified, ranged ? &range : nullptr));
   }

@@ -1101,7 +1101,7 @@ void TestMapAxesInFile()
   // Versions this build does not know are refused by number.
   writeBytes(withVersion(2));
   resmr_testing::ExpectError<FileFormatError>("version 2", [&] { MultiresolutionFile f(damaged); },
-    { damaged, "format version 2", "versions 3 to 8", "resmr build" });
+    { damaged, "format version 2", "versions 3 to 9", "resmr build" });
   const std::string newer = std::to_string(MultiresolutionHeader::Version + 1);
   writeBytes(withVersion(MultiresolutionHeader::Version + 1));
   resmr_testing::ExpectError<FileFormatError>(

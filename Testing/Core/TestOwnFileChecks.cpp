@@ -130,7 +130,7 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
   const auto& h = file.Header();
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
 
-  ExpectGeometryRefused("version 9", valid, "format version 9", Set<uint32_t>(Version, 9));
+  ExpectGeometryRefused("version 10", valid, "format version 10", Set<uint32_t>(Version, 10));
   ExpectGeometryRefused("version 2", valid, "format version 2", Set<uint32_t>(Version, 2));
   ExpectGeometryRefused("header size", valid, "'header size'", Set<uint32_t>(HeaderSize, 255));
   ExpectGeometryRefused("nx 0", valid, "'dimensions (nx)' is 0", Set<int64_t>(Dims, 0));
@@ -142,7 +142,7 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
       Store<int64_t>(f, Dims + 8 * a, int64_t(1) << 24);
     }
   });
-  ExpectGeometryRefused("nz 4 (of 2)", valid, "'model chunk count'", Set<int64_t>(Dims + 16, 4));
+  ExpectGeometryRefused("nz 8 (of 2)", valid, "'model chunk count'", Set<int64_t>(Dims + 16, 8));
   ExpectGeometryRefused("box xmin NaN", valid, "'hierarchy box (x)'", Set<double>(Box, NaN));
   ExpectGeometryRefused("box ymax < ymin", valid, "'hierarchy box (y)'", Set<double>(Box + 24, h.box[1] - 1));
   ExpectGeometryRefused("box xmax = xmin", valid, "'hierarchy box (x)'", Set<double>(Box + 16, h.box[0]));

@@ -1875,7 +1875,8 @@ void TestUploadPacer()
   CHECK(pacer.SpentBytes() == 0 && pacer.SpentMs() == 0 && pacer.Admit(100 * MB));
 }
 
-/// The I/J/K range view (CellRange.h): a region's footprint holds every leaf column below it;
+/// The I/J/K range view (CellRange.h): the file's footprints are the node boxes of a region
+/// and its descendants together, and a region's widened own box holds every leaf column below it;
 /// with everything resident and a tolerance no region splits by, every drawn region a side of
 /// a random range crosses is a leaf, none lies outside, and every leaf column in the range is
 /// drawn by itself or by an ancestor wholly inside; a leaf's masked mesh keeps exactly the
@@ -1908,14 +1909,35 @@ void TestRanges(const Model& model)
         f[0] <= columns[leaf][0] && f[1] >= columns[leaf][1] && f[2] <= columns[leaf][2] && f[3] >= columns[leaf][3]);
     }
   }
+  // The file's footprints: the node boxes of each region and its descendants together, exactly.
+  const std::vector<std::array<float, 4>> exact = model.file->ReadFootprints();
+  CHECK(exact.size() == regions.size());
+  std::vector<std::array<float, 4>> united(regions.size(), { 0.f, -1.f, 0.f, -1.f });
+  for (std::size_t region = 0; region < regions.size(); ++region)
+  {
+    const std::array<float, 4> box = TopologyBox(model.file->ReadRegion(region));
+    for (int64_t a = static_cast<int64_t>(region); a >= 0 && box[0] <= box[1];
+         a = model.Parent(static_cast<std::size_t>(a)))
+    {
+      auto& u = united[static_cast<std::size_t>(a)];
+      u = u[1] < u[0] ? box
+                      : std::array<float, 4>{ std::min(u[0], box[0]), std::max(u[1], box[1]), std::min(u[2], box[2]),
+                          std::max(u[3], box[3]) };
+    }
+  }
+  for (std::size_t r = 0; r < regions.size() && r < exact.size(); ++r)
+  {
+    CHECK(exact[r] == united[r]);
+  }
   std::mt19937 random(7);
   ViewParameters view;
   view.worldToClip = Everything(1e-9);
   view.parallel = true;
   view.direction = { 0, 0, -1 };
   view.tolerancePixels = 1e30; // only the range splits
-  for (int trial = 0; trial < 12; ++trial)
+  for (int trial = 0; trial < 24; ++trial)
   {
+    const bool fromFile = trial % 2 == 1; // the file's footprints, or the widened own boxes
     CellRange range;
     for (int a = 0; a < 3; ++a)
     {
@@ -1928,7 +1950,8 @@ void TestRanges(const Model& model)
     }
     std::vector<RangeClass> classes(regions.size());
     for (std::size_t r = 0; r < regions.size(); ++r)
-      classes[r] = ClassifyFootprint(footprints[r], range, dims);
+      classes[r] =
+        fromFile ? ClassifyFootprint(exact[r], range, dims, 1) : ClassifyFootprint(footprints[r], range, dims);
     ViewSelector selector(*model.file);
     selector.SetRangeClassifier([&](std::vector<RangeClass>& out) { out = classes; });
     const ViewSelection selection = selector.Select(view, AllResident);
