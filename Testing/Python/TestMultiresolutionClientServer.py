@@ -6,7 +6,10 @@ The readout pulled in pvpython is the server's (vtkSMMultiresolutionSurfaceRepre
 triangles and regions equal the server's TRACE log of the same frame, resident MB > 0, and the
 tolerance is the one set (fixed, no target frame rate), at 0 px and at 12 px; LayerRange is
 the model's (0 to nk = 8). Picks (resmr_inspect.PickCell) at 12 covered pixels name the same
-cells and PORO values through pvserver as builtin, each the cell the image shows there."""
+cells and PORO values through pvserver as builtin, each the cell the image shows there.
+Multiresolution Extract Subset through pvserver: its VOI sliders are the model's dimensions
+(from the server's reader), and a box drawn on the server gives builtin's image (>= 99.9% of the
+pixels name the same cell, every one in the box), its range in the server's log."""
 import re
 import os
 import socket
@@ -33,6 +36,7 @@ if not os.path.exists(path):
 if not os.path.exists(path + "p"):
     subprocess.run([resmr, "add-properties", path, grid], check=True, capture_output=True)
 PICKED = []  # display pixels picked in both modes: the builtin image's covered pixels
+BOX = [11, 40, 16, 35, 3, 6]  # I, J, K from 1, of the 60 x 50 x 8 model
 
 
 def picks(view, display):
@@ -80,9 +84,25 @@ def render(name):
     simple.Render(view)
     readouts.append(readout(display))
     error = readouts[0]["LastError"]
+    # A box of the model, drawn where the file is.
+    subset = simple.MultiresolutionExtractSubset(Input=reader)
+    subset.UpdatePipelineInformation()
+    sliders = list(subset.GetPropertyValue("VOIRange"))
+    subset.VOI = BOX
+    boxed = simple.Show(subset, view)
+    simple.Hide(reader, view)
+    boxed.PaintBy = "Cell Id"
+    boxed.GridLines = 0
+    boxed.PixelTolerance = 0
+    boxed.WaitForDetailMs = 60000
+    simple.Render(view)
+    box_image = os.path.join(temp, name + "-box.png")
+    simple.SaveScreenshot(box_image, view, ImageResolution=[480, 360], TransparentBackground=0)
+    error = error or readout(boxed)["LastError"]
+    simple.Delete(subset)
     simple.Delete(reader)
     simple.Delete(view)
-    return cell_id_pixels(image), readouts, error, picked
+    return cell_id_pixels(image), readouts, error, picked, (cell_id_pixels(box_image), sliders)
 
 
 def cell_id_pixels(image):
@@ -102,7 +122,7 @@ def readout(display):
 
 
 simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
-builtin, builtin_readouts, _, builtin_picks = render("builtin")
+builtin, builtin_readouts, _, builtin_picks, builtin_box = render("builtin")
 builtin_triangles = builtin_readouts[0]["TrianglesDrawn"]
 print(f"builtin: {int(np.sum(builtin > 0))} pixels covered, {builtin_triangles:.0f} triangles")
 
@@ -132,7 +152,7 @@ try:
     simple.Connect("localhost", port)
     simple.LoadPlugin(args.plugin, remote=True, ns=vars(simple))
     simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
-    remote, remote_readouts, error, remote_picks = render("server")
+    remote, remote_readouts, error, remote_picks, remote_box = render("server")
     simple.Disconnect()
 finally:
     server.terminate()
@@ -142,9 +162,12 @@ finally:
         server.kill()
 # The server's frames: (regions, triangles, tolerance); the last at each tolerance is the one
 # the readout after it describes (WaitForDetailMs: the still render's final frame).
+# (Those before the box: its frames are checked apart.)
+lines = server_lines()
+box_at = [n for n, line in enumerate(lines) if "multiresolution range shown: I" in line]
 frames = [(int(m.group(1)), int(m.group(2)), float(m.group(3))) for m in
           (re.search(r"multiresolution surface: (\d+) regions, (\d+) triangles at ([\d.]+) px", line)
-           for line in server_lines()) if m]
+           for line in lines[:box_at[0] if box_at else len(lines)]) if m]
 last_at = {}
 for frame in frames:
     last_at[frame[2]] = frame
@@ -183,4 +206,16 @@ for (x, y), a, b in zip(PICKED, builtin_picks, remote_picks):
     if a is None or b != a or a[0] != shown or a[1] is None:
         rt.fail(f"pick at ({x}, {y}): builtin {a}, server {b}, the image shows {shown}")
 print(f"{len(PICKED)} picks name the same cells and values through pvserver as builtin")
+# The box: the same image through pvserver, every pixel a cell in it, the range in the log.
+(box_builtin, _), (box_remote, sliders) = builtin_box, remote_box
+both = (box_builtin > 0) & (box_remote > 0)
+share = float(np.mean(box_builtin[both] == box_remote[both])) if both.any() else 0.0
+index = box_remote[box_remote > 0] - 1
+i, j, k = index % 60 + 1, index // 60 % 50 + 1, index // 3000 + 1
+outside = int(np.sum((i < BOX[0]) | (i > BOX[1]) | (j < BOX[2]) | (j > BOX[3]) | (k < BOX[4]) | (k > BOX[5])))
+shown = [line for line in server_lines() if "multiresolution range shown: I 11-40, J 16-35, K 3-6" in line]
+print(f"box through pvserver: sliders {sliders}; {100 * share:.2f}% of {int(both.sum())} pixels name the same cell "
+      f"as builtin, {outside} out of the box; range logged by the server {len(shown)} time(s)")
+if sliders != [1, 60, 1, 60, 1, 50, 1, 50, 1, 8, 1, 8] or share < 0.999 or both.sum() < 2000 or outside or not shown:
+    rt.fail("Multiresolution Extract Subset through pvserver differs from builtin")
 print("Multiresolution Surface renders through pvserver; its readout is the server's")
