@@ -6,7 +6,10 @@
   RESMR_DEMO_FILE) it sets up the view and leaves the flying to the user.
 - In pvpython (`pvpython scripts/demo_view.py PLUGIN FILE.resmr OUTPUT_DIR`) it flies a scripted
   path (orbit, zoom to close inspection, low flight along the faults) and writes every 25th
-  frame as a PNG and the frame times, tolerances and memory to OUTPUT_DIR/flythrough.txt.
+  frame as a PNG and the frame times, tolerances and memory to OUTPUT_DIR/flythrough.txt,
+  then cuts the model open with Multiresolution Extract Subset (the cells with I up to three
+  fifths of NI and K from the second layer down, exact at 0 px) and shows the water saturation
+  of the last report step on the cut: OUTPUT_DIR/*_range_swat.png.
 """
 import math
 import os
@@ -116,6 +119,43 @@ def flythrough(plugin, path, output):
     with open(os.path.join(output, f"{prefix}_flythrough.txt"), "w") as out:
         out.write("# " + summary + "\n" + "\n".join(lines) + "\n")
     print(summary)
+    range_view(reader, display, view, os.path.join(output, f"{prefix}_range_swat.png"))
+
+
+def range_view(reader, display, view, screenshot):
+    """The model cut open along I and below its first layer, coloured by SWAT at the last step."""
+    subset = simple.MultiresolutionExtractSubset(Input=reader)
+    subset.UpdatePipelineInformation()
+    voi_range = list(subset.GetPropertyValue("VOIRange"))
+    ni, nj, nk = voi_range[1], voi_range[5], voi_range[9]
+    subset.VOI = [1, 3 * ni // 5, 1, nj, 2, nk]
+    simple.Hide(reader, view)
+    cut = simple.Show(subset, view)
+    cut.Scale = [1, 1, VERTICAL_EXAGGERATION]
+    cut.GridLines = 1
+    cut.PixelTolerance = 1
+    cut.WaitForDetailMs = 120000
+    scene = simple.GetAnimationScene()
+    scene.UpdateAnimationUsingDataTimeSteps()
+    times = list(reader.TimestepValues) if reader.TimestepValues else [0]
+    scene.AnimationTime = times[-1]
+    simple.ColorBy(cut, ("CELLS", "SWAT"))
+    simple.GetColorTransferFunction("SWAT").ApplyPreset("Blue Orange (divergent)", True)
+    simple.GetColorTransferFunction("SWAT").RescaleTransferFunction(0.0, 1.0)
+    cut.SetScalarBarVisibility(view, True)
+    bounds = reader.GetDataInformation().GetBounds()
+    cx, cy = (bounds[0] + bounds[1]) / 2, (bounds[2] + bounds[3]) / 2
+    cz = VERTICAL_EXAGGERATION * (bounds[4] + bounds[5]) / 2
+    size = max(bounds[1] - bounds[0], bounds[3] - bounds[2])
+    camera = view.GetActiveCamera()
+    # Facing the cut at I = 3/5 from outside the box, a little above it.
+    cut_x = bounds[0] + 0.6 * (bounds[1] - bounds[0])
+    camera.SetFocalPoint(cut_x - 0.1 * size, cy, cz)
+    camera.SetPosition(cut_x + 0.55 * size, cy - 0.45 * size, cz + 0.25 * size)
+    camera.SetViewUp(0, 0, 1)
+    simple.Render(view)
+    simple.SaveScreenshot(screenshot, view, ImageResolution=[1280, 720])
+    print(f"demo: the model cut open at I = {3 * ni // 5} and below K = 1, SWAT at day {times[-1]:g}: {screenshot}")
 
 
 if len(sys.argv) >= 4:
