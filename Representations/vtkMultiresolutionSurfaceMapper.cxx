@@ -763,10 +763,9 @@ void vtkMultiresolutionSurfaceMapper::RequestProperty(Frame& frame)
   {
     planes.push_back({ slot.axis, slot.index });
   }
-  if (frame.property.wanted && !planes.empty())
-  {
-    in.Cache->RequestCutPlanes(frame.property.name, frame.property.step, planes);
-  }
+  // (None when no range or no property: what an earlier range asked for is not read.)
+  in.Cache->RequestCutPlanes(
+    frame.property.name, frame.property.step, frame.property.wanted ? planes : std::vector<std::array<int64_t, 2>>{});
 }
 
 void vtkMultiresolutionSurfaceMapper::ComputeView(Frame& frame)
@@ -1206,10 +1205,6 @@ int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bo
     // A leaf's sides are the original faces: their coordinates name the layer exactly.
     const bool leaf = in.File->Regions()[drawn.region].level == in.File->Header().leafLevel;
     frame.program->SetUniformi("wallLookup", leaf ? 0 : 1);
-    if (getenv("RESMR_DEBUG_RANGE") && frame.ranged && !frame.pickPixel[0] >= 0)
-      fprintf(stderr, "DBG region %zu level %d tris top %u bottom %u side %u coarse %u bytes %zu exact %d\n",
-        drawn.region, in.File->Regions()[drawn.region].level, buffers->topIndices / 3, buffers->bottomIndices / 3,
-        buffers->sideIndices / 3, buffers->coarseSideIndices / 3, buffers->Bytes(), int(buffers->exactSides));
     in.Triangles += static_cast<vtkIdType>(
       in.Regions.Draw(drawn.region, parts, frame.program, frame.window->GetState(), frame.cullBackFaces));
     ++regions;

@@ -708,9 +708,15 @@ void RegionCache::RequestCutPlanes(
 {
   {
     std::lock_guard<std::mutex> lock(this->Lock);
+    const std::vector<std::array<int64_t, 2>> wanted(
+      planes.begin(), planes.begin() + static_cast<std::ptrdiff_t>(std::min(planes.size(), MaxCutPlanes)));
+    if (name == this->CutName && step == this->CutStep && wanted == this->CutWanted)
+    {
+      return; // asked every frame: nothing new
+    }
     this->CutName = name;
     this->CutStep = step;
-    this->CutWanted.assign(planes.begin(), planes.begin() + std::min(planes.size(), MaxCutPlanes));
+    this->CutWanted = wanted;
   }
   this->Wake.notify_all();
   this->StandbyWake.notify_all();
@@ -1469,8 +1475,6 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, 
   {
     // ReadRegion, not ReadRegionSurfaces: the buffers need the positions.
     const bool simplified = layer == this->SimplifiedLayer();
-    if (getenv("RESMR_DEBUG_RANGE"))
-      fprintf(stderr, "DBGLOAD region %zu level %d ranged %d\n", region, this->File->Regions()[region].level, int(ranged));
     buffers = std::make_shared<RegionDrawBuffers>(LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin,
       handedness, simplified || ranged ? -1 : layer, !simplified, ranged ? &range : nullptr));
   }
