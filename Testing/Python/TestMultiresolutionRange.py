@@ -10,6 +10,7 @@ of Multiresolution Extract Subset at tolerance 0 in its Cell Id mode, from 4 cam
 - every pixel of ours names a cell in the range;
 - no background pixel of ours where stock covers the pixel and its 8 neighbours;
 - the filter's VOI sliders are bounded by the grid's dimensions; chained filters intersect;
+  with Layer set, only that layer of the box is drawn;
 - at a tolerance of 8 px every pixel of ours still names a cell in the range (coarse regions
   never cross a side of the range);
 - an empty range draws nothing;
@@ -248,6 +249,18 @@ for name, grid_path in models():
         if outside or not np.any(got > 0):
             failures.append(f"{name} box at 8 px {camera_name}: {outside} pixels out of the range")
     ours.PixelTolerance = 0
+
+    # With Layer set, that layer of the box.
+    ours.Layer = 3
+    rt.place_camera(view, bounds, 1.0, cameras[0][1], cameras[0][2])
+    simple.Render(view)
+    got = rt.cell_ids(capture(f"{name}-box-layer3.png"))
+    layer_voi = [voi[0], voi[1], voi[2], voi[3], 3, 3]
+    outside = int(np.sum(~in_range(got, layer_voi, dims)))
+    print(f"{name} box, Layer 3: {int(np.sum(got > 0))} pixels, {outside} out of {layer_voi}")
+    if outside or not np.any(got > 0):
+        failures.append(f"{name} box with Layer 3: {outside} pixels out of {layer_voi}, {int(np.sum(got > 0))} drawn")
+    ours.Layer = 0
 
     # Chained filters intersect their boxes; a box holding no cell draws nothing.
     second = simple.MultiresolutionExtractSubset(Input=subset)
