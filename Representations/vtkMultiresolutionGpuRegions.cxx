@@ -7,9 +7,12 @@
 
 #include "vtkNew.h"
 #include "vtkOpenGLBufferObject.h"
+#include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLState.h"
 #include "vtkOpenGLVertexArrayObject.h"
 #include "vtkShaderProgram.h"
+#include "vtkSmartPointer.h"
+#include "vtkTextureObject.h"
 #include "vtk_glew.h"
 
 #include <algorithm>
@@ -56,6 +59,25 @@ public:
   std::vector<std::unique_ptr<GpuPiece>> Pieces;
   std::size_t Bytes = 0;                        ///< copied so far
   std::vector<std::array<float, 6>> ChunkBoxes; ///< made at the region's first pick
+  /// The buffers' face values (a property filter's leaves), one a triangle, as a buffer
+  /// texture the fragment stage reads by gl_PrimitiveID; made at the region's first draw.
+  vtkNew<vtkOpenGLBufferObject> FaceBuffer;
+  vtkSmartPointer<vtkTextureObject> FaceTexture;
+
+  /// Copies the face values, once; the bytes copied.
+  std::size_t UploadFaceValues(vtkOpenGLRenderWindow* window)
+  {
+    const std::vector<float>& values = this->Buffers->faceValues;
+    if (this->FaceTexture || values.empty() || !window)
+    {
+      return 0;
+    }
+    this->FaceBuffer->Upload(values, vtkOpenGLBufferObject::TextureBuffer);
+    this->FaceTexture = vtkSmartPointer<vtkTextureObject>::New();
+    this->FaceTexture->SetContext(window);
+    this->FaceTexture->CreateTextureBuffer(static_cast<unsigned int>(values.size()), 1, VTK_FLOAT, this->FaceBuffer);
+    return values.size() * 4;
+  }
 
   bool Ready() const { return this->Cursor.Done(); }
   /// Bytes the next piece will copy.
@@ -106,6 +128,12 @@ public:
     {
       piece->Release();
     }
+    if (this->FaceTexture)
+    {
+      this->FaceTexture->ReleaseGraphicsResources(this->FaceTexture->GetContext());
+      this->FaceTexture = nullptr;
+    }
+    this->FaceBuffer->ReleaseGraphicsResources();
   }
 
 private:
@@ -266,10 +294,22 @@ const std::vector<std::array<float, 6>>& vtkMultiresolutionGpuRegions::ChunkBoxe
 }
 
 std::size_t vtkMultiresolutionGpuRegions::Draw(std::size_t region, const std::vector<resmr::DrawPart>& parts,
-  vtkShaderProgram* program, vtkOpenGLState* state, bool cull)
+  vtkShaderProgram* program, vtkOpenGLRenderWindow* window, bool cull)
 {
+  vtkOpenGLState* state = window->GetState();
+  Region& gpu = *this->Regions.at(region);
+  const std::size_t faceBytes = gpu.UploadFaceValues(window);
+  gpu.Bytes += faceBytes;
+  this->GpuBytes += faceBytes;
+  vtkTextureObject* faces = gpu.FaceTexture;
+  if (faces)
+  {
+    faces->Activate();
+    program->SetUniformi("faceValues", faces->GetTextureUnit());
+  }
+  program->SetUniformi("faceValuesOn", faces ? 1 : 0);
   std::size_t triangles = 0;
-  for (const auto& piece : this->Regions.at(region)->Pieces)
+  for (const auto& piece : gpu.Pieces)
   {
     piece->layout->Bind();
     piece->indices->Bind();
@@ -290,6 +330,7 @@ std::size_t vtkMultiresolutionGpuRegions::Draw(std::size_t region, const std::ve
         }
         program->SetUniformi("faceKind", part.kind);
         program->SetUniformi("sideOneLayer", part.oneLayer ? 1 : 0);
+        program->SetUniformi("primitiveBase", static_cast<int>(begin / 3)); // gl_PrimitiveID counts from 0
         glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(end - begin), GL_UNSIGNED_INT,
           reinterpret_cast<const void*>(std::size_t(begin - piece->first) * sizeof(uint32_t)));
         triangles += (end - begin) / 3;
@@ -297,6 +338,10 @@ std::size_t vtkMultiresolutionGpuRegions::Draw(std::size_t region, const std::ve
     }
     piece->indices->Release();
     piece->layout->Release();
+  }
+  if (faces)
+  {
+    faces->Deactivate();
   }
   return triangles;
 }

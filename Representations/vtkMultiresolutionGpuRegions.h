@@ -16,7 +16,7 @@
 #include <memory>
 #include <vector>
 
-class vtkOpenGLState;
+class vtkOpenGLRenderWindow;
 class vtkShaderProgram;
 
 namespace resmr
@@ -53,11 +53,12 @@ public:
   /// unfinished; null when the cache no longer has it.
   const resmr::RegionDrawBuffers* Prepare(
     std::size_t region, const resmr::RegionCache& cache, vtkShaderProgram* program);
-  /// Draws the shown parts of a Prepare'd region piece by piece, setting `faceKind` for each,
+  /// Draws the shown parts of a Prepare'd region piece by piece, setting `faceKind` for each
+  /// (and its face values' texture and first triangle, when the region has face values),
   /// with back faces culled where `cull` and the part allows it (DrawPart::cullBackFaces);
   /// the triangles drawn.
   std::size_t Draw(std::size_t region, const std::vector<resmr::DrawPart>& parts, vtkShaderProgram* program,
-    vtkOpenGLState* state, bool cull);
+    vtkOpenGLRenderWindow* window, bool cull);
   /// The boxes of a Prepare'd region's triangle chunks (resmr::TriangleChunkBoxes), made at its
   /// first pick and kept with its copy, those of the regions picked longest ago dropped past
   /// resmr::MaxPickBoxBytes.

@@ -8,6 +8,7 @@
 
 #include "CellInspection.h"
 #include "CellRange.h"
+#include "PropertyFilter.h"
 #include "CornerPointGeometry.h"
 #include "FramePlanning.h"
 #include "FrameRateController.h"
@@ -151,6 +152,9 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   std::string RangeShown; ///< the I/J/K range drawn last (CellRange::Describe), for the log
   /// The file's region footprints (MultiresolutionFile::ReadFootprints), empty without them.
   std::vector<std::array<float, 4>> Footprints;
+  /// The property filters drawn last, resolved against the property file (their block ranges
+  /// read once a filter and step); null: none.
+  std::shared_ptr<const resmr::ValueFilterSet> ValueFilters;
   std::string Reported;     ///< the last error sent to vtkErrorMacro (each failure once)
   bool WallsWarned = false; ///< a damaged wall depth table was reported
 
@@ -249,8 +253,10 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   bool applyMapAxes = false;
   int32_t layer = -1;    ///< 0-based; -1: the whole model
   std::string rangeText; ///< the descriptor's I/J/K range, from 1 (empty: none)
-  bool ranged = false;   ///< drawing the cells of `range` only
+  std::string filterText; ///< the descriptor's property filters, "low high name" a line
+  bool ranged = false;     ///< drawing the cells of `range` (and `filters`) only
   resmr::CellRange range;
+  std::vector<resmr::ValueFilter> filters;
   resmr::PropertyRequest property;
   /// The property table drawn: the requested one or one standing in; null: solid colour.
   std::shared_ptr<const resmr::PropertyTableData> drawnProperty;
@@ -457,6 +463,42 @@ std::vector<CutPlaneSlot> CutPlaneSlots(bool ranged, const resmr::CellRange& ran
   return slots;
 }
 
+/// Property filters, one a line: "low high name" (inclusive).
+bool ParseFilters(const std::string& text, std::vector<resmr::ValueFilter>& filters)
+{
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line))
+  {
+    std::istringstream in(line);
+    resmr::ValueFilter filter;
+    double low = 0, high = 0;
+    if (!(in >> low >> high >> filter.name))
+    {
+      if (line.find_first_not_of(" \t") == std::string::npos)
+      {
+        continue;
+      }
+      return false;
+    }
+    filter.low = static_cast<float>(low);
+    filter.high = static_cast<float>(high);
+    filters.push_back(filter);
+  }
+  return true;
+}
+
+/// Where a region lies against a range and property filters together.
+resmr::RangeClass Combine(resmr::RangeClass range, resmr::RangeClass values)
+{
+  using C = resmr::RangeClass;
+  if (range == C::Unknown || range == C::Outside || values == C::Outside)
+  {
+    return range == C::Unknown ? C::Unknown : C::Outside;
+  }
+  return range == C::Inside && values == C::Inside ? C::Inside : C::Crossed;
+}
+
 /// A range "I0 I1 J0 J1 K0 K1" (ECLIPSE's, from 1, inclusive) as a 0-based CellRange.
 bool ParseRange(const std::string& text, resmr::CellRange& range)
 {
@@ -495,6 +537,7 @@ bool vtkMultiresolutionSurfaceMapper::ReadSource(Frame& frame)
   frame.applyMapAxes = source->GetNumberOfValues() > 3 && source->GetValue(3) == "1";
   frame.propertyStamp = source->GetNumberOfValues() > 4 ? source->GetValue(4) : std::string();
   frame.rangeText = source->GetNumberOfValues() > 5 ? source->GetValue(5) : std::string();
+  frame.filterText = source->GetNumberOfValues() > 6 ? source->GetValue(6) : std::string();
   return true;
 }
 
@@ -688,7 +731,14 @@ bool vtkMultiresolutionSurfaceMapper::SelectRange(Frame& frame)
   Internals& in = *this->Internal;
   const auto& dims = in.File->Header().dims;
   frame.ranged = !frame.rangeText.empty();
-  if (frame.ranged && !ParseRange(frame.rangeText, frame.range))
+  if (!frame.ranged)
+  {
+    frame.range.lo = { 0, 0, 0 };
+    frame.range.hi = { dims[0] - 1, dims[1] - 1, dims[2] - 1 };
+    // A layer under a property filter: that layer's cells, filtered, painted as a range.
+    frame.ranged = frame.layer >= 0 && !frame.filterText.empty();
+  }
+  else if (!ParseRange(frame.rangeText, frame.range))
   {
     in.LayerError = "the I/J/K range '" + frame.rangeText + "' is not six whole numbers";
     in.Pending = false;
@@ -701,14 +751,35 @@ bool vtkMultiresolutionSurfaceMapper::SelectRange(Frame& frame)
     frame.range.hi[2] = std::min<int64_t>(frame.range.hi[2], frame.layer);
     frame.layer = -1;
   }
-  frame.ranged = frame.ranged && !frame.range.Whole({ dims[0], dims[1], dims[2] });
-  if (frame.ranged && frame.range.Empty({ dims[0], dims[1], dims[2] }))
+  const std::array<int64_t, 3> grid{ dims[0], dims[1], dims[2] };
+  frame.ranged = frame.ranged && !frame.range.Whole(grid);
+  if (frame.ranged && frame.range.Empty(grid))
   {
     in.Pending = false;
     return false; // no cell in it: nothing to draw
   }
-  in.Cache->SetRange(frame.ranged ? &frame.range : nullptr);
-  const std::string shown = frame.ranged ? frame.range.Describe() : std::string("the whole grid");
+  if (!this->SelectFilters(frame))
+  {
+    return false;
+  }
+  const bool filtered = !frame.filters.empty();
+  frame.ranged = frame.ranged || filtered;
+  resmr::CellFilter filter;
+  filter.range = frame.range;
+  if (filtered)
+  {
+    filter.values = in.ValueFilters;
+    // The faces a filter exposes carry the painted array's values (the packed table has none).
+    filter.paintTable = this->ColorMode == PropertyColors && this->ArrayName
+      ? resmr::FindFilterTable(*in.Properties, this->ArrayName, frame.step)
+      : -1;
+  }
+  in.Cache->SetFilter(frame.ranged ? &filter : nullptr);
+  std::string shown = frame.ranged ? frame.range.Describe() : std::string("the whole grid");
+  for (const resmr::ValueFilter& f : frame.filters)
+  {
+    shown += ", " + f.name + " " + std::to_string(f.low) + " to " + std::to_string(f.high);
+  }
   if (shown != in.RangeShown)
   {
     vtkLogF(TRACE, "multiresolution range shown: %s of %s", shown.c_str(), in.FilePath.c_str());
@@ -723,27 +794,71 @@ bool vtkMultiresolutionSurfaceMapper::SelectRange(Frame& frame)
   // footprint comes with its buffers); ancestors are decoded before their children.
   resmr::RegionCache* cache = in.Cache.get();
   const resmr::CellRange range = frame.range;
-  const std::array<int64_t, 3> grid{ dims[0], dims[1], dims[2] };
+  const std::shared_ptr<const resmr::ValueFilterSet> values = filtered ? in.ValueFilters : nullptr;
+  const auto classify = [range, grid, values](const std::array<float, 4>& footprint, float margin) {
+    const resmr::RangeClass byRange = resmr::ClassifyFootprint(footprint, range, grid, margin);
+    return values ? Combine(byRange, values->Classify(footprint, 1)) : byRange;
+  };
   if (!in.Footprints.empty())
   {
     // The file's footprints: every region is classified before anything loads.
     const std::vector<std::array<float, 4>>* footprints = &in.Footprints;
-    in.Selector->SetRangeClassifier([footprints, range, grid](std::vector<resmr::RangeClass>& classes) {
+    in.Selector->SetRangeClassifier([footprints, classify](std::vector<resmr::RangeClass>& classes) {
       for (std::size_t r = 0; r < classes.size() && r < footprints->size(); ++r)
       {
-        classes[r] = resmr::ClassifyFootprint((*footprints)[r], range, grid, 1);
+        classes[r] = classify((*footprints)[r], 1);
       }
     });
     return true;
   }
-  in.Selector->SetRangeClassifier([cache, range, grid](std::vector<resmr::RangeClass>& classes) {
+  in.Selector->SetRangeClassifier([cache, classify](std::vector<resmr::RangeClass>& classes) {
     cache->VisitFootprints([&](std::size_t region, const std::array<float, 4>& footprint) {
       if (region < classes.size())
       {
-        classes[region] = resmr::ClassifyFootprint(footprint, range, grid);
+        classes[region] = classify(footprint, 0);
       }
     });
   });
+  return true;
+}
+
+bool vtkMultiresolutionSurfaceMapper::SelectFilters(Frame& frame)
+{
+  Internals& in = *this->Internal;
+  frame.filters.clear();
+  if (!ParseFilters(frame.filterText, frame.filters))
+  {
+    in.LayerError = "the property filter '" + frame.filterText + "' is not lines of 'low high name'";
+    in.Pending = false;
+    return false;
+  }
+  if (frame.filters.empty())
+  {
+    in.ValueFilters.reset();
+    return true;
+  }
+  if (!in.Properties)
+  {
+    in.LayerError = "a property filter needs the property file (.resmrp) of " + in.FilePath;
+    this->Fail(frame, in.LayerError);
+    return false;
+  }
+  const bool same = in.ValueFilters && in.ValueFilters->Filters() == frame.filters &&
+    in.ValueFilters->Step() == frame.step && &in.ValueFilters->File() == in.Properties.get();
+  if (!same)
+  {
+    try
+    {
+      in.ValueFilters = std::make_shared<resmr::ValueFilterSet>(in.Properties, frame.filters, frame.step);
+    }
+    catch (const std::exception& error)
+    {
+      in.ValueFilters.reset();
+      in.LayerError = error.what();
+      this->Fail(frame, error.what());
+      return false;
+    }
+  }
   return true;
 }
 
@@ -1206,7 +1321,7 @@ int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bo
     const bool leaf = in.File->Regions()[drawn.region].level == in.File->Header().leafLevel;
     frame.program->SetUniformi("wallLookup", leaf ? 0 : 1);
     in.Triangles += static_cast<vtkIdType>(
-      in.Regions.Draw(drawn.region, parts, frame.program, frame.window->GetState(), frame.cullBackFaces));
+      in.Regions.Draw(drawn.region, parts, frame.program, frame.window, frame.cullBackFaces));
     ++regions;
   }
   return regions;

@@ -218,6 +218,8 @@ private:
   /// The I/J/K range the descriptor names, if any (with Layer set, that layer of it); false
   /// (nothing drawn) when it holds no cell or cannot be read (LastError says why).
   bool SelectRange(Frame& frame);
+  /// The descriptor's property filters, resolved against the property file (SelectRange).
+  bool SelectFilters(Frame& frame);
   /// What the descriptor names; false without a descriptor (an empty piece, no file yet).
   bool ReadSource(Frame& frame);
   void RequestProperty(Frame& frame);

@@ -1,6 +1,7 @@
 #include "vtkMultiresolutionSurfaceRepresentation.h"
 
 #include "vtkMultiresolutionExtractSubset.h"
+#include "vtkMultiresolutionThreshold.h"
 #include "vtkMultiresolutionReader.h"
 #include "vtkMultiresolutionSurfaceMapper.h"
 
@@ -92,6 +93,10 @@ int vtkMultiresolutionSurfaceRepresentation::RequestData(
         rangeText += (n ? " " : "") + std::to_string(range->GetValue(n));
       }
       source->InsertNextValue(rangeText);
+      // Property filters set upstream (Multiresolution Threshold), "low high name" a line.
+      vtkStringArray* filters = vtkStringArray::SafeDownCast(
+        input->GetFieldData()->GetAbstractArray(vtkMultiresolutionThreshold::FilterArrayName()));
+      source->InsertNextValue(filters && filters->GetNumberOfValues() == 1 ? filters->GetValue(0) : std::string());
       this->Delivered->GetFieldData()->AddArray(source);
       // The Layer property's range: the header is read once a file (the mapper opens it again
       // where it draws, which may be another process).

@@ -21,7 +21,7 @@ namespace
 {
 constexpr char Magic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'R', 'P' };
 constexpr char TrailerMagic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'I', 'X' };
-constexpr uint32_t Version = 3;
+constexpr uint32_t Version = 4;
 constexpr uint32_t OldestVersion = 2; ///< a chunk a layer: read as one band a layer
 constexpr std::size_t HeaderBytes = 128;
 constexpr std::size_t NameBytes = 32;
@@ -132,9 +132,14 @@ void NearestActiveSources(std::vector<uint64_t>& slotCells, const std::vector<st
 
 /// Index bytes a table takes: name, step, report, days, range, then the packed table's chunk
 /// and one chunk a band of every layer.
-uint64_t TableRecordBytes(uint64_t layerBands)
+uint64_t TableRecordBytes(uint64_t layerBands, uint32_t version)
 {
-  return NameBytes + 4 + 4 + 8 + 4 + 4 + 20 * (layerBands + 1);
+  return NameBytes + 4 + 4 + 8 + 4 + 4 + 20 * (layerBands + 1) + (version >= 4 ? 20 : 0);
+}
+
+int64_t BlocksAlong(int64_t cells)
+{
+  return (cells + ColumnBlockSide - 1) / ColumnBlockSide;
 }
 
 std::string TableName(const PropertyTable& t)
@@ -175,6 +180,7 @@ PropertyFile::PropertyFile(const std::string& path)
     head.Get(this->TableSides);
     const uint32_t tables = head.Get<uint32_t>();
     const uint32_t bandRows = version >= 3 ? head.Get<uint32_t>() : 0;
+    this->FormatVersion = version;
     const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
     this->CheckHeader(tables, indexSize, version, bandRows);
     ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
@@ -246,7 +252,7 @@ void PropertyFile::CheckHeader(uint32_t tables, uint64_t indexSize, uint32_t ver
       bad("reserved bytes", "byte " + std::to_string(at) + " = " + std::to_string(this->Data[at]), "zero");
     }
   }
-  const uint64_t recordBytes = TableRecordBytes(static_cast<uint64_t>(this->Dims[2] * this->Bands()));
+  const uint64_t recordBytes = TableRecordBytes(static_cast<uint64_t>(this->Dims[2] * this->Bands()), version);
   if (indexSize % recordBytes != 0 || indexSize / recordBytes != tables)
   {
     bad("table count", std::to_string(tables),
@@ -267,6 +273,10 @@ PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t in
   table.minimum = index.Get<float>();
   table.maximum = index.Get<float>();
   table.packed = GetRef(index);
+  if (this->FormatVersion >= 4)
+  {
+    table.blockRanges = GetRef(index);
+  }
   const int64_t bands = this->Bands();
   table.layerBands.resize(static_cast<std::size_t>(this->Dims[2] * bands));
   for (ChunkRef& band : table.layerBands)
@@ -310,6 +320,17 @@ PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t in
     if (c.raw != values * 4)
     {
       fail(what + " of " + std::to_string(c.raw) + " bytes for " + std::to_string(values) + " values");
+    }
+  }
+  if (this->FormatVersion >= 4)
+  {
+    const ChunkRef& c = table.blockRanges;
+    const auto blocks = this->BlockCounts();
+    const uint64_t bytes = static_cast<uint64_t>(blocks[0] * blocks[1]) * sizeof(ValueRange);
+    if (c.offset < HeaderBytes || c.offset > indexOffset || c.stored > indexOffset - c.offset || c.raw != bytes)
+    {
+      fail("block ranges at byte " + std::to_string(c.offset) + " (" + std::to_string(c.stored) + " bytes stored, " +
+        std::to_string(c.raw) + " raw) lie outside the file or are not " + std::to_string(bytes) + " bytes");
     }
   }
   return table;
@@ -364,6 +385,68 @@ std::vector<float> PropertyFile::ReadPacked(std::size_t table) const
   const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
   return this->ReadValues(t.packed, slots,
     this->FilePath + ": packed table of " + TableName(t) + " at byte " + std::to_string(t.packed.offset));
+}
+
+std::array<int64_t, 2> PropertyFile::BlockCounts() const
+{
+  return { BlocksAlong(this->Dims[0]), BlocksAlong(this->Dims[1]) };
+}
+
+std::vector<ValueRange> PropertyFile::ReadBlockRanges(std::size_t table) const
+{
+  const PropertyTable& t = this->Entries.at(table);
+  if (!this->HasBlockRanges())
+  {
+    return {};
+  }
+  const auto blocks = this->BlockCounts();
+  const std::string place =
+    this->FilePath + ": block ranges of " + TableName(t) + " at byte " + std::to_string(t.blockRanges.offset);
+  const auto floats = this->ReadValues(t.blockRanges, static_cast<uint64_t>(blocks[0] * blocks[1]) * 2, place);
+  std::vector<ValueRange> ranges(floats.size() / 2);
+  for (std::size_t b = 0; b < ranges.size(); ++b)
+  {
+    ranges[b] = { floats[2 * b], floats[2 * b + 1] };
+    if (std::isnan(ranges[b].low) || std::isnan(ranges[b].high))
+    {
+      throw FileFormatError(place + ": block " + std::to_string(b) + " has a NaN bound (corrupt)");
+    }
+  }
+  return ranges;
+}
+
+std::vector<float> PropertyFile::ReadBox(
+  std::size_t table, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) const
+{
+  const PropertyTable& t = this->Entries.at(table);
+  for (int a = 0; a < 3; ++a)
+  {
+    if (lo[a] < 0 || hi[a] >= this->Dims[a] || lo[a] > hi[a])
+    {
+      throw std::out_of_range(this->FilePath + ": box " + std::to_string(lo[a] + 1) + "-" + std::to_string(hi[a] + 1) +
+        " along " + "IJK"[a] + " lies outside the grid");
+    }
+  }
+  const int64_t nx = this->Dims[0], width = hi[0] - lo[0] + 1, rows = hi[1] - lo[1] + 1;
+  std::vector<float> box;
+  box.reserve(static_cast<std::size_t>(width * rows * (hi[2] - lo[2] + 1)));
+  for (int64_t k = lo[2]; k <= hi[2]; ++k)
+  {
+    for (int64_t b = lo[1] / this->RowsInBand; b <= hi[1] / this->RowsInBand; ++b)
+    {
+      std::string place;
+      const ChunkRef& ref = this->Band(t, k, b, place);
+      const auto values = this->ReadValues(ref, static_cast<uint64_t>(nx * this->RowsIn(b)), place);
+      const int64_t first = std::max(lo[1], b * this->RowsInBand);
+      const int64_t last = std::min(hi[1], b * this->RowsInBand + this->RowsIn(b) - 1);
+      for (int64_t j = first; j <= last; ++j)
+      {
+        const auto row = values.begin() + static_cast<std::ptrdiff_t>((j - b * this->RowsInBand) * nx + lo[0]);
+        box.insert(box.end(), row, row + width);
+      }
+    }
+  }
+  return box;
 }
 
 int64_t PropertyFile::RowsIn(int64_t band) const
@@ -615,6 +698,34 @@ ChunkRef PropertyFileWriter::CopyChunk(const PropertyFile& from, const ChunkRef&
   return moved;
 }
 
+ChunkRef PropertyFileWriter::PutBlockRanges(const std::vector<ValueRange>& blocks, const PropertyTable& table)
+{
+  std::vector<uint8_t> raw(blocks.size() * sizeof(ValueRange));
+  std::memcpy(raw.data(), blocks.data(), raw.size());
+  return this->PutChunk(raw, TableName(table) + " block ranges");
+}
+
+void PropertyFileWriter::AddToBlockRanges(std::vector<ValueRange>& blocks, const float* values, int64_t k) const
+{
+  const int64_t nx = this->Dims[0], ny = this->Dims[1], bx = BlocksAlong(nx);
+  const std::vector<uint64_t>& active = this->Active[static_cast<std::size_t>(k)];
+  for (int64_t j = 0; j < ny; ++j)
+  {
+    for (int64_t i = 0; i < nx; ++i)
+    {
+      const uint64_t c = static_cast<uint64_t>(j * nx + i);
+      if (!Bit(active, c))
+      {
+        continue;
+      }
+      ValueRange& block = blocks[static_cast<std::size_t>((j / ColumnBlockSide) * bx + i / ColumnBlockSide)];
+      const float v = values[c];
+      block.low = std::isnan(v) ? -std::numeric_limits<float>::infinity() : std::min(block.low, v);
+      block.high = std::isnan(v) ? block.high : std::max(block.high, v);
+    }
+  }
+}
+
 void PropertyFileWriter::Add(PropertyTable table, const std::vector<float>& cellValues)
 {
   const int64_t layer = this->Dims[0] * this->Dims[1];
@@ -651,6 +762,8 @@ std::size_t PropertyFileWriter::BeginTable(PropertyTable table)
   opened.table.layerBands.clear();
   opened.low = std::numeric_limits<float>::infinity();
   opened.high = -opened.low;
+  opened.blocks.assign(static_cast<std::size_t>(BlocksAlong(this->Dims[0]) * BlocksAlong(this->Dims[1])),
+    ValueRange{ opened.low, opened.high });
   // Slots without a source (empty, or inactive in a layer with no active cell) stay NaN.
   const float none = std::numeric_limits<float>::quiet_NaN();
   opened.packed.resize(static_cast<std::size_t>(this->SlotCount) * 4);
@@ -704,6 +817,7 @@ void PropertyFileWriter::AddLayer(std::size_t handle, const float* layerValues)
     std::memcpy(&raw[static_cast<std::size_t>(c) * 4], &v, 4);
   }
   this->PutLayerBands(t.table, raw, k);
+  this->AddToBlockRanges(t.blocks, reinterpret_cast<const float*>(raw.data()), k);
   ++t.layers;
   for (uint64_t at = this->LayerSlotStart[static_cast<std::size_t>(k)];
        at < this->LayerSlotStart[static_cast<std::size_t>(k) + 1]; ++at)
@@ -727,7 +841,9 @@ void PropertyFileWriter::EndTable(std::size_t handle)
   table.minimum = t.low <= t.high ? t.low : none;
   table.maximum = t.low <= t.high ? t.high : none;
   table.packed = this->PutChunk(t.packed, TableName(table) + " packed table");
+  table.blockRanges = this->PutBlockRanges(t.blocks, table);
   t.packed = std::vector<uint8_t>();
+  t.blocks = std::vector<ValueRange>();
   t.open = false;
   for (auto& old : this->Entries)
   {
@@ -755,7 +871,22 @@ void PropertyFileWriter::CopyFrom(const PropertyFile& older)
       continue;
     }
     PropertyTable copy = table;
+    const std::size_t t = static_cast<std::size_t>(&table - older.Tables().data());
     copy.packed = this->CopyChunk(older, table.packed);
+    if (older.HasBlockRanges())
+    {
+      copy.blockRanges = this->CopyChunk(older, table.blockRanges);
+    }
+    else // an older version's table: its block ranges from its layers
+    {
+      std::vector<ValueRange> blocks(static_cast<std::size_t>(BlocksAlong(this->Dims[0]) * BlocksAlong(this->Dims[1])),
+        ValueRange{ std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity() });
+      for (int64_t k = 0; k < this->Dims[2]; ++k)
+      {
+        this->AddToBlockRanges(blocks, older.ReadLayer(t, k).data(), k);
+      }
+      copy.blockRanges = this->PutBlockRanges(blocks, copy);
+    }
     if (older.BandRows() == this->RowsInBand)
     {
       for (ChunkRef& band : copy.layerBands)
@@ -766,7 +897,6 @@ void PropertyFileWriter::CopyFrom(const PropertyFile& older)
     else // an older version's layers: cut into this file's bands
     {
       copy.layerBands.clear();
-      const std::size_t t = static_cast<std::size_t>(&table - older.Tables().data());
       for (int64_t k = 0; k < this->Dims[2]; ++k)
       {
         const std::vector<float> layer = older.ReadLayer(t, k);
@@ -800,6 +930,7 @@ void PropertyFileWriter::Commit()
     index.Put(t.minimum);
     index.Put(t.maximum);
     PutRef(index, t.packed);
+    PutRef(index, t.blockRanges);
     for (const ChunkRef& band : t.layerBands)
     {
       PutRef(index, band);

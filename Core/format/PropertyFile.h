@@ -11,11 +11,12 @@
 //   view's 3D texture, Sec. 5.4) and layer by layer (nx ny values, i fastest; the single-
 //   layer view's 2D texture, Sec. 5.2), each layer cut into bands of whole rows of at most
 //   LayerBandValues values, a chunk a band (ours: reading one cell's value, a pick, decodes one
-//   band instead of a whole layer).
+//   band instead of a whole layer). From version 4, each table also keeps the value range of
+//   each block of ColumnBlockSide^2 columns over all layers (ours: PropertyFilter.h).
 // - Layout (little-endian): header (128 bytes, CRC-32 at its end: magic, version, the
 //   geometry id of the .resmr file, grid dimensions, hash table side, table count, rows a
 //   band), chunks, index (per table: name, step, report number, days, value range, packed
-//   chunk, then nz times the bands of a layer), trailer (index offset and size, index CRC,
+//   chunk, block ranges chunk (version 4 on), then nz times the bands of a layer), trailer (index offset and size, index CRC,
 //   magic "RESMRPIX"). Version 2 files (a chunk a layer, no band rows) are read as one band.
 // - A file is written under a temporary name and renamed; one that names another geometry
 //   is refused (CheckGeometry). Every header and index field is checked when the file is
@@ -48,7 +49,22 @@ struct PropertyTable
   double days = 0;                ///< simulated time of the step
   float minimum = 0, maximum = 0; ///< over the cells with a value (NaN if none)
   ChunkRef packed;
+  /// Value ranges of blocks of ColumnBlockSide x ColumnBlockSide columns over all layers
+  /// (ColumnBlockRanges); raw 0 in files before version 4.
+  ChunkRef blockRanges;
   std::vector<ChunkRef> layerBands; ///< nz times the bands of a layer: layer k's band b at k * bands + b
+};
+
+/// Columns a side of the blocks whose value ranges a table keeps (ours: a property filter,
+/// PropertyFilter.h, tells from them which regions it leaves whole or removes whole).
+constexpr int64_t ColumnBlockSide = 8;
+
+/// The range of a table's values over the active cells of a block of columns, all layers:
+/// low > high when no active cell has a value; low is -infinity when an active cell has none
+/// (NaN), so such a block never passes a filter whole.
+struct ValueRange
+{
+  float low = 0, high = 0;
 };
 
 /// Most values in a band of a layer's rows (1 MB of floats); a band holds at least one row.
@@ -79,6 +95,15 @@ public:
   /// Throws FileFormatError if this file was not made for `geometry`.
   void CheckGeometry(const MultiresolutionFile& geometry) const;
 
+  /// Whether the tables carry block ranges (version 4 on).
+  bool HasBlockRanges() const { return this->FormatVersion >= 4; }
+  /// Blocks along i and j: ceil(nx / ColumnBlockSide), ceil(ny / ColumnBlockSide).
+  std::array<int64_t, 2> BlockCounts() const;
+  /// The table's block ranges, block (bi, bj) at bi + bx * bj; empty before version 4.
+  std::vector<ValueRange> ReadBlockRanges(std::size_t table) const;
+  /// The values of a box of cells, [lo, hi] inclusive and 0-based, i fastest, then j, then k:
+  /// one band a layer for each band the box's rows reach.
+  std::vector<float> ReadBox(std::size_t table, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) const;
   /// The packed table (m0 m1 m2 values, Sec. 5.4).
   std::vector<float> ReadPacked(std::size_t table) const;
   /// Layer k of the table (nx ny values).
@@ -114,6 +139,7 @@ private:
   std::array<int64_t, 3> Dims{};
   std::array<uint32_t, 3> TableSides{};
   int64_t RowsInBand = 1;
+  uint32_t FormatVersion = 0;
   std::vector<PropertyTable> Entries;
   mutable std::mutex VerifiedLock;
   mutable std::unordered_set<uint64_t> Verified; ///< offsets of layer chunks whose CRC held (ReadCell)
@@ -154,12 +180,17 @@ private:
     PropertyTable table;
     std::vector<uint8_t> packed; ///< m0 m1 m2 floats, filled as the layers come
     float low = 0, high = 0;     ///< value range so far
+    std::vector<ValueRange> blocks; ///< block ranges so far (BlockCounts)
     int64_t layers = 0;          ///< layers added so far
     bool open = false;
   };
   OpenTable& Opened(std::size_t handle);
   ChunkRef PutChunk(const std::vector<uint8_t>& raw, const std::string& what);
   ChunkRef CopyChunk(const PropertyFile& from, const ChunkRef& ref);
+  /// Stores block ranges as the table's chunk.
+  ChunkRef PutBlockRanges(const std::vector<ValueRange>& blocks, const PropertyTable& table);
+  /// Widens `blocks` by layer k's values (nx ny, NaN where inactive) and active flags.
+  void AddToBlockRanges(std::vector<ValueRange>& blocks, const float* values, int64_t k) const;
   /// Layer values (nx ny floats as bytes) stored as this file's bands.
   void PutLayerBands(PropertyTable& table, const std::vector<uint8_t>& raw, int64_t k);
   void Write(const void* data, std::size_t size, const std::string& what);

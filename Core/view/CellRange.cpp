@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 namespace resmr
@@ -112,45 +113,53 @@ RangeClass ClassifyFootprint(
   return inside ? RangeClass::Inside : RangeClass::Crossed;
 }
 
-void MaskToRange(RegionMesh& mesh, const CellRange& range)
+std::array<double, 2> ColumnCentreOf(const RegionMesh& mesh, std::size_t column)
+{
+  return ColumnCentre(mesh, column);
+}
+
+void MaskCells(RegionMesh& mesh, const std::function<bool(const std::array<double, 2>&, int64_t)>& keep)
 {
   const std::size_t layers = static_cast<std::size_t>(mesh.layers);
-  std::vector<uint8_t> cutOpen(mesh.corners.size(), 0); // cut edges whose column across is out
+  std::vector<uint8_t> cutOpen(mesh.active.size(), 0); // per cell, cut edges whose cell across goes
   for (std::size_t c = 0; c < mesh.corners.size(); ++c)
   {
     const std::array<double, 2> centre = ColumnCentre(mesh, c);
-    const bool in = InRangeIJ(range, centre);
     for (std::size_t k = 0; k < layers; ++k)
     {
       uint8_t& active = mesh.active[c * layers + k];
-      active = active && in && int64_t(k) >= range.lo[2] && int64_t(k) <= range.hi[2];
-    }
-    for (int e = 0; in && e < 4; ++e)
-    {
-      if (!(mesh.cutEdges[c] & (1u << e)))
+      active = active && keep(centre, int64_t(k));
+      for (int e = 0; active && e < 4; ++e)
       {
-        continue;
-      }
-      const auto& a = mesh.topology[mesh.corners[c][e]];
-      const auto& b = mesh.topology[mesh.corners[c][(e + 1) % 4]];
-      const std::array<double, 2> across{ double(a[0]) + double(b[0]) - centre[0],
-        double(a[1]) + double(b[1]) - centre[1] };
-      if (!InRangeIJ(range, across))
-      {
-        cutOpen[c] |= static_cast<uint8_t>(1u << e);
+        if (!(mesh.cutEdges[c] & (1u << e)))
+        {
+          continue;
+        }
+        const auto& a = mesh.topology[mesh.corners[c][e]];
+        const auto& b = mesh.topology[mesh.corners[c][(e + 1) % 4]];
+        const std::array<double, 2> across{ double(a[0]) + double(b[0]) - centre[0],
+          double(a[1]) + double(b[1]) - centre[1] };
+        if (!keep(across, int64_t(k)))
+        {
+          cutOpen[c * layers + k] |= static_cast<uint8_t>(1u << e);
+        }
       }
     }
   }
   // Inside the region, from the masked cells; the cut edges keep what the file says of the
-  // cell across, unless that column is out of the range.
+  // cell across, unless that cell goes.
   ComputeOpenSides(mesh);
-  for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+  for (std::size_t n = 0; n < cutOpen.size(); ++n)
   {
-    for (std::size_t k = 0; cutOpen[c] && k < layers; ++k)
-    {
-      mesh.openSides[c * layers + k] |= cutOpen[c];
-    }
+    mesh.openSides[n] |= cutOpen[n];
   }
+}
+
+void MaskToRange(RegionMesh& mesh, const CellRange& range)
+{
+  MaskCells(mesh, [&](const std::array<double, 2>& centre, int64_t k) {
+    return InRangeIJ(range, centre) && k >= range.lo[2] && k <= range.hi[2];
+  });
 }
 
 } // namespace resmr

@@ -282,7 +282,7 @@ void UseOriginalSideFaces(RegionMesh& mesh)
 }
 
 RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
-  const std::array<double, 3>& origin, int handedness, int32_t layer, bool exactSides, const CellRange* range)
+  const std::array<double, 3>& origin, int handedness, int32_t layer, bool exactSides, const CellFilter* filter)
 {
   RegionMesh mesh = file.ReadRegion(region); // not ReadRegionSurfaces: the buffers need positions
   const std::array<float, 4> footprint = RegionFootprint(mesh);
@@ -299,11 +299,33 @@ RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::si
     // of the leaves' top and bottom triangles.
     mesh.sealedPinchThickness = std::numeric_limits<double>::min();
   }
-  if (range)
+  if (filter)
   {
-    MaskToRange(mesh, *range);
+    // A property filter: a leaf it crosses is masked by its cells' values, a coarse region it
+    // crosses by blocks (a stand-in until the leaves come), a region it leaves whole by range.
+    const RangeClass valueClass =
+      filter->HasValues() ? filter->values->Classify(footprint, 1) : RangeClass::Inside;
+    const bool leaf = file.Regions()[region].level >= file.Header().leafLevel;
+    CellBox box;
+    if (valueClass != RangeClass::Inside && leaf)
+    {
+      box = ReadCellBox(mesh, *filter, file.Header().dims);
+    }
+    const bool boxed = !box.tables.empty();
+    if (valueClass == RangeClass::Inside)
+    {
+      MaskToRange(mesh, filter->range);
+    }
+    else
+    {
+      MaskToFilter(mesh, *filter, boxed ? &box : nullptr);
+    }
     UseOriginalSideFaces(mesh);
     RegionDrawBuffers out = PrepareRegionDrawBuffers(mesh, origin, handedness);
+    if (boxed && filter->paintTable >= 0)
+    {
+      out.faceValues = FaceValues(out.vertices, out.indices, box);
+    }
     out.ranged = true;
     out.footprint = footprint;
     out.topCone = mesh.top.cone; // the range's faces, not the region's stored surfaces
@@ -521,16 +543,26 @@ bool RegionCache::SetLayer(int32_t layer)
 
 void RegionCache::SetRange(const CellRange* range)
 {
+  CellFilter filter;
+  if (range)
+  {
+    filter.range = *range;
+  }
+  this->SetFilter(range ? &filter : nullptr);
+}
+
+void RegionCache::SetFilter(const CellFilter* filter)
+{
   {
     std::lock_guard<std::mutex> lock(this->Lock);
     const bool ranged = this->CurrentLayer == this->RangeLayer();
-    if (range && (!ranged || *range != this->CurrentRange))
+    if (filter && (!ranged || *filter != this->CurrentFilter))
     {
-      this->CurrentRange = *range;
+      this->CurrentFilter = *filter;
       ++this->RangeGeneration;
       this->CurrentLayer = -2; // switched below, whatever it was
     }
-    this->SwitchLayerLocked(range ? this->RangeLayer() : this->ChosenLayer);
+    this->SwitchLayerLocked(filter ? this->RangeLayer() : this->ChosenLayer);
   }
   this->Wake.notify_all();
   this->StandbyWake.notify_all();
@@ -1454,7 +1486,7 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, 
   const int32_t layer = this->LayerOf(key);
   const int handedness = this->Handedness;
   const bool ranged = layer == this->RangeLayer();
-  const CellRange range = this->CurrentRange;
+  const CellFilter filter = this->CurrentFilter;
   if (ranged && key != this->KeyOf(region, layer))
   {
     this->Entries[key].failed = true; // an earlier range's: nothing asks for it any more
@@ -1476,7 +1508,7 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, 
     // ReadRegion, not ReadRegionSurfaces: the buffers need the positions.
     const bool simplified = layer == this->SimplifiedLayer();
     buffers = std::make_shared<RegionDrawBuffers>(LoadRegionDrawBuffers(*this->File, region, this->ModelOrigin,
-      handedness, simplified || ranged ? -1 : layer, !simplified, ranged ? &range : nullptr));
+      handedness, simplified || ranged ? -1 : layer, !simplified, ranged ? &filter : nullptr));
   }
   catch (const std::exception& e)
   {

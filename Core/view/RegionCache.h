@@ -54,6 +54,7 @@
 #pragma once
 
 #include "CellRange.h"
+#include "PropertyFilter.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
 
@@ -93,13 +94,19 @@ struct RegionDrawBuffers
   /// coarse side stands for it.
   bool exactSides = true;
   int32_t layer = -1;  ///< the layer drawn (0-based), -1: the whole model
-  bool ranged = false; ///< the cells of a range (CellRange.h), not the whole model
+  bool ranged = false; ///< the cells of a range or filter (CellFilter), not the whole model
+  /// With a property filter, at a leaf it crosses: one value a triangle, the painted table's
+  /// value of the triangle's cell (FaceValues); empty otherwise (painted through the tables).
+  std::vector<float> faceValues;
   /// The region's footprint in (i, j) (RegionFootprint): where a range lies against it.
   std::array<float, 4> footprint{ 0.f, -1.f, 0.f, -1.f };
   /// Normal cones of the top and bottom parts (RegionSurface::cone). A layer's faces are not
   /// the region's stored surfaces, so their culling needs their own cones.
   std::array<float, 4> topCone{ 0.f, 0.f, 1.f, -2.f }, bottomCone{ 0.f, 0.f, 1.f, -2.f };
-  std::size_t Bytes() const { return this->vertices.size() * 4 + this->indices.size() * 4; }
+  std::size_t Bytes() const
+  {
+    return this->vertices.size() * 4 + this->indices.size() * 4 + this->faceValues.size() * 4;
+  }
 };
 
 /// +1 or -1: the sign of the determinant of d(x, y, z) / d(i, j, k) over the model (z up),
@@ -132,12 +139,14 @@ RegionDrawBuffers PrepareLayerDrawBuffers(
 /// What the cache loads for a region: its mesh read and checked, its own side faces, buffers;
 /// of one layer (0-based) when `layer` >= 0. Without `exactSides` (the whole model only) the
 /// region's own side faces are left out when the file has its simplified side: on models of
-/// many layers they are most of a coarse region's bytes. With `range` (and `layer` -1), the
-/// cells in the range alone (MaskToRange), with their exact side faces and no simplified side
-/// (its triangles span every layer).
+/// many layers they are most of a coarse region's bytes. With `filter` (and `layer` -1), the
+/// cells it keeps alone (MaskToFilter), with their exact side faces and no simplified side
+/// (its triangles span every layer); at a leaf its values cross, read for the region's box,
+/// with face values when it paints a table; a coarse region its values cross stands in masked
+/// by blocks (PropertyFilter.h).
 RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
   const std::array<double, 3>& origin, int handedness, int32_t layer = -1, bool exactSides = true,
-  const CellRange* range = nullptr);
+  const CellFilter* filter = nullptr);
 
 /// A run of a region's triangles copied to the GPU as one piece: indices [first, end) and
 /// the vertices [lowVertex, highVertex] they use.
@@ -213,6 +222,8 @@ public:
   /// whole model. A new range makes new buffers; those of an earlier one are evicted first as
   /// nothing requests them. Never blocks on loading.
   void SetRange(const CellRange* range);
+  /// The same for a range with property filters and painted face values (PropertyFilter.h).
+  void SetFilter(const CellFilter* filter);
   bool Ranged() const;
   /// Calls `visit(region, footprint)` for each region resident in the current layer or range
   /// (RegionDrawBuffers::footprint), under the cache's lock: `visit` must not call the cache.
@@ -351,7 +362,7 @@ private:
   uint64_t LayerSlots = 1; ///< nk + 3
   int32_t CurrentLayer = -1;
   int32_t ChosenLayer = -1; ///< SetLayer's, shown again when the range goes
-  CellRange CurrentRange;
+  CellFilter CurrentFilter;
   Key RangeGeneration = 0;
   /// Makes `layer` the one Get and Request deal in (SetLayer, SetRange). Lock held.
   void SwitchLayerLocked(int32_t layer);

@@ -6,7 +6,8 @@
 // coordinate crosses an integer, drawn a fixed width in pixels and faded out where cells
 // shrink below a few pixels. In the single-layer view (layer >= 0) the property comes from
 // that layer's 2D table, indexed by (i, j) without the hash; the cells an I/J/K range's cuts
-// expose (inside the model, not in the hash) from the planes of cells along each cut.
+// expose (inside the model, not in the hash) from the planes of cells along each cut; the
+// faces a property filter exposes from the values their region's triangles carry.
 //
 // Lit as VTK lights its surfaces (ours: the renderer's lights and the actor's material, so
 // the surface looks as ParaView's Surface of the full grid): a property's colour is both the
@@ -38,6 +39,9 @@ uniform sampler2D cutLowK;  // nx x ny, R32F: the values of the range's K low pl
 uniform sampler2D cutHighK; // nx x ny, R32F: of its K high plane
 uniform sampler2D cutSides; // max(nx, ny) x 4 nz, R32F: of its I low, I high, J low, J high planes
 uniform int cutReady;       // bit p: plane p (K low, K high, I low, ..., J high) is loaded
+uniform int faceValuesOn;   // 1: the region's faces carry their cells' values (a property filter)
+uniform samplerBuffer faceValues; // one value a triangle of the region
+uniform int primitiveBase;  // the region's triangle number of this draw's first
 uniform ivec3 tableSides; // m
 uniform ivec3 offsetSides; // r
 uniform usampler3D hashOffsets;  // r0 x r1 x r2, RGB16UI
@@ -346,6 +350,11 @@ void main()
     int plane = CutPlane(cell);
     bool waiting = plane >= 0 && (cutReady / (1 << max(plane, 0))) % 2 == 0;
     value = plane >= 0 ? CutValue(plane, cell) : value;
+    if (faceValuesOn == 1)
+    {
+      value = texelFetch(faceValues, primitiveBase + gl_PrimitiveID).r;
+      waiting = false;
+    }
 #endif
     if (waiting || isnan(value))
     {

@@ -292,25 +292,40 @@ void PropertyFields(const Bytes& valid, const std::string& validPath, const std:
   }
   const uint32_t tables = Load<uint32_t>(valid, PTables);
   const uint64_t index = IndexAt(valid);
-  const std::size_t table = 56 + 20 * 3; // nz = 2: the packed table and two layers
+  const std::size_t table = 56 + 20 * 4; // nz = 2: the packed table, block ranges, two layers
   const auto setTable = [&](std::size_t t, std::size_t field, auto value) -> Change {
     return [=](Bytes& f) { Store(f, static_cast<std::size_t>(index + t * table + field), value); };
   };
-  ExpectPropertiesRefused("version 4", valid, "format version 4", Set<uint32_t>(PVersion, 4));
+  ExpectPropertiesRefused("version 5", valid, "format version 5", Set<uint32_t>(PVersion, 5));
   ExpectPropertiesRefused("version 1", valid, "format version 1", Set<uint32_t>(PVersion, 1));
   ExpectPropertiesRefused("band rows 0", valid, "'rows a band' is 0", Set<uint32_t>(PBandRows, 0));
   ExpectPropertiesRefused("band rows ny + 1", valid, "'rows a band'",
     [](Bytes& f) { Store<uint32_t>(f, PBandRows, static_cast<uint32_t>(Load<int64_t>(f, PDims + 8) + 1)); });
   {
     // A version 2 file (a chunk a layer, no band rows) reads as one band a layer.
+    // Its index has no block ranges: each table's reference to them taken out.
     const std::string old = Temp + "/version2.resmrp";
-    Spill(old, Changed(valid, resmr_fuzz::ResmrpLayout(), [](Bytes& f) {
+    Spill(old, Changed(valid, resmr_fuzz::ResmrpLayout(), [&](Bytes& f) {
       Store<uint32_t>(f, PVersion, 2);
       Store<uint32_t>(f, PBandRows, 0);
+      const uint64_t at = IndexAt(f);
+      std::vector<uint8_t> index;
+      for (uint32_t t = 0; t < tables; ++t)
+      {
+        const auto record = f.begin() + static_cast<std::ptrdiff_t>(at + t * table);
+        index.insert(index.end(), record, record + 76);
+        index.insert(index.end(), record + 96, record + static_cast<std::ptrdiff_t>(table));
+      }
+      f.resize(static_cast<std::size_t>(at));
+      f.insert(f.end(), index.begin(), index.end());
+      const char magic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'I', 'X' };
+      const auto trailer = IndexTrailer(at, index, magic);
+      f.insert(f.end(), trailer.begin(), trailer.end());
     }));
     const PropertyFile now(validPath), before(old);
     CHECK(before.Bands() == 1 && now.Bands() == 1 && before.BandRows() == now.BandRows());
     CHECK(before.Tables().size() == now.Tables().size());
+    CHECK(!before.HasBlockRanges() && before.ReadBlockRanges(0).empty() && now.ReadBlockRanges(0).size() == 2);
     for (std::size_t t = 0; t < now.Tables().size(); ++t)
     {
       const auto a = now.ReadLayer(t, 1), b = before.ReadLayer(t, 1);
@@ -366,8 +381,9 @@ void PropertyFields(const Bytes& valid, const std::string& validPath, const std:
   });
   ExpectPropertiesRefused("range half NaN", valid, "value range", setTable(1, 48, NAN));
   ExpectPropertiesRefused("packed raw", valid, "packed table of", setTable(0, 56 + 12, uint32_t(12)));
-  ExpectPropertiesRefused("layer raw", valid, "layer 2 of", setTable(0, 56 + 40 + 12, uint32_t(8)));
-  ExpectPropertiesRefused("layer offset", valid, "layer 1 at byte", setTable(0, 56 + 20, uint64_t(1) << 40));
+  ExpectPropertiesRefused("blocks raw", valid, "block ranges at byte", setTable(0, 56 + 20 + 12, uint32_t(8)));
+  ExpectPropertiesRefused("layer raw", valid, "layer 2 of", setTable(0, 56 + 60 + 12, uint32_t(8)));
+  ExpectPropertiesRefused("layer offset", valid, "layer 1 at byte", setTable(0, 56 + 40, uint64_t(1) << 40));
   ExpectPropertiesRefused("duplicate table", valid, "a second table", [&](Bytes& f) {
     std::memcpy(&f[static_cast<std::size_t>(index + table)], &f[static_cast<std::size_t>(index)], 48);
   });

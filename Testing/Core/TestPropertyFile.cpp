@@ -199,6 +199,39 @@ int CheckTables(const MultiresolutionFile& geometry, const PropertyFile& propert
         wrong += !SameValue(plane[std::size_t(n)], expected[std::size_t(k * layer + j * dims[0] + i)]);
       }
     }
+    // Block ranges (a property filter's): each block's bounds are its active cells' values
+    // over all layers, brute force; -infinity low where an active cell has no value.
+    const std::vector<ValueRange> blocks = properties.ReadBlockRanges(t);
+    const auto counts = properties.BlockCounts();
+    CHECK(blocks.size() == std::size_t(counts[0] * counts[1]));
+    std::vector<ValueRange> want(blocks.size(),
+      ValueRange{ std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity() });
+    for (int64_t n = 0; n < layer * dims[2]; ++n)
+    {
+      if (!grid.IsActive(n))
+      {
+        continue;
+      }
+      const int64_t i = n % dims[0], j = n / dims[0] % dims[1];
+      ValueRange& b = want[std::size_t(i / ColumnBlockSide + counts[0] * (j / ColumnBlockSide))];
+      const float v = expected[std::size_t(n)];
+      b.low = std::isnan(v) ? -std::numeric_limits<float>::infinity() : std::min(b.low, v);
+      b.high = std::isnan(v) ? b.high : std::max(b.high, v);
+    }
+    for (std::size_t b = 0; b < blocks.size() && b < want.size(); ++b)
+    {
+      wrong += blocks[b].low != want[b].low || blocks[b].high != want[b].high;
+    }
+    // A box of cells (a filtered leaf's): every value where the layers put it.
+    const std::array<int64_t, 3> lo{ dims[0] / 3, dims[1] / 4, 0 }, hi{ dims[0] - 1, dims[1] * 3 / 4, dims[2] - 1 };
+    const std::vector<float> box = properties.ReadBox(t, lo, hi);
+    CHECK(box.size() == std::size_t((hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1)));
+    for (std::size_t n = 0; n < box.size(); ++n)
+    {
+      const int64_t w = hi[0] - lo[0] + 1, h = hi[1] - lo[1] + 1;
+      const int64_t i = lo[0] + int64_t(n) % w, j = lo[1] + int64_t(n) / w % h, k = lo[2] + int64_t(n) / (w * h);
+      wrong += !SameValue(box[n], expected[std::size_t(k * layer + j * dims[0] + i)]);
+    }
     if (wrong)
     {
       std::fprintf(

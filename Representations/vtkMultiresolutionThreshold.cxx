@@ -1,0 +1,67 @@
+#include "vtkMultiresolutionThreshold.h"
+
+#include "vtkDataArray.h"
+#include "vtkDataSetAttributes.h"
+#include "vtkFieldData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkObjectFactory.h"
+#include "vtkPolyData.h"
+#include "vtkStringArray.h"
+
+#include <cstdio>
+#include <string>
+
+vtkStandardNewMacro(vtkMultiresolutionThreshold);
+
+vtkMultiresolutionThreshold::vtkMultiresolutionThreshold()
+{
+  this->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_CELLS, vtkDataSetAttributes::SCALARS);
+}
+
+vtkMultiresolutionThreshold::~vtkMultiresolutionThreshold() = default;
+
+int vtkMultiresolutionThreshold::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
+  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
+  if (!input || !output)
+  {
+    return 0;
+  }
+  output->ShallowCopy(input);
+  // The descriptor's cell arrays are the property file's (two cells: the step's range).
+  vtkDataArray* array = this->GetInputArrayToProcess(0, inputVector);
+  const char* name = array ? array->GetName() : nullptr;
+  vtkStringArray* upstream =
+    vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray(FilterArrayName()));
+  std::string lines = upstream && upstream->GetNumberOfValues() == 1 ? upstream->GetValue(0) : std::string();
+  if (name && *name)
+  {
+    char bounds[64];
+    // %.9g: a float's value survives the text exactly.
+    std::snprintf(bounds, sizeof(bounds), "%.9g %.9g ", this->LowerThreshold, this->UpperThreshold);
+    lines += bounds + std::string(name) + "\n";
+  }
+  else
+  {
+    vtkWarningMacro(<< "no array to filter by: the model shows unfiltered");
+  }
+  vtkNew<vtkStringArray> filters;
+  filters->SetName(FilterArrayName());
+  filters->InsertNextValue(lines);
+  vtkNew<vtkFieldData> fields;
+  fields->ShallowCopy(input->GetFieldData()); // the input's own field data stays unchanged
+  fields->RemoveArray(FilterArrayName());
+  fields->AddArray(filters);
+  output->SetFieldData(fields);
+  return 1;
+}
+
+void vtkMultiresolutionThreshold::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "LowerThreshold: " << this->LowerThreshold << "\n";
+  os << indent << "UpperThreshold: " << this->UpperThreshold << "\n";
+}
