@@ -49,8 +49,8 @@ std::string vtkSMMultiresolutionReaderProxy::StockFilterWarning(const char* xmlN
       return std::string(filter[1]) + " on " + file +
         " acts on the multiresolution descriptor's 8 corner points, not on the model's cells: use "
         "Filters > Multiresolution > Multiresolution Extract Subset (MultiresolutionExtractSubset in pvpython) "
-        "for I, J, K boxes and slices of the model; a property threshold needs the full grid "
-        "(EGRIDReader or GRDECLReader).";
+        "for I, J, K boxes and slices of the model, and Multiresolution Threshold "
+        "(MultiresolutionThreshold) to keep the cells whose property value lies in a range.";
     }
   }
   return std::string();

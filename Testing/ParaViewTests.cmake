@@ -145,3 +145,5 @@ set_property(TEST Multiresolution.Pick APPEND PROPERTY ENVIRONMENT "RESMR_EXECUT
 # on I, J, K and ACTNUM of the full grid, pixel by pixel; coarse tolerances stay in range.
 resmr_add_pvpython_test(Multiresolution.Range TestMultiresolutionRange.py)
 set_property(TEST Multiresolution.Range APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
+resmr_add_pvpython_test(Multiresolution.Threshold TestMultiresolutionThreshold.py)
+set_property(TEST Multiresolution.Threshold APPEND PROPERTY ENVIRONMENT "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>")
