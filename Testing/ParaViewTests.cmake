@@ -132,11 +132,11 @@ resmr_add_pvpython_test(Multiresolution.GUIGoTo TestMultiresolutionGUIGoTo.py)
 set_property(TEST Multiresolution.GUIGoTo APPEND PROPERTY ENVIRONMENT
   "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>" "PARAVIEW_EXECUTABLE=${PARAVIEW_EXECUTABLE}")
 set_property(TEST Multiresolution.GUIGoTo PROPERTY SKIP_RETURN_CODE 125)
-# Multiresolution Extract Subset set through the Properties panel, by ParaView's test playback.
-resmr_add_pvpython_test(Multiresolution.GUIRange TestMultiresolutionGUIRange.py)
-set_property(TEST Multiresolution.GUIRange APPEND PROPERTY ENVIRONMENT
+# Multiresolution Extract Subset and Threshold set through the Properties panel, by ParaView's test playback.
+resmr_add_pvpython_test(Multiresolution.GUIFilters TestMultiresolutionGUIFilters.py)
+set_property(TEST Multiresolution.GUIFilters APPEND PROPERTY ENVIRONMENT
   "RESMR_EXECUTABLE=$<TARGET_FILE:resmr>" "PARAVIEW_EXECUTABLE=${PARAVIEW_EXECUTABLE}")
-set_property(TEST Multiresolution.GUIRange PROPERTY SKIP_RETURN_CODE 125)
+set_property(TEST Multiresolution.GUIFilters PROPERTY SKIP_RETURN_CODE 125)
 
 # Picking a cell: the frame's own cell at any level, stock's at 0 px, EGRIDReader's values and corners.
 resmr_add_pvpython_test(Multiresolution.Pick TestMultiresolutionPick.py)
