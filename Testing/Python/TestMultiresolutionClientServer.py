@@ -9,7 +9,9 @@ the model's (0 to nk = 8). Picks (resmr_inspect.PickCell) at 12 covered pixels n
 cells and PORO values through pvserver as builtin, each the cell the image shows there.
 Multiresolution Extract Subset through pvserver: its VOI sliders are the model's dimensions
 (from the server's reader), and a box drawn on the server gives builtin's image (>= 99.9% of the
-pixels name the same cell, every one in the box), its range in the server's log."""
+pixels name the same cell, every one in the box), its range in the server's log. Multiresolution
+Threshold on the box (PORO 0.15 to 0.25) through pvserver gives builtin's image (>= 99.9%), fewer
+pixels than the box alone, the filter in the server's log."""
 import re
 import os
 import socket
@@ -37,6 +39,7 @@ if not os.path.exists(path + "p"):
     subprocess.run([resmr, "add-properties", path, grid], check=True, capture_output=True)
 PICKED = []  # display pixels picked in both modes: the builtin image's covered pixels
 BOX = [11, 40, 16, 35, 3, 6]  # I, J, K from 1, of the 60 x 50 x 8 model
+PORO = (0.15, 0.25)  # the Multiresolution Threshold on the box
 
 
 def picks(view, display):
@@ -99,10 +102,26 @@ def render(name):
     box_image = os.path.join(temp, name + "-box.png")
     simple.SaveScreenshot(box_image, view, ImageResolution=[480, 360], TransparentBackground=0)
     error = error or readout(boxed)["LastError"]
+    # The box filtered by PORO, drawn where the property file is.
+    threshold = simple.MultiresolutionThreshold(Input=subset)
+    threshold.Scalars = ["CELLS", "PORO"]
+    threshold.LowerThreshold, threshold.UpperThreshold = PORO
+    filtered = simple.Show(threshold, view)
+    simple.Hide(subset, view)
+    filtered.PaintBy = "Cell Id"
+    filtered.GridLines = 0
+    filtered.PixelTolerance = 0
+    filtered.WaitForDetailMs = 60000
+    simple.Render(view)
+    filter_image = os.path.join(temp, name + "-poro.png")
+    simple.SaveScreenshot(filter_image, view, ImageResolution=[480, 360], TransparentBackground=0)
+    error = error or readout(filtered)["LastError"]
+    simple.Delete(threshold)
     simple.Delete(subset)
     simple.Delete(reader)
     simple.Delete(view)
-    return cell_id_pixels(image), readouts, error, picked, (cell_id_pixels(box_image), sliders)
+    return (cell_id_pixels(image), readouts, error, picked, (cell_id_pixels(box_image), sliders),
+            cell_id_pixels(filter_image))
 
 
 def cell_id_pixels(image):
@@ -122,7 +141,7 @@ def readout(display):
 
 
 simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
-builtin, builtin_readouts, _, builtin_picks, builtin_box = render("builtin")
+builtin, builtin_readouts, _, builtin_picks, builtin_box, builtin_poro = render("builtin")
 builtin_triangles = builtin_readouts[0]["TrianglesDrawn"]
 print(f"builtin: {int(np.sum(builtin > 0))} pixels covered, {builtin_triangles:.0f} triangles")
 
@@ -152,7 +171,7 @@ try:
     simple.Connect("localhost", port)
     simple.LoadPlugin(args.plugin, remote=True, ns=vars(simple))
     simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
-    remote, remote_readouts, error, remote_picks, remote_box = render("server")
+    remote, remote_readouts, error, remote_picks, remote_box, remote_poro = render("server")
     simple.Disconnect()
 finally:
     server.terminate()
@@ -218,4 +237,13 @@ print(f"box through pvserver: sliders {sliders}; {100 * share:.2f}% of {int(both
       f"as builtin, {outside} out of the box; range logged by the server {len(shown)} time(s)")
 if sliders != [1, 60, 1, 60, 1, 50, 1, 50, 1, 8, 1, 8] or share < 0.999 or both.sum() < 2000 or outside or not shown:
     rt.fail("Multiresolution Extract Subset through pvserver differs from builtin")
+# The box filtered by PORO: the same image through pvserver, the filter in the server's log.
+both = (builtin_poro > 0) & (remote_poro > 0)
+share = float(np.mean(builtin_poro[both] == remote_poro[both])) if both.any() else 0.0
+shown = [line for line in server_lines() if "K 3-6, PORO 0.150000 to 0.250000" in line]
+print(f"PORO filter through pvserver: {100 * share:.2f}% of {int(both.sum())} pixels name the same cell as builtin "
+      f"({int(np.sum(builtin_poro > 0))} builtin, {int(np.sum(box_builtin > 0))} in the box unfiltered); "
+      f"logged by the server {len(shown)} time(s)")
+if share < 0.999 or both.sum() < 1000 or not shown or np.sum(builtin_poro > 0) >= np.sum(box_builtin > 0):
+    rt.fail("Multiresolution Threshold through pvserver differs from builtin")
 print("Multiresolution Surface renders through pvserver; its readout is the server's")
