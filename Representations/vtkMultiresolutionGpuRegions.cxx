@@ -301,13 +301,12 @@ std::size_t vtkMultiresolutionGpuRegions::Draw(std::size_t region, const std::ve
   const std::size_t faceBytes = gpu.UploadFaceValues(window);
   gpu.Bytes += faceBytes;
   this->GpuBytes += faceBytes;
-  vtkTextureObject* faces = gpu.FaceTexture;
-  if (faces)
-  {
-    faces->Activate();
-    program->SetUniformi("faceValues", faces->GetTextureUnit());
-  }
-  program->SetUniformi("faceValuesOn", faces ? 1 : 0);
+  // The sampler always names a buffer texture: left on a unit that holds a texture of another
+  // kind, it makes every draw an invalid operation.
+  vtkTextureObject* faces = gpu.FaceTexture ? gpu.FaceTexture.Get() : this->NoFaceValues(window);
+  faces->Activate();
+  program->SetUniformi("faceValues", faces->GetTextureUnit());
+  program->SetUniformi("faceValuesOn", gpu.FaceTexture ? 1 : 0);
   std::size_t triangles = 0;
   for (const auto& piece : gpu.Pieces)
   {
@@ -339,15 +338,31 @@ std::size_t vtkMultiresolutionGpuRegions::Draw(std::size_t region, const std::ve
     piece->indices->Release();
     piece->layout->Release();
   }
-  if (faces)
-  {
-    faces->Deactivate();
-  }
+  faces->Deactivate();
   return triangles;
+}
+
+vtkTextureObject* vtkMultiresolutionGpuRegions::NoFaceValues(vtkOpenGLRenderWindow* window)
+{
+  if (!this->EmptyFaceTexture)
+  {
+    const std::vector<float> one{ 0.f };
+    this->EmptyFaceBuffer->Upload(one, vtkOpenGLBufferObject::TextureBuffer);
+    this->EmptyFaceTexture = vtkSmartPointer<vtkTextureObject>::New();
+    this->EmptyFaceTexture->SetContext(window);
+    this->EmptyFaceTexture->CreateTextureBuffer(1, 1, VTK_FLOAT, this->EmptyFaceBuffer);
+  }
+  return this->EmptyFaceTexture;
 }
 
 void vtkMultiresolutionGpuRegions::ReleaseGraphicsResources()
 {
+  if (this->EmptyFaceTexture)
+  {
+    this->EmptyFaceTexture->ReleaseGraphicsResources(this->EmptyFaceTexture->GetContext());
+    this->EmptyFaceTexture = nullptr;
+  }
+  this->EmptyFaceBuffer->ReleaseGraphicsResources();
   for (auto& entry : this->Regions)
   {
     entry.second->Release();

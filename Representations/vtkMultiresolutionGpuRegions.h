@@ -9,6 +9,11 @@
 
 #include "Residency.h"
 
+#include "vtkNew.h"
+#include "vtkOpenGLBufferObject.h"
+#include "vtkSmartPointer.h"
+#include "vtkTextureObject.h"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -17,6 +22,7 @@
 #include <vector>
 
 class vtkOpenGLRenderWindow;
+class vtkTextureObject;
 class vtkShaderProgram;
 
 namespace resmr
@@ -78,11 +84,16 @@ private:
   void ReleaseUnwanted(
     const std::vector<std::size_t>& order, std::size_t position, RegionMap::iterator entry, std::size_t gpuShare);
 
+  /// A one-value buffer texture for the regions without face values (see Draw).
+  vtkTextureObject* NoFaceValues(vtkOpenGLRenderWindow* window);
+
   RegionMap Regions;
   std::size_t GpuBytes = 0;
   std::vector<uint32_t> IndexScratch; ///< a piece's rebased indices, kept from piece to piece
   std::vector<std::size_t> Boxed;     ///< regions holding chunk boxes, picked longest ago first
   std::size_t BoxBytes = 0;
+  vtkNew<vtkOpenGLBufferObject> EmptyFaceBuffer;
+  vtkSmartPointer<vtkTextureObject> EmptyFaceTexture;
 };
 
 #endif

@@ -9,7 +9,9 @@
   frame as a PNG and the frame times, tolerances and memory to OUTPUT_DIR/flythrough.txt,
   then cuts the model open with Multiresolution Extract Subset (the cells with I up to three
   fifths of NI and K from the second layer down, exact at 0 px) and shows the water saturation
-  of the last report step on the cut: OUTPUT_DIR/*_range_swat.png.
+  of the last report step on the cut: OUTPUT_DIR/*_range_swat.png; then keeps, with
+  Multiresolution Threshold, only the cells the water has swept at the last step (SWAT of 0.5
+  and more), the water front: OUTPUT_DIR/*_waterfront.png.
 """
 import math
 import os
@@ -120,6 +122,7 @@ def flythrough(plugin, path, output):
         out.write("# " + summary + "\n" + "\n".join(lines) + "\n")
     print(summary)
     range_view(reader, display, view, os.path.join(output, f"{prefix}_range_swat.png"))
+    water_front(reader, view, os.path.join(output, f"{prefix}_waterfront.png"))
 
 
 def range_view(reader, display, view, screenshot):
@@ -156,6 +159,33 @@ def range_view(reader, display, view, screenshot):
     simple.Render(view)
     simple.SaveScreenshot(screenshot, view, ImageResolution=[1280, 720])
     print(f"demo: the model cut open at I = {3 * ni // 5} and below K = 1, SWAT at day {times[-1]:g}: {screenshot}")
+
+
+def water_front(reader, view, screenshot):
+    """The cells swept by water at the last step (SWAT >= 0.5), coloured by SWAT: the front."""
+    for source in simple.GetSources().values():
+        simple.Hide(source, view)
+    swept = simple.MultiresolutionThreshold(Input=reader)
+    swept.Scalars = ["CELLS", "SWAT"]
+    swept.LowerThreshold, swept.UpperThreshold = 0.5, 1.0
+    front = simple.Show(swept, view)
+    front.Scale = [1, 1, VERTICAL_EXAGGERATION]
+    front.GridLines = 1
+    front.PixelTolerance = 1
+    front.WaitForDetailMs = 120000
+    simple.ColorBy(front, ("CELLS", "SWAT"))
+    front.SetScalarBarVisibility(view, True)
+    bounds = reader.GetDataInformation().GetBounds()
+    cx, cy = (bounds[0] + bounds[1]) / 2, (bounds[2] + bounds[3]) / 2
+    cz = VERTICAL_EXAGGERATION * (bounds[4] + bounds[5]) / 2
+    size = max(bounds[1] - bounds[0], bounds[3] - bounds[2])
+    camera = view.GetActiveCamera()
+    camera.SetFocalPoint(cx, cy, cz)
+    camera.SetPosition(cx + 0.45 * size, cy - 1.0 * size, cz + 0.75 * size)
+    camera.SetViewUp(0, 0, 1)
+    simple.Render(view)
+    simple.SaveScreenshot(screenshot, view, ImageResolution=[1280, 720])
+    print(f"demo: the cells with SWAT from 0.5 to 1 at the last step (the water front): {screenshot}")
 
 
 if len(sys.argv) >= 4:
