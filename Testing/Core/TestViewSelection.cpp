@@ -32,6 +32,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <memory>
@@ -2008,6 +2009,108 @@ void TestRanges(const Model& model)
   }
 }
 
+/// Property filters (PropertyFilter.h) on the synthetic model with its properties: each
+/// region's class from the block ranges holds against its cells' values (Outside: no active
+/// cell of its footprint, widened by one, passes; Inside: every one does); at every leaf, every
+/// triangle of the filtered buffers belongs to an active cell that passes and carries that
+/// cell's value, and every passing cell beside an active cell of its leaf the filter removes
+/// (one step in I, J or K) shows a face.
+void TestValueFilters(const Model& model)
+{
+  const std::string properties = Temp + "/synth.resmrp";
+  std::remove(properties.c_str());
+  CHECK(Run(Tool + " add-properties '" + model.path + "' synth:96x80x10:5:1 -o '" + properties + "' > /dev/null 2>&1") == 0);
+  const auto file = std::make_shared<const PropertyFile>(properties);
+  const auto& header = model.file->Header();
+  const std::array<int64_t, 3> dims{ header.dims[0], header.dims[1], header.dims[2] };
+  const std::vector<float> all = file->ReadBox(static_cast<std::size_t>(FindFilterTable(*file, "PORO", 0)),
+    { 0, 0, 0 }, { dims[0] - 1, dims[1] - 1, dims[2] - 1 });
+  const auto value = [&](int64_t i, int64_t j, int64_t k) {
+    return all[static_cast<std::size_t>(i + dims[0] * (j + dims[1] * k))];
+  };
+  const std::vector<std::array<float, 4>> footprints = model.file->ReadFootprints();
+  const int handedness = TopologyHandedness(*model.file);
+  std::size_t crossedLeaves = 0, triangles = 0, exposed = 0;
+  for (const std::array<float, 2> quantiles : { std::array<float, 2>{ 0.5f, 1.f }, { 0.2f, 0.4f } })
+  {
+    std::vector<float> sorted;
+    std::copy_if(all.begin(), all.end(), std::back_inserter(sorted), [](float v) { return !std::isnan(v); });
+    std::sort(sorted.begin(), sorted.end());
+    const ValueFilter filter{ "PORO", sorted[std::size_t(quantiles[0] * float(sorted.size() - 1))],
+      sorted[std::size_t(quantiles[1] * float(sorted.size() - 1))] };
+    CellFilter cells;
+    cells.range.hi = { dims[0] - 1, dims[1] - 1, dims[2] - 1 };
+    cells.values = std::make_shared<ValueFilterSet>(file, std::vector<ValueFilter>{ filter }, 0);
+    cells.paintTable = FindFilterTable(*file, "PORO", 0);
+    for (std::size_t r = 0; r < model.file->Regions().size(); ++r)
+    {
+      const RangeClass c = cells.values->Classify(footprints[r], 1);
+      const auto& f = footprints[r];
+      bool any = false, every = true;
+      for (int64_t k = 0; k < dims[2]; ++k)
+        for (int64_t j = std::max<int64_t>(0, int64_t(f[2]) - 1); j < std::min<int64_t>(dims[1], int64_t(std::ceil(f[3])) + 1); ++j)
+          for (int64_t i = std::max<int64_t>(0, int64_t(f[0]) - 1); i < std::min<int64_t>(dims[0], int64_t(std::ceil(f[1])) + 1); ++i)
+          {
+            const float v = value(i, j, k);
+            if (std::isnan(v))
+              continue;
+            any = any || filter.Passes(v);
+            every = every && filter.Passes(v);
+          }
+      CHECK(c != RangeClass::Outside || !any);
+      CHECK(c != RangeClass::Inside || every);
+    }
+    for (const std::size_t leaf : model.Leaves())
+    {
+      if (cells.values->Classify(footprints[leaf], 1) != RangeClass::Crossed)
+        continue;
+      ++crossedLeaves;
+      const RegionDrawBuffers buffers = LoadRegionDrawBuffers(*model.file, leaf, { 0, 0, 0 }, handedness, -1, true, &cells);
+      CHECK(buffers.faceValues.size() == buffers.indices.size() / 3);
+      std::set<std::array<int64_t, 3>> shown;
+      for (std::size_t t = 0; t < buffers.indices.size() / 3 && t < buffers.faceValues.size(); ++t)
+      {
+        std::array<double, 3> centroid{ 0, 0, 0 };
+        for (int v = 0; v < 3; ++v)
+          for (int a = 0; a < 3; ++a)
+            centroid[a] += buffers.vertices[std::size_t(buffers.indices[3 * t + v]) * 6 + 3 + a] / 3.0;
+        const std::array<int64_t, 3> cell{ int64_t(std::floor(centroid[0])), int64_t(std::floor(centroid[1])),
+          int64_t(std::floor(centroid[2])) };
+        const float v = value(cell[0], cell[1], cell[2]);
+        CHECK(filter.Passes(v));
+        CHECK(v == buffers.faceValues[t]);
+        shown.insert(cell);
+        ++triangles;
+      }
+      // Passing cells beside a removed active cell of this leaf show a face.
+      const RegionMesh mesh = model.file->ReadRegion(leaf);
+      std::set<std::array<int64_t, 3>> active;
+      for (std::size_t c = 0; c < mesh.corners.size(); ++c)
+        for (int64_t k = 0; k < dims[2]; ++k)
+          if (mesh.active[c * std::size_t(dims[2]) + std::size_t(k)])
+            active.insert({ int64_t(mesh.ColumnCell(c)[0]), int64_t(mesh.ColumnCell(c)[1]), k });
+      for (const auto& cell : active)
+      {
+        if (!filter.Passes(value(cell[0], cell[1], cell[2])))
+          continue;
+        bool besideRemoved = false;
+        for (int a = 0; a < 3 && !besideRemoved; ++a)
+          for (int d = -1; d <= 1 && !besideRemoved; d += 2)
+          {
+            auto other = cell;
+            other[a] += d;
+            besideRemoved = active.count(other) && !filter.Passes(value(other[0], other[1], other[2]));
+          }
+        exposed += besideRemoved;
+        CHECK(!besideRemoved || shown.count(cell));
+      }
+    }
+  }
+  std::printf("  value filters: %zu crossed leaves, %zu triangles, %zu cells beside removed ones shown\n", crossedLeaves,
+    triangles, exposed);
+  CHECK(crossedLeaves > 0 && exposed > 0);
+}
+
 int main(int argc, char** argv)
 {
   if (argc < 4)
@@ -2045,6 +2148,7 @@ int main(int argc, char** argv)
         for (const auto& m : models)
           TestRanges(*m);
       } },
+    { "ValueFilters", [&] { TestValueFilters(*models[2]); } },
     { "ToleranceInterval",
       [&] {
         for (const auto& m : models)
