@@ -155,6 +155,9 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   /// The property filters drawn last, resolved against the property file (their block ranges
   /// read once a filter and step); null: none.
   std::shared_ptr<const resmr::ValueFilterSet> ValueFilters;
+  /// The painted table's layer blocks (faces of coarse filtered regions), and which table.
+  std::shared_ptr<const std::vector<resmr::BlockSummary>> PaintBlocks;
+  int PaintBlocksTable = -1;
   std::string Reported;     ///< the last error sent to vtkErrorMacro (each failure once)
   bool WallsWarned = false; ///< a damaged wall depth table was reported
 
@@ -488,15 +491,13 @@ bool ParseFilters(const std::string& text, std::vector<resmr::ValueFilter>& filt
   return true;
 }
 
-/// Where a region lies against a range and property filters together.
+/// Where a region lies against a range and property filters together, for the selection: the
+/// filters remove what they leave nothing of; a region they cross splits by its filter error
+/// (ViewSelector::SetFilterErrors), not down to the leaves as one a range's side crosses.
 resmr::RangeClass Combine(resmr::RangeClass range, resmr::RangeClass values)
 {
   using C = resmr::RangeClass;
-  if (range == C::Unknown || range == C::Outside || values == C::Outside)
-  {
-    return range == C::Unknown ? C::Unknown : C::Outside;
-  }
-  return range == C::Inside && values == C::Inside ? C::Inside : C::Crossed;
+  return range != C::Unknown && values == C::Outside ? C::Outside : range;
 }
 
 /// A range "I0 I1 J0 J1 K0 K1" (ECLIPSE's, from 1, inclusive) as a 0-based CellRange.
@@ -773,6 +774,14 @@ bool vtkMultiresolutionSurfaceMapper::SelectRange(Frame& frame)
     filter.paintTable = this->ColorMode == PropertyColors && this->ArrayName
       ? resmr::FindFilterTable(*in.Properties, this->ArrayName, frame.step)
       : -1;
+    if (filter.paintTable != in.PaintBlocksTable)
+    {
+      in.PaintBlocksTable = filter.paintTable;
+      in.PaintBlocks = filter.paintTable < 0 ? nullptr
+                                             : std::make_shared<const std::vector<resmr::BlockSummary>>(
+                                                 in.Properties->ReadLayerBlocks(std::size_t(filter.paintTable)));
+    }
+    filter.paintBlocks = in.PaintBlocks;
   }
   in.Cache->SetFilter(frame.ranged ? &filter : nullptr);
   std::string shown = frame.ranged ? frame.range.Describe() : std::string("the whole grid");
@@ -788,8 +797,10 @@ bool vtkMultiresolutionSurfaceMapper::SelectRange(Frame& frame)
   if (!frame.ranged)
   {
     in.Selector->SetRangeClassifier({});
+    in.Selector->SetFilterErrors({});
     return true;
   }
+  this->SetFilterErrors(frame, filtered ? in.ValueFilters : nullptr);
   // Where the range lies against a region is known once the region was decoded (its
   // footprint comes with its buffers); ancestors are decoded before their children.
   resmr::RegionCache* cache = in.Cache.get();
@@ -820,6 +831,47 @@ bool vtkMultiresolutionSurfaceMapper::SelectRange(Frame& frame)
     });
   });
   return true;
+}
+
+void vtkMultiresolutionSurfaceMapper::SetFilterErrors(
+  Frame&, const std::shared_ptr<const resmr::ValueFilterSet>& values)
+{
+  Internals& in = *this->Internal;
+  if (!values)
+  {
+    in.Selector->SetFilterErrors({});
+    return;
+  }
+  // Coarse regions a filter crosses: the width its masking by layer blocks may widen the cells
+  // drawn by. Leaves are exact.
+  const resmr::MultiresolutionFile* file = in.File.get();
+  const auto widen = [file, values](std::size_t region, const std::array<float, 4>& footprint, float& width) {
+    const resmr::RegionRecord& record = file->Regions()[region];
+    if (record.level < file->Header().leafLevel && values->Classify(footprint, 1) == resmr::RangeClass::Crossed)
+    {
+      width = resmr::FilterError(record, footprint);
+    }
+  };
+  if (!in.Footprints.empty())
+  {
+    const std::vector<std::array<float, 4>>* footprints = &in.Footprints;
+    in.Selector->SetFilterErrors([footprints, widen](std::vector<float>& widths) {
+      for (std::size_t r = 0; r < widths.size() && r < footprints->size(); ++r)
+      {
+        widen(r, (*footprints)[r], widths[r]);
+      }
+    });
+    return;
+  }
+  resmr::RegionCache* cache = in.Cache.get();
+  in.Selector->SetFilterErrors([cache, widen](std::vector<float>& widths) {
+    cache->VisitFootprints([&](std::size_t region, const std::array<float, 4>& footprint) {
+      if (region < widths.size())
+      {
+        widen(region, footprint, widths[region]);
+      }
+    });
+  });
 }
 
 bool vtkMultiresolutionSurfaceMapper::SelectFilters(Frame& frame)

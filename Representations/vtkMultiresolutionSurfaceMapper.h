@@ -28,6 +28,10 @@
 #include <string>
 
 class vtkShaderProgram;
+namespace resmr
+{
+class ValueFilterSet;
+}
 
 class RESMRREPRESENTATIONS_EXPORT vtkMultiresolutionSurfaceMapper : public vtkMapper
 {
@@ -220,6 +224,8 @@ private:
   bool SelectRange(Frame& frame);
   /// The descriptor's property filters, resolved against the property file (SelectRange).
   bool SelectFilters(Frame& frame);
+  /// The selection's filter errors for `values` (none when null).
+  void SetFilterErrors(Frame& frame, const std::shared_ptr<const resmr::ValueFilterSet>& values);
   /// What the descriptor names; false without a descriptor (an empty piece, no file yet).
   bool ReadSource(Frame& frame);
   void RequestProperty(Frame& frame);

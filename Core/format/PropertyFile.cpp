@@ -134,12 +134,12 @@ void NearestActiveSources(std::vector<uint64_t>& slotCells, const std::vector<st
 /// and one chunk a band of every layer.
 uint64_t TableRecordBytes(uint64_t layerBands, uint32_t version)
 {
-  return NameBytes + 4 + 4 + 8 + 4 + 4 + 20 * (layerBands + 1) + (version >= 4 ? 20 : 0);
+  return NameBytes + 4 + 4 + 8 + 4 + 4 + 20 * (layerBands + 1) + (version >= 4 ? 40 : 0);
 }
 
-int64_t BlocksAlong(int64_t cells)
+int64_t BlocksAlong(int64_t cells, int64_t side = ColumnBlockSide)
 {
-  return (cells + ColumnBlockSide - 1) / ColumnBlockSide;
+  return (cells + side - 1) / side;
 }
 
 std::string TableName(const PropertyTable& t)
@@ -276,6 +276,7 @@ PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t in
   if (this->FormatVersion >= 4)
   {
     table.blockRanges = GetRef(index);
+    table.layerBlocks = GetRef(index);
   }
   const int64_t bands = this->Bands();
   table.layerBands.resize(static_cast<std::size_t>(this->Dims[2] * bands));
@@ -331,6 +332,15 @@ PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t in
     {
       fail("block ranges at byte " + std::to_string(c.offset) + " (" + std::to_string(c.stored) + " bytes stored, " +
         std::to_string(c.raw) + " raw) lie outside the file or are not " + std::to_string(bytes) + " bytes");
+    }
+    const ChunkRef& l = table.layerBlocks;
+    const auto layerBlocks = this->LayerBlockCounts();
+    const uint64_t summaries =
+      static_cast<uint64_t>(layerBlocks[0] * layerBlocks[1] * this->Dims[2]) * sizeof(BlockSummary);
+    if (l.offset < HeaderBytes || l.offset > indexOffset || l.stored > indexOffset - l.offset || l.raw != summaries)
+    {
+      fail("layer blocks at byte " + std::to_string(l.offset) + " (" + std::to_string(l.stored) + " bytes stored, " +
+        std::to_string(l.raw) + " raw) lie outside the file or are not " + std::to_string(summaries) + " bytes");
     }
   }
   return table;
@@ -413,6 +423,37 @@ std::vector<ValueRange> PropertyFile::ReadBlockRanges(std::size_t table) const
     }
   }
   return ranges;
+}
+
+std::array<int64_t, 2> PropertyFile::LayerBlockCounts() const
+{
+  return { BlocksAlong(this->Dims[0], LayerBlockSide), BlocksAlong(this->Dims[1], LayerBlockSide) };
+}
+
+std::vector<BlockSummary> PropertyFile::ReadLayerBlocks(std::size_t table) const
+{
+  const PropertyTable& t = this->Entries.at(table);
+  if (!this->HasBlockRanges())
+  {
+    return {};
+  }
+  const auto blocks = this->LayerBlockCounts();
+  const std::string place =
+    this->FilePath + ": layer blocks of " + TableName(t) + " at byte " + std::to_string(t.layerBlocks.offset);
+  const uint64_t count = static_cast<uint64_t>(blocks[0] * blocks[1] * this->Dims[2]);
+  const auto floats = this->ReadValues(t.layerBlocks, count * 3, place);
+  std::vector<BlockSummary> summaries(count);
+  std::memcpy(summaries.data(), floats.data(), floats.size() * 4);
+  for (std::size_t b = 0; b < summaries.size(); ++b)
+  {
+    const BlockSummary& s = summaries[b];
+    const bool none = s.low > s.high && std::isnan(s.mean);
+    if (std::isnan(s.low) || std::isnan(s.high) || (!none && !(s.low <= s.high)))
+    {
+      throw FileFormatError(place + ": block " + std::to_string(b) + " has an impossible range (corrupt)");
+    }
+  }
+  return summaries;
 }
 
 std::vector<float> PropertyFile::ReadBox(
@@ -726,6 +767,48 @@ void PropertyFileWriter::AddToBlockRanges(std::vector<ValueRange>& blocks, const
   }
 }
 
+void PropertyFileWriter::AddLayerBlocks(std::vector<BlockSummary>& summaries, const float* values, int64_t k) const
+{
+  const int64_t nx = this->Dims[0], ny = this->Dims[1];
+  const int64_t bx = BlocksAlong(nx, LayerBlockSide), by = BlocksAlong(ny, LayerBlockSide);
+  const std::vector<uint64_t>& active = this->Active[static_cast<std::size_t>(k)];
+  const float infinity = std::numeric_limits<float>::infinity();
+  const std::size_t first = summaries.size();
+  summaries.resize(first + static_cast<std::size_t>(bx * by), BlockSummary{ infinity, -infinity, 0.f });
+  std::vector<double> sums(static_cast<std::size_t>(bx * by), 0.0);
+  std::vector<int64_t> counts(sums.size(), 0);
+  for (int64_t j = 0; j < ny; ++j)
+  {
+    for (int64_t i = 0; i < nx; ++i)
+    {
+      const uint64_t c = static_cast<uint64_t>(j * nx + i);
+      if (!Bit(active, c))
+      {
+        continue;
+      }
+      const std::size_t b = static_cast<std::size_t>((j / LayerBlockSide) * bx + i / LayerBlockSide);
+      BlockSummary& s = summaries[first + b];
+      const float v = values[c];
+      s.low = std::isnan(v) ? -infinity : std::min(s.low, v);
+      s.high = std::isnan(v) ? s.high : std::max(s.high, v);
+      sums[b] += std::isnan(v) ? 0.0 : double(v);
+      counts[b] += std::isnan(v) ? 0 : 1;
+    }
+  }
+  for (std::size_t b = 0; b < sums.size(); ++b)
+  {
+    summaries[first + b].mean =
+      counts[b] ? static_cast<float>(sums[b] / double(counts[b])) : std::numeric_limits<float>::quiet_NaN();
+  }
+}
+
+ChunkRef PropertyFileWriter::PutLayerBlocks(const std::vector<BlockSummary>& summaries, const PropertyTable& table)
+{
+  std::vector<uint8_t> raw(summaries.size() * sizeof(BlockSummary));
+  std::memcpy(raw.data(), summaries.data(), raw.size());
+  return this->PutChunk(raw, TableName(table) + " layer blocks");
+}
+
 void PropertyFileWriter::Add(PropertyTable table, const std::vector<float>& cellValues)
 {
   const int64_t layer = this->Dims[0] * this->Dims[1];
@@ -818,6 +901,7 @@ void PropertyFileWriter::AddLayer(std::size_t handle, const float* layerValues)
   }
   this->PutLayerBands(t.table, raw, k);
   this->AddToBlockRanges(t.blocks, reinterpret_cast<const float*>(raw.data()), k);
+  this->AddLayerBlocks(t.layerBlocks, reinterpret_cast<const float*>(raw.data()), k);
   ++t.layers;
   for (uint64_t at = this->LayerSlotStart[static_cast<std::size_t>(k)];
        at < this->LayerSlotStart[static_cast<std::size_t>(k) + 1]; ++at)
@@ -842,8 +926,10 @@ void PropertyFileWriter::EndTable(std::size_t handle)
   table.maximum = t.low <= t.high ? t.high : none;
   table.packed = this->PutChunk(t.packed, TableName(table) + " packed table");
   table.blockRanges = this->PutBlockRanges(t.blocks, table);
+  table.layerBlocks = this->PutLayerBlocks(t.layerBlocks, table);
   t.packed = std::vector<uint8_t>();
   t.blocks = std::vector<ValueRange>();
+  t.layerBlocks = std::vector<BlockSummary>();
   t.open = false;
   for (auto& old : this->Entries)
   {
@@ -876,16 +962,21 @@ void PropertyFileWriter::CopyFrom(const PropertyFile& older)
     if (older.HasBlockRanges())
     {
       copy.blockRanges = this->CopyChunk(older, table.blockRanges);
+      copy.layerBlocks = this->CopyChunk(older, table.layerBlocks);
     }
-    else // an older version's table: its block ranges from its layers
+    else // an older version's table: its block ranges and summaries from its layers
     {
       std::vector<ValueRange> blocks(static_cast<std::size_t>(BlocksAlong(this->Dims[0]) * BlocksAlong(this->Dims[1])),
         ValueRange{ std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity() });
+      std::vector<BlockSummary> summaries;
       for (int64_t k = 0; k < this->Dims[2]; ++k)
       {
-        this->AddToBlockRanges(blocks, older.ReadLayer(t, k).data(), k);
+        const std::vector<float> layer = older.ReadLayer(t, k);
+        this->AddToBlockRanges(blocks, layer.data(), k);
+        this->AddLayerBlocks(summaries, layer.data(), k);
       }
       copy.blockRanges = this->PutBlockRanges(blocks, copy);
+      copy.layerBlocks = this->PutLayerBlocks(summaries, copy);
     }
     if (older.BandRows() == this->RowsInBand)
     {
@@ -931,6 +1022,7 @@ void PropertyFileWriter::Commit()
     index.Put(t.maximum);
     PutRef(index, t.packed);
     PutRef(index, t.blockRanges);
+    PutRef(index, t.layerBlocks);
     for (const ChunkRef& band : t.layerBands)
     {
       PutRef(index, band);

@@ -12,11 +12,12 @@
 //   layer view's 2D texture, Sec. 5.2), each layer cut into bands of whole rows of at most
 //   LayerBandValues values, a chunk a band (ours: reading one cell's value, a pick, decodes one
 //   band instead of a whole layer). From version 4, each table also keeps the value range of
-//   each block of ColumnBlockSide^2 columns over all layers (ours: PropertyFilter.h).
+//   each block of ColumnBlockSide^2 columns over all layers, and of each block of
+//   LayerBlockSide^2 columns in each layer with its mean (ours: PropertyFilter.h).
 // - Layout (little-endian): header (128 bytes, CRC-32 at its end: magic, version, the
 //   geometry id of the .resmr file, grid dimensions, hash table side, table count, rows a
 //   band), chunks, index (per table: name, step, report number, days, value range, packed
-//   chunk, block ranges chunk (version 4 on), then nz times the bands of a layer), trailer (index offset and size, index CRC,
+//   chunk, block ranges and layer blocks chunks (version 4 on), then nz times the bands of a layer), trailer (index offset and size, index CRC,
 //   magic "RESMRPIX"). Version 2 files (a chunk a layer, no band rows) are read as one band.
 // - A file is written under a temporary name and renamed; one that names another geometry
 //   is refused (CheckGeometry). Every header and index field is checked when the file is
@@ -52,6 +53,9 @@ struct PropertyTable
   /// Value ranges of blocks of ColumnBlockSide x ColumnBlockSide columns over all layers
   /// (ColumnBlockRanges); raw 0 in files before version 4.
   ChunkRef blockRanges;
+  /// Summaries of blocks of LayerBlockSide x LayerBlockSide columns, layer by layer
+  /// (ReadLayerBlocks); raw 0 in files before version 4.
+  ChunkRef layerBlocks;
   std::vector<ChunkRef> layerBands; ///< nz times the bands of a layer: layer k's band b at k * bands + b
 };
 
@@ -65,6 +69,17 @@ constexpr int64_t ColumnBlockSide = 8;
 struct ValueRange
 {
   float low = 0, high = 0;
+};
+
+/// Columns a side of the blocks a table summarises layer by layer (ours: coarse regions a
+/// property filter crosses are masked and painted from them, PropertyFilter.h).
+constexpr int64_t LayerBlockSide = 16;
+
+/// A block of columns in one layer: the range of its active cells' values (as ValueRange)
+/// and their mean (NaN when none has a value).
+struct BlockSummary
+{
+  float low = 0, high = 0, mean = 0;
 };
 
 /// Most values in a band of a layer's rows (1 MB of floats); a band holds at least one row.
@@ -101,6 +116,11 @@ public:
   std::array<int64_t, 2> BlockCounts() const;
   /// The table's block ranges, block (bi, bj) at bi + bx * bj; empty before version 4.
   std::vector<ValueRange> ReadBlockRanges(std::size_t table) const;
+  /// Layer blocks along i and j: ceil(nx / LayerBlockSide), ceil(ny / LayerBlockSide).
+  std::array<int64_t, 2> LayerBlockCounts() const;
+  /// The table's layer block summaries, block (bi, bj) of layer k at bi + bx (bj + by k); empty
+  /// before version 4.
+  std::vector<BlockSummary> ReadLayerBlocks(std::size_t table) const;
   /// The values of a box of cells, [lo, hi] inclusive and 0-based, i fastest, then j, then k:
   /// one band a layer for each band the box's rows reach.
   std::vector<float> ReadBox(std::size_t table, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) const;
@@ -181,6 +201,7 @@ private:
     std::vector<uint8_t> packed; ///< m0 m1 m2 floats, filled as the layers come
     float low = 0, high = 0;     ///< value range so far
     std::vector<ValueRange> blocks; ///< block ranges so far (BlockCounts)
+    std::vector<BlockSummary> layerBlocks; ///< layer block summaries of the layers so far
     int64_t layers = 0;          ///< layers added so far
     bool open = false;
   };
@@ -191,6 +212,9 @@ private:
   ChunkRef PutBlockRanges(const std::vector<ValueRange>& blocks, const PropertyTable& table);
   /// Widens `blocks` by layer k's values (nx ny, NaN where inactive) and active flags.
   void AddToBlockRanges(std::vector<ValueRange>& blocks, const float* values, int64_t k) const;
+  /// Appends layer k's block summaries of its values (nx ny, NaN where inactive).
+  void AddLayerBlocks(std::vector<BlockSummary>& summaries, const float* values, int64_t k) const;
+  ChunkRef PutLayerBlocks(const std::vector<BlockSummary>& summaries, const PropertyTable& table);
   /// Layer values (nx ny floats as bytes) stored as this file's bands.
   void PutLayerBands(PropertyTable& table, const std::vector<uint8_t>& raw, int64_t k);
   void Write(const void* data, std::size_t size, const std::string& what);

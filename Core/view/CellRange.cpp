@@ -118,7 +118,8 @@ std::array<double, 2> ColumnCentreOf(const RegionMesh& mesh, std::size_t column)
   return ColumnCentre(mesh, column);
 }
 
-void MaskCells(RegionMesh& mesh, const std::function<bool(const std::array<double, 2>&, int64_t)>& keep)
+void MaskCells(
+  RegionMesh& mesh, const std::function<bool(const std::array<double, 2>&, int64_t, std::size_t)>& keep)
 {
   const std::size_t layers = static_cast<std::size_t>(mesh.layers);
   std::vector<uint8_t> cutOpen(mesh.active.size(), 0); // per cell, cut edges whose cell across goes
@@ -128,7 +129,7 @@ void MaskCells(RegionMesh& mesh, const std::function<bool(const std::array<doubl
     for (std::size_t k = 0; k < layers; ++k)
     {
       uint8_t& active = mesh.active[c * layers + k];
-      active = active && keep(centre, int64_t(k));
+      active = active && keep(centre, int64_t(k), c);
       for (int e = 0; active && e < 4; ++e)
       {
         if (!(mesh.cutEdges[c] & (1u << e)))
@@ -139,7 +140,7 @@ void MaskCells(RegionMesh& mesh, const std::function<bool(const std::array<doubl
         const auto& b = mesh.topology[mesh.corners[c][(e + 1) % 4]];
         const std::array<double, 2> across{ double(a[0]) + double(b[0]) - centre[0],
           double(a[1]) + double(b[1]) - centre[1] };
-        if (!keep(across, int64_t(k)))
+        if (!keep(across, int64_t(k), AcrossCutEdge))
         {
           cutOpen[c * layers + k] |= static_cast<uint8_t>(1u << e);
         }
@@ -157,7 +158,7 @@ void MaskCells(RegionMesh& mesh, const std::function<bool(const std::array<doubl
 
 void MaskToRange(RegionMesh& mesh, const CellRange& range)
 {
-  MaskCells(mesh, [&](const std::array<double, 2>& centre, int64_t k) {
+  MaskCells(mesh, [&](const std::array<double, 2>& centre, int64_t k, std::size_t) {
     return InRangeIJ(range, centre) && k >= range.lo[2] && k <= range.hi[2];
   });
 }

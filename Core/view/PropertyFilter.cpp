@@ -31,6 +31,7 @@ ValueFilterSet::ValueFilterSet(std::shared_ptr<const PropertyFile> file, std::ve
     }
     this->TableIndices.push_back(table);
     this->Blocks.push_back(this->Properties->ReadBlockRanges(static_cast<std::size_t>(table)));
+    this->LayerBlocks.push_back(this->Properties->ReadLayerBlocks(static_cast<std::size_t>(table)));
   }
 }
 
@@ -81,22 +82,40 @@ RangeClass ValueFilterSet::Classify(const std::array<float, 4>& footprint, float
   return inside ? RangeClass::Inside : RangeClass::Crossed;
 }
 
-bool ValueFilterSet::BlockMayPass(int64_t i, int64_t j) const
+bool ValueFilterSet::LayerBlocksMayPass(
+  const std::array<int64_t, 2>& lo, const std::array<int64_t, 2>& hi, int64_t k) const
 {
-  const auto counts = this->Properties->BlockCounts();
+  const auto counts = this->Properties->LayerBlockCounts();
   for (std::size_t f = 0; f < this->Wanted.size(); ++f)
   {
-    if (this->Blocks[f].empty())
+    if (this->LayerBlocks[f].empty())
     {
       continue;
     }
-    const ValueRange& b = this->Blocks[f][static_cast<std::size_t>(i / ColumnBlockSide + counts[0] * (j / ColumnBlockSide))];
-    if (!(b.low <= b.high && b.high >= this->Wanted[f].low && b.low <= this->Wanted[f].high))
+    bool may = false;
+    for (int64_t bj = lo[1] / LayerBlockSide; bj <= hi[1] / LayerBlockSide && !may; ++bj)
+    {
+      for (int64_t bi = lo[0] / LayerBlockSide; bi <= hi[0] / LayerBlockSide && !may; ++bi)
+      {
+        const BlockSummary& b = this->LayerBlocks[f][static_cast<std::size_t>(bi + counts[0] * (bj + counts[1] * k))];
+        may = b.low <= b.high && b.high >= this->Wanted[f].low && b.low <= this->Wanted[f].high;
+      }
+    }
+    if (!may)
     {
       return false;
     }
   }
   return true;
+}
+
+float FilterError(const RegionRecord& region, const std::array<float, 4>& footprint)
+{
+  const double cells = std::max(double(footprint[1] - footprint[0]) * double(footprint[3] - footprint[2]), 1.0);
+  const auto& b = region.bounds;
+  const double area = std::max(double(b[3] - b[0]) * double(b[4] - b[1]), 0.0);
+  const double columnWidth = 2 * std::sqrt(cells / double(std::max<int64_t>(region.columns, 1)));
+  return static_cast<float>(std::max(columnWidth, double(LayerBlockSide)) * std::sqrt(area / cells));
 }
 
 CellBox ReadCellBox(const RegionMesh& mesh, const CellFilter& filter, const std::array<int64_t, 3>& dims)
@@ -133,7 +152,26 @@ void MaskToFilter(RegionMesh& mesh, const CellFilter& filter, const CellBox* box
 {
   const CellRange& range = filter.range;
   const ValueFilterSet* values = filter.HasValues() ? filter.values.get() : nullptr;
-  MaskCells(mesh, [&](const std::array<double, 2>& at, int64_t k) {
+  // A coarse column's cells: the box of its nodes' topology, within the grid.
+  const auto& dims = filter.values ? filter.values->File().Dimensions() : std::array<int64_t, 3>{};
+  std::vector<std::array<int64_t, 4>> columnCells;
+  for (std::size_t c = 0; values && !box && c < mesh.corners.size(); ++c)
+  {
+    std::array<float, 2> low = mesh.topology[mesh.corners[c][0]], high = low;
+    for (const uint32_t node : mesh.corners[c])
+    {
+      for (int a = 0; a < 2; ++a)
+      {
+        low[a] = std::min(low[a], mesh.topology[node][a]);
+        high[a] = std::max(high[a], mesh.topology[node][a]);
+      }
+    }
+    const auto cell = [&](float t, int a) {
+      return std::clamp<int64_t>(static_cast<int64_t>(std::floor(t)), 0, dims[a] - 1);
+    };
+    columnCells.push_back({ cell(low[0], 0), cell(std::ceil(high[0]) - 1, 0), cell(low[1], 1), cell(std::ceil(high[1]) - 1, 1) });
+  }
+  MaskCells(mesh, [&](const std::array<double, 2>& at, int64_t k, std::size_t column) {
     const double fi = std::floor(at[0]), fj = std::floor(at[1]);
     if (!range.Contains(int64_t(fi), int64_t(fj), k) || fi != fi || fj != fj)
     {
@@ -143,7 +181,6 @@ void MaskToFilter(RegionMesh& mesh, const CellFilter& filter, const CellBox* box
     {
       return true;
     }
-    const auto& dims = values->File().Dimensions();
     if (fi < 0 || fj < 0 || fi >= double(dims[0]) || fj >= double(dims[1]))
     {
       return false;
@@ -151,7 +188,9 @@ void MaskToFilter(RegionMesh& mesh, const CellFilter& filter, const CellBox* box
     const int64_t i = int64_t(fi), j = int64_t(fj);
     if (!box)
     {
-      return values->BlockMayPass(i, j);
+      const std::array<int64_t, 4> cells =
+        column == AcrossCutEdge ? std::array<int64_t, 4>{ i, i, j, j } : columnCells[column];
+      return values->LayerBlocksMayPass({ cells[0], cells[2] }, { cells[1], cells[3] }, k);
     }
     const int64_t ci = std::clamp(i, box->lo[0], box->hi[0]), cj = std::clamp(j, box->lo[1], box->hi[1]);
     for (std::size_t f = 0; f < values->Filters().size(); ++f)
@@ -163,6 +202,35 @@ void MaskToFilter(RegionMesh& mesh, const CellFilter& filter, const CellBox* box
     }
     return true;
   });
+}
+
+std::vector<float> FaceMeans(const std::vector<float>& vertices, const std::vector<uint32_t>& indices,
+  const std::vector<BlockSummary>& blocks, const std::array<int64_t, 3>& dims)
+{
+  std::vector<float> out(indices.size() / 3, std::numeric_limits<float>::quiet_NaN());
+  const int64_t bx = (dims[0] + LayerBlockSide - 1) / LayerBlockSide, by = (dims[1] + LayerBlockSide - 1) / LayerBlockSide;
+  if (blocks.size() != static_cast<std::size_t>(bx * by * dims[2]))
+  {
+    return out;
+  }
+  for (std::size_t t = 0; t < out.size(); ++t)
+  {
+    std::array<double, 3> c{ 0, 0, 0 };
+    for (int v = 0; v < 3; ++v)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        c[a] += vertices[std::size_t(indices[3 * t + v]) * 6 + 3 + a] / 3.0;
+      }
+    }
+    std::array<int64_t, 3> cell{};
+    for (int a = 0; a < 3; ++a)
+    {
+      cell[a] = std::clamp<int64_t>(static_cast<int64_t>(std::floor(c[a])), 0, dims[a] - 1);
+    }
+    out[t] = blocks[static_cast<std::size_t>(cell[0] / LayerBlockSide + bx * (cell[1] / LayerBlockSide + by * cell[2]))].mean;
+  }
+  return out;
 }
 
 std::vector<float> FaceValues(const std::vector<float>& vertices, const std::vector<uint32_t>& indices, const CellBox& box)

@@ -14,12 +14,19 @@
 //   Conservative both ways: a block range is a bound of its cells' values.
 // - Leaves (original columns) are masked cell by cell from the cells' own values, read for
 //   the region's box from the layer bands (PropertyFile::ReadBox): exact, the cells shown are
-//   the cells that pass. Coarse regions that a filter crosses are split to the leaves by the
-//   selection; while the leaves load, a coarse region stands in masked by blocks (a coarse
-//   column is kept when the block under its centre has a cell that may pass): approximate,
-//   never the final picture.
+//   the cells that pass.
+// - A coarse region a filter crosses is masked by the layer blocks (PropertyFile::
+//   ReadLayerBlocks): a coarse cell (column c, layer k) stays when a block of layer k under
+//   the column's cells may pass, so every passing cell's coarse cell stays (nothing kept is
+//   lost) and what is drawn besides lies within the column, or the LayerBlockSide-cell block,
+//   around a passing cell of its layer; K is exact to the layer. The selection splits such a
+//   region while that width (FilterError) projects above the tolerance, so at a tolerance
+//   of t pixels the cells drawn are the passing cells widened by at most about t pixels in I
+//   and J; at 0 every crossed region is a leaf, exact.
 // - Faces of a filtered view carry the value of their cell in the painted array (FaceValues):
-//   the faces a filter exposes lie inside the model, where the packed table has no value.
+//   the faces a filter exposes lie inside the model, where the packed table has no value. A
+//   coarse crossed region's faces carry the mean of the painted array over their layer block
+//   (FaceMeans): within the block's range of values.
 #pragma once
 
 #include "CellRange.h"
@@ -63,8 +70,9 @@ public:
   /// Where a footprint (ti min, ti max, tj min, tj max) lies against the filters, with `margin`
   /// cells around it (Outside, Inside, or Crossed; Crossed in files without block ranges).
   RangeClass Classify(const std::array<float, 4>& footprint, float margin) const;
-  /// Whether a cell may pass by its block's ranges (false: it surely fails).
-  bool BlockMayPass(int64_t i, int64_t j) const;
+  /// Whether a cell of columns [lo, hi] (inclusive, i then j) in layer k may pass by the
+  /// layer blocks under them (false: none passes); true in files without layer blocks.
+  bool LayerBlocksMayPass(const std::array<int64_t, 2>& lo, const std::array<int64_t, 2>& hi, int64_t k) const;
 
 private:
   std::shared_ptr<const PropertyFile> Properties;
@@ -72,7 +80,14 @@ private:
   int32_t AtStep = -1;
   std::vector<int> TableIndices;
   std::vector<std::vector<ValueRange>> Blocks; ///< per filter; empty in files without them
+  std::vector<std::vector<BlockSummary>> LayerBlocks; ///< per filter; empty in files without them
 };
+
+/// A coarse region's I/J width, model units, within which a property filter's masking by
+/// layer blocks may draw cells that do not pass (see the contract): twice its columns' mean
+/// width, or a block, in cells (from its footprint's area and its column count), times its
+/// cells' mean width (from its bounds' area over its footprint's).
+float FilterError(const RegionRecord& region, const std::array<float, 4>& footprint);
 
 /// What a filtered view draws: the cells of `range` that pass `values` (none: every cell of
 /// the range), their faces carrying the values of table `paintTable` (-1: none).
@@ -81,6 +96,9 @@ struct CellFilter
   CellRange range;
   std::shared_ptr<const ValueFilterSet> values;
   int paintTable = -1;
+  /// The painted table's layer blocks (PropertyFile::ReadLayerBlocks), for coarse regions'
+  /// faces; null or empty: those faces carry NaN.
+  std::shared_ptr<const std::vector<BlockSummary>> paintBlocks;
   bool operator==(const CellFilter& o) const
   {
     const bool sameValues =
@@ -109,8 +127,13 @@ CellBox ReadCellBox(const RegionMesh& mesh, const CellFilter& filter, const std:
 
 /// Leaves in `mesh` only the cells `filter` keeps active and opens their sides towards cells
 /// it removes (MaskToRange, with values): with `box` (a leaf), from each cell's own values;
-/// without (a coarse stand-in), a column whose centre's block surely fails goes.
+/// without (a coarse region), by the layer blocks under each column's cells.
 void MaskToFilter(RegionMesh& mesh, const CellFilter& filter, const CellBox* box);
+
+/// One value a triangle: the mean of the painted table over the layer block of the cell under
+/// the triangle's centroid (NaN without layer blocks). `dims`: the grid's.
+std::vector<float> FaceMeans(const std::vector<float>& vertices, const std::vector<uint32_t>& indices,
+  const std::vector<BlockSummary>& blocks, const std::array<int64_t, 3>& dims);
 
 /// One value a triangle of `vertices`/`indices` (RegionDrawBuffers' layout): the painted
 /// table's value of the cell under the triangle's centroid, from `box` (NaN outside it).

@@ -302,7 +302,8 @@ RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::si
   if (filter)
   {
     // A property filter: a leaf it crosses is masked by its cells' values, a coarse region it
-    // crosses by blocks (a stand-in until the leaves come), a region it leaves whole by range.
+    // crosses by layer blocks (within the region's filter error), a region it leaves whole by
+    // range.
     const RangeClass valueClass =
       filter->HasValues() ? filter->values->Classify(footprint, 1) : RangeClass::Inside;
     const bool leaf = file.Regions()[region].level >= file.Header().leafLevel;
@@ -325,6 +326,10 @@ RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::si
     if (boxed && filter->paintTable >= 0)
     {
       out.faceValues = FaceValues(out.vertices, out.indices, box);
+    }
+    else if (valueClass != RangeClass::Inside && !leaf && filter->paintTable >= 0 && filter->paintBlocks)
+    {
+      out.faceValues = FaceMeans(out.vertices, out.indices, *filter->paintBlocks, file.Header().dims);
     }
     out.ranged = true;
     out.footprint = footprint;

@@ -95,8 +95,9 @@ struct RegionDrawBuffers
   bool exactSides = true;
   int32_t layer = -1;  ///< the layer drawn (0-based), -1: the whole model
   bool ranged = false; ///< the cells of a range or filter (CellFilter), not the whole model
-  /// With a property filter, at a leaf it crosses: one value a triangle, the painted table's
-  /// value of the triangle's cell (FaceValues); empty otherwise (painted through the tables).
+  /// With a property filter, in a region it crosses: one value a triangle, the painted table's
+  /// value of the triangle's cell (FaceValues; a coarse region's: its block's mean, FaceMeans);
+  /// empty otherwise (painted through the tables).
   std::vector<float> faceValues;
   /// The region's footprint in (i, j) (RegionFootprint): where a range lies against it.
   std::array<float, 4> footprint{ 0.f, -1.f, 0.f, -1.f };
@@ -142,8 +143,8 @@ RegionDrawBuffers PrepareLayerDrawBuffers(
 /// many layers they are most of a coarse region's bytes. With `filter` (and `layer` -1), the
 /// cells it keeps alone (MaskToFilter), with their exact side faces and no simplified side
 /// (its triangles span every layer); at a leaf its values cross, read for the region's box,
-/// with face values when it paints a table; a coarse region its values cross stands in masked
-/// by blocks (PropertyFilter.h).
+/// with face values when it paints a table; a coarse region its values cross masked by layer
+/// blocks, its faces carrying their blocks' means (PropertyFilter.h).
 RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
   const std::array<double, 3>& origin, int handedness, int32_t layer = -1, bool exactSides = true,
   const CellFilter* filter = nullptr);

@@ -69,9 +69,9 @@ double Distance(const RegionRecord& record, const std::array<double, 3>& eye)
 /// the box nearest the eye, but no nearer than the near clipping plane: nothing nearer is
 /// drawn, so a box around the eye (a low flight over a dipping region, a camera inside the
 /// model) need not be refined to its leaves. An error of 0 projects to 0 even from inside.
-double ProjectedError(const RegionRecord& record, const ViewParameters& view)
+/// A model-space `error` of the region's, in pixels at the box's nearest point.
+double ProjectedErrorOf(const RegionRecord& record, double error, const ViewParameters& view)
 {
-  const double error = record.error;
   if (!(error > 0))
   {
     return 0;
@@ -82,6 +82,11 @@ double ProjectedError(const RegionRecord& record, const ViewParameters& view)
   }
   const double d = std::max(Distance(record, view.eye), std::max(view.nearDistance, 0.0));
   return d > 0 ? error * view.pixelsPerUnit / d : std::numeric_limits<double>::infinity();
+}
+
+double ProjectedError(const RegionRecord& record, const ViewParameters& view)
+{
+  return ProjectedErrorOf(record, record.error, view);
 }
 
 /// The region's typical error (its own where the file has none) at the box's centre (no
@@ -297,7 +302,7 @@ namespace
 template<typename Nodes>
 Traversal Traverse(const MultiresolutionFile& file, const Nodes& nodes, const std::vector<std::size_t>& roots,
   const ViewParameters& view, const std::function<bool(std::size_t)>& resident, const std::vector<RangeClass>& classes,
-  const std::vector<uint8_t>& forced, bool ideal)
+  const std::vector<uint8_t>& forced, const std::vector<float>& filterErrors, bool ideal)
 {
   const auto& regions = file.Regions();
   const int leaves = file.Header().leafLevel;
@@ -349,11 +354,17 @@ Traversal Traverse(const MultiresolutionFile& file, const Nodes& nodes, const st
           complete = false; // the partner's area is still covered by a coarser region
         }
       }
-      bool anyVisible = false, ready = true, crossed = false;
+      bool anyVisible = false, ready = true, crossed = false, filtered = false;
       double error = 0;
       for (std::size_t t : diamond)
       {
         error = std::max(error, ProjectedError(regions[t], view));
+        if (t < filterErrors.size() && filterErrors[t] > 0)
+        {
+          const double filterError = ProjectedErrorOf(regions[t], filterErrors[t], view);
+          error = std::max(error, filterError);
+          filtered = filtered || filterError > view.tolerancePixels;
+        }
         crossed = crossed || (!forced.empty() && forced[t]);
         if (isCulled(t))
         {
@@ -374,7 +385,8 @@ Traversal Traverse(const MultiresolutionFile& file, const Nodes& nodes, const st
       }
       // A range may need a diamond with no triangle in view split: a neighbour's is in the cut
       // only once it is.
-      const bool splittable = depth < leaves && complete && (anyVisible || crossed) && ready;
+      // So may a property filter's (its errors reach the diamonds a crossed one needs split).
+      const bool splittable = depth < leaves && complete && (anyVisible || crossed || filtered) && ready;
       const bool split = splittable && (error > view.tolerancePixels || crossed);
       // A range's split is no tolerance's.
       if (split && !crossed)
@@ -427,6 +439,40 @@ double EstimatedErrorPixels(const RegionRecord& region, const ViewParameters& vi
   return EstimatedError(region, view);
 }
 
+void ViewSelector::PropagateFilterErrors(std::vector<float>& widths) const
+{
+  // Deepest level first: a diamond's two triangles share the larger width, then their parents
+  // take it, so a region that must split finds its diamond in the cut (as ForcedSplits does).
+  const auto& regions = this->File->Regions();
+  std::vector<std::vector<std::size_t>> byLevel;
+  for (std::size_t r = 0; r < widths.size() && r < regions.size(); ++r)
+  {
+    const std::size_t level = static_cast<std::size_t>(std::max(regions[r].level, 0));
+    byLevel.resize(std::max(byLevel.size(), level + 1));
+    byLevel[level].push_back(r);
+  }
+  for (std::size_t level = byLevel.size(); level-- > 0;)
+  {
+    for (const std::size_t r : byLevel[level])
+    {
+      const int64_t partner = this->Nodes[r].partner;
+      if (partner >= 0 && static_cast<std::size_t>(partner) < widths.size())
+      {
+        const float both = std::max(widths[r], widths[static_cast<std::size_t>(partner)]);
+        widths[r] = widths[static_cast<std::size_t>(partner)] = both;
+      }
+    }
+    for (const std::size_t r : byLevel[level])
+    {
+      const int64_t parent = this->Nodes[r].parent;
+      if (parent >= 0 && static_cast<std::size_t>(parent) < widths.size())
+      {
+        widths[static_cast<std::size_t>(parent)] = std::max(widths[static_cast<std::size_t>(parent)], widths[r]);
+      }
+    }
+  }
+}
+
 std::vector<uint8_t> ViewSelector::ForcedSplits(const std::vector<RangeClass>& classes) const
 {
   const int leaves = this->File->Header().leafLevel;
@@ -473,9 +519,17 @@ ViewSelection ViewSelector::Select(const ViewParameters& view, const std::functi
     this->Ranged(classes);
     forced = this->ForcedSplits(classes);
   }
+  std::vector<float> filterErrors;
+  if (this->FilterErrors)
+  {
+    filterErrors.assign(regions.size(), 0.f);
+    this->FilterErrors(filterErrors);
+    this->PropagateFilterErrors(filterErrors);
+  }
   const Traversal actual =
-    Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, classes, forced, false);
-  const Traversal ideal = Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, classes, forced, true);
+    Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, classes, forced, filterErrors, false);
+  const Traversal ideal =
+    Traverse(*this->File, this->Nodes, this->RootRegions, view, resident, classes, forced, filterErrors, true);
 
   ViewSelection selection;
   selection.largestProjectedError = actual.largest;

@@ -123,6 +123,15 @@ public:
   using RangeClassifier = std::function<void(std::vector<RangeClass>& classes)>;
   void SetRangeClassifier(RangeClassifier ranged) { this->Ranged = std::move(ranged); }
 
+  /// Property filters (PropertyFilter.h): `errors(widths)` fills, per region (the vector comes
+  /// sized to the regions, every one 0), the width (model units) within which a filter that
+  /// crosses it may draw cells that do not pass while it is drawn coarse. A region splits while
+  /// that width projects above the tolerance, as while its error does, and so do the diamonds
+  /// its split needs (its partner and parent take its width; culled ones split too, as for a
+  /// range). Empty: none.
+  using FilterErrorSource = std::function<void(std::vector<float>& widths)>;
+  void SetFilterErrors(FilterErrorSource errors) { this->FilterErrors = std::move(errors); }
+
   /// The root regions (level 0), which the caller keeps resident.
   const std::vector<std::size_t>& Roots() const { return this->RootRegions; }
 
@@ -133,6 +142,9 @@ private:
     int64_t partner = -1;                      ///< the other triangle of its diamond, -1: none
     int64_t parent = -1;                       ///< -1: a root
   };
+  /// Makes filter widths monotone over what a split needs (a region's diamond partner and
+  /// parent take its width), as regions' errors are (see SetFilterErrors).
+  void PropagateFilterErrors(std::vector<float>& widths) const;
   /// Per region, whether the range forces it to split (see SetRangeClassifier).
   std::vector<uint8_t> ForcedSplits(const std::vector<RangeClass>& classes) const;
   const MultiresolutionFile* File = nullptr;
@@ -140,6 +152,7 @@ private:
   std::vector<std::size_t> RootRegions;
   std::array<double, 6> ModelBox{}; ///< every region's box: xmin, xmax, ymin, ymax, zmin, zmax (z up)
   RangeClassifier Ranged;
+  FilterErrorSource FilterErrors;
 };
 
 /// Whether a surface of `region` whose normals lie in `cone` (RegionSurface::cone; cosine -2:

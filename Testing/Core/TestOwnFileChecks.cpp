@@ -292,7 +292,7 @@ void PropertyFields(const Bytes& valid, const std::string& validPath, const std:
   }
   const uint32_t tables = Load<uint32_t>(valid, PTables);
   const uint64_t index = IndexAt(valid);
-  const std::size_t table = 56 + 20 * 4; // nz = 2: the packed table, block ranges, two layers
+  const std::size_t table = 56 + 20 * 5; // nz = 2: packed table, block ranges, layer blocks, 2 layers
   const auto setTable = [&](std::size_t t, std::size_t field, auto value) -> Change {
     return [=](Bytes& f) { Store(f, static_cast<std::size_t>(index + t * table + field), value); };
   };
@@ -314,7 +314,7 @@ void PropertyFields(const Bytes& valid, const std::string& validPath, const std:
       {
         const auto record = f.begin() + static_cast<std::ptrdiff_t>(at + t * table);
         index.insert(index.end(), record, record + 76);
-        index.insert(index.end(), record + 96, record + static_cast<std::ptrdiff_t>(table));
+        index.insert(index.end(), record + 116, record + static_cast<std::ptrdiff_t>(table));
       }
       f.resize(static_cast<std::size_t>(at));
       f.insert(f.end(), index.begin(), index.end());
@@ -326,6 +326,7 @@ void PropertyFields(const Bytes& valid, const std::string& validPath, const std:
     CHECK(before.Bands() == 1 && now.Bands() == 1 && before.BandRows() == now.BandRows());
     CHECK(before.Tables().size() == now.Tables().size());
     CHECK(!before.HasBlockRanges() && before.ReadBlockRanges(0).empty() && now.ReadBlockRanges(0).size() == 2);
+    CHECK(before.ReadLayerBlocks(0).empty() && now.ReadLayerBlocks(0).size() == 2); // 1 x 1 blocks, 2 layers
     for (std::size_t t = 0; t < now.Tables().size(); ++t)
     {
       const auto a = now.ReadLayer(t, 1), b = before.ReadLayer(t, 1);
@@ -382,8 +383,9 @@ void PropertyFields(const Bytes& valid, const std::string& validPath, const std:
   ExpectPropertiesRefused("range half NaN", valid, "value range", setTable(1, 48, NAN));
   ExpectPropertiesRefused("packed raw", valid, "packed table of", setTable(0, 56 + 12, uint32_t(12)));
   ExpectPropertiesRefused("blocks raw", valid, "block ranges at byte", setTable(0, 56 + 20 + 12, uint32_t(8)));
-  ExpectPropertiesRefused("layer raw", valid, "layer 2 of", setTable(0, 56 + 60 + 12, uint32_t(8)));
-  ExpectPropertiesRefused("layer offset", valid, "layer 1 at byte", setTable(0, 56 + 40, uint64_t(1) << 40));
+  ExpectPropertiesRefused("layer blocks raw", valid, "layer blocks at byte", setTable(0, 56 + 40 + 12, uint32_t(8)));
+  ExpectPropertiesRefused("layer raw", valid, "layer 2 of", setTable(0, 56 + 80 + 12, uint32_t(8)));
+  ExpectPropertiesRefused("layer offset", valid, "layer 1 at byte", setTable(0, 56 + 60, uint64_t(1) << 40));
   ExpectPropertiesRefused("duplicate table", valid, "a second table", [&](Bytes& f) {
     std::memcpy(&f[static_cast<std::size_t>(index + table)], &f[static_cast<std::size_t>(index)], 48);
   });

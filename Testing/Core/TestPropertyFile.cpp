@@ -222,6 +222,37 @@ int CheckTables(const MultiresolutionFile& geometry, const PropertyFile& propert
     {
       wrong += blocks[b].low != want[b].low || blocks[b].high != want[b].high;
     }
+    // Layer blocks: each block's range and mean in each layer, brute force.
+    const std::vector<BlockSummary> summaries = properties.ReadLayerBlocks(t);
+    const auto layerCounts = properties.LayerBlockCounts();
+    CHECK(summaries.size() == std::size_t(layerCounts[0] * layerCounts[1] * dims[2]));
+    for (std::size_t b = 0; b < summaries.size(); ++b)
+    {
+      const int64_t bi = int64_t(b) % layerCounts[0], bj = int64_t(b) / layerCounts[0] % layerCounts[1],
+                    k = int64_t(b) / (layerCounts[0] * layerCounts[1]);
+      float low = std::numeric_limits<float>::infinity(), high = -low;
+      double sum = 0;
+      int64_t count = 0;
+      for (int64_t j = bj * LayerBlockSide; j < std::min(dims[1], (bj + 1) * LayerBlockSide); ++j)
+      {
+        for (int64_t i = bi * LayerBlockSide; i < std::min(dims[0], (bi + 1) * LayerBlockSide); ++i)
+        {
+          const int64_t n = k * layer + j * dims[0] + i;
+          if (!grid.IsActive(n))
+          {
+            continue;
+          }
+          const float v = expected[std::size_t(n)];
+          low = std::isnan(v) ? -std::numeric_limits<float>::infinity() : std::min(low, v);
+          high = std::isnan(v) ? high : std::max(high, v);
+          sum += std::isnan(v) ? 0.0 : double(v);
+          count += std::isnan(v) ? 0 : 1;
+        }
+      }
+      const BlockSummary& s = summaries[b];
+      const float mean = count ? float(sum / double(count)) : std::numeric_limits<float>::quiet_NaN();
+      wrong += s.low != low || s.high != high || !(s.mean == mean || (std::isnan(s.mean) && std::isnan(mean)));
+    }
     // A box of cells (a filtered leaf's): every value where the layers put it.
     const std::array<int64_t, 3> lo{ dims[0] / 3, dims[1] / 4, 0 }, hi{ dims[0] - 1, dims[1] * 3 / 4, dims[2] - 1 };
     const std::vector<float> box = properties.ReadBox(t, lo, hi);

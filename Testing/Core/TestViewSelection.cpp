@@ -2011,7 +2011,8 @@ void TestRanges(const Model& model)
 
 /// Property filters (PropertyFilter.h) on the synthetic model with its properties: each
 /// region's class from the block ranges holds against its cells' values (Outside: no active
-/// cell of its footprint, widened by one, passes; Inside: every one does); at every leaf, every
+/// cell of its footprint, widened by one, passes; Inside: every one does); coarse regions it
+/// crosses keep every passing cell's coarse cell and only those near a passing cell; at every leaf, every
 /// triangle of the filtered buffers belongs to an active cell that passes and carries that
 /// cell's value, and every passing cell beside an active cell of its leaf the filter removes
 /// (one step in I, J or K) shows a face.
@@ -2030,7 +2031,7 @@ void TestValueFilters(const Model& model)
   };
   const std::vector<std::array<float, 4>> footprints = model.file->ReadFootprints();
   const int handedness = TopologyHandedness(*model.file);
-  std::size_t crossedLeaves = 0, triangles = 0, exposed = 0;
+  std::size_t crossedLeaves = 0, triangles = 0, exposed = 0, coarseCells = 0, keptCoarse = 0;
   for (const std::array<float, 2> quantiles : { std::array<float, 2>{ 0.5f, 1.f }, { 0.2f, 0.4f } })
   {
     std::vector<float> sorted;
@@ -2059,6 +2060,47 @@ void TestValueFilters(const Model& model)
           }
       CHECK(c != RangeClass::Outside || !any);
       CHECK(c != RangeClass::Inside || every);
+    }
+    // Coarse regions the filter crosses, masked by layer blocks: every passing cell's coarse
+    // cell stays; a coarse cell that stays has a passing cell of its layer within its column's
+    // cells widened by a layer block.
+    for (std::size_t r = 0; r < model.file->Regions().size(); ++r)
+    {
+      if (model.file->Regions()[r].level >= header.leafLevel || cells.values->Classify(footprints[r], 1) != RangeClass::Crossed)
+        continue;
+      const RegionMesh original = model.file->ReadRegion(r);
+      RegionMesh masked = original;
+      MaskToFilter(masked, cells, nullptr);
+      const std::size_t layers = std::size_t(dims[2]);
+      for (std::size_t c = 0; c < original.corners.size(); ++c)
+      {
+        std::array<float, 2> low = original.topology[original.corners[c][0]], high = low;
+        for (const uint32_t node : original.corners[c])
+          for (int a = 0; a < 2; ++a)
+          {
+            low[a] = std::min(low[a], original.topology[node][a]);
+            high[a] = std::max(high[a], original.topology[node][a]);
+          }
+        const auto anyPasses = [&](int64_t k, int64_t margin) {
+          for (int64_t j = std::max<int64_t>(0, int64_t(std::floor(low[1])) - margin);
+               j < std::min<int64_t>(dims[1], int64_t(std::ceil(high[1])) + margin); ++j)
+            for (int64_t i = std::max<int64_t>(0, int64_t(std::floor(low[0])) - margin);
+                 i < std::min<int64_t>(dims[0], int64_t(std::ceil(high[0])) + margin); ++i)
+              if (filter.Passes(value(i, j, k)))
+                return true;
+          return false;
+        };
+        for (std::size_t k = 0; k < layers; ++k)
+        {
+          if (!original.active[c * layers + k])
+            continue;
+          ++coarseCells;
+          const bool kept = masked.active[c * layers + k];
+          CHECK(kept || !anyPasses(int64_t(k), 0));
+          CHECK(!kept || anyPasses(int64_t(k), LayerBlockSide));
+          keptCoarse += kept;
+        }
+      }
     }
     for (const std::size_t leaf : model.Leaves())
     {
@@ -2106,9 +2148,10 @@ void TestValueFilters(const Model& model)
       }
     }
   }
-  std::printf("  value filters: %zu crossed leaves, %zu triangles, %zu cells beside removed ones shown\n", crossedLeaves,
-    triangles, exposed);
-  CHECK(crossedLeaves > 0 && exposed > 0);
+  std::printf("  value filters: %zu crossed leaves, %zu triangles, %zu cells beside removed ones shown; coarse crossed "
+              "regions keep %zu of %zu active coarse cells\n",
+    crossedLeaves, triangles, exposed, keptCoarse, coarseCells);
+  CHECK(crossedLeaves > 0 && exposed > 0 && keptCoarse > 0 && keptCoarse < coarseCells);
 }
 
 int main(int argc, char** argv)

@@ -277,8 +277,9 @@ inline FileLayout ResmrpLayout()
       return 0;
     }
     const uint64_t bands = static_cast<uint64_t>((rows + bandRows - 1) / bandRows);
-    // The packed table's chunk, the block ranges' (version 4 on), then the layers' bands.
-    const uint64_t blocks = Load<uint32_t>(file, VersionAt) >= 4 ? 1 : 0;
+    // The packed table's chunk, the block ranges' and layer blocks' (version 4 on), then the
+    // layers' bands.
+    const uint64_t blocks = Load<uint32_t>(file, VersionAt) >= 4 ? 2 : 0;
     return TableHead + 20 * (static_cast<uint64_t>(layers) * bands + 1 + blocks);
   };
   layout.indexBytes = [=](const std::vector<uint8_t>& file) -> uint64_t {

@@ -168,10 +168,11 @@ walls = [m for m in model if m[0] == 5]
 leaf = max(regions, key=lambda r: (r[0], r[3]))
 root = max((r for r in regions if r[0] == 0), key=lambda r: r[3])
 # The .resmrp index: per table a 32-byte name, step, report number, days, minimum, maximum,
-# then the packed chunk's reference (offset, stored, raw, CRC) and one a layer.
+# then the packed chunk's reference (offset, stored, raw, CRC), the block ranges' and the layer
+# blocks', and one a layer (one band a layer at this size).
 p_offset, p_size = index_of(property_data)
 poro = None
-for position in range(p_offset, p_offset + p_size, 56 + 20 * (1 + NZ)):
+for position in range(p_offset, p_offset + p_size, 56 + 20 * (3 + NZ)):
     if property_data[position:position + 32].split(b"\0")[0] == b"PORO":
         poro = struct.unpack_from("<QI", property_data, position + 56)
 if len(regions) < 4 or len(hash_offsets) != 1 or len(walls) != 1 or poro is None:
