@@ -8,12 +8,12 @@
 
 #include "CellInspection.h"
 #include "CellRange.h"
-#include "PropertyFilter.h"
 #include "CornerPointGeometry.h"
 #include "FramePlanning.h"
 #include "FrameRateController.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
+#include "PropertyFilter.h"
 #include "RegionCache.h"
 #include "Residency.h"
 #include "UploadPacer.h"
@@ -254,10 +254,10 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   std::string filePath, propertyPath, propertyStamp;
   int32_t step = 0;
   bool applyMapAxes = false;
-  int32_t layer = -1;    ///< 0-based; -1: the whole model
-  std::string rangeText; ///< the descriptor's I/J/K range, from 1 (empty: none)
+  int32_t layer = -1;     ///< 0-based; -1: the whole model
+  std::string rangeText;  ///< the descriptor's I/J/K range, from 1 (empty: none)
   std::string filterText; ///< the descriptor's property filters, "low high name" a line
-  bool ranged = false;     ///< drawing the cells of `range` (and `filters`) only
+  bool ranged = false;    ///< drawing the cells of `range` (and `filters`) only
   resmr::CellRange range;
   std::vector<resmr::ValueFilter> filters;
   resmr::PropertyRequest property;
@@ -1372,8 +1372,8 @@ int vtkMultiresolutionSurfaceMapper::DrawFaces(Frame& frame, const std::array<bo
     // A leaf's sides are the original faces: their coordinates name the layer exactly.
     const bool leaf = in.File->Regions()[drawn.region].level == in.File->Header().leafLevel;
     frame.program->SetUniformi("wallLookup", leaf ? 0 : 1);
-    in.Triangles += static_cast<vtkIdType>(
-      in.Regions.Draw(drawn.region, parts, frame.program, frame.window, frame.cullBackFaces));
+    in.Triangles +=
+      static_cast<vtkIdType>(in.Regions.Draw(drawn.region, parts, frame.program, frame.window, frame.cullBackFaces));
     ++regions;
   }
   return regions;

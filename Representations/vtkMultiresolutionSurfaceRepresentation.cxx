@@ -1,9 +1,9 @@
 #include "vtkMultiresolutionSurfaceRepresentation.h"
 
 #include "vtkMultiresolutionExtractSubset.h"
-#include "vtkMultiresolutionThreshold.h"
 #include "vtkMultiresolutionReader.h"
 #include "vtkMultiresolutionSurfaceMapper.h"
+#include "vtkMultiresolutionThreshold.h"
 
 #include "MultiresolutionFile.h"
 

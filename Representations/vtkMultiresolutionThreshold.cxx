@@ -34,8 +34,7 @@ int vtkMultiresolutionThreshold::RequestData(
   // The descriptor's cell arrays are the property file's (two cells: the step's range).
   vtkDataArray* array = this->GetInputArrayToProcess(0, inputVector);
   const char* name = array ? array->GetName() : nullptr;
-  vtkStringArray* upstream =
-    vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray(FilterArrayName()));
+  vtkStringArray* upstream = vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray(FilterArrayName()));
   std::string lines = upstream && upstream->GetNumberOfValues() == 1 ? upstream->GetValue(0) : std::string();
   if (name && *name)
   {

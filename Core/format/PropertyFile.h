@@ -17,8 +17,9 @@
 // - Layout (little-endian): header (128 bytes, CRC-32 at its end: magic, version, the
 //   geometry id of the .resmr file, grid dimensions, hash table side, table count, rows a
 //   band), chunks, index (per table: name, step, report number, days, value range, packed
-//   chunk, block ranges and layer blocks chunks (version 4 on), then nz times the bands of a layer), trailer (index offset and size, index CRC,
-//   magic "RESMRPIX"). Version 2 files (a chunk a layer, no band rows) are read as one band.
+//   chunk, block ranges and layer blocks chunks (version 4 on), then nz times the bands of a layer), trailer (index
+//   offset and size, index CRC, magic "RESMRPIX"). Version 2 files (a chunk a layer, no band rows) are read as one
+//   band.
 // - A file is written under a temporary name and renamed; one that names another geometry
 //   is refused (CheckGeometry). Every header and index field is checked when the file is
 //   opened (dimensions, sides, the table count against the index size, names, steps, value
@@ -123,7 +124,8 @@ public:
   std::vector<BlockSummary> ReadLayerBlocks(std::size_t table) const;
   /// The values of a box of cells, [lo, hi] inclusive and 0-based, i fastest, then j, then k:
   /// one band a layer for each band the box's rows reach.
-  std::vector<float> ReadBox(std::size_t table, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) const;
+  std::vector<float> ReadBox(
+    std::size_t table, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) const;
   /// The packed table (m0 m1 m2 values, Sec. 5.4).
   std::vector<float> ReadPacked(std::size_t table) const;
   /// Layer k of the table (nx ny values).
@@ -198,11 +200,11 @@ private:
   struct OpenTable
   {
     PropertyTable table;
-    std::vector<uint8_t> packed; ///< m0 m1 m2 floats, filled as the layers come
-    float low = 0, high = 0;     ///< value range so far
-    std::vector<ValueRange> blocks; ///< block ranges so far (BlockCounts)
+    std::vector<uint8_t> packed;           ///< m0 m1 m2 floats, filled as the layers come
+    float low = 0, high = 0;               ///< value range so far
+    std::vector<ValueRange> blocks;        ///< block ranges so far (BlockCounts)
     std::vector<BlockSummary> layerBlocks; ///< layer block summaries of the layers so far
-    int64_t layers = 0;          ///< layers added so far
+    int64_t layers = 0;                    ///< layers added so far
     bool open = false;
   };
   OpenTable& Opened(std::size_t handle);

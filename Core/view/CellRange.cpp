@@ -118,8 +118,7 @@ std::array<double, 2> ColumnCentreOf(const RegionMesh& mesh, std::size_t column)
   return ColumnCentre(mesh, column);
 }
 
-void MaskCells(
-  RegionMesh& mesh, const std::function<bool(const std::array<double, 2>&, int64_t, std::size_t)>& keep)
+void MaskCells(RegionMesh& mesh, const std::function<bool(const std::array<double, 2>&, int64_t, std::size_t)>& keep)
 {
   const std::size_t layers = static_cast<std::size_t>(mesh.layers);
   std::vector<uint8_t> cutOpen(mesh.active.size(), 0); // per cell, cut edges whose cell across goes

@@ -79,8 +79,7 @@ void MaskToRange(RegionMesh& mesh, const CellRange& range);
 /// opens a kept cell's side across a cut edge when keep fails for the cell across (the column's
 /// centre mirrored through the edge's midpoint, same layer; column: AcrossCutEdge).
 constexpr std::size_t AcrossCutEdge = ~std::size_t(0);
-void MaskCells(
-  RegionMesh& mesh, const std::function<bool(const std::array<double, 2>&, int64_t, std::size_t)>& keep);
+void MaskCells(RegionMesh& mesh, const std::function<bool(const std::array<double, 2>&, int64_t, std::size_t)>& keep);
 /// The mean of a column's four nodes' topological coordinates.
 std::array<double, 2> ColumnCentreOf(const RegionMesh& mesh, std::size_t column);
 

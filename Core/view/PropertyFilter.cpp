@@ -142,8 +142,9 @@ CellBox ReadCellBox(const RegionMesh& mesh, const CellFilter& filter, const std:
   {
     const auto& tables = filter.values->Tables();
     const auto same = std::find(tables.begin(), tables.end(), filter.paintTable);
-    box.tables.push_back(same != tables.end() ? box.tables[static_cast<std::size_t>(same - tables.begin())]
-                                              : file.ReadBox(static_cast<std::size_t>(filter.paintTable), box.lo, box.hi));
+    box.tables.push_back(same != tables.end()
+        ? box.tables[static_cast<std::size_t>(same - tables.begin())]
+        : file.ReadBox(static_cast<std::size_t>(filter.paintTable), box.lo, box.hi));
   }
   return box;
 }
@@ -169,7 +170,8 @@ void MaskToFilter(RegionMesh& mesh, const CellFilter& filter, const CellBox* box
     const auto cell = [&](float t, int a) {
       return std::clamp<int64_t>(static_cast<int64_t>(std::floor(t)), 0, dims[a] - 1);
     };
-    columnCells.push_back({ cell(low[0], 0), cell(std::ceil(high[0]) - 1, 0), cell(low[1], 1), cell(std::ceil(high[1]) - 1, 1) });
+    columnCells.push_back(
+      { cell(low[0], 0), cell(std::ceil(high[0]) - 1, 0), cell(low[1], 1), cell(std::ceil(high[1]) - 1, 1) });
   }
   MaskCells(mesh, [&](const std::array<double, 2>& at, int64_t k, std::size_t column) {
     const double fi = std::floor(at[0]), fj = std::floor(at[1]);
@@ -208,7 +210,8 @@ std::vector<float> FaceMeans(const std::vector<float>& vertices, const std::vect
   const std::vector<BlockSummary>& blocks, const std::array<int64_t, 3>& dims)
 {
   std::vector<float> out(indices.size() / 3, std::numeric_limits<float>::quiet_NaN());
-  const int64_t bx = (dims[0] + LayerBlockSide - 1) / LayerBlockSide, by = (dims[1] + LayerBlockSide - 1) / LayerBlockSide;
+  const int64_t bx = (dims[0] + LayerBlockSide - 1) / LayerBlockSide,
+                by = (dims[1] + LayerBlockSide - 1) / LayerBlockSide;
   if (blocks.size() != static_cast<std::size_t>(bx * by * dims[2]))
   {
     return out;
@@ -228,12 +231,14 @@ std::vector<float> FaceMeans(const std::vector<float>& vertices, const std::vect
     {
       cell[a] = std::clamp<int64_t>(static_cast<int64_t>(std::floor(c[a])), 0, dims[a] - 1);
     }
-    out[t] = blocks[static_cast<std::size_t>(cell[0] / LayerBlockSide + bx * (cell[1] / LayerBlockSide + by * cell[2]))].mean;
+    out[t] =
+      blocks[static_cast<std::size_t>(cell[0] / LayerBlockSide + bx * (cell[1] / LayerBlockSide + by * cell[2]))].mean;
   }
   return out;
 }
 
-std::vector<float> FaceValues(const std::vector<float>& vertices, const std::vector<uint32_t>& indices, const CellBox& box)
+std::vector<float> FaceValues(
+  const std::vector<float>& vertices, const std::vector<uint32_t>& indices, const CellBox& box)
 {
   std::vector<float> out(indices.size() / 3, std::numeric_limits<float>::quiet_NaN());
   if (box.tables.empty())

@@ -79,7 +79,7 @@ private:
   std::vector<ValueFilter> Wanted;
   int32_t AtStep = -1;
   std::vector<int> TableIndices;
-  std::vector<std::vector<ValueRange>> Blocks; ///< per filter; empty in files without them
+  std::vector<std::vector<ValueRange>> Blocks;        ///< per filter; empty in files without them
   std::vector<std::vector<BlockSummary>> LayerBlocks; ///< per filter; empty in files without them
 };
 
@@ -117,7 +117,8 @@ struct CellBox
   float At(std::size_t table, int64_t i, int64_t j, int64_t k) const
   {
     const int64_t w = this->hi[0] - this->lo[0] + 1, h = this->hi[1] - this->lo[1] + 1;
-    return this->tables[table][static_cast<std::size_t>((i - this->lo[0]) + w * ((j - this->lo[1]) + h * (k - this->lo[2])))];
+    return this
+      ->tables[table][static_cast<std::size_t>((i - this->lo[0]) + w * ((j - this->lo[1]) + h * (k - this->lo[2])))];
   }
 };
 
@@ -137,6 +138,7 @@ std::vector<float> FaceMeans(const std::vector<float>& vertices, const std::vect
 
 /// One value a triangle of `vertices`/`indices` (RegionDrawBuffers' layout): the painted
 /// table's value of the cell under the triangle's centroid, from `box` (NaN outside it).
-std::vector<float> FaceValues(const std::vector<float>& vertices, const std::vector<uint32_t>& indices, const CellBox& box);
+std::vector<float> FaceValues(
+  const std::vector<float>& vertices, const std::vector<uint32_t>& indices, const CellBox& box);
 
 } // namespace resmr

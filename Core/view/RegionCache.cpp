@@ -304,8 +304,7 @@ RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::si
     // A property filter: a leaf it crosses is masked by its cells' values, a coarse region it
     // crosses by layer blocks (within the region's filter error), a region it leaves whole by
     // range.
-    const RangeClass valueClass =
-      filter->HasValues() ? filter->values->Classify(footprint, 1) : RangeClass::Inside;
+    const RangeClass valueClass = filter->HasValues() ? filter->values->Classify(footprint, 1) : RangeClass::Inside;
     const bool leaf = file.Regions()[region].level >= file.Header().leafLevel;
     CellBox box;
     if (valueClass != RangeClass::Inside && leaf)

@@ -54,9 +54,9 @@
 #pragma once
 
 #include "CellRange.h"
-#include "PropertyFilter.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
+#include "PropertyFilter.h"
 
 #include <array>
 #include <chrono>

@@ -204,8 +204,8 @@ int CheckTables(const MultiresolutionFile& geometry, const PropertyFile& propert
     const std::vector<ValueRange> blocks = properties.ReadBlockRanges(t);
     const auto counts = properties.BlockCounts();
     CHECK(blocks.size() == std::size_t(counts[0] * counts[1]));
-    std::vector<ValueRange> want(blocks.size(),
-      ValueRange{ std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity() });
+    std::vector<ValueRange> want(
+      blocks.size(), ValueRange{ std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity() });
     for (int64_t n = 0; n < layer * dims[2]; ++n)
     {
       if (!grid.IsActive(n))

@@ -2020,12 +2020,13 @@ void TestValueFilters(const Model& model)
 {
   const std::string properties = Temp + "/synth.resmrp";
   std::remove(properties.c_str());
-  CHECK(Run(Tool + " add-properties '" + model.path + "' synth:96x80x10:5:1 -o '" + properties + "' > /dev/null 2>&1") == 0);
+  CHECK(Run(Tool + " add-properties '" + model.path + "' synth:96x80x10:5:1 -o '" + properties +
+          "' > /dev/null 2>&1") == 0);
   const auto file = std::make_shared<const PropertyFile>(properties);
   const auto& header = model.file->Header();
   const std::array<int64_t, 3> dims{ header.dims[0], header.dims[1], header.dims[2] };
-  const std::vector<float> all = file->ReadBox(static_cast<std::size_t>(FindFilterTable(*file, "PORO", 0)),
-    { 0, 0, 0 }, { dims[0] - 1, dims[1] - 1, dims[2] - 1 });
+  const std::vector<float> all = file->ReadBox(static_cast<std::size_t>(FindFilterTable(*file, "PORO", 0)), { 0, 0, 0 },
+    { dims[0] - 1, dims[1] - 1, dims[2] - 1 });
   const auto value = [&](int64_t i, int64_t j, int64_t k) {
     return all[static_cast<std::size_t>(i + dims[0] * (j + dims[1] * k))];
   };
@@ -2049,8 +2050,10 @@ void TestValueFilters(const Model& model)
       const auto& f = footprints[r];
       bool any = false, every = true;
       for (int64_t k = 0; k < dims[2]; ++k)
-        for (int64_t j = std::max<int64_t>(0, int64_t(f[2]) - 1); j < std::min<int64_t>(dims[1], int64_t(std::ceil(f[3])) + 1); ++j)
-          for (int64_t i = std::max<int64_t>(0, int64_t(f[0]) - 1); i < std::min<int64_t>(dims[0], int64_t(std::ceil(f[1])) + 1); ++i)
+        for (int64_t j = std::max<int64_t>(0, int64_t(f[2]) - 1);
+             j < std::min<int64_t>(dims[1], int64_t(std::ceil(f[3])) + 1); ++j)
+          for (int64_t i = std::max<int64_t>(0, int64_t(f[0]) - 1);
+               i < std::min<int64_t>(dims[0], int64_t(std::ceil(f[1])) + 1); ++i)
           {
             const float v = value(i, j, k);
             if (std::isnan(v))
@@ -2066,7 +2069,8 @@ void TestValueFilters(const Model& model)
     // cells widened by a layer block.
     for (std::size_t r = 0; r < model.file->Regions().size(); ++r)
     {
-      if (model.file->Regions()[r].level >= header.leafLevel || cells.values->Classify(footprints[r], 1) != RangeClass::Crossed)
+      if (model.file->Regions()[r].level >= header.leafLevel ||
+        cells.values->Classify(footprints[r], 1) != RangeClass::Crossed)
         continue;
       const RegionMesh original = model.file->ReadRegion(r);
       RegionMesh masked = original;
@@ -2107,7 +2111,8 @@ void TestValueFilters(const Model& model)
       if (cells.values->Classify(footprints[leaf], 1) != RangeClass::Crossed)
         continue;
       ++crossedLeaves;
-      const RegionDrawBuffers buffers = LoadRegionDrawBuffers(*model.file, leaf, { 0, 0, 0 }, handedness, -1, true, &cells);
+      const RegionDrawBuffers buffers =
+        LoadRegionDrawBuffers(*model.file, leaf, { 0, 0, 0 }, handedness, -1, true, &cells);
       CHECK(buffers.faceValues.size() == buffers.indices.size() / 3);
       std::set<std::array<int64_t, 3>> shown;
       for (std::size_t t = 0; t < buffers.indices.size() / 3 && t < buffers.faceValues.size(); ++t)
