@@ -57,7 +57,6 @@ int vtkMultiresolutionExtractSubset::RequestData(
   {
     return 0;
   }
-  output->ShallowCopy(input);
   int box[6];
   std::copy(this->VOI, this->VOI + 6, box);
   // Chained filters: the intersection of their boxes.
@@ -77,12 +76,19 @@ int vtkMultiresolutionExtractSubset::RequestData(
   {
     range->SetValue(n, box[n]);
   }
+  PassWithFieldArray(input, output, range);
+  return 1;
+}
+
+void vtkMultiresolutionExtractSubset::PassWithFieldArray(
+  vtkPolyData* input, vtkPolyData* output, vtkAbstractArray* array)
+{
+  output->ShallowCopy(input);
   vtkNew<vtkFieldData> fields;
   fields->ShallowCopy(input->GetFieldData()); // the input's own field data stays unchanged
-  fields->RemoveArray(RangeArrayName());
-  fields->AddArray(range);
+  fields->RemoveArray(array->GetName());
+  fields->AddArray(array);
   output->SetFieldData(fields);
-  return 1;
 }
 
 void vtkMultiresolutionExtractSubset::PrintSelf(ostream& os, vtkIndent indent)

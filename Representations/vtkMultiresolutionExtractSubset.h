@@ -17,6 +17,9 @@
 #include "ResMRRepresentationsModule.h"
 #include "vtkPolyDataAlgorithm.h"
 
+class vtkAbstractArray;
+class vtkPolyData;
+
 class RESMRREPRESENTATIONS_EXPORT vtkMultiresolutionExtractSubset : public vtkPolyDataAlgorithm
 {
 public:
@@ -26,6 +29,10 @@ public:
 
   /// The field array holding the range: 6 ints, I0 I1 J0 J1 K0 K1 from 1, inclusive.
   static const char* RangeArrayName() { return "ResMR Cell Range"; }
+
+  /// What the descriptor's filters output: `input` with `array` in place of its field array of
+  /// the same name (the input's own field data stays unchanged).
+  static void PassWithFieldArray(vtkPolyData* input, vtkPolyData* output, vtkAbstractArray* array);
 
   /// The box: I from VOI[0] to VOI[1], J from VOI[2] to VOI[3], K from VOI[4] to VOI[5],
   /// from 1 and inclusive. By default every cell.

@@ -1,5 +1,7 @@
 #include "vtkMultiresolutionThreshold.h"
 
+#include "vtkMultiresolutionExtractSubset.h"
+
 #include "vtkDataArray.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkFieldData.h"
@@ -30,7 +32,6 @@ int vtkMultiresolutionThreshold::RequestData(
   {
     return 0;
   }
-  output->ShallowCopy(input);
   // The descriptor's cell arrays are the property file's (two cells: the step's range).
   vtkDataArray* array = this->GetInputArrayToProcess(0, inputVector);
   const char* name = array ? array->GetName() : nullptr;
@@ -50,11 +51,7 @@ int vtkMultiresolutionThreshold::RequestData(
   vtkNew<vtkStringArray> filters;
   filters->SetName(FilterArrayName());
   filters->InsertNextValue(lines);
-  vtkNew<vtkFieldData> fields;
-  fields->ShallowCopy(input->GetFieldData()); // the input's own field data stays unchanged
-  fields->RemoveArray(FilterArrayName());
-  fields->AddArray(filters);
-  output->SetFieldData(fields);
+  vtkMultiresolutionExtractSubset::PassWithFieldArray(input, output, filters);
   return 1;
 }
 
