@@ -43,7 +43,7 @@ std::string vtkMultiresolutionShaderVariants::FragmentSource(const Painting& pai
     flag(painting.layerView) + "\n#define LOG_SCALE " + flag(painting.logScale) + "\n#define GRID_LINES " +
     flag(painting.gridLines) + "\n#define SPECULAR " + flag(painting.specular) + "\n#define TABLE_NORMALS " +
     flag(painting.tableNormals) + "\n#define WALL_DEPTHS " + flag(painting.wallDepths) + "\n#define LIGHTING " +
-    std::to_string(painting.lighting) + "\n";
+    std::to_string(painting.lighting) + "\n#define CELL_FILTER " + flag(painting.cellFilter) + "\n";
   ReplaceTag(source, "//RESMR::LightUniforms\n", painting.lighting > 0 ? lightUniforms + "\n" : "");
   ReplaceTag(source, "//RESMR::Lights\n", LightTerms(painting.lighting, painting.lightCount));
   const std::string versionLine = "//VTK::System::Dec\n";
@@ -56,7 +56,8 @@ vtkShaderProgram* vtkMultiresolutionShaderVariants::Ready(
 {
   const long key = painting.colorMode | (painting.layerView ? 4 : 0) | (painting.logScale ? 8 : 0) |
     (painting.gridLines ? 16 : 0) | (painting.specular ? 32 : 0) | (long(painting.lighting) << 6) |
-    (long(painting.lightCount) << 8) | (painting.tableNormals ? 1L << 40 : 0) | (painting.wallDepths ? 1L << 41 : 0);
+    (long(painting.lightCount) << 8) | (painting.tableNormals ? 1L << 40 : 0) | (painting.wallDepths ? 1L << 41 : 0) |
+    (painting.cellFilter ? 1L << 42 : 0);
   auto found = this->Sources.find(key);
   if (found == this->Sources.end())
   {

@@ -25,6 +25,7 @@ public:
     bool specular = false;
     bool tableNormals = false; ///< tops and bottoms only, lit by the normal table
     bool wallDepths = false;   ///< side fragments find their layer in the wall depth table
+    bool cellFilter = false;   ///< an I/J/K range or property filter: cut planes, face values
     int lighting = 0;          ///< vtkOpenGLRenderer's lighting complexity (0: unlit)
     int lightCount = 0;        ///< the renderer's lights switched on
   };

@@ -1092,6 +1092,7 @@ vtkShaderProgram* vtkMultiresolutionSurfaceMapper::ReadyProgram(Frame& frame, in
   painting.specular = painting.lighting > 0 && look->GetSpecular() > 0;
   painting.tableNormals = tableNormals;
   painting.wallDepths = !tableNormals && frame.layer < 0 && in.Tables.WallsReady();
+  painting.cellFilter = frame.ranged;
   frame.lit = painting.lighting > 0;
   vtkShaderProgram* ready =
     in.Shaders.Ready(frame.window, painting, painting.lighting > 0 ? lights->GetLightingUniforms() : nullptr);

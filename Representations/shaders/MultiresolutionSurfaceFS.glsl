@@ -17,8 +17,10 @@
 // The mapper compiles one variant per painting mode, with these defined (0 or 1):
 // COLOR_MODE (0: solid colour, 1: property, 2: cell id, 3: the pick pass's cell (i, j, k)), LAYER_VIEW (one layer drawn),
 // LOG_SCALE, GRID_LINES, SPECULAR, TABLE_NORMALS (tops and bottoms lit by the normal
-// table), WALL_DEPTHS (side fragments find their layer from their depth, below), and LIGHTING (0: unlit, 1: headlight, 2: directional
-// lights, 3: positional lights, as vtkOpenGLRenderer's lighting complexity), with the
+// table), WALL_DEPTHS (side fragments find their layer from their depth, below), CELL_FILTER
+// (an I/J/K range or a property filter: cut planes and face values), and LIGHTING (0: unlit,
+// 1: headlight, 2: directional lights, 3: positional lights, as vtkOpenGLRenderer's lighting
+// complexity), with the
 // renderer's light uniforms declared and one call a light generated at //RESMR::Lights.
 // A software rasterizer (llvmpipe) runs both sides of every branch on a uniform, masked;
 // compiled out, the unused paths cost nothing (a tenth of a full-screen frame there), and
@@ -345,16 +347,19 @@ void main()
     bool waiting = false;
 #else
     float value = texelFetch(propertyTable, slot, 0).r;
+    bool waiting = false;
+#if CELL_FILTER
     // A cut's cells from its plane's values: in the NaN colour until they are loaded, never
     // in the colour of the cell the hash would name.
     int plane = CutPlane(cell);
-    bool waiting = plane >= 0 && (cutReady / (1 << max(plane, 0))) % 2 == 0;
+    waiting = plane >= 0 && (cutReady / (1 << max(plane, 0))) % 2 == 0;
     value = plane >= 0 ? CutValue(plane, cell) : value;
     if (faceValuesOn == 1)
     {
       value = texelFetch(faceValues, primitiveBase + gl_PrimitiveID).r;
       waiting = false;
     }
+#endif
 #endif
     if (waiting || isnan(value))
     {
