@@ -471,19 +471,35 @@ std::vector<float> PropertyFile::ReadBox(
   const int64_t nx = this->Dims[0], width = hi[0] - lo[0] + 1, rows = hi[1] - lo[1] + 1;
   std::vector<float> box;
   box.reserve(static_cast<std::size_t>(width * rows * (hi[2] - lo[2] + 1)));
+  CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
   for (int64_t k = lo[2]; k <= hi[2]; ++k)
   {
     for (int64_t b = lo[1] / this->RowsInBand; b <= hi[1] / this->RowsInBand; ++b)
     {
       std::string place;
       const ChunkRef& ref = this->Band(t, k, b, place);
-      const auto values = this->ReadValues(ref, static_cast<uint64_t>(nx * this->RowsIn(b)), place);
       const int64_t first = std::max(lo[1], b * this->RowsInBand);
       const int64_t last = std::min(hi[1], b * this->RowsInBand + this->RowsIn(b) - 1);
+      // The band decoded up to the box's last row only, its CRC checked the first time (as
+      // ReadCell): a leaf region's box is a few rows of a band.
+      bool verified = false;
+      {
+        const std::lock_guard<std::mutex> lock(this->VerifiedLock);
+        verified = this->Verified.count(ref.offset) != 0;
+      }
+      const uint64_t bytes = static_cast<uint64_t>((last - b * this->RowsInBand + 1) * nx) * 4;
+      const auto raw = DecompressChunkPrefix(this->Data, this->Size, ref, bytes, place, !verified);
+      if (!verified)
+      {
+        const std::lock_guard<std::mutex> lock(this->VerifiedLock);
+        this->Verified.insert(ref.offset);
+      }
       for (int64_t j = first; j <= last; ++j)
       {
-        const auto row = values.begin() + static_cast<std::ptrdiff_t>((j - b * this->RowsInBand) * nx + lo[0]);
-        box.insert(box.end(), row, row + width);
+        const std::size_t at = static_cast<std::size_t>(((j - b * this->RowsInBand) * nx + lo[0]) * 4);
+        const std::size_t before = box.size();
+        box.resize(before + static_cast<std::size_t>(width));
+        std::memcpy(box.data() + before, raw.data() + at, static_cast<std::size_t>(width) * 4);
       }
     }
   }

@@ -123,7 +123,8 @@ public:
   /// before version 4.
   std::vector<BlockSummary> ReadLayerBlocks(std::size_t table) const;
   /// The values of a box of cells, [lo, hi] inclusive and 0-based, i fastest, then j, then k:
-  /// one band a layer for each band the box's rows reach.
+  /// each band the box's rows reach in each layer, decoded up to the box's last row (its CRC
+  /// checked the first time a band is read, as ReadCell).
   std::vector<float> ReadBox(
     std::size_t table, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) const;
   /// The packed table (m0 m1 m2 values, Sec. 5.4).
@@ -164,7 +165,7 @@ private:
   uint32_t FormatVersion = 0;
   std::vector<PropertyTable> Entries;
   mutable std::mutex VerifiedLock;
-  mutable std::unordered_set<uint64_t> Verified; ///< offsets of layer chunks whose CRC held (ReadCell)
+  mutable std::unordered_set<uint64_t> Verified; ///< offsets of layer chunks whose CRC held (ReadCell, ReadBox)
 };
 
 /// Writes a .resmrp file for `geometry` under a temporary name; Commit() puts it in place.
