@@ -54,6 +54,7 @@ for (name, grid), (variant, options, watertight) in [(m, b) for m in MODELS for 
     path = os.path.join(temp, name + ("-" + variant if variant else "") + ".resmr")
     if not os.path.exists(path):
         rt.run_resmr("build", grid, "-o", path, "--quiet", *options)
+    if not os.path.exists(path + "p"):
         rt.run_resmr("add-properties", path, grid)
     # Each cell's PORO by natural index (NaN where inactive), from the grid reader.
     grid_data = servermanager.Fetch(simple.EGRIDReader(FileName=grid, ApplyMapAxes=0))

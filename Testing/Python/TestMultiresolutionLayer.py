@@ -73,8 +73,8 @@ for name, grid_path in models():
     resmr_path = os.path.join(temp, name + ".resmr")
     if not os.path.exists(resmr_path):
         run("build", grid_path, "-o", resmr_path, "--quiet")
-        if name == "reek":
-            run("add-properties", resmr_path, grid_path)
+    if name == "reek" and not os.path.exists(resmr_path + "p"):
+        run("add-properties", resmr_path, grid_path)
     stock_reader = simple.EGRIDReader(FileName=grid_path)
     stock_reader.UpdatePipeline()
     grid = servermanager.Fetch(stock_reader)

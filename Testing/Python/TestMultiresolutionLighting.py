@@ -70,6 +70,7 @@ for name, grid_path in MODELS:
     resmr_path = os.path.join(temp, name + ".resmr")
     if not os.path.exists(resmr_path):
         rt.run_resmr("build", grid_path, "-o", resmr_path, "--quiet")
+    if not os.path.exists(resmr_path + "p"):
         rt.run_resmr("add-properties", resmr_path, grid_path)
     stock_reader = simple.EGRIDReader(FileName=grid_path, ApplyMapAxes=0)
     stock_reader.UpdatePipeline()
