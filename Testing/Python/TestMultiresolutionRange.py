@@ -181,22 +181,13 @@ for name, grid_path in models():
         failures.append(f"{name}: VOI sliders {voi_range}")
     if name == "reek":
         check_stock_warnings(reader, subset, stock_reader)
-    ours = simple.Show(subset, view)
-    ours.PaintBy = "Cell Id"
-    ours.GridLines = 0
-    ours.PixelTolerance = 0
-    ours.WaitForDetailMs = 120000
-    unlit(ours)
+    ours = rt.show_cell_ids(subset, view)
     shown = [subset]
 
     for tag, voi in ranges(nx, ny, nk):
         subset.VOI = voi
         stock_source = stock_range(ids, voi)
-        stock = simple.Show(stock_source, view)
-        stock.SetRepresentationType("Surface")
-        simple.ColorBy(stock, ("CELLS", "CellIdColor"))
-        stock.MapScalars = 0
-        unlit(stock)
+        rt.show_stock_cell_ids(stock_source, view)
         shown.append(stock_source)
         same = covered = 0
         for camera_name, direction, zoom in cameras:
@@ -266,12 +257,7 @@ for name, grid_path in models():
     second = simple.MultiresolutionExtractSubset(Input=subset)
     second.VOI = [1, nx, 1, ny, 1, 2]
     made.append(second)
-    chained = simple.Show(second, view)
-    chained.PaintBy = "Cell Id"
-    chained.GridLines = 0
-    chained.PixelTolerance = 0
-    chained.WaitForDetailMs = 120000
-    unlit(chained)
+    chained = rt.show_cell_ids(second, view)
     simple.Hide(subset, view)
     rt.place_camera(view, bounds, 1.0, cameras[0][1], cameras[0][2])
     simple.Render(view)

@@ -195,12 +195,7 @@ for name, grid_path in rt.image_models(args.data, temp):
     print(f"{name}: {nx} x {ny} x {nk}; Scalars offered {listed}")
     if "PORO" not in listed or (dynamic and dynamic not in listed):
         failures.append(f"{name}: Scalars offers {listed}")
-    ours = simple.Show(threshold, view)
-    ours.PaintBy = "Cell Id"
-    ours.GridLines = 0
-    ours.PixelTolerance = 0
-    ours.WaitForDetailMs = 120000
-    unlit(ours)
+    ours = rt.show_cell_ids(threshold, view)
     shown = [threshold]
 
     cases = [("poro", "PORO", 0.5, 1.0, times[0], None)]
@@ -223,20 +218,11 @@ for name, grid_path in rt.image_models(args.data, temp):
             subset = simple.MultiresolutionExtractSubset(Input=threshold)
             subset.VOI = voi
             made.append(subset)
-            chained = simple.Show(subset, view)
-            chained.PaintBy = "Cell Id"
-            chained.GridLines = 0
-            chained.PixelTolerance = 0
-            chained.WaitForDetailMs = 120000
-            unlit(chained)
+            chained = rt.show_cell_ids(subset, view)
             shown.append(subset)
             ours_proxy = subset
         stock_source = stock_threshold(id_source, array_name, low, high, voi)
-        stock = simple.Show(stock_source, view)
-        stock.SetRepresentationType("Surface")
-        simple.ColorBy(stock, ("CELLS", "CellIdColor"))
-        stock.MapScalars = 0
-        unlit(stock)
+        rt.show_stock_cell_ids(stock_source, view)
         shown.append(stock_source)
         kept, _ = cell_values(stock_source, array_name)
         label = f"{name}-{tag}"

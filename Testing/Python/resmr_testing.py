@@ -307,6 +307,31 @@ def image_models(data, temp):
     ]
 
 
+def show_cell_ids(proxy, view):
+    """Shows a Multiresolution Surface `proxy` in its exact Cell Id colouring (0 px, no grid
+    lines, unlit, waiting for full detail); returns the display."""
+    from paraview import simple
+    display = simple.Show(proxy, view)
+    display.PaintBy = "Cell Id"
+    display.GridLines = 0
+    display.PixelTolerance = 0
+    display.WaitForDetailMs = 120000
+    unlit(display)
+    return display
+
+
+def show_stock_cell_ids(source, view):
+    """Shows a stock source carrying CellIdColor (stock_cell_id_filter) as a surface in those
+    colours, unlit; returns the display."""
+    from paraview import simple
+    display = simple.Show(source, view)
+    display.SetRepresentationType("Surface")
+    simple.ColorBy(display, ("CELLS", "CellIdColor"))
+    display.MapScalars = 0
+    unlit(display)
+    return display
+
+
 def unlit(display):
     """Ambient light only: colours come out as the lookup table or cell-id colouring gives them."""
     display.Ambient = 1.0
