@@ -12,6 +12,7 @@ its Cell Id mode, from 4 cameras. Checks:
 - every pixel of ours names a cell stock's Threshold keeps (or, in Cell Id mode, lies on the
   edge of a kept neighbour's face);
 - no background pixel of ours where stock covers the pixel and its 8 neighbours;
+- with Layer 3, every pixel of ours names a kept cell of layer 3;
 - at a tolerance of 8 px, every pixel of ours still names a cell the filter keeps; at 32 px
   (these models' crossed regions still their leaves: a block is wider than 32 px here) every
   inner pixel of stock's covered and >= 99.9% of ours naming a kept cell; at 128 px (crossed
@@ -244,6 +245,21 @@ for name, grid_path in rt.image_models(args.data, temp):
                       f"away from a kept neighbour's edge ({at_edges} in all)")
                 if failing or not np.any(got > 0):
                     failures.append(f"{label} at 8 px {camera_name}: {failing} pixels name removed cells")
+            # With Layer set, that layer's passing cells.
+            ours.Layer = 3
+            rt.place_camera(view, bounds, 1.0, CAMERAS[0][1], CAMERAS[0][2])
+            simple.Render(view)
+            got = rt.cell_ids(capture(f"{label}-layer3.png"))
+            named = got[got > 0].astype(np.int64) - 1
+            off_layer = int(np.sum(named // (dims[0] * dims[1]) != 2))
+            failing, at_edges = removed_pixels(got, kept)
+            in_layer = int(np.sum((np.asarray(kept, dtype=np.int64) - 1) // (dims[0] * dims[1]) == 2))
+            print(f"{label}, Layer 3: {named.size} pixels ({in_layer} cells kept in it), {off_layer} off the layer, "
+                  f"{failing} name removed cells "
+                  f"away from a kept neighbour's edge ({at_edges} in all)")
+            if off_layer or failing or (in_layer and named.size == 0):
+                failures.append(f"{label} with Layer 3: {named.size} pixels, {off_layer} off the layer, {failing} removed")
+            ours.Layer = 0
             # Coarser: regions the filter crosses drawn coarse, masked by layer blocks (cells
             # widened in I and J, never one that passes left out): the real image error.
             show_only(stock_source)
