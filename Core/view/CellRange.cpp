@@ -73,18 +73,10 @@ std::array<float, 4> RegionFootprint(const RegionMesh& mesh)
     return box; // lies nowhere
   }
   float widest = 0;
-  for (const auto& corners : mesh.corners)
+  for (std::size_t c = 0; c < mesh.corners.size(); ++c)
   {
-    std::array<float, 2> low = mesh.topology[corners[0]], high = low;
-    for (const uint32_t node : corners)
-    {
-      for (int a = 0; a < 2; ++a)
-      {
-        low[a] = std::min(low[a], mesh.topology[node][a]);
-        high[a] = std::max(high[a], mesh.topology[node][a]);
-      }
-    }
-    widest = std::max({ widest, high[0] - low[0], high[1] - low[1] });
+    const std::array<float, 4> column = ColumnTopologyBox(mesh, c);
+    widest = std::max({ widest, column[1] - column[0], column[3] - column[2] });
   }
   const float margin = std::ceil(widest) + 1;
   return { box[0] - margin, box[1] + margin, box[2] - margin, box[3] + margin };
@@ -111,6 +103,21 @@ RangeClass ClassifyFootprint(
     inside = inside && from >= low + insideMargin && to <= high - insideMargin;
   }
   return inside ? RangeClass::Inside : RangeClass::Crossed;
+}
+
+std::array<float, 4> ColumnTopologyBox(const RegionMesh& mesh, std::size_t column)
+{
+  const auto& first = mesh.topology[mesh.corners[column][0]];
+  std::array<float, 4> box{ first[0], first[0], first[1], first[1] };
+  for (const uint32_t node : mesh.corners[column])
+  {
+    for (int a = 0; a < 2; ++a)
+    {
+      box[2 * a] = std::min(box[2 * a], mesh.topology[node][a]);
+      box[2 * a + 1] = std::max(box[2 * a + 1], mesh.topology[node][a]);
+    }
+  }
+  return box;
 }
 
 std::array<double, 2> ColumnCentreOf(const RegionMesh& mesh, std::size_t column)

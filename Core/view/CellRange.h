@@ -80,6 +80,8 @@ void MaskToRange(RegionMesh& mesh, const CellRange& range);
 /// centre mirrored through the edge's midpoint, same layer; column: AcrossCutEdge).
 constexpr std::size_t AcrossCutEdge = ~std::size_t(0);
 void MaskCells(RegionMesh& mesh, const std::function<bool(const std::array<double, 2>&, int64_t, std::size_t)>& keep);
+/// The box of a column's four nodes' topological coordinates: ti min, ti max, tj min, tj max.
+std::array<float, 4> ColumnTopologyBox(const RegionMesh& mesh, std::size_t column);
 /// The mean of a column's four nodes' topological coordinates.
 std::array<double, 2> ColumnCentreOf(const RegionMesh& mesh, std::size_t column);
 

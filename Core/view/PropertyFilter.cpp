@@ -158,20 +158,12 @@ void MaskToFilter(RegionMesh& mesh, const CellFilter& filter, const CellBox* box
   std::vector<std::array<int64_t, 4>> columnCells;
   for (std::size_t c = 0; values && !box && c < mesh.corners.size(); ++c)
   {
-    std::array<float, 2> low = mesh.topology[mesh.corners[c][0]], high = low;
-    for (const uint32_t node : mesh.corners[c])
-    {
-      for (int a = 0; a < 2; ++a)
-      {
-        low[a] = std::min(low[a], mesh.topology[node][a]);
-        high[a] = std::max(high[a], mesh.topology[node][a]);
-      }
-    }
+    const std::array<float, 4> column = ColumnTopologyBox(mesh, c);
     const auto cell = [&](float t, int a) {
       return std::clamp<int64_t>(static_cast<int64_t>(std::floor(t)), 0, dims[a] - 1);
     };
     columnCells.push_back(
-      { cell(low[0], 0), cell(std::ceil(high[0]) - 1, 0), cell(low[1], 1), cell(std::ceil(high[1]) - 1, 1) });
+      { cell(column[0], 0), cell(std::ceil(column[1]) - 1, 0), cell(column[2], 1), cell(std::ceil(column[3]) - 1, 1) });
   }
   MaskCells(mesh, [&](const std::array<double, 2>& at, int64_t k, std::size_t column) {
     const double fi = std::floor(at[0]), fj = std::floor(at[1]);
