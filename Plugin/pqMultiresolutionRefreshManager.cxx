@@ -16,9 +16,14 @@
 
 namespace
 {
-// Long enough to let the loader thread land a few meshes between frames, short enough that
+// Long enough to let the loader threads land a few meshes between frames, short enough that
 // detail streams in visibly.
 constexpr int RefreshDelayMs = 30;
+// At a fixed tolerance, a refresh also waits as long as the last frame took, up to this: a
+// software rasterizer's frame of a million triangles takes a few hundred ms of every core,
+// and such frames back to back left the loaders (below the render thread's priority) almost
+// nothing; waiting a frame's time leaves them at least half the machine.
+constexpr int LongestRefreshDelayMs = 1000;
 // A frame lowering the tolerance by less than this counts as settled (the controller's
 // smallest refining step is 2%).
 constexpr double RefiningStep = 0.99;
@@ -105,6 +110,10 @@ void pqMultiresolutionRefreshManager::onRenderEnded()
       previous->Triangles != readout.Triangles || previous->Substituted != readout.Substituted;
     // A moving frame drawn at a reduced resolution: the still frame after it is drawn in full.
     again = again || readout.LoadsPending || (readout.Substituted > 0 && changed) || readout.RenderScale < 1;
+    if (readout.TargetFrameRate <= 0 && readout.LoadsPending)
+    {
+      delayMs = std::max(delayMs, std::min(LongestRefreshDelayMs, static_cast<int>(readout.FrameMs)));
+    }
     if (readout.TargetFrameRate > 0)
     {
       // The controller counts the gap between back-to-back frames as frame time: keep it

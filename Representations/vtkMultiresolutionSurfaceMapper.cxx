@@ -1156,7 +1156,8 @@ void vtkMultiresolutionSurfaceMapper::UploadMeshes(Frame& frame)
   // takes), in bytes and in predicted time, since fresh GPU memory costs far more than reused
   // memory; the tables' copies count against it.
   Internals& in = *this->Internal;
-  in.Pacer.BeginFrame(resmr::UploadBudgetMs(this->TargetFrameRate), resmr::UploadBytesPerFrame);
+  const double uploadMs = resmr::UploadBudgetMs(this->TargetFrameRate, in.FrameMs);
+  in.Pacer.BeginFrame(uploadMs, resmr::UploadByteCap(uploadMs));
   in.Pacer.Spend(frame.tableBytes, ElapsedMs(frame.tablesStart));
   std::vector<std::size_t> order = in.Selector->Roots();
   order.insert(order.end(), frame.selection.wanted.begin(), frame.selection.wanted.end());

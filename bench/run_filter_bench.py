@@ -9,8 +9,10 @@ default 1 px tolerance and a 1024 MB budget, from an oblique overview, through M
 Extract Subset and then Multiresolution Threshold. Each filter change below is measured as:
 - first image: the wall time of the first render after the change, waiting for no detail
   (what a user sees first);
-- full detail: renders back to back (none waiting for detail) until no load is pending, the
-  wall time from the change to the first render with nothing pending;
+- full detail: renders at the GUI's refresh cadence (none waiting for detail; the next one as
+  long after the last as that frame took, at least 30 ms, as ParaView's view is refreshed while
+  the loaders stream) until no load is pending, the wall time from the change to the first
+  render with nothing pending;
 - memory: the surface's resident MB (CPU buffers + GPU copies) against the budget, and the
   regions standing in for descendants the budget left out (RegionsSubstituted: 0 when the
   picture is the tolerance's).
@@ -92,6 +94,7 @@ def measure_change(view, display, change, row):
     first_regions = readout(display, "RegionsDrawn")
     renders = 1
     while readout(display, "LoadsPending") and time.perf_counter() - start < 600:
+        time.sleep(min(1.0, max(0.03, readout(display, "LastFrameMs") / 1000)))
         simple.Render(view)
         renders += 1
     row.update({

@@ -2,13 +2,25 @@
 #include "FramePlanning.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace resmr
 {
 
-double UploadBudgetMs(double targetFramesPerSecond)
+double UploadBudgetMs(double targetFramesPerSecond, double previousFrameMs)
 {
-  return targetFramesPerSecond > 0 ? UploadShareOfFrame * 1000 / targetFramesPerSecond : UploadMsAtFixedTolerance;
+  if (targetFramesPerSecond > 0)
+  {
+    return UploadShareOfFrame * 1000 / targetFramesPerSecond;
+  }
+  const double previous = std::isfinite(previousFrameMs) ? previousFrameMs : 0.0;
+  return std::max(UploadMsAtFixedTolerance, UploadShareOfPreviousFrame * previous);
+}
+
+std::size_t UploadByteCap(double budgetMs)
+{
+  const double scale = std::isfinite(budgetMs) ? std::max(1.0, budgetMs / UploadMsAtFixedTolerance) : 1.0;
+  return static_cast<std::size_t>(scale * static_cast<double>(UploadBytesPerFrame));
 }
 
 uint32_t SlicesThisFrame(uint32_t slicesLeft, std::size_t sliceBytes, std::size_t& budget, bool unbounded)

@@ -26,12 +26,21 @@ constexpr std::size_t TableBytesPerFrame = std::size_t(4) << 20;
 /// admits a frame's copies a piece at a time.
 constexpr std::size_t PieceBytes = std::size_t(1) << 20;
 /// The time an interactive frame may spend copying meshes (see UploadPacer): a tenth of the
-/// target frame time, or UploadMsAtFixedTolerance at a fixed tolerance.
+/// target frame time; at a fixed tolerance UploadMsAtFixedTolerance, or a share of the previous
+/// frame's time when that is more (ours: a software rasterizer draws a million triangles in a
+/// few hundred ms, and 10 ms of copies behind such frames kept a filtered 100M-cell view
+/// waiting seconds for meshes already loaded; a frame then takes at most about twice its
+/// drawing).
 constexpr double UploadShareOfFrame = 0.1;
 constexpr double UploadMsAtFixedTolerance = 10.0;
+constexpr double UploadShareOfPreviousFrame = 0.5;
 
-/// Milliseconds of copying a frame may spend at `targetFramesPerSecond` (0: fixed tolerance).
-double UploadBudgetMs(double targetFramesPerSecond);
+/// Milliseconds of copying a frame may spend at `targetFramesPerSecond` (0: fixed tolerance),
+/// after a frame of `previousFrameMs`.
+double UploadBudgetMs(double targetFramesPerSecond, double previousFrameMs = 0);
+/// Bytes a frame may copy in `budgetMs`: UploadBytesPerFrame, more in proportion for a budget
+/// above UploadMsAtFixedTolerance.
+std::size_t UploadByteCap(double budgetMs);
 
 /// Slices of a 3D table (`slicesLeft` still to copy, `sliceBytes` each) to copy now: whole
 /// slices while `budget` lasts, at least one if any budget is left, or all when `unbounded`;

@@ -1,5 +1,5 @@
 // Out-of-core loading of region meshes, paper Sec. 6.2-6.3: draw buffers with cell
-// coordinates, and the loader thread with its least-recently-used memory budget.
+// coordinates, and the loader threads with their least-recently-used memory budget.
 #include "RegionCache.h"
 
 #ifdef __linux__
@@ -500,11 +500,22 @@ RegionCache::RegionCache(std::shared_ptr<const MultiresolutionFile> file,
       this->Pinned.push_back(this->RequestKeyLocked(r, this->CurrentLayer, true));
     }
   }
-  this->Loader = std::thread([this] { this->Run(Role::Idle); });
+  const unsigned loaders = std::clamp(std::thread::hardware_concurrency(), 1u, IdleLoaders);
+  for (unsigned l = 0; l < loaders; ++l)
+  {
+    this->Loaders.emplace_back([this] { this->Run(Role::Idle); });
+  }
 #ifdef __linux__
   {
     std::lock_guard<std::mutex> lock(this->Lock);
-    this->HaveLoaderClock = pthread_getcpuclockid(this->Loader.native_handle(), &this->LoaderClock) == 0;
+    for (std::thread& loader : this->Loaders)
+    {
+      clockid_t clock{};
+      if (pthread_getcpuclockid(loader.native_handle(), &clock) == 0)
+      {
+        this->LoaderClocks.push_back(clock);
+      }
+    }
     this->WindowStart = std::chrono::steady_clock::now();
   }
 #endif
@@ -521,7 +532,10 @@ RegionCache::~RegionCache()
   this->Wake.notify_all();
   this->StandbyWake.notify_all();
   this->Idle.notify_all();
-  this->Loader.join();
+  for (std::thread& loader : this->Loaders)
+  {
+    loader.join();
+  }
   this->Standby.join();
   this->Essential.join();
 }
@@ -1092,7 +1106,7 @@ int64_t RegionCache::NextRegionLocked(bool roots)
     {
       if (!missing(key) || this->Loading.count(key))
       {
-        continue; // loaded, or being read by the other loader
+        continue; // loaded, or being read by another loader
       }
       // An entry refused earlier for the budget is not decoded again while it cannot fit.
       const std::size_t known = this->Entries[key].bytes;
@@ -1195,7 +1209,7 @@ void RegionCache::Run(Role role)
   }
   else if (standby)
   {
-    // The standby only loads while the idle loader is starved (see RescueIfStarvedLocked): an
+    // The standby only loads while the idle loaders are starved (see RescueIfStarvedLocked): an
     // ordinary thread, below the render thread. (An unprivileged thread cannot lower its nice
     // value, so the idle loader cannot be raised instead.)
     setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
@@ -1216,7 +1230,7 @@ void RegionCache::Run(Role role)
     {
       if (role != Role::Essential)
       {
-        // Either loader may see the end of the work (the other's last read in flight ends
+        // Any loader may see the end of the work (another's last read in flight ends
         // it when nothing else is left).
         this->Rescuing = this->Rescuing && this->PendingLocked();
         this->Idle.notify_all();
@@ -1281,20 +1295,28 @@ int64_t RegionCache::NextUrgentLocked() const
 void RegionCache::RescueIfStarvedLocked() const
 {
 #ifdef __linux__
-  // Starved: work waited through a whole window while the idle loader ran for under a tenth
-  // of it (the machine's other processes keep every core busy). A long read that runs does
-  // not count, so the standby does not take a core from the frames for it.
+  // Starved: work waited through a whole window while the idle loaders together ran for under
+  // a tenth of it (the machine's other processes keep every core busy). A long read that runs
+  // does not count, so the standby does not take a core from the frames for it.
   const auto window = this->StarvationWindow;
   const auto now = std::chrono::steady_clock::now();
-  timespec cpu{};
-  if (!this->HaveLoaderClock || clock_gettime(this->LoaderClock, &cpu) != 0)
+  double cpuSeconds = 0;
+  for (const clockid_t clock : this->LoaderClocks)
+  {
+    timespec cpu{};
+    if (clock_gettime(clock, &cpu) != 0)
+    {
+      return;
+    }
+    cpuSeconds += cpu.tv_sec + 1e-9 * cpu.tv_nsec;
+  }
+  if (this->LoaderClocks.empty())
   {
     return;
   }
-  const double cpuSeconds = cpu.tv_sec + 1e-9 * cpu.tv_nsec;
   if (!this->PendingLocked())
   {
-    this->Rescuing = false; // the work is done: the next wait is the idle loader's again
+    this->Rescuing = false; // the work is done: the next wait is the idle loaders' again
   }
   if (this->Rescuing || !this->PendingLocked())
   {
@@ -1496,7 +1518,7 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, 
     this->Entries[key].failed = true; // an earlier range's: nothing asks for it any more
     return;
   }
-  // The essential loader may read again what the starved idle loader holds (NextUrgentLocked):
+  // The essential loader may read again what a starved idle loader holds (NextUrgentLocked):
   // whichever read ends first goes in.
   const bool again = this->Loading.count(key) != 0;
   (again ? this->ReadAgain : this->Loading).insert(key);
@@ -1521,8 +1543,8 @@ void RegionCache::LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, 
   lock.lock();
   // Regions go in in the request's order: one read beside an earlier one waits for it, so
   // that loading stops at the first region that cannot fit, as with one loader. Not for the
-  // idle loader's reads, though: on a busy machine it may not run for seconds, and the
-  // standby and essential loaders waiting on it brought in almost nothing (a 100 s flight of
+  // idle loaders' reads, though: on a busy machine they may not run for seconds, and the
+  // standby and essential loaders waiting on them brought in almost nothing (a 100 s flight of
   // the 100M model with two cores busy held under 60 MB of 512); the earlier region, when it
   // comes, evicts later ones to fit (InsertLocked).
   while (!again && !this->Stopping && this->EarlierWantedLoadingLocked(key, role != Role::Idle))

@@ -1,4 +1,4 @@
-// Out-of-core loading of region meshes, paper Sec. 6.2 (Fig. 10): a loader thread receives
+// Out-of-core loading of region meshes, paper Sec. 6.2 (Fig. 10): loader threads receive
 // each frame's wanted regions, decompresses their meshes from the memory-mapped file,
 // prepares draw buffers and marks them resident; a least-recently-used budget bounds what
 // stays resident. The render thread looks up what is ready; it waits on disk only when it
@@ -36,11 +36,14 @@
 //   most of a coarse region's bytes, and a region whose error shows draws the simplified one.
 // - Property tables (Sec. 5.4: one value a hash slot) load the same way, off the render
 //   thread; the previous table stays current until the new one is ready.
-// - Loading runs on a thread below the render thread (nice 19 on Linux: it takes little of
-//   the cores the frames need). When the machine's other work keeps every core busy, that
-//   thread gets almost nothing; then (work waiting 300 ms, under a tenth of it used, checked
-//   by Request, Pending and WaitIdle) a standby thread at nice 10 loads until nothing is
-//   pending: detail still arrives, a share slower.
+// - Loading runs on threads below the render thread (nice 19 on Linux: they take little of
+//   the cores the frames need), one a core up to IdleLoaders (ours: the paper has one; a
+//   second core then decodes while the first draws or waits, and a filtered view's leaves,
+//   hundreds of them, arrive about twice as fast on two cores). Each holds at most one
+//   region's buffers outside the budget while it reads. When the machine's other work keeps
+//   every core busy, those threads get almost nothing; then (work waiting 300 ms, under a
+//   tenth of it used by them together, checked by Request, Pending and WaitIdle) a standby
+//   thread at nice 10 loads until nothing is pending: detail still arrives, a share slower.
 // - What the picture cannot do without is loaded at the process's own priority, by a third
 //   thread that does nothing else (ours): the topology's handedness, the roots, the model's
 //   tables and a property no earlier step of it stands in for. Without them a frame draws
@@ -198,11 +201,13 @@ struct ModelTables
 class RegionCache
 {
 public:
-  /// Starts the loader thread. `properties` may be null. With `simplifiedSides`, whole-model
+  /// Most loader threads below the render thread (one a core up to this many).
+  static constexpr unsigned IdleLoaders = 4;
+  /// Starts the loader threads. `properties` may be null. With `simplifiedSides`, whole-model
   /// regions above the leaves may be loaded without their exact side (see Request).
   RegionCache(std::shared_ptr<const MultiresolutionFile> file, std::shared_ptr<const PropertyFile> properties,
     std::size_t budgetBytes, bool simplifiedSides = false);
-  ~RegionCache(); ///< stops and joins the loader thread
+  ~RegionCache(); ///< stops and joins the loader threads
   RegionCache(const RegionCache&) = delete;
   RegionCache& operator=(const RegionCache&) = delete;
 
@@ -285,7 +290,7 @@ public:
   std::string LastError() const;
   /// How often the standby loader took over from the idle one (see the contract).
   uint64_t StandbyRescues() const;
-  /// How long work waits, the idle loader almost without CPU, before the standby takes over
+  /// How long work waits, the idle loaders almost without CPU, before the standby takes over
   /// (300 ms by default).
   void SetStarvationWindow(std::chrono::milliseconds window);
 
@@ -306,7 +311,7 @@ private:
   enum class Role
   {
     Idle,     ///< below every other thread (nice 19 on Linux)
-    Standby,  ///< nice 10, only while the idle loader is starved
+    Standby,  ///< nice 10, only while the idle loaders are starved
     Essential ///< the process's priority, only what the picture cannot do without
   };
   /// A loader's loop.
@@ -325,7 +330,7 @@ private:
   void LoadCutPlaneLocked(std::unique_lock<std::mutex>& lock, std::size_t wanted);
   void LoadRegionLocked(std::unique_lock<std::mutex>& lock, Key key, Role role);
   /// For the essential loader, an urgent request's next wanted region: one nobody reads, else
-  /// one the idle loader reads and nobody reads again; -1 if none. Lock held.
+  /// one an idle loader reads and nobody reads again; -1 if none. Lock held.
   int64_t NextUrgentLocked() const;
   /// Work the picture cannot do without is waiting, not being read: the handedness, a root,
   /// the tables, a property table with no earlier step of it standing in, or an urgent
@@ -334,7 +339,7 @@ private:
   /// The current property table is an earlier step of the one wanted, which stands in for
   /// it meanwhile. Lock held.
   bool StandsInLocked() const;
-  /// Sets the standby loading when work has waited a while and the idle loader got almost no
+  /// Sets the standby loading when work has waited a while and the idle loaders got almost no
   /// CPU meanwhile. Lock held.
   void RescueIfStarvedLocked() const;
   /// The next entry to load (roots, then wanted, then predicted), or -1; may mark loading
@@ -379,21 +384,21 @@ private:
   Key RequestKeyLocked(std::size_t region, int32_t layer, bool simplified) const;
   mutable std::mutex Lock;
   mutable std::condition_variable Wake, Idle, StandbyWake;
-  std::thread Loader, Standby, Essential;
+  std::vector<std::thread> Loaders; ///< the idle role's
+  std::thread Standby, Essential;
   std::unordered_set<Key> Loading;     ///< being read by a loader
-  std::unordered_set<Key> IdleLoading; ///< of those, by the idle loader
-  /// Of those, read again by the essential loader for an urgent request: the idle loader may
+  std::unordered_set<Key> IdleLoading; ///< of those, by an idle loader
+  /// Of those, read again by the essential loader for an urgent request: an idle loader may
   /// hold one for seconds on a busy machine, the picture past its floor meanwhile.
   std::unordered_set<Key> ReadAgain;
   bool HandednessKnown = false, TablesLoading = false, PropertyLoading = false;
-  // Starvation of the idle loader (see RescueIfStarvedLocked).
+  // Starvation of the idle loaders (see RescueIfStarvedLocked).
   mutable bool Rescuing = false;
   mutable uint64_t Rescues = 0;
   mutable std::chrono::steady_clock::time_point WindowStart;
   mutable double WindowCpuSeconds = 0;
   std::chrono::milliseconds StarvationWindow{ 300 };
-  bool HaveLoaderClock = false;
-  clockid_t LoaderClock{};
+  std::vector<clockid_t> LoaderClocks; ///< the idle loaders' CPU clocks
   bool Stopping = false;
   std::size_t BudgetBytes = 0;
   std::size_t Bytes = 0;
@@ -417,7 +422,7 @@ private:
   /// Resident, unpinned entries of Wanted from place `first` on, the last first. Lock held.
   std::vector<Key> ResidentWantedFromLocked(std::size_t first) const;
   /// Another loader is reading a region the newest frame wants before `key`; with `passIdle`,
-  /// not counting the idle loader's reads (the machine's other work may starve it for
+  /// not counting the idle loaders' reads (the machine's other work may starve them for
   /// seconds). Lock held.
   bool EarlierWantedLoadingLocked(Key key, bool passIdle) const;
   std::size_t Resident = 0;

@@ -159,6 +159,12 @@ void TestUploadPlan()
 {
   CHECK(UploadBudgetMs(0) == 10);
   CHECK(Near(UploadBudgetMs(20), 5));
+  // A still view behind slow frames (software rendering) copies half a frame's time, in bytes
+  // in proportion; a fast frame keeps the fixed allowance; a frame-rate target ignores both.
+  CHECK(Near(UploadBudgetMs(0, 300), 150) && UploadBudgetMs(0, 12) == 10 && Near(UploadBudgetMs(20, 300), 5));
+  CHECK(UploadBudgetMs(0, std::nan("")) == 10);
+  CHECK(UploadByteCap(10) == UploadBytesPerFrame && UploadByteCap(5) == UploadBytesPerFrame);
+  CHECK(UploadByteCap(150) == 15 * UploadBytesPerFrame);
   CHECK(UploadBytesPerFrame == 8u << 20 && TableBytesPerFrame == 4u << 20 && PieceBytes == 1u << 20);
 
   // Table slabs: 1 MB slices, 4 MB a frame.
