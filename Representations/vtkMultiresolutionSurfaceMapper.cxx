@@ -1113,7 +1113,8 @@ void vtkMultiresolutionSurfaceMapper::StreamTables(Frame& frame)
   // The hash's offsets (once a file, when the loader has read them), then the property table
   // when another is current, then the cells' normals: colours before per-cell lighting.
   Internals& in = *this->Internal;
-  std::size_t budget = resmr::TableBytesPerFrame;
+  const std::size_t cap = resmr::TableByteCap(resmr::UploadBudgetMs(this->TargetFrameRate, in.FrameMs));
+  std::size_t budget = cap;
   frame.tablesStart = std::chrono::steady_clock::now();
   in.Tables.StreamHash(frame.window, *in.Cache, budget, !frame.bounded);
   std::shared_ptr<const resmr::PropertyTableData> loaded = frame.property.wanted ? in.Cache->Property() : nullptr;
@@ -1139,7 +1140,7 @@ void vtkMultiresolutionSurfaceMapper::StreamTables(Frame& frame)
     vtkWarningMacro(<< tables->wallsError << "; walls are painted without it");
     in.WallsWarned = true;
   }
-  frame.tableBytes = resmr::TableBytesPerFrame - budget;
+  frame.tableBytes = cap - budget;
   // The wanted table once on the GPU; until then an earlier time step of the same property
   // and layer stands in (as an ancestor does for a mesh), anything else is drawn in the solid
   // colour rather than through another property's colour map.

@@ -21,7 +21,7 @@ namespace
 {
 constexpr char Magic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'R', 'P' };
 constexpr char TrailerMagic[8] = { 'R', 'E', 'S', 'M', 'R', 'P', 'I', 'X' };
-constexpr uint32_t Version = 4;
+constexpr uint32_t Version = 5;
 constexpr uint32_t OldestVersion = 2; ///< a chunk a layer: read as one band a layer
 constexpr std::size_t HeaderBytes = 128;
 constexpr std::size_t NameBytes = 32;
@@ -45,7 +45,7 @@ ChunkRef GetRef(ByteReader& in)
 }
 
 std::vector<uint8_t> HeaderOf(uint64_t geometry, const std::array<int64_t, 3>& dims,
-  const std::array<uint32_t, 3>& tableSides, uint32_t tables, int64_t bandRows)
+  const std::array<uint32_t, 3>& tableSides, uint32_t tables, int64_t bandRows, int64_t bandColumns)
 {
   ByteWriter head;
   head.PutBytes(Magic, 8);
@@ -55,6 +55,7 @@ std::vector<uint8_t> HeaderOf(uint64_t geometry, const std::array<int64_t, 3>& d
   head.Put(tableSides);
   head.Put(tables);
   head.Put(static_cast<uint32_t>(bandRows));
+  head.Put(static_cast<uint32_t>(bandColumns));
   head.Bytes.resize(HeaderBytes - 4, 0);
   head.Put(Crc32(head.Bytes.data(), head.Bytes.size()));
   return std::move(head.Bytes);
@@ -150,11 +151,6 @@ std::string TableName(const PropertyTable& t)
 }
 } // namespace
 
-int64_t LayerBandRows(int64_t nx, int64_t ny)
-{
-  return std::clamp<int64_t>(LayerBandValues / std::max<int64_t>(nx, 1), 1, std::max<int64_t>(ny, 1));
-}
-
 PropertyFile::PropertyFile(const std::string& path)
   : FilePath(path)
 {
@@ -180,14 +176,17 @@ PropertyFile::PropertyFile(const std::string& path)
     head.Get(this->TableSides);
     const uint32_t tables = head.Get<uint32_t>();
     const uint32_t bandRows = version >= 3 ? head.Get<uint32_t>() : 0;
+    const uint32_t bandColumns = version >= 5 ? head.Get<uint32_t>() : 0;
     this->FormatVersion = version;
     const auto [indexOffset, indexSize] = ReadIndexTrailer(this->Data, this->Size, HeaderBytes, TrailerMagic, path);
-    this->CheckHeader(tables, indexSize, version, bandRows);
+    this->CheckHeader(tables, indexSize, version, bandRows, bandColumns);
     ByteReader index(this->Data + indexOffset, indexSize, path + ": index");
     std::set<std::pair<std::string, int32_t>> seen;
     for (uint32_t t = 0; t < tables; ++t)
     {
+      const uint64_t record = static_cast<uint64_t>(index.Skip(0) - this->Data);
       PropertyTable table = this->ReadTable(index, t, indexOffset);
+      this->BandRefsAt.push_back(record + TableRecordBytes(0, version));
       if (!seen.insert({ table.name, table.step }).second)
       {
         throw FileFormatError(path + ": index table " + std::to_string(t) + " (" + TableName(table) +
@@ -204,9 +203,10 @@ PropertyFile::PropertyFile(const std::string& path)
   }
 }
 
-void PropertyFile::CheckHeader(uint32_t tables, uint64_t indexSize, uint32_t version, uint32_t bandRows)
+void PropertyFile::CheckHeader(
+  uint32_t tables, uint64_t indexSize, uint32_t version, uint32_t bandRows, uint32_t bandColumns)
 {
-  // Sets RowsInBand, which the index's size depends on.
+  // Sets RowsInBand and ColumnsInBand, which the index's size depends on.
   const auto bad = [&](const std::string& field, const std::string& value, const std::string& must) {
     throw FileFormatError(
       this->FilePath + ": header field '" + field + "' is " + value + ", must be " + must + " (corrupt)");
@@ -244,8 +244,13 @@ void PropertyFile::CheckHeader(uint32_t tables, uint64_t indexSize, uint32_t ver
   {
     bad("rows a band", std::to_string(bandRows), "1 to ny (" + std::to_string(this->Dims[1]) + ")");
   }
+  if (version >= 5 && (bandColumns < 1 || bandColumns > this->Dims[0]))
+  {
+    bad("columns a band", std::to_string(bandColumns), "1 to nx (" + std::to_string(this->Dims[0]) + ")");
+  }
   this->RowsInBand = version >= 3 ? static_cast<int64_t>(bandRows) : this->Dims[1];
-  for (std::size_t at = version >= 3 ? 64 : 60; at < HeaderBytes - 4; ++at)
+  this->ColumnsInBand = version >= 5 ? static_cast<int64_t>(bandColumns) : this->Dims[0];
+  for (std::size_t at = version >= 5 ? 68 : version >= 3 ? 64 : 60; at < HeaderBytes - 4; ++at)
   {
     if (this->Data[at] != 0)
     {
@@ -278,12 +283,10 @@ PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t in
     table.blockRanges = GetRef(index);
     table.layerBlocks = GetRef(index);
   }
+  // The bands' references stay in the mapped index (LayerBand); each is checked below.
   const int64_t bands = this->Bands();
-  table.layerBands.resize(static_cast<std::size_t>(this->Dims[2] * bands));
-  for (ChunkRef& band : table.layerBands)
-  {
-    band = GetRef(index);
-  }
+  const uint64_t bandCount = static_cast<uint64_t>(this->Dims[2] * bands);
+  const uint8_t* bandRefs = index.Skip(static_cast<std::size_t>(bandCount * 20));
   const std::string place = this->FilePath + ": index table " + std::to_string(t) + " (" + TableName(table) + ")";
   const auto fail = [&](const std::string& what) { throw FileFormatError(place + ": " + what + " (corrupt)"); };
   const bool text = std::all_of(table.name.begin(), table.name.end(), [](char c) { return c >= 0x20 && c <= 0x7e; });
@@ -306,18 +309,25 @@ PropertyTable PropertyFile::ReadTable(ByteReader& index, uint32_t t, uint64_t in
     fail("value range " + std::to_string(table.minimum) + " to " + std::to_string(table.maximum) + " impossible");
   }
   const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
-  for (int64_t n = -1; n < static_cast<int64_t>(table.layerBands.size()); ++n)
+  for (int64_t n = -1; n < static_cast<int64_t>(bandCount); ++n)
   {
-    const ChunkRef& c = n < 0 ? table.packed : table.layerBands[static_cast<std::size_t>(n)];
+    ChunkRef band;
+    if (n >= 0)
+    {
+      ByteReader at(bandRefs + 20 * n, 20, place);
+      band = GetRef(at);
+    }
+    const ChunkRef& c = n < 0 ? table.packed : band;
+    const int64_t b = n < 0 ? 0 : n % bands, bi = b % this->BandsAlongI(), bj = b / this->BandsAlongI();
     const std::string what = n < 0
       ? std::string("packed table")
-      : "layer " + std::to_string(n / bands + 1) + (bands > 1 ? " band " + std::to_string(n % bands + 1) : "");
+      : "layer " + std::to_string(n / bands + 1) + (bands > 1 ? " band " + std::to_string(b + 1) : "");
     if (c.offset < HeaderBytes || c.offset > indexOffset || c.stored > indexOffset - c.offset)
     {
       fail(what + " at byte " + std::to_string(c.offset) + " of " + std::to_string(c.stored) +
         " bytes lies outside the file");
     }
-    const uint64_t values = n < 0 ? slots : static_cast<uint64_t>(this->Dims[0] * this->RowsIn(n % bands));
+    const uint64_t values = n < 0 ? slots : static_cast<uint64_t>(this->ColumnsIn(bi) * this->RowsIn(bj));
     if (c.raw != values * 4)
     {
       fail(what + " of " + std::to_string(c.raw) + " bytes for " + std::to_string(values) + " values");
@@ -459,7 +469,7 @@ std::vector<BlockSummary> PropertyFile::ReadLayerBlocks(std::size_t table) const
 std::vector<float> PropertyFile::ReadBox(
   std::size_t table, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) const
 {
-  const PropertyTable& t = this->Entries.at(table);
+  this->Entries.at(table);
   for (int a = 0; a < 3; ++a)
   {
     if (lo[a] < 0 || hi[a] >= this->Dims[a] || lo[a] > hi[a])
@@ -468,75 +478,94 @@ std::vector<float> PropertyFile::ReadBox(
         " along " + "IJK"[a] + " lies outside the grid");
     }
   }
-  const int64_t nx = this->Dims[0], width = hi[0] - lo[0] + 1, rows = hi[1] - lo[1] + 1;
-  std::vector<float> box;
-  box.reserve(static_cast<std::size_t>(width * rows * (hi[2] - lo[2] + 1)));
-  CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
+  const int64_t width = hi[0] - lo[0] + 1, rows = hi[1] - lo[1] + 1;
+  std::vector<float> box(static_cast<std::size_t>(width * rows * (hi[2] - lo[2] + 1)));
+  const int64_t cols = this->ColumnsInBand, bandRows = this->RowsInBand;
   for (int64_t k = lo[2]; k <= hi[2]; ++k)
   {
-    for (int64_t b = lo[1] / this->RowsInBand; b <= hi[1] / this->RowsInBand; ++b)
+    float* slab = box.data() + (k - lo[2]) * width * rows;
+    for (int64_t bj = lo[1] / bandRows; bj <= hi[1] / bandRows; ++bj)
     {
-      std::string place;
-      const ChunkRef& ref = this->Band(t, k, b, place);
-      const int64_t first = std::max(lo[1], b * this->RowsInBand);
-      const int64_t last = std::min(hi[1], b * this->RowsInBand + this->RowsIn(b) - 1);
-      // The band decoded up to the box's last row only, its CRC checked the first time (as
-      // ReadCell): a leaf region's box is a few rows of a band.
-      bool verified = false;
+      const int64_t first = std::max(lo[1], bj * bandRows), last = std::min(hi[1], bj * bandRows + this->RowsIn(bj) - 1);
+      for (int64_t bi = lo[0] / cols; bi <= hi[0] / cols; ++bi)
       {
-        const std::lock_guard<std::mutex> lock(this->VerifiedLock);
-        verified = this->Verified.count(ref.offset) != 0;
-      }
-      const uint64_t bytes = static_cast<uint64_t>((last - b * this->RowsInBand + 1) * nx) * 4;
-      const auto raw = DecompressChunkPrefix(this->Data, this->Size, ref, bytes, place, !verified);
-      if (!verified)
-      {
-        const std::lock_guard<std::mutex> lock(this->VerifiedLock);
-        this->Verified.insert(ref.offset);
-      }
-      for (int64_t j = first; j <= last; ++j)
-      {
-        const std::size_t at = static_cast<std::size_t>(((j - b * this->RowsInBand) * nx + lo[0]) * 4);
-        const std::size_t before = box.size();
-        box.resize(before + static_cast<std::size_t>(width));
-        std::memcpy(box.data() + before, raw.data() + at, static_cast<std::size_t>(width) * 4);
+        // The band decoded up to the box's last row only: a leaf region's box is a few rows
+        // of a band.
+        const auto raw = this->DecodeBand(table, k, bi, bj, last - bj * bandRows);
+        const int64_t left = std::max(lo[0], bi * cols), right = std::min(hi[0], bi * cols + this->ColumnsIn(bi) - 1);
+        for (int64_t j = first; j <= last; ++j)
+        {
+          const std::size_t at = static_cast<std::size_t>(((j - bj * bandRows) * this->ColumnsIn(bi) + left - bi * cols) * 4);
+          std::memcpy(slab + (j - lo[1]) * width + (left - lo[0]), raw.data() + at, static_cast<std::size_t>(right - left + 1) * 4);
+        }
       }
     }
   }
   return box;
 }
 
-int64_t PropertyFile::RowsIn(int64_t band) const
+int64_t PropertyFile::RowsIn(int64_t bj) const
 {
-  return std::min(this->RowsInBand, this->Dims[1] - band * this->RowsInBand);
+  return std::min(this->RowsInBand, this->Dims[1] - bj * this->RowsInBand);
 }
 
-const ChunkRef& PropertyFile::Band(const PropertyTable& t, int64_t k, int64_t band, std::string& place) const
+int64_t PropertyFile::ColumnsIn(int64_t bi) const
 {
-  const ChunkRef& ref = t.layerBands[static_cast<std::size_t>(k * this->Bands() + band)];
-  place = this->FilePath + ": layer " + std::to_string(k + 1) + " of " + TableName(t) +
+  return std::min(this->ColumnsInBand, this->Dims[0] - bi * this->ColumnsInBand);
+}
+
+ChunkRef PropertyFile::LayerBand(std::size_t table, int64_t k, int64_t band) const
+{
+  this->Entries.at(table);
+  if (k < 0 || k >= this->Dims[2] || band < 0 || band >= this->Bands())
+  {
+    throw std::out_of_range(this->FilePath + ": no band " + std::to_string(band + 1) + " of layer " + std::to_string(k + 1));
+  }
+  ByteReader at(this->Data + this->BandRefsAt[table] + 20 * static_cast<uint64_t>(k * this->Bands() + band), 20,
+    this->FilePath + ": index");
+  return GetRef(at);
+}
+
+ChunkRef PropertyFile::Band(std::size_t t, int64_t k, int64_t bi, int64_t bj, std::string& place) const
+{
+  const int64_t band = bj * this->BandsAlongI() + bi;
+  const ChunkRef ref = this->LayerBand(t, k, band);
+  place = this->FilePath + ": layer " + std::to_string(k + 1) + " of " + TableName(this->Entries[t]) +
     (this->Bands() > 1 ? " (band " + std::to_string(band + 1) + ")" : std::string()) + " at byte " +
     std::to_string(ref.offset);
   return ref;
 }
 
+std::vector<uint8_t> PropertyFile::DecodeBand(std::size_t t, int64_t k, int64_t bi, int64_t bj, int64_t lastRow) const
+{
+  std::string place;
+  const ChunkRef ref = this->Band(t, k, bi, bj, place);
+  CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
+  const uint64_t band = static_cast<uint64_t>(k * this->Bands() + bj * this->BandsAlongI() + bi);
+  bool verified = false;
+  {
+    const std::lock_guard<std::mutex> lock(this->VerifiedLock);
+    std::vector<uint64_t>& bits = this->Verified[t];
+    bits.resize(static_cast<std::size_t>((this->Dims[2] * this->Bands() + 63) / 64), 0);
+    verified = bits[band >> 6] >> (band & 63) & 1;
+  }
+  const uint64_t bytes = static_cast<uint64_t>((lastRow + 1) * this->ColumnsIn(bi)) * 4;
+  auto raw = DecompressChunkPrefix(this->Data, this->Size, ref, bytes, place, !verified);
+  if (!verified)
+  {
+    const std::lock_guard<std::mutex> lock(this->VerifiedLock);
+    this->Verified[t][band >> 6] |= uint64_t(1) << (band & 63);
+  }
+  return raw;
+}
+
 std::vector<float> PropertyFile::ReadLayer(std::size_t table, int64_t k) const
 {
-  const PropertyTable& t = this->Entries.at(table);
   if (k < 0 || k >= this->Dims[2])
   {
     throw std::out_of_range(this->FilePath + ": no layer " + std::to_string(k + 1));
   }
-  std::vector<float> layer;
-  layer.reserve(static_cast<std::size_t>(this->Dims[0] * this->Dims[1]));
-  for (int64_t b = 0; b < this->Bands(); ++b)
-  {
-    std::string place;
-    const ChunkRef& ref = this->Band(t, k, b, place);
-    const auto values = this->ReadValues(ref, static_cast<uint64_t>(this->Dims[0] * this->RowsIn(b)), place);
-    layer.insert(layer.end(), values.begin(), values.end());
-  }
-  return layer;
+  return this->ReadBox(table, { 0, 0, k }, { this->Dims[0] - 1, this->Dims[1] - 1, k });
 }
 
 std::vector<float> PropertyFile::ReadPlane(std::size_t table, int axis, int64_t index) const
@@ -545,7 +574,6 @@ std::vector<float> PropertyFile::ReadPlane(std::size_t table, int axis, int64_t 
   {
     return this->ReadLayer(table, index);
   }
-  const PropertyTable& t = this->Entries.at(table);
   if (axis < 0 || axis > 2 || index < 0 || index >= this->Dims[axis])
   {
     const char* names[3] = { "I", "J", "K" };
@@ -554,37 +582,15 @@ std::vector<float> PropertyFile::ReadPlane(std::size_t table, int axis, int64_t 
       std::to_string(index + 1));
   }
   const int64_t nx = this->Dims[0], ny = this->Dims[1], nz = this->Dims[2];
-  std::vector<float> plane;
-  plane.reserve(static_cast<std::size_t>((axis == 0 ? ny : nx) * nz));
-  for (int64_t k = 0; k < nz; ++k)
-  {
-    if (axis == 0)
-    {
-      for (int64_t b = 0; b < this->Bands(); ++b)
-      {
-        std::string place;
-        const ChunkRef& ref = this->Band(t, k, b, place);
-        const auto values = this->ReadValues(ref, static_cast<uint64_t>(nx * this->RowsIn(b)), place);
-        for (int64_t row = 0; row < this->RowsIn(b); ++row)
-        {
-          plane.push_back(values[static_cast<std::size_t>(row * nx + index)]);
-        }
-      }
-      continue;
-    }
-    const int64_t band = index / this->RowsInBand;
-    std::string place;
-    const ChunkRef& ref = this->Band(t, k, band, place);
-    const auto values = this->ReadValues(ref, static_cast<uint64_t>(nx * this->RowsIn(band)), place);
-    const auto row = values.begin() + static_cast<std::ptrdiff_t>((index - band * this->RowsInBand) * nx);
-    plane.insert(plane.end(), row, row + nx);
-  }
-  return plane;
+  std::array<int64_t, 3> lo{ 0, 0, 0 }, hi{ nx - 1, ny - 1, nz - 1 };
+  lo[axis] = hi[axis] = index;
+  // A box one cell thick: i fastest, then j, then k, which is the plane's order either way.
+  return this->ReadBox(table, lo, hi);
 }
 
 float PropertyFile::ReadCell(std::size_t table, const std::array<int64_t, 3>& cell) const
 {
-  const PropertyTable& t = this->Entries.at(table);
+  this->Entries.at(table);
   for (int a = 0; a < 3; ++a)
   {
     if (cell[a] < 0 || cell[a] >= this->Dims[a])
@@ -593,22 +599,10 @@ float PropertyFile::ReadCell(std::size_t table, const std::array<int64_t, 3>& ce
         std::to_string(cell[1] + 1) + ", " + std::to_string(cell[2] + 1) + ")");
     }
   }
-  const int64_t band = cell[1] / this->RowsInBand;
-  std::string place;
-  const ChunkRef& ref = this->Band(t, cell[2], band, place);
-  const uint64_t at = static_cast<uint64_t>(cell[0] + this->Dims[0] * (cell[1] - band * this->RowsInBand));
-  CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
-  bool verified = false;
-  {
-    const std::lock_guard<std::mutex> lock(this->VerifiedLock);
-    verified = this->Verified.count(ref.offset) != 0;
-  }
-  const auto raw = DecompressChunkPrefix(this->Data, this->Size, ref, (at + 1) * 4, place, !verified);
-  if (!verified)
-  {
-    const std::lock_guard<std::mutex> lock(this->VerifiedLock);
-    this->Verified.insert(ref.offset);
-  }
+  const int64_t bi = cell[0] / this->ColumnsInBand, bj = cell[1] / this->RowsInBand;
+  const int64_t row = cell[1] - bj * this->RowsInBand;
+  const auto raw = this->DecodeBand(table, cell[2], bi, bj, row);
+  const std::size_t at = static_cast<std::size_t>(row * this->ColumnsIn(bi) + cell[0] - bi * this->ColumnsInBand);
   float value = 0;
   std::memcpy(&value, raw.data() + at * 4, 4);
   return value;
@@ -616,26 +610,32 @@ float PropertyFile::ReadCell(std::size_t table, const std::array<int64_t, 3>& ce
 
 void PropertyFile::PrefetchCell(std::size_t table, const std::array<int64_t, 3>& cell) const
 {
-  const PropertyTable& t = this->Entries.at(table);
-  if (cell[0] < 0 || cell[1] < 0 || cell[2] < 0 || cell[0] >= this->Dims[0] || cell[1] >= this->Dims[1] ||
-    cell[2] >= this->Dims[2])
+  if (table >= this->Entries.size() || cell[0] < 0 || cell[1] < 0 || cell[2] < 0 || cell[0] >= this->Dims[0] ||
+    cell[1] >= this->Dims[1] || cell[2] >= this->Dims[2])
   {
     return;
   }
-  const ChunkRef& ref = t.layerBands[static_cast<std::size_t>(cell[2] * this->Bands() + cell[1] / this->RowsInBand)];
+  const int64_t band = (cell[1] / this->RowsInBand) * this->BandsAlongI() + cell[0] / this->ColumnsInBand;
+  const ChunkRef ref = this->LayerBand(table, cell[2], band);
+  if (ref.offset > this->Size || ref.stored > this->Size - ref.offset)
+  {
+    return; // ReadCell names it
+  }
   const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
   const uintptr_t begin = reinterpret_cast<uintptr_t>(this->Data + ref.offset) & ~(page - 1);
   const uintptr_t end = reinterpret_cast<uintptr_t>(this->Data + ref.offset + ref.stored);
   posix_madvise(reinterpret_cast<void*>(begin), end - begin, POSIX_MADV_WILLNEED);
 }
 
-PropertyFileWriter::PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry, int64_t bandRows)
+PropertyFileWriter::PropertyFileWriter(
+  const std::string& path, const MultiresolutionFile& geometry, int64_t bandRows, int64_t bandColumns)
   : Output(new AtomicOutputFile(path))
   , Geometry(geometry.Header().geometryId)
   , Dims(geometry.Header().dims)
   , TableSides(geometry.Header().hashTableSides)
-  , RowsInBand(bandRows > 0 ? std::min(bandRows, geometry.Header().dims[1])
-                            : LayerBandRows(geometry.Header().dims[0], geometry.Header().dims[1]))
+  , RowsInBand(std::clamp<int64_t>(bandRows > 0 ? bandRows : LayerTileSide, 1, std::max<int64_t>(Dims[1], 1)))
+  , ColumnsInBand(std::clamp<int64_t>(bandColumns > 0 ? bandColumns : bandRows > 0 ? Dims[0] : LayerTileSide, 1,
+      std::max<int64_t>(Dims[0], 1)))
 {
   const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
   const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);
@@ -701,7 +701,7 @@ PropertyFileWriter::PropertyFileWriter(const std::string& path, const Multiresol
     }
   }
   // The table count is patched in at Commit.
-  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, 0, this->RowsInBand);
+  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, 0, this->RowsInBand, this->ColumnsInBand);
   this->Write(head.data(), head.size(), "header");
 }
 
@@ -731,14 +731,24 @@ ChunkRef PropertyFileWriter::PutChunk(const std::vector<uint8_t>& raw, const std
 
 void PropertyFileWriter::PutLayerBands(PropertyTable& table, const std::vector<uint8_t>& raw, int64_t k)
 {
-  const std::size_t bandBytes = static_cast<std::size_t>(this->Dims[0] * this->RowsInBand) * 4;
+  const int64_t nx = this->Dims[0], ny = this->Dims[1];
   std::vector<uint8_t> band;
-  for (std::size_t at = 0; at < raw.size(); at += bandBytes)
+  int64_t number = 0;
+  for (int64_t j0 = 0; j0 < ny; j0 += this->RowsInBand)
   {
-    band.assign(raw.begin() + static_cast<std::ptrdiff_t>(at),
-      raw.begin() + static_cast<std::ptrdiff_t>(std::min(raw.size(), at + bandBytes)));
-    table.layerBands.push_back(this->PutChunk(
-      band, TableName(table) + " layer " + std::to_string(k + 1) + " band " + std::to_string(at / bandBytes + 1)));
+    const int64_t rows = std::min(this->RowsInBand, ny - j0);
+    for (int64_t i0 = 0; i0 < nx; i0 += this->ColumnsInBand)
+    {
+      const std::size_t rowBytes = static_cast<std::size_t>(std::min(this->ColumnsInBand, nx - i0)) * 4;
+      band.resize(static_cast<std::size_t>(rows) * rowBytes);
+      for (int64_t j = 0; j < rows; ++j)
+      {
+        std::memcpy(band.data() + static_cast<std::size_t>(j) * rowBytes,
+          raw.data() + static_cast<std::size_t>(((j0 + j) * nx + i0) * 4), rowBytes);
+      }
+      table.layerBands.push_back(this->PutChunk(
+        band, TableName(table) + " layer " + std::to_string(k + 1) + " band " + std::to_string(++number)));
+    }
   }
 }
 
@@ -994,16 +1004,16 @@ void PropertyFileWriter::CopyFrom(const PropertyFile& older)
       copy.blockRanges = this->PutBlockRanges(blocks, copy);
       copy.layerBlocks = this->PutLayerBlocks(summaries, copy);
     }
-    if (older.BandRows() == this->RowsInBand)
+    copy.layerBands.clear();
+    if (older.BandRows() == this->RowsInBand && older.BandColumns() == this->ColumnsInBand)
     {
-      for (ChunkRef& band : copy.layerBands)
+      for (int64_t n = 0; n < this->Dims[2] * older.Bands(); ++n)
       {
-        band = this->CopyChunk(older, band);
+        copy.layerBands.push_back(this->CopyChunk(older, older.LayerBand(t, n / older.Bands(), n % older.Bands())));
       }
     }
     else // an older version's layers: cut into this file's bands
     {
-      copy.layerBands.clear();
       for (int64_t k = 0; k < this->Dims[2]; ++k)
       {
         const std::vector<float> layer = older.ReadLayer(t, k);
@@ -1049,8 +1059,8 @@ void PropertyFileWriter::Commit()
   const auto trailer = IndexTrailer(indexOffset, index.Bytes, TrailerMagic);
   this->Write(trailer.data(), trailer.size(), "trailer");
   // The table count goes in the header, which was written first: rewrite it in place.
-  const auto head = HeaderOf(
-    this->Geometry, this->Dims, this->TableSides, static_cast<uint32_t>(this->Entries.size()), this->RowsInBand);
+  const auto head = HeaderOf(this->Geometry, this->Dims, this->TableSides, static_cast<uint32_t>(this->Entries.size()),
+    this->RowsInBand, this->ColumnsInBand);
   if (!this->Output->WriteAt(head.data(), head.size(), 0))
   {
     throw FileFormatError(this->Output->Path() + ": rewriting the header failed: " + std::strerror(errno));

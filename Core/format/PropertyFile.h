@@ -9,17 +9,20 @@
 //   compressed with a CRC-32 a chunk: packed through the geometry's perfect spatial hash
 //   (m^3 values, slot s holding the cell the geometry's HashCells names; the whole-model
 //   view's 3D texture, Sec. 5.4) and layer by layer (nx ny values, i fastest; the single-
-//   layer view's 2D texture, Sec. 5.2), each layer cut into bands of whole rows of at most
-//   LayerBandValues values, a chunk a band (ours: reading one cell's value, a pick, decodes one
-//   band instead of a whole layer). From version 4, each table also keeps the value range of
+//   layer view's 2D texture, Sec. 5.2), each layer cut into bands, a chunk a band (ours): from
+//   version 5 tiles of LayerTileSide x LayerTileSide columns (a property filter's leaf region
+//   reads its own columns' tiles, not whole rows of the model), before it whole rows. Reading
+//   one cell's value (a pick) decodes one band, not a layer. From version 4, each table also keeps the value range of
 //   each block of ColumnBlockSide^2 columns over all layers, and of each block of
 //   LayerBlockSide^2 columns in each layer with its mean (ours: PropertyFilter.h).
 // - Layout (little-endian): header (128 bytes, CRC-32 at its end: magic, version, the
 //   geometry id of the .resmr file, grid dimensions, hash table side, table count, rows a
-//   band), chunks, index (per table: name, step, report number, days, value range, packed
-//   chunk, block ranges and layer blocks chunks (version 4 on), then nz times the bands of a layer), trailer (index
-//   offset and size, index CRC, magic "RESMRPIX"). Version 2 files (a chunk a layer, no band rows) are read as one
-//   band.
+//   band, columns a band (version 5 on)), chunks, index (per table: name, step, report
+//   number, days, value range, packed chunk, block ranges and layer blocks chunks (version 4
+//   on), then nz times the bands of a layer), trailer (index offset and size, index CRC, magic
+//   "RESMRPIX"). Version 2 files (a chunk a layer, no band rows) are read as one band.
+// - The bands' chunk references are read from the mapped index when a band is read, not held
+//   (a table of the 1.26-billion-cell model has 300,000 bands): opening checks them all.
 // - A file is written under a temporary name and renamed; one that names another geometry
 //   is refused (CheckGeometry). Every header and index field is checked when the file is
 //   opened (dimensions, sides, the table count against the index size, names, steps, value
@@ -34,7 +37,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
-#include <unordered_set>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -57,7 +60,9 @@ struct PropertyTable
   /// Summaries of blocks of LayerBlockSide x LayerBlockSide columns, layer by layer
   /// (ReadLayerBlocks); raw 0 in files before version 4.
   ChunkRef layerBlocks;
-  std::vector<ChunkRef> layerBands; ///< nz times the bands of a layer: layer k's band b at k * bands + b
+  /// nz times the bands of a layer (layer k's band b at k * bands + b): the writer's; a file
+  /// opened for reading leaves it empty and reads each from its index (LayerBand).
+  std::vector<ChunkRef> layerBands;
 };
 
 /// Columns a side of the blocks whose value ranges a table keeps (ours: a property filter,
@@ -83,10 +88,9 @@ struct BlockSummary
   float low = 0, high = 0, mean = 0;
 };
 
-/// Most values in a band of a layer's rows (1 MB of floats); a band holds at least one row.
-constexpr int64_t LayerBandValues = int64_t(1) << 18;
-/// Rows of nx cells in each band of a layer (the last band of a layer may hold fewer).
-int64_t LayerBandRows(int64_t nx, int64_t ny);
+/// Columns a side of the bands (tiles) of a layer files are written with: 16 KB of values; a
+/// leaf region's box of about 80 x 80 columns decodes about twice its own cells.
+constexpr int64_t LayerTileSide = 64;
 
 /// A .resmrp file opened for reading (memory-mapped).
 class PropertyFile
@@ -102,9 +106,15 @@ public:
   /// Grid dimensions and hash table sides of the geometry the file was made for.
   const std::array<int64_t, 3>& Dimensions() const { return this->Dims; }
   const std::array<uint32_t, 3>& HashTableSides() const { return this->TableSides; }
-  /// Rows in each band of a layer, and bands in a layer.
+  /// Rows and columns of each band of a layer (the last along i and j may hold fewer), bands
+  /// along i and j, and bands in a layer (band (bi, bj) of a layer at bi + BandsAlongI() bj).
   int64_t BandRows() const { return this->RowsInBand; }
-  int64_t Bands() const { return (this->Dims[1] + this->RowsInBand - 1) / this->RowsInBand; }
+  int64_t BandColumns() const { return this->ColumnsInBand; }
+  int64_t BandsAlongI() const { return (this->Dims[0] + this->ColumnsInBand - 1) / this->ColumnsInBand; }
+  int64_t BandsAlongJ() const { return (this->Dims[1] + this->RowsInBand - 1) / this->RowsInBand; }
+  int64_t Bands() const { return this->BandsAlongI() * this->BandsAlongJ(); }
+  /// The chunk of band `band` of layer k of table `table`, from the index.
+  ChunkRef LayerBand(std::size_t table, int64_t k, int64_t band) const;
   const std::vector<PropertyTable>& Tables() const { return this->Entries; }
   /// Index of table (name, step) or -1.
   int Find(const std::string& name, int32_t step) const;
@@ -123,7 +133,7 @@ public:
   /// before version 4.
   std::vector<BlockSummary> ReadLayerBlocks(std::size_t table) const;
   /// The values of a box of cells, [lo, hi] inclusive and 0-based, i fastest, then j, then k:
-  /// each band the box's rows reach in each layer, decoded up to the box's last row (its CRC
+  /// each band the box reaches in each layer, decoded up to the box's last row (its CRC
   /// checked the first time a band is read, as ReadCell).
   std::vector<float> ReadBox(
     std::size_t table, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) const;
@@ -132,9 +142,8 @@ public:
   /// Layer k of the table (nx ny values).
   std::vector<float> ReadLayer(std::size_t table, int64_t k) const;
   /// A plane of cells of the table with one index fixed: `axis` 0, I = `index` (ny nz values,
-  /// j fastest); 1, J = `index` (nx nz values, i fastest); 2, a layer (ReadLayer). An I plane
-  /// decodes every band of every layer, a J plane one band a layer (ours: the cut faces of an
-  /// I/J/K range, CellRange.h).
+  /// j fastest); 1, J = `index` (nx nz values, i fastest); 2, a layer (ReadLayer). Each decodes
+  /// the bands the plane crosses (ours: the cut faces of an I/J/K range, CellRange.h).
   std::vector<float> ReadPlane(std::size_t table, int axis, int64_t index) const;
   /// The value of cell (i, j, k) in the table: the band of its layer that holds it decoded up to
   /// it only, the band's CRC checked the first time it is read (later reads of it, a cursor
@@ -147,11 +156,15 @@ public:
   const uint8_t* ChunkBytes(const ChunkRef& ref) const { return this->Data + ref.offset; }
 
 private:
-  void CheckHeader(uint32_t tables, uint64_t indexSize, uint32_t version, uint32_t bandRows);
-  /// Rows of band `band` of a layer.
-  int64_t RowsIn(int64_t band) const;
-  /// Band `band` of layer k of table t, and where it lies, in words for errors.
-  const ChunkRef& Band(const PropertyTable& t, int64_t k, int64_t band, std::string& place) const;
+  void CheckHeader(uint32_t tables, uint64_t indexSize, uint32_t version, uint32_t bandRows, uint32_t bandColumns);
+  /// Rows of the bands in band row `bj`, columns of those in band column `bi`.
+  int64_t RowsIn(int64_t bj) const;
+  int64_t ColumnsIn(int64_t bi) const;
+  /// Band (bi, bj) of layer k of table t, and where it lies, in words for errors.
+  ChunkRef Band(std::size_t t, int64_t k, int64_t bi, int64_t bj, std::string& place) const;
+  /// Decodes band (bi, bj) of layer k of table t up to its row `lastRow` (band rows from 0),
+  /// its CRC checked the first time the band is read.
+  std::vector<uint8_t> DecodeBand(std::size_t t, int64_t k, int64_t bi, int64_t bj, int64_t lastRow) const;
   PropertyTable ReadTable(ByteReader& index, uint32_t t, uint64_t indexOffset) const;
   std::vector<float> ReadValues(const ChunkRef& ref, uint64_t count, const std::string& place) const;
   std::string FilePath;
@@ -161,19 +174,23 @@ private:
   uint64_t Geometry = 0;
   std::array<int64_t, 3> Dims{};
   std::array<uint32_t, 3> TableSides{};
-  int64_t RowsInBand = 1;
+  int64_t RowsInBand = 1, ColumnsInBand = 1;
   uint32_t FormatVersion = 0;
   std::vector<PropertyTable> Entries;
+  std::vector<uint64_t> BandRefsAt; ///< per table, where its first band reference lies in the file
   mutable std::mutex VerifiedLock;
-  mutable std::unordered_set<uint64_t> Verified; ///< offsets of layer chunks whose CRC held (ReadCell, ReadBox)
+  /// Per table, a bit a band whose CRC held (DecodeBand).
+  mutable std::unordered_map<std::size_t, std::vector<uint64_t>> Verified;
 };
 
 /// Writes a .resmrp file for `geometry` under a temporary name; Commit() puts it in place.
 class PropertyFileWriter
 {
 public:
-  /// `bandRows`: rows a band of each layer (0: LayerBandRows, what files are written with).
-  PropertyFileWriter(const std::string& path, const MultiresolutionFile& geometry, int64_t bandRows = 0);
+  /// `bandRows`, `bandColumns`: a band's rows and columns (0: LayerTileSide, what files are
+  /// written with; with only rows given, whole rows).
+  PropertyFileWriter(
+    const std::string& path, const MultiresolutionFile& geometry, int64_t bandRows = 0, int64_t bandColumns = 0);
   ~PropertyFileWriter();
 
   /// Adds a table from one value a cell (nx ny nz, ECLIPSE order; NaN: no value); cells
@@ -226,7 +243,7 @@ private:
   uint64_t Geometry = 0;
   std::array<int64_t, 3> Dims{};
   std::array<uint32_t, 3> TableSides{};
-  int64_t RowsInBand = 1;
+  int64_t RowsInBand = 1, ColumnsInBand = 1;
   uint64_t SlotCount = 0;                    ///< of the packed tables
   std::vector<std::vector<uint64_t>> Active; ///< per layer, a bit a cell
   std::vector<uint64_t> LayerSlotStart;      ///< nz + 1: where each layer's slots start below

@@ -17,10 +17,22 @@ double UploadBudgetMs(double targetFramesPerSecond, double previousFrameMs)
   return std::max(UploadMsAtFixedTolerance, UploadShareOfPreviousFrame * previous);
 }
 
+namespace
+{
+double CapScale(double budgetMs)
+{
+  return std::isfinite(budgetMs) ? std::max(1.0, budgetMs / UploadMsAtFixedTolerance) : 1.0;
+}
+} // namespace
+
 std::size_t UploadByteCap(double budgetMs)
 {
-  const double scale = std::isfinite(budgetMs) ? std::max(1.0, budgetMs / UploadMsAtFixedTolerance) : 1.0;
-  return static_cast<std::size_t>(scale * static_cast<double>(UploadBytesPerFrame));
+  return static_cast<std::size_t>(CapScale(budgetMs) * static_cast<double>(UploadBytesPerFrame));
+}
+
+std::size_t TableByteCap(double budgetMs)
+{
+  return static_cast<std::size_t>(CapScale(budgetMs) * static_cast<double>(TableBytesPerFrame));
 }
 
 uint32_t SlicesThisFrame(uint32_t slicesLeft, std::size_t sliceBytes, std::size_t& budget, bool unbounded)

@@ -279,7 +279,7 @@ void RegionContents(const Bytes& valid)
 }
 
 // .resmrp header fields (PropertyFile.cpp, HeaderOf).
-constexpr std::size_t PVersion = 8, PDims = 20, PSides = 44, PTables = 56, PBandRows = 60;
+constexpr std::size_t PVersion = 8, PDims = 20, PSides = 44, PTables = 56, PBandRows = 60, PBandColumns = 64;
 
 void PropertyFields(const Bytes& valid, const std::string& validPath, const std::string& geometryPath)
 {
@@ -296,11 +296,31 @@ void PropertyFields(const Bytes& valid, const std::string& validPath, const std:
   const auto setTable = [&](std::size_t t, std::size_t field, auto value) -> Change {
     return [=](Bytes& f) { Store(f, static_cast<std::size_t>(index + t * table + field), value); };
   };
-  ExpectPropertiesRefused("version 5", valid, "format version 5", Set<uint32_t>(PVersion, 5));
+  ExpectPropertiesRefused("version 6", valid, "format version 6", Set<uint32_t>(PVersion, 6));
   ExpectPropertiesRefused("version 1", valid, "format version 1", Set<uint32_t>(PVersion, 1));
   ExpectPropertiesRefused("band rows 0", valid, "'rows a band' is 0", Set<uint32_t>(PBandRows, 0));
   ExpectPropertiesRefused("band rows ny + 1", valid, "'rows a band'",
     [](Bytes& f) { Store<uint32_t>(f, PBandRows, static_cast<uint32_t>(Load<int64_t>(f, PDims + 8) + 1)); });
+  ExpectPropertiesRefused("band columns 0", valid, "'columns a band' is 0", Set<uint32_t>(PBandColumns, 0));
+  ExpectPropertiesRefused("band columns nx + 1", valid, "'columns a band'",
+    [](Bytes& f) { Store<uint32_t>(f, PBandColumns, static_cast<uint32_t>(Load<int64_t>(f, PDims) + 1)); });
+  {
+    // A version 4 file (bands of whole rows, no columns a band) reads the same: this grid's
+    // layers are one band either way.
+    const std::string old = Temp + "/version4.resmrp";
+    Spill(old, Changed(valid, resmr_fuzz::ResmrpLayout(), [&](Bytes& f) {
+      Store<uint32_t>(f, PVersion, 4);
+      Store<uint32_t>(f, PBandColumns, 0);
+    }));
+    const PropertyFile now(validPath), before(old);
+    CHECK(before.Bands() == 1 && before.BandColumns() == now.BandColumns() && now.BandColumns() == 9);
+    for (std::size_t t = 0; t < now.Tables().size(); ++t)
+    {
+      const auto a = now.ReadLayer(t, 1), b = before.ReadLayer(t, 1);
+      CHECK(std::memcmp(a.data(), b.data(), a.size() * 4) == 0 && a.size() == b.size());
+    }
+    ExpectPropertiesRefused("version 4 band columns", valid, "'reserved bytes'", Set<uint32_t>(PVersion, 4));
+  }
   {
     // A version 2 file (a chunk a layer, no band rows) reads as one band a layer.
     // Its index has no block ranges: each table's reference to them taken out.
@@ -308,6 +328,7 @@ void PropertyFields(const Bytes& valid, const std::string& validPath, const std:
     Spill(old, Changed(valid, resmr_fuzz::ResmrpLayout(), [&](Bytes& f) {
       Store<uint32_t>(f, PVersion, 2);
       Store<uint32_t>(f, PBandRows, 0);
+      Store<uint32_t>(f, PBandColumns, 0);
       const uint64_t at = IndexAt(f);
       std::vector<uint8_t> index;
       for (uint32_t t = 0; t < tables; ++t)

@@ -456,9 +456,22 @@ int main(int argc, char** argv)
       const PropertyFile cut(banded);
       CHECK(cut.BandRows() == 5 && cut.Bands() == (reekGrid.deck.dims[1] + 4) / 5 && cut.Bands() > 2);
       CHECK(CheckTables(geometry, cut, reekGrid, reekResults) == static_cast<int>(properties.Tables().size()));
+      // Tiles of 5 rows x 7 columns (the last of each row and column smaller), copied from the
+      // bands of rows: boxes, planes, cells and layers read across tile edges.
+      const std::string tiled = temp + "/reek-tiled.resmrp";
+      {
+        PropertyFileWriter writer(tiled, geometry, 5, 7);
+        writer.CopyFrom(cut);
+        writer.Commit();
+      }
+      const PropertyFile tiles(tiled);
+      CHECK(tiles.BandRows() == 5 && tiles.BandColumns() == 7 && tiles.BandsAlongI() == (reekGrid.deck.dims[0] + 6) / 7);
+      CHECK(tiles.Bands() == tiles.BandsAlongI() * cut.Bands() && tiles.BandsAlongI() > 2);
+      CHECK(CheckTables(geometry, tiles, reekGrid, reekResults) == static_cast<int>(properties.Tables().size()));
       PropertyFileWriter writer(again, geometry);
-      writer.CopyFrom(cut);
+      writer.CopyFrom(tiles);
       writer.Commit();
+      std::remove(tiled.c_str());
     }
     {
       const PropertyFile whole(again);

@@ -164,7 +164,8 @@ void TestUploadPlan()
   CHECK(Near(UploadBudgetMs(0, 300), 150) && UploadBudgetMs(0, 12) == 10 && Near(UploadBudgetMs(20, 300), 5));
   CHECK(UploadBudgetMs(0, std::nan("")) == 10);
   CHECK(UploadByteCap(10) == UploadBytesPerFrame && UploadByteCap(5) == UploadBytesPerFrame);
-  CHECK(UploadByteCap(150) == 15 * UploadBytesPerFrame);
+  CHECK(UploadByteCap(150) == 15 * UploadBytesPerFrame && TableByteCap(150) == 15 * TableBytesPerFrame);
+  CHECK(TableByteCap(UploadBudgetMs(10, 500)) == TableBytesPerFrame);
   CHECK(UploadBytesPerFrame == 8u << 20 && TableBytesPerFrame == 4u << 20 && PieceBytes == 1u << 20);
 
   // Table slabs: 1 MB slices, 4 MB a frame.

@@ -263,20 +263,26 @@ inline FileLayout ResmrLayout()
 /// every layer (version 2: one a layer).
 inline FileLayout ResmrpLayout()
 {
-  constexpr std::size_t Header = 128, VersionAt = 8, RowsAt = 28, LayersAt = 36, TablesAt = 56, BandRowsAt = 60,
-                        TableHead = 56;
+  constexpr std::size_t Header = 128, VersionAt = 8, ColumnsAt = 20, RowsAt = 28, LayersAt = 36, TablesAt = 56,
+                        BandRowsAt = 60, BandColumnsAt = 64, TableHead = 56;
   FileLayout layout;
   layout.headerBytes = Header;
   std::memcpy(layout.trailerMagic, "RESMRPIX", 8);
   const auto tableBytes = [=](const std::vector<uint8_t>& file) -> uint64_t {
     const int64_t limit = int64_t(1) << 24;
     const int64_t layers = Load<int64_t>(file, LayersAt), rows = Load<int64_t>(file, RowsAt);
-    const int64_t bandRows = Load<uint32_t>(file, VersionAt) >= 3 ? Load<uint32_t>(file, BandRowsAt) : rows;
-    if (layers <= 0 || layers > limit || rows <= 0 || rows > limit || bandRows <= 0 || bandRows > rows)
+    const int64_t columns = Load<int64_t>(file, ColumnsAt);
+    const uint32_t version = Load<uint32_t>(file, VersionAt);
+    const int64_t bandRows = version >= 3 ? Load<uint32_t>(file, BandRowsAt) : rows;
+    const int64_t bandColumns = version >= 5 ? Load<uint32_t>(file, BandColumnsAt) : columns;
+    if (layers <= 0 || layers > limit || rows <= 0 || rows > limit || bandRows <= 0 || bandRows > rows ||
+      columns <= 0 || columns > limit || bandColumns <= 0 || bandColumns > columns)
     {
       return 0;
     }
-    const uint64_t bands = static_cast<uint64_t>((rows + bandRows - 1) / bandRows);
+    // Bands are tiles of bandRows x bandColumns (version 5 on; whole rows before).
+    const uint64_t bands =
+      static_cast<uint64_t>((rows + bandRows - 1) / bandRows) * static_cast<uint64_t>((columns + bandColumns - 1) / bandColumns);
     // The packed table's chunk, the block ranges' and layer blocks' (version 4 on), then the
     // layers' bands.
     const uint64_t blocks = Load<uint32_t>(file, VersionAt) >= 4 ? 2 : 0;

@@ -60,20 +60,22 @@ void CheckIndex(const resmr::PropertyFile& file, const std::vector<uint8_t>& byt
   const auto& dims = file.Dimensions();
   const uint64_t indexSize = resmr_fuzz::Load<uint64_t>(bytes, bytes.size() - resmr::IndexTrailerBytes + 8);
   const int64_t bands = file.Bands();
-  const uint64_t perTable = 56 + 20 * (static_cast<uint64_t>(dims[2] * bands) + 1);
+  const uint64_t perTable = 56 + 20 * (static_cast<uint64_t>(dims[2] * bands) + 1) + (file.HasBlockRanges() ? 40 : 0);
   if (indexSize != file.Tables().size() * perTable)
   {
     BrokenInvariant("opened with " + std::to_string(file.Tables().size()) + " tables in an index of " +
       std::to_string(indexSize) + " bytes");
   }
-  for (const auto& table : file.Tables())
+  for (std::size_t t = 0; t < file.Tables().size(); ++t)
   {
+    const auto& table = file.Tables()[t];
     bool sized = table.packed.raw == slots * 4;
-    for (std::size_t n = 0; n < table.layerBands.size(); ++n)
+    for (int64_t n = 0; n < dims[2] * bands; ++n)
     {
-      const int64_t b = static_cast<int64_t>(n) % bands;
-      const int64_t rows = std::min(file.BandRows(), dims[1] - b * file.BandRows());
-      sized = sized && table.layerBands[n].raw == static_cast<uint64_t>(dims[0] * rows) * 4;
+      const int64_t b = n % bands, bi = b % file.BandsAlongI(), bj = b / file.BandsAlongI();
+      const int64_t rows = std::min(file.BandRows(), dims[1] - bj * file.BandRows());
+      const int64_t columns = std::min(file.BandColumns(), dims[0] - bi * file.BandColumns());
+      sized = sized && file.LayerBand(t, n / bands, b).raw == static_cast<uint64_t>(columns * rows) * 4;
     }
     if (!sized)
     {
@@ -89,11 +91,10 @@ int ReadEverything(
   int refused = 0;
   for (std::size_t t = 0; t < file.Tables().size(); ++t)
   {
-    const auto& table = file.Tables()[t];
-    if (resmr_fuzz::InvariantsChecked() && table.layerBands.size() != static_cast<std::size_t>(dims[2] * file.Bands()))
+    if (resmr_fuzz::InvariantsChecked() && file.BandsAlongI() * file.BandColumns() < dims[0])
     {
-      BrokenInvariant("table " + std::to_string(t) + " has " + std::to_string(table.layerBands.size()) +
-        " layer bands for " + std::to_string(dims[2]) + " layers of " + std::to_string(file.Bands()));
+      BrokenInvariant("table " + std::to_string(t) + ": bands of " + std::to_string(file.BandColumns()) +
+        " columns do not cover " + std::to_string(dims[0]));
     }
     for (int64_t k = -1; k < dims[2]; ++k)
     {
