@@ -466,31 +466,6 @@ std::vector<CutPlaneSlot> CutPlaneSlots(bool ranged, const resmr::CellRange& ran
   return slots;
 }
 
-/// Property filters, one a line: "low high name" (inclusive).
-bool ParseFilters(const std::string& text, std::vector<resmr::ValueFilter>& filters)
-{
-  std::istringstream lines(text);
-  std::string line;
-  while (std::getline(lines, line))
-  {
-    std::istringstream in(line);
-    resmr::ValueFilter filter;
-    double low = 0, high = 0;
-    if (!(in >> low >> high >> filter.name))
-    {
-      if (line.find_first_not_of(" \t") == std::string::npos)
-      {
-        continue;
-      }
-      return false;
-    }
-    filter.low = static_cast<float>(low);
-    filter.high = static_cast<float>(high);
-    filters.push_back(filter);
-  }
-  return true;
-}
-
 /// Where a region lies against a range and property filters together, for the selection: the
 /// filters remove what they leave nothing of; a region they cross splits by its filter error
 /// (ViewSelector::SetFilterErrors), not down to the leaves as one a range's side crosses.
@@ -878,7 +853,7 @@ bool vtkMultiresolutionSurfaceMapper::SelectFilters(Frame& frame)
 {
   Internals& in = *this->Internal;
   frame.filters.clear();
-  if (!ParseFilters(frame.filterText, frame.filters))
+  if (!resmr::ParseValueFilters(frame.filterText, frame.filters))
   {
     in.LayerError = "the property filter '" + frame.filterText + "' is not lines of 'low high name'";
     in.Pending = false;

@@ -33,8 +33,18 @@ int vtkMultiresolutionThreshold::RequestData(
     return 0;
   }
   // The descriptor's cell arrays are the property file's (two cells: the step's range).
+  // An array named but not the descriptor's (a script's typo, a property file without it)
+  // still filters, by name: the surface then draws nothing and says which array it lacks, as
+  // stock Threshold outputs nothing, rather than showing the model unfiltered.
   vtkDataArray* array = this->GetInputArrayToProcess(0, inputVector);
-  const char* name = array ? array->GetName() : nullptr;
+  vtkInformation* selected = this->GetInputArrayInformation(0);
+  const char* name = array                                   ? array->GetName()
+    : selected && selected->Has(vtkDataObject::FIELD_NAME()) ? selected->Get(vtkDataObject::FIELD_NAME())
+                                                             : nullptr;
+  if (!array && name && *name)
+  {
+    vtkWarningMacro(<< "the model has no array '" << name << "': nothing passes");
+  }
   vtkStringArray* upstream = vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray(FilterArrayName()));
   std::string lines = upstream && upstream->GetNumberOfValues() == 1 ? upstream->GetValue(0) : std::string();
   if (name && *name)

@@ -11,8 +11,8 @@
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
 
-#include <sys/mman.h>
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -28,8 +28,7 @@ using namespace resmr;
 namespace
 {
 /// The cells of a leaf's columns: its nodes' topology box (as ReadCellBox), all layers.
-std::pair<std::array<int64_t, 3>, std::array<int64_t, 3>> LeafBox(
-  const MultiresolutionFile& file, std::size_t region)
+std::pair<std::array<int64_t, 3>, std::array<int64_t, 3>> LeafBox(const MultiresolutionFile& file, std::size_t region)
 {
   const RegionMesh mesh = file.ReadRegion(region);
   const auto& dims = file.Header().dims;

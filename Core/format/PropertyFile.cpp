@@ -486,7 +486,8 @@ std::vector<float> PropertyFile::ReadBox(
     float* slab = box.data() + (k - lo[2]) * width * rows;
     for (int64_t bj = lo[1] / bandRows; bj <= hi[1] / bandRows; ++bj)
     {
-      const int64_t first = std::max(lo[1], bj * bandRows), last = std::min(hi[1], bj * bandRows + this->RowsIn(bj) - 1);
+      const int64_t first = std::max(lo[1], bj * bandRows),
+                    last = std::min(hi[1], bj * bandRows + this->RowsIn(bj) - 1);
       for (int64_t bi = lo[0] / cols; bi <= hi[0] / cols; ++bi)
       {
         // The band decoded up to the box's last row only: a leaf region's box is a few rows
@@ -495,8 +496,10 @@ std::vector<float> PropertyFile::ReadBox(
         const int64_t left = std::max(lo[0], bi * cols), right = std::min(hi[0], bi * cols + this->ColumnsIn(bi) - 1);
         for (int64_t j = first; j <= last; ++j)
         {
-          const std::size_t at = static_cast<std::size_t>(((j - bj * bandRows) * this->ColumnsIn(bi) + left - bi * cols) * 4);
-          std::memcpy(slab + (j - lo[1]) * width + (left - lo[0]), raw.data() + at, static_cast<std::size_t>(right - left + 1) * 4);
+          const std::size_t at =
+            static_cast<std::size_t>(((j - bj * bandRows) * this->ColumnsIn(bi) + left - bi * cols) * 4);
+          std::memcpy(slab + (j - lo[1]) * width + (left - lo[0]), raw.data() + at,
+            static_cast<std::size_t>(right - left + 1) * 4);
         }
       }
     }
@@ -519,7 +522,8 @@ ChunkRef PropertyFile::LayerBand(std::size_t table, int64_t k, int64_t band) con
   this->Entries.at(table);
   if (k < 0 || k >= this->Dims[2] || band < 0 || band >= this->Bands())
   {
-    throw std::out_of_range(this->FilePath + ": no band " + std::to_string(band + 1) + " of layer " + std::to_string(k + 1));
+    throw std::out_of_range(
+      this->FilePath + ": no band " + std::to_string(band + 1) + " of layer " + std::to_string(k + 1));
   }
   ByteReader at(this->Data + this->BandRefsAt[table] + 20 * static_cast<uint64_t>(k * this->Bands() + band), 20,
     this->FilePath + ": index");
@@ -634,8 +638,10 @@ PropertyFileWriter::PropertyFileWriter(
   , Dims(geometry.Header().dims)
   , TableSides(geometry.Header().hashTableSides)
   , RowsInBand(std::clamp<int64_t>(bandRows > 0 ? bandRows : LayerTileSide, 1, std::max<int64_t>(Dims[1], 1)))
-  , ColumnsInBand(std::clamp<int64_t>(bandColumns > 0 ? bandColumns : bandRows > 0 ? Dims[0] : LayerTileSide, 1,
-      std::max<int64_t>(Dims[0], 1)))
+  , ColumnsInBand(std::clamp<int64_t>(bandColumns > 0 ? bandColumns
+        : bandRows > 0                                ? Dims[0]
+                                                      : LayerTileSide,
+      1, std::max<int64_t>(Dims[0], 1)))
 {
   const uint64_t slots = uint64_t(this->TableSides[0]) * this->TableSides[1] * this->TableSides[2];
   const uint64_t layer = static_cast<uint64_t>(this->Dims[0] * this->Dims[1]);

@@ -5,10 +5,45 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 namespace resmr
 {
+
+bool ParseValueFilters(const std::string& text, std::vector<ValueFilter>& filters)
+{
+  std::vector<ValueFilter> parsed;
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line))
+  {
+    if (line.find_first_not_of(" \t\r") == std::string::npos)
+    {
+      continue;
+    }
+    std::istringstream in(line);
+    double low = 0, high = 0;
+    std::string name;
+    if (!(in >> low >> high) || !std::getline(in, name))
+    {
+      return false;
+    }
+    const std::size_t first = name.find_first_not_of(" \t");
+    const std::size_t last = name.find_last_not_of(" \t\r");
+    if (first == std::string::npos || name[0] != ' ')
+    {
+      return false; // no name, or one run into the number
+    }
+    ValueFilter filter;
+    filter.name = name.substr(first, last - first + 1);
+    filter.low = static_cast<float>(low);
+    filter.high = static_cast<float>(high);
+    parsed.push_back(filter);
+  }
+  filters.insert(filters.end(), parsed.begin(), parsed.end());
+  return true;
+}
 
 int FindFilterTable(const PropertyFile& file, const std::string& name, int32_t step)
 {

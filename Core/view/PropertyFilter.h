@@ -49,6 +49,11 @@ struct ValueFilter
   bool Passes(float v) const { return v >= this->low && v <= this->high; } ///< false for NaN
 };
 
+/// Parses value filters written as Multiresolution Threshold writes them, one a line: "low
+/// high name", the name the rest of the line (names may hold spaces); blank lines are skipped.
+/// False, `filters` unchanged, when a line is not of that form.
+bool ParseValueFilters(const std::string& text, std::vector<ValueFilter>& filters);
+
 /// The table of `name` at `step` in `file`, else its static table, else -1.
 int FindFilterTable(const PropertyFile& file, const std::string& name, int32_t step);
 

@@ -465,7 +465,8 @@ int main(int argc, char** argv)
         writer.Commit();
       }
       const PropertyFile tiles(tiled);
-      CHECK(tiles.BandRows() == 5 && tiles.BandColumns() == 7 && tiles.BandsAlongI() == (reekGrid.deck.dims[0] + 6) / 7);
+      CHECK(
+        tiles.BandRows() == 5 && tiles.BandColumns() == 7 && tiles.BandsAlongI() == (reekGrid.deck.dims[0] + 6) / 7);
       CHECK(tiles.Bands() == tiles.BandsAlongI() * cut.Bands() && tiles.BandsAlongI() > 2);
       CHECK(CheckTables(geometry, tiles, reekGrid, reekResults) == static_cast<int>(properties.Tables().size()));
       PropertyFileWriter writer(again, geometry);

@@ -2018,6 +2018,20 @@ void TestRanges(const Model& model)
 /// (one step in I, J or K) shows a face.
 void TestValueFilters(const Model& model)
 {
+  // The filter text Multiresolution Threshold writes, one filter a line; names may hold spaces.
+  {
+    std::vector<ValueFilter> parsed;
+    CHECK(ParseValueFilters("0.25 0.5 PORO\n\n-1e+30 7 MY ARRAY \n", parsed) && parsed.size() == 2);
+    CHECK(parsed.size() == 2 && parsed[0].name == "PORO" && parsed[0].low == 0.25f && parsed[0].high == 0.5f);
+    CHECK(parsed.size() == 2 && parsed[1].name == "MY ARRAY" && parsed[1].low == -1e30f && parsed[1].high == 7);
+    std::vector<ValueFilter> none;
+    CHECK(ParseValueFilters("", none) && none.empty());
+    for (const char* bad : { "low high PORO", "0.1 PORO", "0.1 0.2", "0.1 0.2PORO", "0.1 0.2 \n" })
+    {
+      std::vector<ValueFilter> refused;
+      CHECK(!ParseValueFilters(bad, refused) && refused.empty());
+    }
+  }
   const std::string properties = Temp + "/synth.resmrp";
   std::remove(properties.c_str());
   CHECK(Run(Tool + " add-properties '" + model.path + "' synth:96x80x10:5:1 -o '" + properties +

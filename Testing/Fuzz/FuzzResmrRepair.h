@@ -281,8 +281,8 @@ inline FileLayout ResmrpLayout()
       return 0;
     }
     // Bands are tiles of bandRows x bandColumns (version 5 on; whole rows before).
-    const uint64_t bands =
-      static_cast<uint64_t>((rows + bandRows - 1) / bandRows) * static_cast<uint64_t>((columns + bandColumns - 1) / bandColumns);
+    const uint64_t bands = static_cast<uint64_t>((rows + bandRows - 1) / bandRows) *
+      static_cast<uint64_t>((columns + bandColumns - 1) / bandColumns);
     // The packed table's chunk, the block ranges' and layer blocks' (version 4 on), then the
     // layers' bands.
     const uint64_t blocks = Load<uint32_t>(file, VersionAt) >= 4 ? 2 : 0;

@@ -22,7 +22,11 @@ its Cell Id mode, from 4 cameras. Checks:
   array's range at the step;
 - Reek's SWAT filtered and painted by SWAT, at the first and last steps, through ParaView's
   lookup table (unlit): >= 99% of the pixels both cover within 3 levels of stock's (the faces
-  a filter exposes carry their cells' values).
+  a filter exposes carry their cells' values);
+- bad input (Reek): a filter on an array the property file lacks and a model without its
+  property file draw nothing and say why in LastError (naming the array or the file); the
+  same display, given a valid filter again, draws and clears LastError. (Filter text that is
+  not "low high name" lines: Core.ViewSelection.)
 Images are left in the temporary folder."""
 import builtins
 import os
@@ -105,6 +109,57 @@ def show_only(proxy):
     for other in shown:
         simple.Hide(other, view)
     simple.Show(proxy, view)
+
+
+def covered_pixels(name):
+    return int(np.sum(rt.cell_ids(capture(name)) > 0))
+
+
+def last_error(display):
+    display.UpdatePropertyInformation()
+    return display.GetPropertyValue("LastError") or ""
+
+
+def check_error_paths(resmr_path, reader, threshold, ours, bounds):
+    """A filter the property file cannot answer and no property file: nothing drawn, LastError
+    names the cause; a valid filter draws again."""
+    show_only(threshold)
+    rt.place_camera(view, bounds, 1.0, CAMERAS[0][1], CAMERAS[0][2])
+    threshold.Scalars = ["CELLS", "NOSUCHARRAY"]
+    simple.Render(view)
+    error, pixels = last_error(ours), covered_pixels("error-no-array.png")
+    print(f"filter on a missing array: {pixels} pixels, LastError {error!r}")
+    if "NOSUCHARRAY" not in error or pixels:
+        failures.append(f"missing array: LastError {error!r}, {pixels} pixels drawn")
+    threshold.Scalars = ["CELLS", "PORO"]
+    threshold.LowerThreshold, threshold.UpperThreshold = -1e30, 1e30
+    simple.Render(view)
+    error, pixels = last_error(ours), covered_pixels("error-recovered.png")
+    print(f"valid filter again: {pixels} pixels, LastError {error!r}")
+    if error or not pixels:
+        failures.append(f"after a valid filter: LastError {error!r}, {pixels} pixels")
+    # The model alone, its property file elsewhere: a property filter cannot be answered.
+    alone = os.path.join(temp, "alone")
+    os.makedirs(alone, exist_ok=True)
+    alone_path = os.path.join(alone, os.path.basename(resmr_path))
+    if not os.path.exists(alone_path):
+        os.symlink(resmr_path, alone_path)
+    lone = simple.OpenDataFile(alone_path)
+    lone_threshold = simple.MultiresolutionThreshold(Input=lone)
+    lone_threshold.Scalars = ["CELLS", "PORO"]
+    lone_threshold.LowerThreshold, lone_threshold.UpperThreshold = 0.0, 1.0
+    lone_display = rt.show_cell_ids(lone_threshold, view)
+    shown.append(lone_threshold)
+    show_only(lone_threshold)
+    simple.Render(view)
+    error, pixels = last_error(lone_display), covered_pixels("error-no-property-file.png")
+    print(f"no property file: {pixels} pixels, LastError {error!r}")
+    if ".resmrp" not in error or pixels:
+        failures.append(f"no property file: LastError {error!r}, {pixels} pixels")
+    shown.remove(lone_threshold)
+    for proxy in (lone_threshold, lone):
+        simple.Delete(proxy)
+    show_only(threshold)
 
 
 def compare_views(label, stock_source, ours_proxy, kept):
@@ -294,6 +349,8 @@ for name, grid_path in rt.image_models(args.data, temp):
         threshold.UpperThreshold = high
         check_colors(f"{name}-swat-first", stock_threshold(id_source, dynamic, low, high), threshold, ours, dynamic)
     scene.AnimationTime = times[0]
+    if name == "reek":
+        check_error_paths(resmr_path, reader, threshold, ours, bounds)
 
     ours.UpdatePropertyInformation()
     error = ours.GetPropertyValue("LastError")
