@@ -59,6 +59,24 @@ int vtkMultiresolutionExtractSubset::RequestData(
   }
   int box[6];
   std::copy(this->VOI, this->VOI + 6, box);
+  if (this->Exclude)
+  {
+    // Chained excluded boxes add up; the include boxes upstream pass unchanged.
+    vtkNew<vtkIntArray> excluded;
+    excluded->SetName(ExcludedArrayName());
+    vtkIntArray* before = vtkIntArray::SafeDownCast(input->GetFieldData()->GetAbstractArray(ExcludedArrayName()));
+    const vtkIdType whole = before ? before->GetNumberOfValues() / 6 * 6 : 0;
+    for (vtkIdType n = 0; n < whole; ++n)
+    {
+      excluded->InsertNextValue(before->GetValue(n));
+    }
+    for (int n = 0; n < 6; ++n)
+    {
+      excluded->InsertNextValue(box[n]);
+    }
+    PassWithFieldArray(input, output, excluded);
+    return 1;
+  }
   // Chained filters: the intersection of their boxes.
   vtkIntArray* upstream = vtkIntArray::SafeDownCast(input->GetFieldData()->GetAbstractArray(RangeArrayName()));
   if (upstream && upstream->GetNumberOfValues() == 6)
@@ -96,4 +114,5 @@ void vtkMultiresolutionExtractSubset::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "VOI: " << this->VOI[0] << " " << this->VOI[1] << " " << this->VOI[2] << " " << this->VOI[3] << " "
      << this->VOI[4] << " " << this->VOI[5] << "\n";
+  os << indent << "Exclude: " << this->Exclude << "\n";
 }

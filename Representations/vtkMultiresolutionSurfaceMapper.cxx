@@ -475,25 +475,6 @@ resmr::RangeClass Combine(resmr::RangeClass range, resmr::RangeClass values)
   return range != C::Unknown && values == C::Outside ? C::Outside : range;
 }
 
-/// A range "I0 I1 J0 J1 K0 K1" (ECLIPSE's, from 1, inclusive) as a 0-based CellRange.
-bool ParseRange(const std::string& text, resmr::CellRange& range)
-{
-  std::istringstream in(text);
-  std::array<long long, 6> v{};
-  for (auto& value : v)
-  {
-    if (!(in >> value))
-    {
-      return false;
-    }
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    range.lo[a] = v[2 * a] - 1;
-    range.hi[a] = v[2 * a + 1] - 1;
-  }
-  return true;
-}
 } // namespace
 
 bool vtkMultiresolutionSurfaceMapper::ReadSource(Frame& frame)
@@ -714,9 +695,9 @@ bool vtkMultiresolutionSurfaceMapper::SelectRange(Frame& frame)
     // A layer under a property filter: that layer's cells, filtered, painted as a range.
     frame.ranged = frame.layer >= 0 && !frame.filterText.empty();
   }
-  else if (!ParseRange(frame.rangeText, frame.range))
+  else if (!resmr::ParseCellRange(frame.rangeText, { dims[0], dims[1], dims[2] }, frame.range))
   {
-    in.LayerError = "the I/J/K range '" + frame.rangeText + "' is not six whole numbers";
+    in.LayerError = "the I/J/K range '" + frame.rangeText + "' is not six whole numbers and 'exclude' lines of six";
     in.Pending = false;
     return false;
   }
@@ -742,7 +723,7 @@ bool vtkMultiresolutionSurfaceMapper::SelectRange(Frame& frame)
   frame.ranged = frame.ranged || filtered;
   resmr::CellFilter filter;
   filter.range = frame.range;
-  if (filtered)
+  if (in.ValueFilters)
   {
     filter.values = in.ValueFilters;
     // The faces a filter exposes carry the painted array's values (the packed table has none).
@@ -859,7 +840,10 @@ bool vtkMultiresolutionSurfaceMapper::SelectFilters(Frame& frame)
     in.Pending = false;
     return false;
   }
-  if (frame.filters.empty())
+  // Cells an excluded box takes out expose faces inside the model, painted from their cells'
+  // values as a property filter's are: the set (no filter of its own) reads them.
+  const bool excluding = frame.ranged && !frame.range.excluded.empty();
+  if (frame.filters.empty() && (!excluding || !in.Properties))
   {
     in.ValueFilters.reset();
     return true;

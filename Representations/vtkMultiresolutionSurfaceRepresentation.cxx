@@ -92,6 +92,17 @@ int vtkMultiresolutionSurfaceRepresentation::RequestData(
       {
         rangeText += (n ? " " : "") + std::to_string(range->GetValue(n));
       }
+      // Boxes left out (Exclude), a line "exclude I0 I1 J0 J1 K0 K1" each.
+      vtkIntArray* excluded = vtkIntArray::SafeDownCast(
+        input->GetFieldData()->GetAbstractArray(vtkMultiresolutionExtractSubset::ExcludedArrayName()));
+      for (vtkIdType n = 0; excluded && n + 6 <= excluded->GetNumberOfValues(); n += 6)
+      {
+        rangeText += "\nexclude";
+        for (vtkIdType v = 0; v < 6; ++v)
+        {
+          rangeText += " " + std::to_string(excluded->GetValue(n + v));
+        }
+      }
       source->InsertNextValue(rangeText);
       // Property filters set upstream (Multiresolution Threshold), "low high name" a line.
       vtkStringArray* filters = vtkStringArray::SafeDownCast(

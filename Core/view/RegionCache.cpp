@@ -306,8 +306,12 @@ RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::si
     // range.
     const RangeClass valueClass = filter->HasValues() ? filter->values->Classify(footprint, 1) : RangeClass::Inside;
     const bool leaf = file.Regions()[region].level >= file.Header().leafLevel;
+    // Faces inside the model that the filter or an excluded box exposes carry their cells'
+    // values (a leaf's) or their layer blocks' means (a coarse region's).
+    const bool exposing =
+      valueClass != RangeClass::Inside || ExclusionExposes(footprint, filter->range, file.Header().dims);
     CellBox box;
-    if (valueClass != RangeClass::Inside && leaf)
+    if (exposing && leaf)
     {
       box = ReadCellBox(mesh, *filter, file.Header().dims);
     }
@@ -326,7 +330,7 @@ RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::si
     {
       out.faceValues = FaceValues(out.vertices, out.indices, box);
     }
-    else if (valueClass != RangeClass::Inside && !leaf && filter->paintTable >= 0 && filter->paintBlocks)
+    else if (exposing && !leaf && filter->paintTable >= 0 && filter->paintBlocks)
     {
       out.faceValues = FaceMeans(out.vertices, out.indices, *filter->paintBlocks, file.Header().dims);
     }

@@ -1884,6 +1884,25 @@ void TestUploadPacer()
 /// active cells in the range, with their sides open towards the cells out of it.
 void TestRanges(const Model& model)
 {
+  // The range as the descriptor carries it: the box, then the excluded boxes, from 1.
+  {
+    CellRange parsed;
+    CHECK(ParseCellRange("2 5 1 3 4 4\nexclude 3 4 1 2 1 9\nexclude 1 1 1 1 1 1", { 9, 8, 9 }, parsed));
+    CHECK(parsed.lo == (std::array<int64_t, 3>{ 1, 0, 3 }) && parsed.hi == (std::array<int64_t, 3>{ 4, 2, 3 }));
+    CHECK(parsed.excluded.size() == 2 && parsed.excluded[0] == (CellBoxBounds{ 2, 3, 0, 1, 0, 8 }));
+    CHECK(
+      parsed.Contains(1, 0, 3) && !parsed.Contains(2, 1, 3) && parsed.Contains(2, 2, 3) && !parsed.Contains(1, 0, 4));
+    CHECK(parsed.Describe() == "I 2-5, J 1-3, K 4-4 without I 3-4, J 1-2, K 1-9 without I 1-1, J 1-1, K 1-1");
+    CellRange onlyExcluded;
+    CHECK(ParseCellRange("\nexclude 1 9 1 8 2 9", { 9, 8, 9 }, onlyExcluded) && onlyExcluded.hi[0] == 8);
+    CHECK(!onlyExcluded.Whole({ 9, 8, 9 }) && !onlyExcluded.Empty({ 9, 8, 9 }) && onlyExcluded.Contains(8, 7, 0));
+    onlyExcluded.excluded[0][4] = 0; // every layer: nothing left
+    CHECK(onlyExcluded.Empty({ 9, 8, 9 }));
+    CellRange untouched;
+    for (const char* bad :
+      { "1 2 3 4 5", "exclude 1 2 3 4 5", "1 2 3 4 5 6 7", "1 2 3 4 5 6\n1 2 3 4 5 6", "x 1 2 3 4 5 6" })
+      CHECK(!ParseCellRange(bad, { 9, 8, 9 }, untouched) && untouched.excluded.empty() && untouched.hi[0] == -1);
+  }
   const auto& regions = model.file->Regions();
   const auto& header = model.file->Header();
   const std::array<int64_t, 3> dims{ header.dims[0], header.dims[1], header.dims[2] };
@@ -1949,6 +1968,24 @@ void TestRanges(const Model& model)
       range.lo[a] = std::min(lo, hi);
       range.hi[a] = std::max(lo, hi);
     }
+    // Excluded boxes in a third of the trials (two in some): anywhere, a slab in K or every layer.
+    for (int e = 0; e < (trial % 3 == 1 ? 1 + trial % 2 : 0); ++e)
+    {
+      CellBoxBounds box{};
+      for (int a = 0; a < 3; ++a)
+      {
+        std::uniform_int_distribution<int64_t> pick(0, dims[a] - 1);
+        const int64_t lo = pick(random), hi = pick(random);
+        box[2 * a] = std::min(lo, hi);
+        box[2 * a + 1] = std::max(lo, hi);
+      }
+      if (e == 1)
+      {
+        box[4] = 0;
+        box[5] = dims[2] - 1;
+      }
+      range.excluded.push_back(box);
+    }
     std::vector<RangeClass> classes(regions.size());
     for (std::size_t r = 0; r < regions.size(); ++r)
       classes[r] =
@@ -1962,13 +1999,30 @@ void TestRanges(const Model& model)
       drawn.insert(d.region);
       CHECK(classes[d.region] != RangeClass::Outside);
       CHECK(classes[d.region] != RangeClass::Crossed || regions[d.region].level == header.leafLevel);
+      // No excluded box's I or J side passes through a coarse region drawn (its leaves' cells
+      // all in the box or all out of it), unless the box misses the range's layers.
+      const auto& u = exact[d.region];
+      for (const CellBoxBounds& e : range.excluded)
+      {
+        const bool layers = e[4] <= range.hi[2] && e[5] >= range.lo[2];
+        const bool meets = u[0] < float(e[1] + 1) && u[1] > float(e[0]) && u[2] < float(e[3] + 1) && u[3] > float(e[2]);
+        const bool held =
+          u[0] >= float(e[0]) && u[1] <= float(e[1] + 1) && u[2] >= float(e[2]) && u[3] <= float(e[3] + 1);
+        CHECK(regions[d.region].level == header.leafLevel || !layers || !meets || held);
+      }
     }
     for (const std::size_t leaf : model.Leaves())
     {
       const auto& box = columns[leaf];
       const bool touches =
         box[0] < range.hi[0] + 1 && box[1] > range.lo[0] && box[2] < range.hi[1] + 1 && box[3] > range.lo[1];
-      if (!touches || drawn.count(leaf))
+      // A leaf an excluded box holds, with every layer of the range, keeps nothing.
+      bool excluded = false;
+      for (const CellBoxBounds& e : range.excluded)
+        excluded = excluded ||
+          (box[0] >= float(e[0]) && box[1] <= float(e[1] + 1) && box[2] >= float(e[2]) && box[3] <= float(e[3] + 1) &&
+            e[4] <= range.lo[2] && e[5] >= range.hi[2]);
+      if (!touches || excluded || drawn.count(leaf))
         continue;
       bool covered = false;
       for (int64_t a = model.Parent(leaf); a >= 0 && !covered; a = model.Parent(static_cast<std::size_t>(a)))
@@ -2001,6 +2055,12 @@ void TestRanges(const Model& model)
             const bool onGrid = (p[0] == q[0] && (p[0] == 0 || p[0] == float(dims[0]))) ||
               (p[1] == q[1] && (p[1] == 0 || p[1] == float(dims[1])));
             if (onSide && !onGrid)
+              CHECK(masked.openSides[c * layers + k] & (1u << e));
+            // Across an edge into an excluded box: open too (the hole's faces are drawn).
+            const int64_t ci = int64_t(cell[0]), cj = int64_t(cell[1]);
+            const int64_t ni = p[0] == q[0] ? (int64_t(p[0]) == ci ? ci - 1 : ci + 1) : ci;
+            const int64_t nj = p[0] == q[0] ? cj : (int64_t(p[1]) == cj ? cj - 1 : cj + 1);
+            if (ni >= 0 && nj >= 0 && ni < dims[0] && nj < dims[1] && range.Excluded(ni, nj, int64_t(k)))
               CHECK(masked.openSides[c * layers + k] & (1u << e));
           }
         }

@@ -18,7 +18,12 @@ of Multiresolution Extract Subset at tolerance 0 in its Cell Id mode, from 4 cam
   naming Multiresolution Extract Subset; on the full grid they do not;
 - Reek's PORO, and SWAT at the first and last report steps, on a box and an I slice through
   ParaView's lookup table (unlit): >= 99% of the pixels both cover within 3 levels a channel
-  of stock's (the cut faces painted from the planes of cells along each cut).
+  of stock's (the cut faces painted from the planes of cells along each cut);
+- Exclude: a pit from the top down and a corner of every layer hidden (stock: Python Calculator
+  flagging the box's cells, Threshold keeping the others, and ACTNUM), 4 cameras each, the
+  same three checks, no pixel naming a hidden cell; a coarse tolerance (8 px) never shows a
+  hidden cell (but for edge pixels of a face beside the hidden cell, as cell ids round there);
+  on Reek, PORO's colours on the faces the pit exposes as above.
 Images are left in the temporary folder."""
 import builtins
 import os
@@ -85,6 +90,126 @@ def in_range(ids, voi, dims):
     i, j, k = n % nx + 1, (n // nx) % ny + 1, n // (nx * ny) + 1
     inside = (i >= voi[0]) & (i <= voi[1]) & (j >= voi[2]) & (j <= voi[3]) & (k >= voi[4]) & (k <= voi[5])
     return inside | (ids == 0)
+
+
+def stock_excluded(source, voi):
+    """Active cells not in `voi`, as stock ParaView finds them."""
+    flag = simple.PythonCalculator(Input=source, ArrayAssociation="Cell Data", ArrayName="InExcluded")
+    flag.Expression = (f"((I >= {voi[0]}) & (I <= {voi[1]}) & (J >= {voi[2]}) & (J <= {voi[3]}) & "
+                       f"(K >= {voi[4]}) & (K <= {voi[5]})).astype(int)")
+    kept = simple.Threshold(Input=flag, Scalars=["CELLS", "InExcluded"], LowerThreshold=0, UpperThreshold=0)
+    active = simple.Threshold(Input=kept, Scalars=["CELLS", "ACTNUM"], LowerThreshold=1, UpperThreshold=3)
+    made.extend([flag, kept, active])
+    return active
+
+
+def beside_shown_neighbour(ids, dims):
+    """Per pixel: whether a pixel around it (3 x 3) names the cell one step away in I, J or K
+    (the edge of that cell's face, where the cell coordinate rounds to this one)."""
+    nx, ny, _ = dims
+    n = ids.astype(np.int64) - 1
+    found = np.zeros(ids.shape, dtype=bool)
+    padded = np.pad(n, 1, constant_values=-1)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            other = padded[1 + dy:1 + dy + n.shape[0], 1 + dx:1 + dx + n.shape[1]]
+            step = np.abs(other - n)
+            found |= (other >= 0) & ((step == 1) | (step == nx) | (step == nx * ny))
+    return found & (n >= 0)
+
+
+def compare_cell_ids(label, stock_source, ours_proxy, ours, allowed):
+    """Cell ids of ours and stock's from the 4 cameras: the share naming the same cell, pixels
+    of ours `allowed` says no to, holes; failures appended; returns (same, covered)."""
+    same = covered = 0
+    for camera_name, direction, zoom in cameras:
+        show_only(stock_source)
+        rt.place_camera(view, bounds, 1.0, direction, zoom)
+        expected = rt.cell_ids(capture(f"{label}-{camera_name}-stock.png"))
+        show_only(ours_proxy)
+        simple.Render(view)
+        got = rt.cell_ids(capture(f"{label}-{camera_name}-ours.png"))
+        both = (expected > 0) & (got > 0)
+        agree = float(np.mean(expected[both] == got[both])) if both.any() else 0.0
+        wrong = int(np.sum(~allowed(got) & ~beside_shown_neighbour(got, dims)))
+        holes = int(np.sum(rt.erode(expected > 0, 1, corners=True) & (got == 0)))
+        ours.UpdatePropertyInformation()
+        print(f"{label}-{camera_name}: {100 * agree:.2f}% of {int(both.sum())} pixels name the same cell; "
+              f"{wrong} of ours name a hidden cell; {holes} holes; {ours.GetPropertyValue('RegionsDrawn')} regions")
+        same += int(np.sum(expected[both] == got[both]))
+        covered += int(both.sum())
+        if both.sum() >= 2000 and agree < 0.995:
+            failures.append(f"{label}-{camera_name}: {100 * agree:.2f}% < 99.5%")
+        if wrong or holes:
+            failures.append(f"{label}-{camera_name}: {wrong} pixels name hidden cells, {holes} holes")
+    share = same / (covered or 1)
+    print(f"{label}: {100 * share:.2f}% of {covered} pixels over {len(cameras)} views")
+    if covered < 0.02 * WIDTH * HEIGHT or share < 0.995:
+        failures.append(f"{label}: {100 * share:.2f}% of {covered} pixels over the views")
+    return same, covered
+
+
+def check_exclude(name, reader, ids, stock_reader, dims):
+    """Exclude boxes against stock, in cell ids, at 8 px, and (Reek) in PORO's colours."""
+    nx, ny, nk = dims
+    hole = simple.MultiresolutionExtractSubset(Input=reader)
+    hole.Exclude = 1
+    made.append(hole)
+    display = rt.show_cell_ids(hole, view)
+    shown.append(hole)
+    # A pit from the top down to the layer above the bottom one, and a corner through every layer.
+    boxes = [("exclude-box", [nx // 4 + 1, 3 * nx // 4, ny // 5 + 1, 4 * ny // 5, 1, builtins.max(1, nk - 1)]),
+             ("exclude-corner", [1, nx // 2, 1, ny // 2, 1, nk])]
+    for tag, voi in boxes:
+        hole.VOI = voi
+        stock_source = stock_excluded(ids, voi)
+        rt.show_stock_cell_ids(stock_source, view)
+        shown.append(stock_source)
+        compare_cell_ids(f"{name}-{tag}", stock_source, hole, display,
+                         lambda got, voi=voi: ~in_range(got, voi, dims) | (got == 0))
+        simple.Hide(stock_source, view)
+        if tag == "exclude-box":
+            show_only(hole)
+            display.PixelTolerance = 8
+            for camera_name, direction, zoom in cameras:
+                rt.place_camera(view, bounds, 1.0, direction, zoom)
+                simple.Render(view)
+                got = rt.cell_ids(capture(f"{name}-{tag}-8px-{camera_name}.png"))
+                hidden = int(np.sum(in_range(got, voi, dims) & (got > 0) & ~beside_shown_neighbour(got, dims)))
+                print(f"{name} {tag} at 8 px {camera_name}: {int(np.sum(got > 0))} pixels, {hidden} name hidden cells")
+                if hidden or not np.any(got > 0):
+                    failures.append(f"{name} {tag} at 8 px {camera_name}: {hidden} pixels name hidden cells")
+            display.PixelTolerance = 0
+            if name == "reek":
+                # The hole's faces (inside the model) in PORO's colours, from their cells' values.
+                display.PaintBy = "Property"
+                simple.ColorBy(display, ("CELLS", "PORO"))
+                stock = simple.Show(stock_source, view)
+                stock.SetRepresentationType("Surface")
+                stock.MapScalars = 1
+                simple.ColorBy(stock, ("CELLS", "PORO"))
+                stock.RescaleTransferFunctionToDataRange(False, False)
+                unlit(stock)
+                for camera_name, direction, zoom in cameras[:3]:
+                    show_only(stock_source)
+                    rt.place_camera(view, bounds, 1.0, direction, zoom)
+                    expected = capture(f"{name}-{tag}-poro-{camera_name}-stock.png")
+                    show_only(hole)
+                    simple.Render(view)
+                    got = capture(f"{name}-{tag}-poro-{camera_name}-ours.png")
+                    both = (expected.sum(axis=2) > 0) & (got.sum(axis=2) > 0)
+                    close = np.abs(expected.astype(int) - got.astype(int)).max(axis=2) <= 3
+                    share = float(np.mean(close[both])) if both.any() else 0.0
+                    print(f"{name}-{tag}-poro-{camera_name}: {100 * share:.2f}% of {int(both.sum())} pixels "
+                          f"within 3 levels of stock")
+                    if share < 0.99 or both.sum() < 2000:
+                        failures.append(f"{name}-{tag}-poro-{camera_name}: {100 * share:.2f}% of "
+                                        f"{int(both.sum())} pixels < 99%")
+                display.PaintBy = "Cell Id"
+                stock.MapScalars = 0
+                simple.ColorBy(stock, ("CELLS", "CellIdColor"))
+                simple.Hide(stock_source, view)
+    simple.Hide(hole, view)
 
 
 def check_properties(subset, ours, stock_reader, bounds, dims):
@@ -277,6 +402,8 @@ for name, grid_path in models():
 
     if name == "reek":
         check_properties(subset, ours, stock_reader, bounds, dims)
+    simple.Hide(subset, view)
+    check_exclude(name, reader, ids, stock_reader, dims)
 
     ours.UpdatePropertyInformation()
     error = ours.GetPropertyValue("LastError")
