@@ -103,52 +103,6 @@ def stock_excluded(source, voi):
     return active
 
 
-def beside_shown_neighbour(ids, dims):
-    """Per pixel: whether a pixel around it (3 x 3) names the cell one step away in I, J or K
-    (the edge of that cell's face, where the cell coordinate rounds to this one)."""
-    nx, ny, _ = dims
-    n = ids.astype(np.int64) - 1
-    found = np.zeros(ids.shape, dtype=bool)
-    padded = np.pad(n, 1, constant_values=-1)
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            other = padded[1 + dy:1 + dy + n.shape[0], 1 + dx:1 + dx + n.shape[1]]
-            step = np.abs(other - n)
-            found |= (other >= 0) & ((step == 1) | (step == nx) | (step == nx * ny))
-    return found & (n >= 0)
-
-
-def compare_cell_ids(label, stock_source, ours_proxy, ours, allowed):
-    """Cell ids of ours and stock's from the 4 cameras: the share naming the same cell, pixels
-    of ours `allowed` says no to, holes; failures appended; returns (same, covered)."""
-    same = covered = 0
-    for camera_name, direction, zoom in cameras:
-        show_only(stock_source)
-        rt.place_camera(view, bounds, 1.0, direction, zoom)
-        expected = rt.cell_ids(capture(f"{label}-{camera_name}-stock.png"))
-        show_only(ours_proxy)
-        simple.Render(view)
-        got = rt.cell_ids(capture(f"{label}-{camera_name}-ours.png"))
-        both = (expected > 0) & (got > 0)
-        agree = float(np.mean(expected[both] == got[both])) if both.any() else 0.0
-        wrong = int(np.sum(~allowed(got) & ~beside_shown_neighbour(got, dims)))
-        holes = int(np.sum(rt.erode(expected > 0, 1, corners=True) & (got == 0)))
-        ours.UpdatePropertyInformation()
-        print(f"{label}-{camera_name}: {100 * agree:.2f}% of {int(both.sum())} pixels name the same cell; "
-              f"{wrong} of ours name a hidden cell; {holes} holes; {ours.GetPropertyValue('RegionsDrawn')} regions")
-        same += int(np.sum(expected[both] == got[both]))
-        covered += int(both.sum())
-        if both.sum() >= 2000 and agree < 0.995:
-            failures.append(f"{label}-{camera_name}: {100 * agree:.2f}% < 99.5%")
-        if wrong or holes:
-            failures.append(f"{label}-{camera_name}: {wrong} pixels name hidden cells, {holes} holes")
-    share = same / (covered or 1)
-    print(f"{label}: {100 * share:.2f}% of {covered} pixels over {len(cameras)} views")
-    if covered < 0.02 * WIDTH * HEIGHT or share < 0.995:
-        failures.append(f"{label}: {100 * share:.2f}% of {covered} pixels over the views")
-    return same, covered
-
-
 def check_exclude(name, reader, ids, stock_reader, dims):
     """Exclude boxes against stock, in cell ids, at 8 px, and (Reek) in PORO's colours."""
     nx, ny, nk = dims
@@ -165,8 +119,11 @@ def check_exclude(name, reader, ids, stock_reader, dims):
         stock_source = stock_excluded(ids, voi)
         rt.show_stock_cell_ids(stock_source, view)
         shown.append(stock_source)
-        compare_cell_ids(f"{name}-{tag}", stock_source, hole, display,
-                         lambda got, voi=voi: ~in_range(got, voi, dims) | (got == 0))
+        def hidden(got, _, voi=voi):
+            count = int(np.sum(in_range(got, voi, dims) & (got > 0) & ~rt.beside_neighbour_cell(got, dims)))
+            return count, f"{count} of ours name a hidden cell"
+        rt.compare_cell_ids(view, bounds, cameras, f"{name}-{tag}", stock_source, hole, show_only, capture, hidden,
+                            failures)
         simple.Hide(stock_source, view)
         if tag == "exclude-box":
             show_only(hole)
@@ -175,7 +132,7 @@ def check_exclude(name, reader, ids, stock_reader, dims):
                 rt.place_camera(view, bounds, 1.0, direction, zoom)
                 simple.Render(view)
                 got = rt.cell_ids(capture(f"{name}-{tag}-8px-{camera_name}.png"))
-                hidden = int(np.sum(in_range(got, voi, dims) & (got > 0) & ~beside_shown_neighbour(got, dims)))
+                hidden = int(np.sum(in_range(got, voi, dims) & (got > 0) & ~rt.beside_neighbour_cell(got, dims)))
                 print(f"{name} {tag} at 8 px {camera_name}: {int(np.sum(got > 0))} pixels, {hidden} name hidden cells")
                 if hidden or not np.any(got > 0):
                     failures.append(f"{name} {tag} at 8 px {camera_name}: {hidden} pixels name hidden cells")
@@ -314,40 +271,11 @@ for name, grid_path in models():
         stock_source = stock_range(ids, voi)
         rt.show_stock_cell_ids(stock_source, view)
         shown.append(stock_source)
-        same = covered = 0
-        for camera_name, direction, zoom in cameras:
-            label = f"{name}-{tag}-{camera_name}"
-            show_only(stock_source)
-            view.ResetCamera(False)
-            rt.place_camera(view, bounds, 1.0, direction, zoom)
-            expected = rt.cell_ids(capture(f"{label}-stock.png"))
-            show_only(subset)
-            simple.Render(view)
-            got = rt.cell_ids(capture(f"{label}-ours.png"))
-            both = (expected > 0) & (got > 0)
-            agree = float(np.mean(expected[both] == got[both])) if both.any() else 0.0
-            outside = int(np.sum(~in_range(got, voi, dims)))
-            stock_outside = int(np.sum(~in_range(expected, voi, dims)))
-            holes = int(np.sum(rt.erode(expected > 0, 1, corners=True) & (got == 0)))
-            if holes or outside:
-                np.save(os.path.join(temp, f"{label}-diff.npy"), np.stack([expected, got]))
-            ours.UpdatePropertyInformation()
-            print(f"{label} {voi}: {100 * agree:.2f}% of {int(both.sum())} pixels name the same cell; "
-                  f"{outside} of ours out of the range ({stock_outside} of stock's); {holes} holes; "
-                  f"{int(ours.GetPropertyValue('TrianglesDrawn'))} triangles, "
-                  f"{ours.GetPropertyValue('RegionsDrawn')} regions")
-            same += int(np.sum(expected[both] == got[both]))
-            covered += int(both.sum())
-            if both.sum() >= 2000 and agree < 0.995:
-                failures.append(f"{label}: {100 * agree:.2f}% < 99.5%")
-            if outside or stock_outside:
-                failures.append(f"{label}: {outside} pixels of ours, {stock_outside} of stock's out of the range")
-            if holes:
-                failures.append(f"{label}: {holes} background pixels inside stock's cells")
-        share = same / (covered or 1)
-        print(f"{name} {tag}: {100 * share:.2f}% of {covered} pixels over {len(cameras)} views")
-        if covered < 0.02 * WIDTH * HEIGHT or share < 0.995:
-            failures.append(f"{name} {tag}: {100 * share:.2f}% of {covered} pixels over the views")
+        def outside(got, expected, voi=voi):
+            ours_out, stock_out = int(np.sum(~in_range(got, voi, dims))), int(np.sum(~in_range(expected, voi, dims)))
+            return ours_out + stock_out, f"{ours_out} of ours out of the range ({stock_out} of stock's)"
+        rt.compare_cell_ids(view, bounds, cameras, f"{name}-{tag}", stock_source, subset, show_only, capture, outside,
+                            failures)
         simple.Hide(stock_source, view)
 
     # A coarse tolerance: regions a side of the range crosses are still split to the leaves,

@@ -332,6 +332,60 @@ def show_stock_cell_ids(source, view):
     return display
 
 
+def beside_neighbour_cell(ids, dims):
+    """Per pixel of a cell-id image: whether a pixel around it (3 x 3) names a cell one step
+    away in I, J or K (the edge of that cell's face, where cell coordinates round to this one)."""
+    nx, ny, _ = dims
+    n = ids.astype(np.int64) - 1
+    found = np.zeros(ids.shape, dtype=bool)
+    padded = np.pad(n, 1, constant_values=-1)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            other = padded[1 + dy:1 + dy + n.shape[0], 1 + dx:1 + dx + n.shape[1]]
+            step = np.abs(other - n)
+            found |= (other >= 0) & ((step == 1) | (step == nx) | (step == nx * ny))
+    return found & (n >= 0)
+
+
+def compare_cell_ids(view, bounds, cameras, label, stock_source, ours_proxy, show_only, capture, wrong_pixels,
+                     failures):
+    """Cell-id images of stock's `stock_source` and `ours_proxy` from each camera (name,
+    direction, zoom): per view the share of the pixels both cover that name the same cell
+    (>= 99.5% with 2000 pixels or more), pixels `wrong_pixels(got, expected)` counts (none;
+    it returns the count and a phrase for the log) and background pixels of ours inside stock's
+    cells (none); over the views >= 99.5% and 2% of the view covered. Failures are appended to
+    `failures`; returns the pixels that agree and those both cover."""
+    from paraview import simple
+    same = covered = 0
+    for camera_name, direction, zoom in cameras:
+        name = f"{label}-{camera_name}"
+        show_only(stock_source)
+        place_camera(view, bounds, 1.0, direction, zoom)
+        expected = cell_ids(capture(f"{name}-stock.png"))
+        show_only(ours_proxy)
+        simple.Render(view)
+        got = cell_ids(capture(f"{name}-ours.png"))
+        both = (expected > 0) & (got > 0)
+        agree = float(np.mean(expected[both] == got[both])) if both.any() else 0.0
+        wrong, note = wrong_pixels(got, expected)
+        holes = int(np.sum(erode(expected > 0, 1, corners=True) & (got == 0)))
+        print(f"{name}: {100 * agree:.2f}% of {int(both.sum())} pixels name the same cell; {note}; {holes} holes")
+        same += int(np.sum(expected[both] == got[both]))
+        covered += int(both.sum())
+        if both.sum() >= 2000 and agree < 0.995:
+            failures.append(f"{name}: {100 * agree:.2f}% < 99.5%")
+        if wrong:
+            failures.append(f"{name}: {note}")
+        if holes:
+            failures.append(f"{name}: {holes} background pixels inside stock's cells")
+    share = same / (covered or 1)
+    width, height = view.ViewSize
+    print(f"{label}: {100 * share:.2f}% of {covered} pixels over {len(cameras)} views")
+    if covered < 0.02 * width * height or share < 0.995:
+        failures.append(f"{label}: {100 * share:.2f}% of {covered} pixels over the views")
+    return same, covered
+
+
 def unlit(display):
     """Ambient light only: colours come out as the lookup table or cell-id colouring gives them."""
     display.Ambient = 1.0
