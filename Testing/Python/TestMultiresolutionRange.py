@@ -128,14 +128,10 @@ def check_exclude(name, reader, ids, stock_reader, dims):
         if tag == "exclude-box":
             show_only(hole)
             display.PixelTolerance = 8
-            for camera_name, direction, zoom in cameras:
-                rt.place_camera(view, bounds, 1.0, direction, zoom)
-                simple.Render(view)
-                got = rt.cell_ids(capture(f"{name}-{tag}-8px-{camera_name}.png"))
-                hidden = int(np.sum(in_range(got, voi, dims) & (got > 0) & ~rt.beside_neighbour_cell(got, dims)))
-                print(f"{name} {tag} at 8 px {camera_name}: {int(np.sum(got > 0))} pixels, {hidden} name hidden cells")
-                if hidden or not np.any(got > 0):
-                    failures.append(f"{name} {tag} at 8 px {camera_name}: {hidden} pixels name hidden cells")
+            def hidden_alone(got, voi=voi):
+                count = int(np.sum(in_range(got, voi, dims) & (got > 0) & ~rt.beside_neighbour_cell(got, dims)))
+                return count, f"{count} name hidden cells"
+            rt.check_alone(view, bounds, cameras, f"{name}-{tag}-8px", capture, hidden_alone, failures)
             display.PixelTolerance = 0
             if name == "reek":
                 # The hole's faces (inside the model) in PORO's colours, from their cells' values.
@@ -147,21 +143,8 @@ def check_exclude(name, reader, ids, stock_reader, dims):
                 simple.ColorBy(stock, ("CELLS", "PORO"))
                 stock.RescaleTransferFunctionToDataRange(False, False)
                 unlit(stock)
-                for camera_name, direction, zoom in cameras[:3]:
-                    show_only(stock_source)
-                    rt.place_camera(view, bounds, 1.0, direction, zoom)
-                    expected = capture(f"{name}-{tag}-poro-{camera_name}-stock.png")
-                    show_only(hole)
-                    simple.Render(view)
-                    got = capture(f"{name}-{tag}-poro-{camera_name}-ours.png")
-                    both = (expected.sum(axis=2) > 0) & (got.sum(axis=2) > 0)
-                    close = np.abs(expected.astype(int) - got.astype(int)).max(axis=2) <= 3
-                    share = float(np.mean(close[both])) if both.any() else 0.0
-                    print(f"{name}-{tag}-poro-{camera_name}: {100 * share:.2f}% of {int(both.sum())} pixels "
-                          f"within 3 levels of stock")
-                    if share < 0.99 or both.sum() < 2000:
-                        failures.append(f"{name}-{tag}-poro-{camera_name}: {100 * share:.2f}% of "
-                                        f"{int(both.sum())} pixels < 99%")
+                rt.compare_colors(view, bounds, cameras[:3], f"{name}-{tag}-poro", stock_source, hole, show_only,
+                                  capture, failures)
                 display.PaintBy = "Cell Id"
                 stock.MapScalars = 0
                 simple.ColorBy(stock, ("CELLS", "CellIdColor"))
@@ -188,19 +171,8 @@ def check_properties(subset, ours, stock_reader, bounds, dims):
             unlit(stock)
             simple.ColorBy(ours, ("CELLS", array))
             shown.append(stock_source)
-            label = f"reek-{tag}-{array}-{time:g}"
-            show_only(stock_source)
-            rt.place_camera(view, bounds, 1.0, cameras[2][1], cameras[2][2])
-            expected = capture(f"{label}-stock.png")
-            show_only(subset)
-            simple.Render(view)
-            got = capture(f"{label}-ours.png")
-            both = (expected.sum(axis=2) > 0) & (got.sum(axis=2) > 0)
-            close = np.abs(expected.astype(int) - got.astype(int)).max(axis=2) <= 3
-            share = float(np.mean(close[both])) if both.any() else 0.0
-            print(f"{label} {voi}: {100 * share:.2f}% of {int(both.sum())} pixels within 3 levels of stock")
-            if share < 0.99 or both.sum() < 2000:
-                failures.append(f"{label}: {100 * share:.2f}% of {int(both.sum())} pixels < 99%")
+            rt.compare_colors(view, bounds, [cameras[2]], f"reek-{tag}-{array}-{time:g}", stock_source, subset,
+                              show_only, capture, failures)
             simple.Hide(stock_source, view)
     scene.AnimationTime = times[0]
     ours.PaintBy = "Cell Id"

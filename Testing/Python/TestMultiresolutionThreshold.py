@@ -182,18 +182,8 @@ def check_colors(label, stock_source, threshold, ours, array_name):
     ours.PaintBy = "Property"
     simple.ColorBy(ours, ("CELLS", array_name))
     shown.append(stock_source)
-    show_only(stock_source)
-    rt.place_camera(view, bounds, 1.0, CAMERAS[2][1], CAMERAS[2][2])
-    expected = capture(f"{label}-colors-stock.png")
-    show_only(threshold)
-    simple.Render(view)
-    got = capture(f"{label}-colors-ours.png")
-    both = (expected.sum(axis=2) > 0) & (got.sum(axis=2) > 0)
-    close = np.abs(expected.astype(int) - got.astype(int)).max(axis=2) <= 3
-    share = float(np.mean(close[both])) if both.any() else 0.0
-    print(f"{label} painted by {array_name}: {100 * share:.2f}% of {int(both.sum())} pixels within 3 levels of stock")
-    if share < 0.99 or both.sum() < 2000:
-        failures.append(f"{label} colours: {100 * share:.2f}% of {int(both.sum())} pixels < 99%")
+    rt.compare_colors(view, bounds, [CAMERAS[2]], f"{label}-colors-{array_name}", stock_source, threshold, show_only,
+                      capture, failures)
     ours.PaintBy = "Cell Id"
     simple.Hide(stock_source, view)
 
@@ -269,15 +259,10 @@ for name, grid_path in rt.image_models(args.data, temp):
             # A coarse tolerance: regions a filter crosses are split to the leaves.
             show_only(threshold)
             ours.PixelTolerance = 8
-            for camera_name, direction, zoom in CAMERAS:
-                rt.place_camera(view, bounds, 1.0, direction, zoom)
-                simple.Render(view)
-                got = rt.cell_ids(capture(f"{label}-8px-{camera_name}.png"))
+            def removed_alone(got):
                 failing, at_edges = removed_pixels(got, kept)
-                print(f"{label} at 8 px {camera_name}: {int(np.sum(got > 0))} pixels, {failing} name removed cells "
-                      f"away from a kept neighbour's edge ({at_edges} in all)")
-                if failing or not np.any(got > 0):
-                    failures.append(f"{label} at 8 px {camera_name}: {failing} pixels name removed cells")
+                return failing, f"{failing} name removed cells away from a kept neighbour's edge ({at_edges} in all)"
+            rt.check_alone(view, bounds, CAMERAS, f"{label}-8px", capture, removed_alone, failures)
             # With Layer set, that layer's passing cells.
             ours.Layer = 3
             rt.place_camera(view, bounds, 1.0, CAMERAS[0][1], CAMERAS[0][2])

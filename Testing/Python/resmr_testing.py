@@ -386,6 +386,40 @@ def compare_cell_ids(view, bounds, cameras, label, stock_source, ours_proxy, sho
     return same, covered
 
 
+def check_alone(view, bounds, cameras, label, capture, wrong_pixels, failures):
+    """Ours alone (what is shown) from each camera, in cell ids: something drawn, and no pixel
+    `wrong_pixels(got)` counts (it returns the count and a phrase for the log)."""
+    from paraview import simple
+    for camera_name, direction, zoom in cameras:
+        place_camera(view, bounds, 1.0, direction, zoom)
+        simple.Render(view)
+        got = cell_ids(capture(f"{label}-{camera_name}.png"))
+        wrong, note = wrong_pixels(got)
+        print(f"{label} {camera_name}: {int(np.sum(got > 0))} pixels, {note}")
+        if wrong or not np.any(got > 0):
+            failures.append(f"{label} {camera_name}: {note}, {int(np.sum(got > 0))} pixels")
+
+
+def compare_colors(view, bounds, cameras, label, stock_source, ours_proxy, show_only, capture, failures):
+    """Colour images of stock and ours (both coloured and unlit by the caller) from each camera:
+    >= 99% of the pixels both cover within 3 levels a channel, over at least 2000 pixels."""
+    from paraview import simple
+    for camera_name, direction, zoom in cameras:
+        name = f"{label}-{camera_name}"
+        show_only(stock_source)
+        place_camera(view, bounds, 1.0, direction, zoom)
+        expected = capture(f"{name}-stock.png")
+        show_only(ours_proxy)
+        simple.Render(view)
+        got = capture(f"{name}-ours.png")
+        both = (expected.sum(axis=2) > 0) & (got.sum(axis=2) > 0)
+        close = np.abs(expected.astype(int) - got.astype(int)).max(axis=2) <= 3
+        share = float(np.mean(close[both])) if both.any() else 0.0
+        print(f"{name}: {100 * share:.2f}% of {int(both.sum())} pixels within 3 levels of stock")
+        if share < 0.99 or both.sum() < 2000:
+            failures.append(f"{name}: {100 * share:.2f}% of {int(both.sum())} pixels < 99%")
+
+
 def unlit(display):
     """Ambient light only: colours come out as the lookup table or cell-id colouring gives them."""
     display.Ambient = 1.0
