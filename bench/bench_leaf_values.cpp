@@ -1,13 +1,14 @@
 // The property values a filtered leaf region reads (PropertyFilter.h, ReadCellBox): for every
 // leaf region of a .resmr, the box of its columns' cells over all layers, read with
-// PropertyFile::ReadBox from each property file given (the same table in each: files of
-// different format versions, so their layouts are measured side by side in one run).
+// PropertyFile::ReadBox. One table of a property file is written twice into SCRATCH, cut into
+// this version's tiles of 64 x 64 columns and into bands of whole rows of at most 1 MB (the
+// layout of version 4 files, the peer), and both are read in the same run.
 //
-//   bench_leaf_values MODEL.resmr TABLE STEP A.resmrp [B.resmrp ...]
+//   bench_leaf_values MODEL.resmr PROPS.resmrp TABLE STEP SCRATCH
 //
-// Prints one JSON line a file: leaves, cells read, milliseconds a leaf (a cold pass after
-// dropping the file's pages from the cache, then a warm one), and whether every file gave the
-// same values.
+// Prints one JSON line a layout: leaves, cells read, file bytes of the table's layers,
+// milliseconds a leaf (a cold pass after dropping the file's pages from the cache, then a
+// warm one), and whether both layouts gave the same values.
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
 
@@ -61,16 +62,48 @@ void DropPages(const std::string& path)
     close(fd);
   }
 }
+
+/// Writes table `table` of `from` alone into a new file at `path`, its layers cut into bands of
+/// `rows` x `columns` (0: the default tiles).
+void WriteTable(const PropertyFile& from, std::size_t table, const MultiresolutionFile& geometry,
+  const std::string& path, int64_t rows, int64_t columns)
+{
+  PropertyFileWriter writer(path, geometry, rows, columns);
+  const std::size_t handle = writer.BeginTable(from.Tables()[table]);
+  for (int64_t k = 0; k < from.Dimensions()[2]; ++k)
+  {
+    const std::vector<float> layer = from.ReadLayer(table, k);
+    writer.AddLayer(handle, layer.data());
+  }
+  writer.EndTable(handle);
+  writer.Commit();
+}
 } // namespace
 
 int main(int argc, char** argv)
 {
-  if (argc < 5)
+  if (argc != 6)
   {
-    std::fprintf(stderr, "usage: %s MODEL.resmr TABLE STEP A.resmrp [B.resmrp ...]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s MODEL.resmr PROPS.resmrp TABLE STEP SCRATCH\n", argv[0]);
     return 2;
   }
   const MultiresolutionFile geometry(argv[1]);
+  const auto& dims = geometry.Header().dims;
+  std::vector<std::string> paths;
+  {
+    const PropertyFile source(argv[2]);
+    const int table = source.Find(argv[3], std::atoi(argv[4]));
+    if (table < 0)
+    {
+      std::fprintf(stderr, "%s: no table %s of step %s\n", argv[2], argv[3], argv[4]);
+      return 1;
+    }
+    const std::string scratch = argv[5];
+    paths = { scratch + "/tiles.resmrp", scratch + "/whole-rows.resmrp" };
+    WriteTable(source, static_cast<std::size_t>(table), geometry, paths[0], 0, 0);
+    const int64_t rows = std::clamp<int64_t>((int64_t(1) << 18) / std::max<int64_t>(dims[0], 1), 1, dims[1]);
+    WriteTable(source, static_cast<std::size_t>(table), geometry, paths[1], rows, dims[0]);
+  }
   std::vector<std::pair<std::array<int64_t, 3>, std::array<int64_t, 3>>> boxes;
   int64_t cells = 0;
   for (std::size_t r = 0; r < geometry.Regions().size(); ++r)
@@ -83,15 +116,17 @@ int main(int argc, char** argv)
     }
   }
   std::vector<double> firstSums;
-  for (int f = 4; f < argc; ++f)
+  for (const std::string& path : paths)
   {
-    DropPages(argv[f]);
-    const PropertyFile properties(argv[f]);
-    const int table = properties.Find(argv[2], std::atoi(argv[3]));
-    if (table < 0)
+    DropPages(path);
+    const PropertyFile properties(path);
+    uint64_t stored = 0;
+    for (int64_t k = 0; k < dims[2]; ++k)
     {
-      std::fprintf(stderr, "%s: no table %s of step %s\n", argv[f], argv[2], argv[3]);
-      return 1;
+      for (int64_t b = 0; b < properties.Bands(); ++b)
+      {
+        stored += properties.LayerBand(0, k, b).stored;
+      }
     }
     double ms[2] = { 0, 0 };
     std::vector<double> sums;
@@ -100,7 +135,7 @@ int main(int argc, char** argv)
       const auto start = std::chrono::steady_clock::now();
       for (const auto& [lo, hi] : boxes)
       {
-        const std::vector<float> values = properties.ReadBox(static_cast<std::size_t>(table), lo, hi);
+        const std::vector<float> values = properties.ReadBox(0, lo, hi);
         double sum = 0;
         for (const float v : values)
         {
@@ -118,12 +153,15 @@ int main(int argc, char** argv)
     {
       firstSums = sums;
     }
-    std::printf("{\"file\": \"%s\", \"band_rows\": %lld, \"band_columns\": %lld, \"leaves\": %zu, \"cells\": %lld, "
-                "\"cold_ms_per_leaf\": %.2f, \"warm_ms_per_leaf\": %.2f, \"same_values\": %s}\n",
-      argv[f], static_cast<long long>(properties.BandRows()), static_cast<long long>(properties.BandColumns()),
-      boxes.size(), static_cast<long long>(cells), ms[0] / double(boxes.size()), ms[1] / double(boxes.size()),
-      same ? "true" : "false");
+    std::printf("{\"layout\": \"%s\", \"band_rows\": %lld, \"band_columns\": %lld, \"bands_a_layer\": %lld, "
+                "\"leaves\": %zu, \"cells\": %lld, \"layer_bytes\": %llu, \"cold_ms_per_leaf\": %.2f, "
+                "\"warm_ms_per_leaf\": %.2f, \"same_values\": %s}\n",
+      path == paths[0] ? "tiles" : "whole rows", static_cast<long long>(properties.BandRows()),
+      static_cast<long long>(properties.BandColumns()), static_cast<long long>(properties.Bands()), boxes.size(),
+      static_cast<long long>(cells), static_cast<unsigned long long>(stored), ms[0] / double(boxes.size()),
+      ms[1] / double(boxes.size()), same ? "true" : "false");
     std::fflush(stdout);
+    std::remove(path.c_str());
   }
   return 0;
 }

@@ -1,0 +1,56 @@
+"""A filtered leaf region's property values, tiles against bands of whole rows:
+
+  python3 bench/run_leaf_values_bench.py --tool build/bin/bench_leaf_values --scratch DIR \
+      --models A.resmr B.resmr ... [--table SWAT --step 1] [--out bench/results/leaf_values]
+
+For each model (its .resmrp beside it), bench_leaf_values writes the table twice into DIR, in
+this version's 64 x 64-column tiles and in bands of whole rows of at most 1 MB (version 4's
+layout, the peer), and reads every leaf region's box of cells (all layers) from each, cold
+(pages dropped) and warm. Results and the machine go to OUT.json and OUT.md."""
+import argparse
+import json
+import os
+import platform
+import subprocess
+
+parser = argparse.ArgumentParser()
+parser.add_argument("--tool", required=True)
+parser.add_argument("--scratch", required=True)
+parser.add_argument("--models", nargs="+", required=True)
+parser.add_argument("--table", default="SWAT")
+parser.add_argument("--step", default="1")
+parser.add_argument("--out", default="bench/results/leaf_values")
+args = parser.parse_args()
+
+
+def cpu_name():
+    with open("/proc/cpuinfo") as info:
+        for line in info:
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    return platform.processor()
+
+
+rows = []
+for model in args.models:
+    out = subprocess.run([args.tool, model, model + "p", args.table, args.step, args.scratch],
+                         check=True, capture_output=True, text=True).stdout
+    for line in out.splitlines():
+        row = dict(json.loads(line), model=os.path.basename(model), table=f"{args.table} step {args.step}")
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+machine = {"cpu": cpu_name(), "cores": os.cpu_count(),
+           "memory_gb": round(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30, 1)}
+with open(args.out + ".json", "w") as out_file:
+    json.dump({"machine": machine, "rows": rows}, out_file, indent=1)
+with open(args.out + ".md", "w") as md:
+    md.write(f"# A filtered leaf region's property values: tiles against bands of whole rows\n\n"
+             f"Machine: {machine['cpu']}, {machine['cores']} cores, {machine['memory_gb']} GB. Every leaf region's "
+             f"box of cells over all layers read with PropertyFile::ReadBox, one pass cold (pages dropped), "
+             f"one warm.\n\n")
+    md.write("| model | table | layout | band | leaves | cells read | layer bytes | cold ms a leaf | warm ms a leaf "
+             "| same values |\n|---|---|---|---|---|---|---|---|---|---|\n")
+    for r in rows:
+        md.write(f"| {r['model']} | {r['table']} | {r['layout']} | {r['band_rows']} x {r['band_columns']} | "
+                 f"{r['leaves']} | {r['cells']:,} | {r['layer_bytes']:,} | {r['cold_ms_per_leaf']} | "
+                 f"{r['warm_ms_per_leaf']} | {r['same_values']} |\n")
