@@ -39,6 +39,7 @@ parser.add_argument("--plugin", required=True)
 parser.add_argument("--models", nargs="+", required=True)
 parser.add_argument("--peer-grid", default="")
 parser.add_argument("--out", default="bench/results/filters")
+parser.add_argument("--append", action="store_true", help="add to OUT.json's rows (models run apart, same machine)")
 args = parser.parse_args()
 
 simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
@@ -253,6 +254,9 @@ def bench_peer(path, view, rows):
 
 
 def write_results(rows):
+    if args.append and os.path.exists(args.out + ".json"):
+        with open(args.out + ".json") as earlier:
+            rows = json.load(earlier)["rows"] + rows
     machine = {"cpu": cpu_name(), "cores": os.cpu_count(),
                "memory_gb": round(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30, 1)}
     with open(args.out + ".json", "w") as out_file:
