@@ -923,9 +923,31 @@ bool RegionCache::RootsMissing() const
   return this->RootsMissingLocked();
 }
 
-bool RegionCache::WaitForRoots(std::chrono::milliseconds timeout) const
+bool RegionCache::WaitForRoots(std::chrono::milliseconds timeout)
 {
-  return this->WaitWhile(timeout, &RegionCache::RootsMissingLocked);
+  std::unique_lock<std::mutex> lock(this->Lock);
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (this->RootsMissingLocked())
+  {
+    const auto waiting = std::find_if(this->Pinned.begin(), this->Pinned.end(),
+      [&](Key key) { return this->MissingLocked(key) && !this->Loading.count(key); });
+    if (this->HandednessKnown && waiting != this->Pinned.end())
+    {
+      this->LoadRegionLocked(lock, *waiting, Role::Essential); // at this thread's priority
+      this->Idle.notify_all();
+      this->Wake.notify_all();
+      continue;
+    }
+    this->RescueIfStarvedLocked();
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= deadline)
+    {
+      return false;
+    }
+    const std::chrono::steady_clock::duration slice = this->StarvationWindow / 2;
+    this->Idle.wait_for(lock, std::min<std::chrono::steady_clock::duration>(deadline - now, slice));
+  }
+  return true;
 }
 
 void RegionCache::SetStarvationWindow(std::chrono::milliseconds window)

@@ -278,8 +278,11 @@ public:
   /// (roots are what a frame draws when nothing else is resident).
   bool RootsMissing() const;
   /// Waits while RootsMissing(), at most `timeout`, blocked on the loader rather than
-  /// polling; true when no root is missing any more.
-  bool WaitForRoots(std::chrono::milliseconds timeout) const;
+  /// polling; true when no root is missing any more. Meanwhile the calling thread reads a root
+  /// no loader reads yet (ours: the frame waits on them all, and the essential loader reads
+  /// one at a time; a filter change's two masked roots of the 100M model came in one after
+  /// the other).
+  bool WaitForRoots(std::chrono::milliseconds timeout);
 
   void SetBudget(std::size_t bytes);
   std::size_t Budget() const;
