@@ -28,9 +28,9 @@ first image, a filter change, and memory added."""
 import argparse
 import json
 import os
-import platform
 import time
 
+import bench_machine
 import numpy as np
 from paraview import simple
 
@@ -76,14 +76,6 @@ def place(view, bounds, direction, zoom=1.0):
 def readout(display, name):
     display.UpdatePropertyInformation()
     return display.GetPropertyValue(name)
-
-
-def cpu_name():
-    with open("/proc/cpuinfo") as info:
-        for line in info:
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    return platform.processor()
 
 
 def measure_change(view, display, change, row):
@@ -257,8 +249,7 @@ def write_results(rows):
     if args.append and os.path.exists(args.out + ".json"):
         with open(args.out + ".json") as earlier:
             rows = json.load(earlier)["rows"] + rows
-    machine = {"cpu": cpu_name(), "cores": os.cpu_count(),
-               "memory_gb": round(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30, 1)}
+    machine = bench_machine.machine()
     with open(args.out + ".json", "w") as out_file:
         json.dump({"machine": machine, "rows": rows}, out_file, indent=1)
     with open(args.out + ".md", "w") as md:

@@ -10,8 +10,9 @@ layout, the peer), and reads every leaf region's box of cells (all layers) from 
 import argparse
 import json
 import os
-import platform
 import subprocess
+
+import bench_machine
 
 parser = argparse.ArgumentParser()
 parser.add_argument("--tool", required=True)
@@ -23,14 +24,6 @@ parser.add_argument("--out", default="bench/results/leaf_values")
 args = parser.parse_args()
 
 
-def cpu_name():
-    with open("/proc/cpuinfo") as info:
-        for line in info:
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    return platform.processor()
-
-
 rows = []
 for model in args.models:
     out = subprocess.run([args.tool, model, model + "p", args.table, args.step, args.scratch],
@@ -39,8 +32,7 @@ for model in args.models:
         row = dict(json.loads(line), model=os.path.basename(model), table=f"{args.table} step {args.step}")
         rows.append(row)
         print(json.dumps(row), flush=True)
-machine = {"cpu": cpu_name(), "cores": os.cpu_count(),
-           "memory_gb": round(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30, 1)}
+machine = bench_machine.machine()
 with open(args.out + ".json", "w") as out_file:
     json.dump({"machine": machine, "rows": rows}, out_file, indent=1)
 with open(args.out + ".md", "w") as md:

@@ -899,15 +899,25 @@ bool RegionCache::WaitWhile(std::chrono::milliseconds timeout, bool (RegionCache
   // Each load ends with Idle notified, so every mesh that arrives wakes this wait.
   while ((this->*busy)())
   {
-    this->RescueIfStarvedLocked();
-    const auto now = std::chrono::steady_clock::now();
-    if (now >= deadline)
+    if (!this->WaitSliceLocked(lock, deadline))
     {
       return false;
     }
-    const std::chrono::steady_clock::duration slice = this->StarvationWindow / 2;
-    this->Idle.wait_for(lock, std::min<std::chrono::steady_clock::duration>(deadline - now, slice));
   }
+  return true;
+}
+
+bool RegionCache::WaitSliceLocked(
+  std::unique_lock<std::mutex>& lock, std::chrono::steady_clock::time_point deadline) const
+{
+  this->RescueIfStarvedLocked();
+  const auto now = std::chrono::steady_clock::now();
+  if (now >= deadline)
+  {
+    return false;
+  }
+  const std::chrono::steady_clock::duration slice = this->StarvationWindow / 2;
+  this->Idle.wait_for(lock, std::min<std::chrono::steady_clock::duration>(deadline - now, slice));
   return true;
 }
 
@@ -938,14 +948,10 @@ bool RegionCache::WaitForRoots(std::chrono::milliseconds timeout)
       this->Wake.notify_all();
       continue;
     }
-    this->RescueIfStarvedLocked();
-    const auto now = std::chrono::steady_clock::now();
-    if (now >= deadline)
+    if (!this->WaitSliceLocked(lock, deadline))
     {
       return false;
     }
-    const std::chrono::steady_clock::duration slice = this->StarvationWindow / 2;
-    this->Idle.wait_for(lock, std::min<std::chrono::steady_clock::duration>(deadline - now, slice));
   }
   return true;
 }

@@ -353,6 +353,9 @@ private:
   bool RootsMissingLocked() const;
   /// Waits (the lock released) while `busy` holds, at most `timeout`; false on timeout.
   bool WaitWhile(std::chrono::milliseconds timeout, bool (RegionCache::*busy)() const) const;
+  /// One slice of such a wait: rescues a starved loader, then waits for a load to end (half a
+  /// starvation window at most); false, without waiting, once `deadline` has passed.
+  bool WaitSliceLocked(std::unique_lock<std::mutex>& lock, std::chrono::steady_clock::time_point deadline) const;
   /// Neither loaded nor failed (it may be being read). Lock held.
   bool MissingLocked(Key key) const;
   /// The current layer's roots are pinned. Lock held.
