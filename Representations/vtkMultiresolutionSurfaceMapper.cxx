@@ -271,6 +271,7 @@ struct vtkMultiresolutionSurfaceMapper::Frame
   // Uploads and drawing.
   std::chrono::steady_clock::time_point tablesStart;
   std::size_t tableBytes = 0; ///< copied for the model's tables this frame
+  double uploadMs = 0;        ///< the frame's copying allowance (resmr::UploadBudgetMs)
   vtkShaderProgram* program = nullptr;
   int colorMode = SolidColor;
   bool lit = false;            ///< the last program readied lights the surface
@@ -1072,7 +1073,8 @@ void vtkMultiresolutionSurfaceMapper::StreamTables(Frame& frame)
   // The hash's offsets (once a file, when the loader has read them), then the property table
   // when another is current, then the cells' normals: colours before per-cell lighting.
   Internals& in = *this->Internal;
-  const std::size_t cap = resmr::TableByteCap(resmr::UploadBudgetMs(this->TargetFrameRate, in.FrameMs));
+  frame.uploadMs = resmr::UploadBudgetMs(this->TargetFrameRate, in.FrameMs);
+  const std::size_t cap = resmr::TableByteCap(frame.uploadMs);
   std::size_t budget = cap;
   frame.tablesStart = std::chrono::steady_clock::now();
   in.Tables.StreamHash(frame.window, *in.Cache, budget, !frame.bounded);
@@ -1116,8 +1118,7 @@ void vtkMultiresolutionSurfaceMapper::UploadMeshes(Frame& frame)
   // takes), in bytes and in predicted time, since fresh GPU memory costs far more than reused
   // memory; the tables' copies count against it.
   Internals& in = *this->Internal;
-  const double uploadMs = resmr::UploadBudgetMs(this->TargetFrameRate, in.FrameMs);
-  in.Pacer.BeginFrame(uploadMs, resmr::UploadByteCap(uploadMs));
+  in.Pacer.BeginFrame(frame.uploadMs, resmr::UploadByteCap(frame.uploadMs));
   in.Pacer.Spend(frame.tableBytes, ElapsedMs(frame.tablesStart));
   std::vector<std::size_t> order = in.Selector->Roots();
   order.insert(order.end(), frame.selection.wanted.begin(), frame.selection.wanted.end());
