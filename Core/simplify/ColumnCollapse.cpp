@@ -106,7 +106,7 @@ void ColumnCollapse::Smooth(int32_t node)
     {
       const glm::dvec3 p = m.Position(other, k);
       average += p * weight;
-      bounds.Add(p, k > 0 ? m.Position(other, k - 1) : p);
+      bounds.Add(p, k > 0 ? m.Position(other, k - 1) : p, this->Stalled);
     }
     average.z = this->PlaceDepth(node, k, average, bounds, above.z);
     average = k > 0 && this->Stalled ? LimitLean(average, above, bounds.steepest, bounds.Slope()) : average;
@@ -258,7 +258,7 @@ void ColumnCollapse::SaveNodeState(NodeState& state, int32_t node) const
   state.alive = m.NodeAlive[node];
   state.topology = m.Topology[node];
   state.positions.assign(m.Positions.begin() + first * 3, m.Positions.begin() + (first + interfaces) * 3);
-  state.quadrics.assign(m.Quadrics.begin() + first, m.Quadrics.begin() + first + interfaces);
+  state.quadricsSaved = false; // most trials merge into one node: the others' quadrics stay
   state.columns.assign(m.ColumnsOfNode[node].begin(), m.ColumnsOfNode[node].end());
 }
 
@@ -268,6 +268,14 @@ void ColumnCollapse::MergeNode(int32_t node, int32_t into)
   if (node == into)
   {
     return;
+  }
+  const auto saved = std::find_if(
+    this->SavedNodes.begin(), this->SavedNodes.end(), [into](const NodeState& state) { return state.node == into; });
+  if (saved != this->SavedNodes.end() && !saved->quadricsSaved)
+  {
+    const std::size_t first = static_cast<std::size_t>(into) * (m.LayerCount + 1);
+    saved->quadrics.assign(m.Quadrics.begin() + first, m.Quadrics.begin() + first + m.LayerCount + 1);
+    saved->quadricsSaved = true;
   }
   for (int32_t k = 0; k <= m.LayerCount; ++k)
   {
@@ -307,7 +315,7 @@ void ColumnCollapse::PlaceAtAverage(int32_t node, const NodeState* const* states
       const std::vector<double>& p = states[i]->positions;
       const glm::dvec3 at(p[k * 3], p[k * 3 + 1], p[k * 3 + 2]);
       average += at * weight;
-      bounds.Add(at, k > 0 ? glm::dvec3(p[(k - 1) * 3], p[(k - 1) * 3 + 1], p[(k - 1) * 3 + 2]) : at);
+      bounds.Add(at, k > 0 ? glm::dvec3(p[(k - 1) * 3], p[(k - 1) * 3 + 1], p[(k - 1) * 3 + 2]) : at, this->Stalled);
     }
     average.z = this->PlaceDepth(node, k, average, bounds, above.z);
     average = k > 0 && this->Stalled ? LimitLean(average, above, bounds.steepest, bounds.Slope()) : average;
@@ -530,8 +538,8 @@ bool ColumnCollapse::SlideAlongBoundary(int32_t node, double allowed)
     const glm::dvec3 a = m.Position(ends[0], k), b = m.Position(ends[1], k);
     glm::dvec3 middle = 0.5 * (a + b);
     DepthBounds bounds;
-    bounds.Add(a, k > 0 ? m.Position(ends[0], k - 1) : a);
-    bounds.Add(b, k > 0 ? m.Position(ends[1], k - 1) : b);
+    bounds.Add(a, k > 0 ? m.Position(ends[0], k - 1) : a, this->Stalled);
+    bounds.Add(b, k > 0 ? m.Position(ends[1], k - 1) : b, this->Stalled);
     middle.z = this->PlaceDepth(node, k, middle, bounds, above.z);
     middle = k > 0 && this->Stalled ? LimitLean(middle, above, bounds.steepest, bounds.Slope()) : middle;
     above = middle;
@@ -916,7 +924,10 @@ void ColumnCollapse::Undo()
     m.NodeAlive[state.node] = state.alive;
     m.Topology[state.node] = state.topology;
     std::copy(state.positions.begin(), state.positions.end(), m.Positions.begin() + first * 3);
-    std::copy(state.quadrics.begin(), state.quadrics.end(), m.Quadrics.begin() + first);
+    if (state.quadricsSaved)
+    {
+      std::copy(state.quadrics.begin(), state.quadrics.end(), m.Quadrics.begin() + first);
+    }
     m.ColumnsOfNode[state.node].swap(state.columns);
   }
   for (int32_t column : this->RemovedColumns)

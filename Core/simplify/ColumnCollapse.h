@@ -159,7 +159,8 @@ private:
     uint8_t alive;
     std::array<double, 2> topology;
     std::vector<double> positions;
-    std::vector<Quadric> quadrics;
+    std::vector<Quadric> quadrics; ///< saved only once a merge is about to change them
+    bool quadricsSaved = false;
     std::vector<int32_t> columns;
   };
   /// A chord: its columns in order and the L + 1 edges they cross (L for a loop).
@@ -251,16 +252,22 @@ private:
       const double extent = glm::length(highXY - lowXY);
       return extent > 0 ? (high - low) / extent : 0;
     }
-    void Add(const glm::dvec3& p, const glm::dvec3& pAbove)
+    /// `lean`: also the lean and the lateral extent, which only a stalled simplification's
+    /// LimitLean reads (skipping them keeps the square root out of every smoothing step).
+    void Add(const glm::dvec3& p, const glm::dvec3& pAbove, bool lean)
     {
       const double thickness = p.z - pAbove.z;
-      const double dx = p.x - pAbove.x, dy = p.y - pAbove.y;
       low = std::min(low, p.z);
       high = std::max(high, p.z);
-      lowXY = glm::min(lowXY, glm::dvec2(p.x, p.y));
-      highXY = glm::max(highXY, glm::dvec2(p.x, p.y));
       thinnest = std::min(thinnest, thickness);
       thickest = std::max(thickest, thickness);
+      if (!lean)
+      {
+        return;
+      }
+      const double dx = p.x - pAbove.x, dy = p.y - pAbove.y;
+      lowXY = glm::min(lowXY, glm::dvec2(p.x, p.y));
+      highXY = glm::max(highXY, glm::dvec2(p.x, p.y));
       if (thickness > 0)
       {
         steepest = std::max(steepest, std::sqrt(dx * dx + dy * dy) / thickness); // not hypot: slow

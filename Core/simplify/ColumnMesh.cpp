@@ -570,7 +570,7 @@ bool ColumnMesh::IsBoundaryNode(int32_t node) const
       for (int32_t second : columns)
       {
         const auto& o = this->Corners[second];
-        shared += std::find(o.begin(), o.end(), other) != o.end() ? 1 : 0;
+        shared += (o[0] == other) | (o[1] == other) | (o[2] == other) | (o[3] == other);
       }
       if (shared == 1)
       {

@@ -58,8 +58,10 @@ if error:
 controller.Barrier()
 parallel_seconds = time.time() - started
 
-failed = False
-if rank == 0:
+
+def build_one_process_and_compare():
+    """Rank 0: `resmr build` of the same model in one process, then the two files region by region."""
+    failed = False
     started = time.time()
     subprocess.run([args.resmr, "build", model, "-o", single, "--cmax", str(args.cmax), "--threads",
                     str(args.single_threads or args.threads), "--quiet"], check=True, stdout=subprocess.DEVNULL)
@@ -99,6 +101,25 @@ if rank == 0:
     if not failed and a["cells"] > 10_000_000:
         for path in (parallel, single):  # large: nothing to look at afterwards
             os.remove(path)
+    return failed
+
+
+# Rank 1 waits for rank 0's build and comparison on a file, sleeping: an MPI barrier polls,
+# and its busy core would take one of the two the one-process build runs on.
+finished = os.path.join(args.temp, "rank0-finished")
+if rank == 0 and os.path.exists(finished):
+    os.remove(finished)
+controller.Barrier()
+failed = False
+if rank == 0:
+    try:
+        failed = build_one_process_and_compare()
+    finally:
+        with open(finished, "w") as marker:
+            marker.write("done")
+else:
+    while not os.path.exists(finished):
+        time.sleep(1)
 controller.Barrier()
 # On success the script just ends: pvbatch then finalizes MPI and mpirun exits 0. sys.exit()
 # leaves without MPI_Finalize, which mpirun reports as a rank "exiting improperly" with a
