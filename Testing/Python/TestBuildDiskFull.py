@@ -110,7 +110,12 @@ def kept_tasks(kept):
 # The partition pass's compressed tiles take a few bytes a cell, far below a 20th of the peak:
 # the smallest disks stop the build there.
 sizes = [256 << 10, 512 << 10, 1 << 20, 3 << 19] + [max(1 << 20, (peak * step // 20) & ~4095) for step in range(1, 20)]
-for size in sorted(set(sizes)):
+stops = {"partition": 0, "hierarchy": 0, "writing": 0}
+for index, size in enumerate(sorted(set(sizes))):
+    if stops["writing"] >= 2:
+        break  # the larger disks stop the writing again, or fit
+    if stops["hierarchy"] >= 4 and index % 2:
+        continue  # the hierarchy spans most sizes: every other one resumes from enough points
     out = f"{disk}/m.resmr"
     script = (f"'{resmr}' build {model} -o '{out}' {flags} --quiet --no-disk-check > '{temp}/first.json' "
               f"2> '{temp}/first.err'; echo $? > '{temp}/first.rc'; "
@@ -132,6 +137,7 @@ for size in sorted(set(sizes)):
     phase = ("partition" if not second["resumed_partition"] else
              "writing" if second["resumed_tasks"] == second["tasks"] else "hierarchy")
     phases.add(phase)
+    stops[phase] += 1
     partway = phase == "partition" and second["resumed_layers"] > 0
     partition_partway = partition_partway or partway
     print(f"{size / 1e6:.1f} MB: stopped in the {phase} phase ({len(kept)} scratch files kept, "
