@@ -21,7 +21,7 @@ set_tests_properties(Multiresolution.MPIBuild PROPERTIES
 # model, one worker a rank, a shared scratch folder) write a whole file: every level and
 # region once, the finest level holding the model's 57,083,593 active cells (the synthetic
 # generator's count for seed 1, as the build report gives it), a coarse level read back. About
-# 17 minutes on 2 cores. Its equality with the one-process file is the small test's above; at
+# 15 minutes on 2 cores. Its equality with the one-process file is the small test's above; at
 # this size the one-process build would double the time (`--reference one-process`, see the
 # build benchmarks).
 add_test(NAME Multiresolution.MPIBuild100M
