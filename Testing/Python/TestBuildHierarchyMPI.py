@@ -108,9 +108,9 @@ def check_whole(a):
     # Chunks of both ranks, read back and decoded through the plugin: the finest level of a
     # small model, a coarse one of a big model (its finest would not fit in memory).
     read = a["leaf_level"] if a["cells"] <= 10_000_000 else min(3, a["leaf_level"])
-    level = simple.ExtractMultiresolutionLevel(FileName=parallel, Level=read)
-    level.UpdatePipeline()
-    cells = level.GetDataInformation().GetNumberOfCells()  # every cell of the level's columns
+    extract = simple.ExtractMultiresolutionLevel(FileName=parallel, Level=read)
+    extract.UpdatePipeline()
+    cells = extract.GetDataInformation().GetNumberOfCells()  # every cell of the level's columns
     if cells != levels[read]["columns"] * a["dims"][2]:
         failures.append(f"level {read} of the two-rank file reads {cells} cells, its record says "
                         f"{levels[read]['columns']} columns of {a['dims'][2]}")
@@ -153,8 +153,8 @@ def check_file():
     return bool(failures)
 
 
-# Rank 1 waits for rank 0's checks (and one-process build) on a file, sleeping: an MPI barrier polls,
-# and its busy core would take one of the two the one-process build runs on.
+# Rank 1 waits for rank 0's checks (and one-process build) on a file, sleeping: an MPI
+# barrier polls, and its busy core would take one of the two the one-process build runs on.
 finished = os.path.join(args.temp, "rank0-finished")
 if rank == 0 and os.path.exists(finished):
     os.remove(finished)
