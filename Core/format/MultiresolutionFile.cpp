@@ -126,22 +126,27 @@ void PutPositions(ByteWriter& out, const RegionMesh& mesh, const Multiresolution
   }
 }
 
-void GetPositions(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header)
+/// Decodes the positions of interfaces [mesh.firstLayer, mesh.firstLayer + mesh.layers] of a
+/// chunk holding `interfaces` per node; the interfaces above the window are decoded (each is
+/// predicted from the two above it) but not kept, those below are skipped.
+void GetPositions(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header, std::size_t interfaces)
 {
-  const std::size_t interfaces = static_cast<std::size_t>(mesh.layers) + 1;
   const std::size_t count = static_cast<std::size_t>(mesh.NodeCount()) * interfaces * 3;
   if (count * 4 > in.Left())
   {
     throw FileFormatError(in.Where() + ": " + std::to_string(mesh.NodeCount()) + " nodes do not fit in the chunk");
   }
-  std::vector<uint8_t> planes(count * 4);
-  in.GetBytes(planes.data(), planes.size());
-  mesh.positions.resize(count);
+  const uint8_t* planes = in.Skip(count * 4);
+  const std::size_t first = static_cast<std::size_t>(mesh.firstLayer);
+  const std::size_t kept = static_cast<std::size_t>(mesh.layers) + 1;
+  mesh.positions.resize(static_cast<std::size_t>(mesh.NodeCount()) * kept * 3);
   std::array<int32_t, 3> previousFirst{ 0, 0, 0 };
   for (std::size_t node = 0; node < static_cast<std::size_t>(mesh.NodeCount()); ++node)
   {
     std::array<int32_t, 3> above = previousFirst, twoAbove = previousFirst;
-    for (std::size_t k = 0; k < interfaces; ++k)
+    // The first interface of the next node is predicted from this one's: always decoded.
+    const std::size_t end = std::max<std::size_t>(first + kept, 1);
+    for (std::size_t k = 0; k < end; ++k)
     {
       const std::size_t at = (node * interfaces + k) * 3;
       std::array<int32_t, 3> q;
@@ -152,7 +157,14 @@ void GetPositions(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader&
           uint32_t(planes[2 * count + i]) << 16 | uint32_t(planes[3 * count + i]) << 24;
         q[axis] = static_cast<int32_t>(
           static_cast<uint32_t>(Predict(axis, k, above, twoAbove)) + static_cast<uint32_t>(UnZigZag(coded)));
-        mesh.positions[i] = header.latticeOrigin[axis] + q[axis] * header.latticeStep[axis];
+      }
+      if (k >= first)
+      {
+        double* out = &mesh.positions[(node * kept + (k - first)) * 3];
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          out[axis] = header.latticeOrigin[axis] + q[axis] * header.latticeStep[axis];
+        }
       }
       if (k == 0)
       {
@@ -201,7 +213,9 @@ void CheckIndices(const ByteReader& in, const std::vector<Polygon>& polygons, ui
   }
 }
 
-void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header, const RegionRecord& record)
+/// Decodes a mesh chunk, keeping layers [window[0], window[1]] (clamped to the model's).
+void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header, const RegionRecord& record,
+  const std::array<int32_t, 2>& window)
 {
   const uint32_t magic = in.Get<uint32_t>();
   const uint32_t layers = in.Get<uint32_t>(), nodes = in.Get<uint32_t>(), columns = in.Get<uint32_t>();
@@ -215,7 +229,10 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
     throw FileFormatError(in.Where() + ": " + std::to_string(layers) + " layers, " + std::to_string(nodes) +
       " nodes, " + std::to_string(columns) + " columns disagree with the index");
   }
-  mesh.layers = static_cast<int32_t>(layers);
+  const int32_t first = std::clamp<int32_t>(window[0], 0, static_cast<int32_t>(layers));
+  const int32_t last = std::clamp<int32_t>(window[1], first - 1, static_cast<int32_t>(layers) - 1);
+  mesh.firstLayer = first;
+  mesh.layers = last - first + 1;
   // The stored surfaces were extracted with this rule; readers extract them again.
   mesh.sealedPinchThickness = header.version >= 5 && record.level != header.leafLevel ? record.ownError : 0;
   if (static_cast<uint64_t>(nodes) * 8 > in.Left())
@@ -232,7 +249,7 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
       throw FileFormatError(in.Where() + ": a topological coordinate lies outside the grid");
     }
   }
-  GetPositions(in, mesh, header);
+  GetPositions(in, mesh, header, static_cast<std::size_t>(layers) + 1);
   if (static_cast<uint64_t>(columns) * (16 + layers + 1) != in.Left())
   {
     throw FileFormatError(in.Where() + ": column data of " + std::to_string(in.Left()) + " bytes for " +
@@ -241,20 +258,27 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
   mesh.corners.resize(columns);
   in.GetBytes(mesh.corners.data(), mesh.corners.size() * sizeof(mesh.corners[0]));
   CheckIndices(in, mesh.corners, nodes, "a column refers to node");
-  mesh.active.resize(static_cast<std::size_t>(columns) * layers);
-  in.GetBytes(mesh.active.data(), mesh.active.size());
+  // Every cell's flags are checked and counted against the index; the window's are kept.
+  const uint8_t* flags = in.Skip(static_cast<std::size_t>(columns) * layers);
+  const std::size_t kept = static_cast<std::size_t>(mesh.layers);
+  mesh.active.resize(static_cast<std::size_t>(columns) * kept);
   mesh.openSides.resize(mesh.active.size());
   int64_t activeCells = 0;
-  for (std::size_t i = 0; i < mesh.active.size(); ++i)
+  for (std::size_t i = 0; i < static_cast<std::size_t>(columns) * layers; ++i)
   {
-    if (mesh.active[i] >> 5)
+    if (flags[i] >> 5)
     {
-      throw FileFormatError(in.Where() + ": cell flags " + std::to_string(mesh.active[i]) + " of cell " +
-        std::to_string(i) + " are not valid");
+      throw FileFormatError(
+        in.Where() + ": cell flags " + std::to_string(flags[i]) + " of cell " + std::to_string(i) + " are not valid");
     }
-    mesh.openSides[i] = mesh.active[i] >> 1;
-    mesh.active[i] &= 1;
-    activeCells += mesh.active[i];
+    activeCells += flags[i] & 1;
+    const std::size_t k = i % layers;
+    if (k >= static_cast<std::size_t>(first) && k - first < kept)
+    {
+      const std::size_t at = (i / layers) * kept + (k - first);
+      mesh.openSides[at] = flags[i] >> 1;
+      mesh.active[at] = flags[i] & 1;
+    }
   }
   if (activeCells != record.activeCells)
   {
@@ -429,9 +453,12 @@ RegionRecord GetRecord(ByteReader& in, uint32_t version, bool& reservedZero)
 namespace
 {
 
+/// Decodes a region; with a window of layers narrower than the model's, only its mesh chunk,
+/// for those layers (MultiresolutionFile::ReadRegionLayers).
 RegionMesh DecodeRegion(const uint8_t* data, uint64_t size, const std::string& path, const RegionRecord& record,
-  const MultiresolutionHeader& header)
+  const MultiresolutionHeader& header, const std::array<int32_t, 2>& window = { 0, -1 })
 {
+  const bool whole = window[0] <= 0 && (window[1] < 0 || window[1] >= header.dims[2] - 1);
   RegionMesh mesh;
   const std::string region =
     path + ": region (level " + std::to_string(record.level) + ", index " + std::to_string(record.index) + ") ";
@@ -442,7 +469,11 @@ RegionMesh DecodeRegion(const uint8_t* data, uint64_t size, const std::string& p
   {
     const auto raw = chunk(RegionRecord::Mesh);
     ByteReader in(raw.data(), raw.size(), region + ChunkNames[0]);
-    DecodeMesh(in, mesh, header, record);
+    DecodeMesh(in, mesh, header, record, whole ? std::array<int32_t, 2>{ 0, int32_t(header.dims[2]) - 1 } : window);
+  }
+  if (!whole)
+  {
+    return mesh; // the stored surfaces number the whole mesh's vertices
   }
   RegionSurface* surfaces[2] = { &mesh.top, &mesh.bottom };
   for (int c = RegionRecord::Top; c <= RegionRecord::Bottom; ++c)
@@ -1302,6 +1333,16 @@ RegionMesh MultiresolutionFile::ReadRegion(std::size_t i) const
   }
   CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
   return DecodeRegion(this->Data, this->Size, this->FilePath, this->Records[i], this->Head);
+}
+
+RegionMesh MultiresolutionFile::ReadRegionLayers(std::size_t i, int32_t first, int32_t last) const
+{
+  if (i >= this->Records.size())
+  {
+    throw std::out_of_range("multiresolution file: no region " + std::to_string(i));
+  }
+  CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
+  return DecodeRegion(this->Data, this->Size, this->FilePath, this->Records[i], this->Head, { first, last });
 }
 
 MappedChunkFile::MappedChunkFile(const std::string& path)

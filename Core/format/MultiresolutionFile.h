@@ -242,6 +242,11 @@ public:
   /// The side surface comes as triangles (sideTriangles, simplified, Sec. 4.3); side quads
   /// are not stored (ExtractSurfaces() derives them from the mesh).
   RegionMesh ReadRegion(std::size_t i) const;
+  /// Decodes the hexahedral mesh of region `i` in layers [first, last] (0-based, clamped to
+  /// the model's) and nothing else (a range's cells need no stored surface): its layer 0 is
+  /// layer `first` of the model (RegionMesh::firstLayer). Every cell's flags are still
+  /// checked against the index. With every layer, ReadRegion().
+  RegionMesh ReadRegionLayers(std::size_t i, int32_t first, int32_t last) const;
   /// Decodes only the surfaces and the nodes' topological coordinates (what the property
   /// side needs): positions, corners and cells are left empty.
   RegionMesh ReadRegionSurfaces(std::size_t i) const;

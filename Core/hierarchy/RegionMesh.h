@@ -49,6 +49,10 @@ struct RegionSurface
 struct RegionMesh
 {
   int32_t layers = 0;
+  /// The model layer of the mesh's layer 0: 0, or a window of the model's layers
+  /// (MultiresolutionFile::ReadRegionLayers). Vertex interfaces and cell layers are the
+  /// mesh's own; a topological tk is firstLayer + interface.
+  int32_t firstLayer = 0;
   std::vector<double> positions;              ///< [node][interface][xyz]
   std::vector<std::array<float, 2>> topology; ///< (ti, tj) per node
   std::vector<std::array<uint32_t, 4>> corners;

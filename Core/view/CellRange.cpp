@@ -281,7 +281,8 @@ void MaskCells(RegionMesh& mesh, const std::function<bool(const std::array<doubl
     for (std::size_t k = 0; k < layers; ++k)
     {
       uint8_t& active = mesh.active[c * layers + k];
-      active = active && keep(centre, int64_t(k), c);
+      const int64_t layer = mesh.firstLayer + int64_t(k); // the model's
+      active = active && keep(centre, layer, c);
       for (int e = 0; active && e < 4; ++e)
       {
         if (!(mesh.cutEdges[c] & (1u << e)))
@@ -292,7 +293,7 @@ void MaskCells(RegionMesh& mesh, const std::function<bool(const std::array<doubl
         const auto& b = mesh.topology[mesh.corners[c][(e + 1) % 4]];
         const std::array<double, 2> across{ double(a[0]) + double(b[0]) - centre[0],
           double(a[1]) + double(b[1]) - centre[1] };
-        if (!keep(across, int64_t(k), AcrossCutEdge))
+        if (!keep(across, layer, AcrossCutEdge))
         {
           cutOpen[c * layers + k] |= static_cast<uint8_t>(1u << e);
         }

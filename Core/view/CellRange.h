@@ -114,7 +114,8 @@ bool ExclusionExposes(
   const std::array<float, 4>& footprint, const CellRange& range, const std::array<int64_t, 3>& dims);
 
 /// The masking MaskToRange and the property filter share: leaves active only the cells for
-/// which keep(centre, k, column) holds (centre: the column's, in topological coordinates), and
+/// which keep(centre, k, column) holds (centre: the column's, in topological coordinates; k:
+/// the model's layer, RegionMesh::firstLayer on), and
 /// opens a kept cell's side across a cut edge when keep fails for the cell across (the column's
 /// centre mirrored through the edge's midpoint, same layer; column: AcrossCutEdge).
 constexpr std::size_t AcrossCutEdge = ~std::size_t(0);

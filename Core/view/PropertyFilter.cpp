@@ -166,8 +166,15 @@ CellBox ReadCellBox(const RegionMesh& mesh, const CellFilter& filter, const std:
     box.lo[a] = std::clamp<int64_t>(static_cast<int64_t>(std::floor(topology[2 * a])) - 1, 0, dims[a] - 1);
     box.hi[a] = std::clamp<int64_t>(static_cast<int64_t>(std::ceil(topology[2 * a + 1])), 0, dims[a] - 1);
   }
-  box.lo[2] = 0;
-  box.hi[2] = dims[2] - 1;
+  // The mesh's layers (a window of the model's when a range keeps some; MaskToFilter asks
+  // for no layer outside the range).
+  box.lo[2] = std::clamp<int64_t>(std::max<int64_t>(mesh.firstLayer, filter.range.lo[2]), 0, dims[2] - 1);
+  box.hi[2] =
+    std::clamp<int64_t>(std::min<int64_t>(mesh.firstLayer + mesh.layers - 1, filter.range.hi[2]), 0, dims[2] - 1);
+  if (box.hi[2] < box.lo[2])
+  {
+    return CellBox{};
+  }
   const PropertyFile& file = filter.values->File();
   for (const int table : filter.values->Tables())
   {

@@ -128,7 +128,8 @@ struct CellBox
 };
 
 /// The box of cells under `mesh`'s columns widened by one cell (the cells across its border),
-/// within a grid of `dims`, with every filter's values and the painted table's read for it.
+/// in the mesh's layers within the filter's range, within a grid of `dims`, with every filter's
+/// values and the painted table's read for it.
 CellBox ReadCellBox(const RegionMesh& mesh, const CellFilter& filter, const std::array<int64_t, 3>& dims);
 
 /// Leaves in `mesh` only the cells `filter` keeps active and opens their sides towards cells

@@ -50,7 +50,7 @@ Vector Topological(const RegionMesh& mesh, uint32_t vertex)
 {
   const uint32_t perNode = static_cast<uint32_t>(mesh.layers + 1);
   const auto& t = mesh.topology[vertex / perNode];
-  return { t[0], t[1], static_cast<double>(vertex % perNode) };
+  return { t[0], t[1], static_cast<double>(mesh.firstLayer + int32_t(vertex % perNode)) };
 }
 
 /// sign(det d(x, y, z)/d(i, j, k)) of one cell, 0 if degenerate: the images of the column's
@@ -91,7 +91,7 @@ bool OwnsSide(const RegionMesh& mesh, const Vector& centre, double plane, int ax
 {
   const int64_t i = static_cast<int64_t>(std::floor(centre[0] + offset[0]));
   const int64_t j = static_cast<int64_t>(std::floor(centre[1] + offset[1]));
-  const int64_t k = static_cast<int64_t>(std::floor(centre[2] + offset[2]));
+  const int64_t k = static_cast<int64_t>(std::floor(centre[2] + offset[2])) - mesh.firstLayer;
   const auto found = columns.find({ i, j });
   if (found == columns.end() || k < 0 || k >= mesh.layers)
   {
@@ -284,7 +284,15 @@ void UseOriginalSideFaces(RegionMesh& mesh)
 RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
   const std::array<double, 3>& origin, int handedness, int32_t layer, bool exactSides, const CellFilter* filter)
 {
-  RegionMesh mesh = file.ReadRegion(region); // not ReadRegionSurfaces: the buffers need positions
+  // Not ReadRegionSurfaces: the buffers need positions. One layer, or a range of some layers,
+  // needs only theirs (their cells and faces; the stored surfaces are extracted again).
+  const int32_t layers = static_cast<int32_t>(file.Header().dims[2]);
+  const std::array<int32_t, 2> window = layer >= 0 ? std::array<int32_t, 2>{ layer, layer }
+    : filter ? std::array<int32_t, 2>{ int32_t(std::clamp<int64_t>(filter->range.lo[2], 0, layers - 1)),
+        int32_t(std::clamp<int64_t>(filter->range.hi[2], 0, layers - 1)) }
+             : std::array<int32_t, 2>{ 0, layers - 1 };
+  RegionMesh mesh = window[0] > 0 || window[1] < layers - 1 ? file.ReadRegionLayers(region, window[0], window[1])
+                                                            : file.ReadRegion(region);
   const std::array<float, 4> footprint = RegionFootprint(mesh);
   if (layer >= 0)
   {
@@ -460,13 +468,14 @@ RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::ar
 RegionDrawBuffers PrepareLayerDrawBuffers(
   const RegionMesh& mesh, int32_t layer, const std::array<double, 3>& origin, int handedness)
 {
-  if (layer < 0 || layer >= mesh.layers)
+  const int32_t own = layer - mesh.firstLayer; // the mesh's
+  if (own < 0 || own >= mesh.layers)
   {
-    throw std::out_of_range(
-      "layer " + std::to_string(layer) + " of a region mesh of " + std::to_string(mesh.layers) + " layers");
+    throw std::out_of_range("layer " + std::to_string(layer) + " of a region mesh of layers " +
+      std::to_string(mesh.firstLayer) + " to " + std::to_string(mesh.firstLayer + mesh.layers - 1));
   }
   RegionSurface top, bottom, side;
-  ExtractLayerSurfaces(mesh, layer, top, bottom, side);
+  ExtractLayerSurfaces(mesh, own, top, bottom, side);
   // Side quads as two triangles each, turning as the quads: the whole model's side is
   // triangles too, so both views share the offset rules (the layer's k is exact either way).
   std::vector<std::array<uint32_t, 3>> triangles;

@@ -132,7 +132,8 @@ void AddCoarseSide(const RegionMesh& mesh, const std::vector<std::array<uint32_t
 /// Draw buffers of a decoded region (surfaces and topological coordinates are enough).
 RegionDrawBuffers PrepareRegionDrawBuffers(const RegionMesh& mesh, const std::array<double, 3>& origin, int handedness);
 
-/// Draw buffers of layer `layer` (0-based) of a decoded region, laid out as the whole model's:
+/// Draw buffers of layer `layer` (0-based, the model's; the mesh holds it) of a decoded region,
+/// laid out as the whole model's:
 /// the top and bottom faces of the layer's active cells and their side faces open in that
 /// layer (no active cell across in the same layer, a fault, the model's limit;
 /// ExtractLayerSurfaces). Cell coordinates lie in the layer: k + 0.5 on top and bottom faces,

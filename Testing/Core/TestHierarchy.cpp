@@ -582,6 +582,45 @@ void TestHierarchyFile()
       leafColumns += mesh.ColumnCount();
     }
   }
+  // A window of layers decodes the same cells and interfaces as the whole mesh, numbered from
+  // the window's first layer; no stored surface.
+  for (std::size_t i = 0; i < file.Regions().size(); i += 3)
+  {
+    const RegionMesh whole = file.ReadRegion(i);
+    const int32_t nz = int32_t(p.nz);
+    for (const std::array<int32_t, 2> window :
+      { std::array<int32_t, 2>{ 0, 0 }, { 1, nz - 2 }, { nz - 1, nz - 1 }, { 2, 3 }, { -5, nz + 5 } })
+    {
+      const RegionMesh part = file.ReadRegionLayers(i, window[0], window[1]);
+      const int32_t first = std::max(window[0], 0), last = std::min(window[1], nz - 1);
+      CHECK(part.firstLayer == first && part.layers == last - first + 1);
+      CHECK(part.topology == whole.topology && part.corners == whole.corners && part.cutEdges == whole.cutEdges);
+      bool same = part.positions.size() == std::size_t(whole.NodeCount()) * (part.layers + 1) * 3 &&
+        part.active.size() == whole.corners.size() * std::size_t(part.layers) &&
+        part.top.quads.empty() == (part.layers < nz);
+      for (std::size_t node = 0; same && node < std::size_t(whole.NodeCount()); ++node)
+      {
+        for (int32_t k = 0; k <= part.layers; ++k)
+        {
+          for (int a = 0; a < 3; ++a)
+          {
+            same = same &&
+              part.positions[(node * (part.layers + 1) + k) * 3 + a] ==
+                whole.positions[(node * (whole.layers + 1) + first + k) * 3 + a];
+          }
+        }
+      }
+      for (std::size_t c = 0; same && c < whole.corners.size(); ++c)
+      {
+        for (int32_t k = 0; k < part.layers; ++k)
+        {
+          same = same && part.active[c * part.layers + k] == whole.active[c * whole.layers + first + k] &&
+            part.openSides[c * part.layers + k] == whole.openSides[c * whole.layers + first + k];
+        }
+      }
+      CHECK(same);
+    }
+  }
   const auto original = OriginalFaces(p);
   CHECK(leafColumns == report.columns);
   CHECK(!original.empty());

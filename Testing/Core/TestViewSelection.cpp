@@ -1825,6 +1825,38 @@ void TestEstimateSteering()
   }
 }
 
+/// The buffers of `region` under `filter` as LoadRegionDrawBuffers draws them, from the region's
+/// whole mesh (every layer decoded): what its read of a window of layers must equal.
+RegionDrawBuffers WholeMeshBuffers(
+  const MultiresolutionFile& file, std::size_t region, const CellFilter& filter, int handedness)
+{
+  RegionMesh mesh = file.ReadRegion(region);
+  if (!(mesh.sealedPinchThickness > 0))
+    mesh.sealedPinchThickness = std::numeric_limits<double>::min();
+  CellBox box;
+  if (filter.HasValues())
+  {
+    box = ReadCellBox(mesh, filter, file.Header().dims);
+    MaskToFilter(mesh, filter, &box);
+  }
+  else
+    MaskToRange(mesh, filter.range);
+  UseOriginalSideFaces(mesh);
+  RegionDrawBuffers out = PrepareRegionDrawBuffers(mesh, { 0, 0, 0 }, handedness);
+  if (filter.HasValues() && filter.paintTable >= 0)
+    out.faceValues = FaceValues(out.vertices, out.indices, box);
+  return out;
+}
+
+bool SameBuffers(const RegionDrawBuffers& a, const RegionDrawBuffers& b)
+{
+  const auto sameValue = [](float x, float y) { return x == y || (std::isnan(x) && std::isnan(y)); };
+  return a.vertices == b.vertices && a.indices == b.indices && a.topIndices == b.topIndices &&
+    a.bottomIndices == b.bottomIndices && a.sideIndices == b.sideIndices &&
+    a.faceValues.size() == b.faceValues.size() &&
+    std::equal(a.faceValues.begin(), a.faceValues.end(), b.faceValues.begin(), sameValue);
+}
+
 } // namespace
 
 void TestUploadPacer()
@@ -2030,10 +2062,16 @@ void TestRanges(const Model& model)
           drawn.count(static_cast<std::size_t>(a)) && classes[static_cast<std::size_t>(a)] == RangeClass::Inside;
       CHECK(covered);
     }
+    CellFilter filter;
+    filter.range = range;
+    const int handedness = TopologyHandedness(*model.file);
     for (const std::size_t leaf : drawn)
     {
       if (regions[leaf].level != header.leafLevel)
         continue;
+      // Only the range's layers are decoded: the same buffers as from every layer.
+      CHECK(SameBuffers(LoadRegionDrawBuffers(*model.file, leaf, { 0, 0, 0 }, handedness, -1, true, &filter),
+        WholeMeshBuffers(*model.file, leaf, filter, handedness)));
       const RegionMesh original = model.file->ReadRegion(leaf);
       RegionMesh masked = original;
       MaskToRange(masked, range);
@@ -2188,6 +2226,15 @@ void TestValueFilters(const Model& model)
       const RegionDrawBuffers buffers =
         LoadRegionDrawBuffers(*model.file, leaf, { 0, 0, 0 }, handedness, -1, true, &cells);
       CHECK(buffers.faceValues.size() == buffers.indices.size() / 3);
+      {
+        // With a range of some layers, only those are decoded and read: the same buffers and
+        // values as from every layer.
+        CellFilter slab = cells;
+        slab.range.lo[2] = 1 + int64_t(leaf % 3);
+        slab.range.hi[2] = dims[2] - 2;
+        CHECK(SameBuffers(LoadRegionDrawBuffers(*model.file, leaf, { 0, 0, 0 }, handedness, -1, true, &slab),
+          WholeMeshBuffers(*model.file, leaf, slab, handedness)));
+      }
       std::set<std::array<int64_t, 3>> shown;
       for (std::size_t t = 0; t < buffers.indices.size() / 3 && t < buffers.faceValues.size(); ++t)
       {
