@@ -2,6 +2,8 @@
 // coordinates, and the loader threads with their least-recently-used memory budget.
 #include "RegionCache.h"
 
+#include "MergedSides.h"
+
 #ifdef __linux__
 #include <pthread.h>
 #include <sys/resource.h>
@@ -334,6 +336,13 @@ RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::si
     }
     UseOriginalSideFaces(mesh);
     RegionDrawBuffers out = PrepareRegionDrawBuffers(mesh, origin, handedness);
+    const double ownError = file.Regions()[region].ownError;
+    if (!leaf && ownError > 0)
+    {
+      // The file's simplified side spans every layer: a masked coarse region draws its exact
+      // side merged in K within its error where that side would be drawn.
+      AddCoarseSide(mesh, MergedSideTriangles(mesh, ownError), origin, handedness, out);
+    }
     if (boxed && filter->paintTable >= 0)
     {
       out.faceValues = FaceValues(out.vertices, out.indices, box);

@@ -14,6 +14,7 @@
 #include "DiamondHierarchy.h"
 #include "FramePlanning.h"
 #include "FrameRateController.h"
+#include "MergedSides.h"
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
 #include "RegionCache.h"
@@ -1848,6 +1849,51 @@ RegionDrawBuffers WholeMeshBuffers(
   return out;
 }
 
+/// A masked coarse region's side merged in K (MergedSides.h): its quads cover every exact side
+/// quad of some thickness and no other face, each once, and a quad of several layers is no
+/// taller than `height` at either node. Counts the exact and merged quads into `counts`.
+void CheckMergedSide(RegionMesh mesh, double height, std::array<std::size_t, 2>& counts)
+{
+  UseOriginalSideFaces(mesh);
+  const uint32_t perNode = uint32_t(mesh.layers + 1);
+  const auto at = [&](uint32_t vertex) { return &mesh.positions[std::size_t(vertex) * 3]; };
+  const auto same = [&](uint32_t a, uint32_t b) { return std::equal(at(a), at(a) + 3, at(b)); };
+  const auto length = [&](uint32_t a, uint32_t b) {
+    double sum = 0;
+    for (int n = 0; n < 3; ++n)
+      sum += (at(a)[n] - at(b)[n]) * (at(a)[n] - at(b)[n]);
+    return std::sqrt(sum);
+  };
+  std::set<std::array<uint32_t, 3>> exact, thick; // node a, node b, layer
+  for (const auto& q : mesh.side.quads)
+  {
+    exact.insert({ q[0] / perNode, q[3] / perNode, q[0] % perNode });
+    if (!same(q[0], q[1]) || !same(q[2], q[3]))
+      thick.insert({ q[0] / perNode, q[3] / perNode, q[0] % perNode });
+  }
+  const auto merged = MergedSideTriangles(mesh, height);
+  CHECK(merged.size() % 2 == 0);
+  std::set<std::array<uint32_t, 3>> covered;
+  bool once = true, low = true, turned = true;
+  for (std::size_t t = 0; t + 1 < merged.size(); t += 2)
+  {
+    // (a top, a bottom, b bottom), (a top, b bottom, b top)
+    const auto& u = merged[t];
+    const auto& v = merged[t + 1];
+    turned = turned && u[0] == v[0] && u[2] == v[1] && u[1] / perNode == u[0] / perNode &&
+      v[2] / perNode == v[1] / perNode && u[1] % perNode == u[2] % perNode && v[2] % perNode == u[0] % perNode;
+    const uint32_t a = u[0] / perNode, b = v[2] / perNode, top = u[0] % perNode, bottom = u[1] % perNode;
+    low = low && (bottom == top + 1 || (length(u[0], u[1]) <= height && length(v[2], v[1]) <= height));
+    for (uint32_t k = top; k < bottom; ++k)
+      once = covered.insert({ a, b, k }).second && once;
+  }
+  CHECK(turned && once && low);
+  CHECK(std::includes(covered.begin(), covered.end(), thick.begin(), thick.end()));
+  CHECK(std::includes(exact.begin(), exact.end(), covered.begin(), covered.end()));
+  counts[0] += exact.size();
+  counts[1] += merged.size() / 2;
+}
+
 bool SameBuffers(const RegionDrawBuffers& a, const RegionDrawBuffers& b)
 {
   const auto sameValue = [](float x, float y) { return x == y || (std::isnan(x) && std::isnan(y)); };
@@ -2145,6 +2191,7 @@ void TestValueFilters(const Model& model)
   const std::vector<std::array<float, 4>> footprints = model.file->ReadFootprints();
   const int handedness = TopologyHandedness(*model.file);
   std::size_t crossedLeaves = 0, triangles = 0, exposed = 0, coarseCells = 0, keptCoarse = 0;
+  std::array<std::size_t, 2> mergedSides{ 0, 0 }; // exact side quads, merged quads
   for (const std::array<float, 2> quantiles : { std::array<float, 2>{ 0.5f, 1.f }, { 0.2f, 0.4f } })
   {
     std::vector<float> sorted;
@@ -2217,6 +2264,7 @@ void TestValueFilters(const Model& model)
           keptCoarse += kept;
         }
       }
+      CheckMergedSide(masked, model.file->Regions()[r].ownError, mergedSides);
     }
     for (const std::size_t leaf : model.Leaves())
     {
@@ -2278,6 +2326,8 @@ void TestValueFilters(const Model& model)
               "regions keep %zu of %zu active coarse cells\n",
     crossedLeaves, triangles, exposed, keptCoarse, coarseCells);
   CHECK(crossedLeaves > 0 && exposed > 0 && keptCoarse > 0 && keptCoarse < coarseCells);
+  std::printf("  masked coarse sides: %zu quads merged in K to %zu\n", mergedSides[0], mergedSides[1]);
+  CHECK(mergedSides[1] > 0 && mergedSides[1] < mergedSides[0]);
 }
 
 int main(int argc, char** argv)
