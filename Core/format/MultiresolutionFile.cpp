@@ -213,9 +213,10 @@ void CheckIndices(const ByteReader& in, const std::vector<Polygon>& polygons, ui
   }
 }
 
-/// Decodes a mesh chunk, keeping layers [window[0], window[1]] (clamped to the model's).
+/// Decodes a mesh chunk, keeping the layers `choose` gives from the nodes' topological
+/// coordinates (clamped to the model's; null: every layer).
 void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header, const RegionRecord& record,
-  const std::array<int32_t, 2>& window)
+  const LayerWindowChooser* choose)
 {
   const uint32_t magic = in.Get<uint32_t>();
   const uint32_t layers = in.Get<uint32_t>(), nodes = in.Get<uint32_t>(), columns = in.Get<uint32_t>();
@@ -229,10 +230,6 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
     throw FileFormatError(in.Where() + ": " + std::to_string(layers) + " layers, " + std::to_string(nodes) +
       " nodes, " + std::to_string(columns) + " columns disagree with the index");
   }
-  const int32_t first = std::clamp<int32_t>(window[0], 0, static_cast<int32_t>(layers));
-  const int32_t last = std::clamp<int32_t>(window[1], first - 1, static_cast<int32_t>(layers) - 1);
-  mesh.firstLayer = first;
-  mesh.layers = last - first + 1;
   // The stored surfaces were extracted with this rule; readers extract them again.
   mesh.sealedPinchThickness = header.version >= 5 && record.level != header.leafLevel ? record.ownError : 0;
   if (static_cast<uint64_t>(nodes) * 8 > in.Left())
@@ -249,6 +246,12 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
       throw FileFormatError(in.Where() + ": a topological coordinate lies outside the grid");
     }
   }
+  const std::array<int32_t, 2> window =
+    choose ? (*choose)(mesh.topology) : std::array<int32_t, 2>{ 0, static_cast<int32_t>(layers) - 1 };
+  const int32_t first = std::clamp<int32_t>(window[0], 0, static_cast<int32_t>(layers));
+  const int32_t last = std::clamp<int32_t>(window[1], first - 1, static_cast<int32_t>(layers) - 1);
+  mesh.firstLayer = first;
+  mesh.layers = last - first + 1;
   GetPositions(in, mesh, header, static_cast<std::size_t>(layers) + 1);
   if (static_cast<uint64_t>(columns) * (16 + layers + 1) != in.Left())
   {
@@ -453,12 +456,11 @@ RegionRecord GetRecord(ByteReader& in, uint32_t version, bool& reservedZero)
 namespace
 {
 
-/// Decodes a region; with a window of layers narrower than the model's, only its mesh chunk,
-/// for those layers (MultiresolutionFile::ReadRegionLayers).
+/// Decodes a region; with a window of layers narrower than the model's (`choose`), only its
+/// mesh chunk, for those layers (MultiresolutionFile::ReadRegionLayers).
 RegionMesh DecodeRegion(const uint8_t* data, uint64_t size, const std::string& path, const RegionRecord& record,
-  const MultiresolutionHeader& header, const std::array<int32_t, 2>& window = { 0, -1 })
+  const MultiresolutionHeader& header, const LayerWindowChooser* choose = nullptr)
 {
-  const bool whole = window[0] <= 0 && (window[1] < 0 || window[1] >= header.dims[2] - 1);
   RegionMesh mesh;
   const std::string region =
     path + ": region (level " + std::to_string(record.level) + ", index " + std::to_string(record.index) + ") ";
@@ -469,9 +471,9 @@ RegionMesh DecodeRegion(const uint8_t* data, uint64_t size, const std::string& p
   {
     const auto raw = chunk(RegionRecord::Mesh);
     ByteReader in(raw.data(), raw.size(), region + ChunkNames[0]);
-    DecodeMesh(in, mesh, header, record, whole ? std::array<int32_t, 2>{ 0, int32_t(header.dims[2]) - 1 } : window);
+    DecodeMesh(in, mesh, header, record, choose);
   }
-  if (!whole)
+  if (mesh.layers < header.dims[2])
   {
     return mesh; // the stored surfaces number the whole mesh's vertices
   }
@@ -1337,12 +1339,17 @@ RegionMesh MultiresolutionFile::ReadRegion(std::size_t i) const
 
 RegionMesh MultiresolutionFile::ReadRegionLayers(std::size_t i, int32_t first, int32_t last) const
 {
+  return this->ReadRegionLayers(i, [first, last](const auto&) { return std::array<int32_t, 2>{ first, last }; });
+}
+
+RegionMesh MultiresolutionFile::ReadRegionLayers(std::size_t i, const LayerWindowChooser& choose) const
+{
   if (i >= this->Records.size())
   {
     throw std::out_of_range("multiresolution file: no region " + std::to_string(i));
   }
   CheckMappedSize(this->Descriptor, this->Size, this->FilePath);
-  return DecodeRegion(this->Data, this->Size, this->FilePath, this->Records[i], this->Head, { first, last });
+  return DecodeRegion(this->Data, this->Size, this->FilePath, this->Records[i], this->Head, &choose);
 }
 
 MappedChunkFile::MappedChunkFile(const std::string& path)

@@ -44,6 +44,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -223,6 +224,10 @@ private:
   uint64_t Size = 0;
 };
 
+/// Chooses the layers (first, last; 0-based) of a region to decode from its nodes'
+/// topological coordinates (MultiresolutionFile::ReadRegionLayers).
+using LayerWindowChooser = std::function<std::array<int32_t, 2>(const std::vector<std::array<float, 2>>& topology)>;
+
 /// A .resmr file opened for reading (memory-mapped).
 class MultiresolutionFile
 {
@@ -247,6 +252,9 @@ public:
   /// layer `first` of the model (RegionMesh::firstLayer). Every cell's flags are still
   /// checked against the index. With every layer, ReadRegion().
   RegionMesh ReadRegionLayers(std::size_t i, int32_t first, int32_t last) const;
+  /// ReadRegionLayers() with the window (first, last) chosen from the region's nodes'
+  /// topological coordinates (ti, tj), which are read first.
+  RegionMesh ReadRegionLayers(std::size_t i, const LayerWindowChooser& choose) const;
   /// Decodes only the surfaces and the nodes' topological coordinates (what the property
   /// side needs): positions, corners and cells are left empty.
   RegionMesh ReadRegionSurfaces(std::size_t i) const;

@@ -153,6 +153,40 @@ float FilterError(const RegionRecord& region, const std::array<float, 4>& footpr
   return static_cast<float>(std::max(columnWidth, double(LayerBlockSide)) * std::sqrt(area / cells));
 }
 
+std::array<int32_t, 2> FilterLayers(
+  const CellFilter& filter, const std::vector<std::array<float, 2>>& topology, const std::array<int64_t, 3>& dims)
+{
+  const int64_t first = std::clamp<int64_t>(filter.range.lo[2], 0, dims[2] - 1);
+  const int64_t last = std::clamp<int64_t>(filter.range.hi[2], first, dims[2] - 1);
+  if (!filter.HasValues() || topology.empty())
+  {
+    return { int32_t(first), int32_t(last) };
+  }
+  // The region's cells: the box of its nodes, within the grid.
+  std::array<float, 4> box{ topology[0][0], topology[0][0], topology[0][1], topology[0][1] };
+  for (const auto& t : topology)
+  {
+    box = { std::min(box[0], t[0]), std::max(box[1], t[0]), std::min(box[2], t[1]), std::max(box[3], t[1]) };
+  }
+  std::array<int64_t, 2> lo{}, hi{};
+  for (int a = 0; a < 2; ++a)
+  {
+    lo[a] = std::clamp<int64_t>(static_cast<int64_t>(std::floor(box[2 * a])), 0, dims[a] - 1);
+    hi[a] = std::clamp<int64_t>(static_cast<int64_t>(std::ceil(box[2 * a + 1])) - 1, lo[a], dims[a] - 1);
+  }
+  int64_t low = last + 1, high = first - 1;
+  for (int64_t k = first; k <= last; ++k)
+  {
+    if (filter.values->LayerBlocksMayPass(lo, hi, k))
+    {
+      low = std::min(low, k);
+      high = k;
+    }
+  }
+  return low <= high ? std::array<int32_t, 2>{ int32_t(low), int32_t(high) }
+                     : std::array<int32_t, 2>{ int32_t(first), int32_t(first) };
+}
+
 CellBox ReadCellBox(const RegionMesh& mesh, const CellFilter& filter, const std::array<int64_t, 3>& dims)
 {
   CellBox box;

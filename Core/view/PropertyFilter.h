@@ -114,6 +114,13 @@ struct CellFilter
   bool HasValues() const { return this->values && !this->values->Filters().empty(); }
 };
 
+/// The layers (first, last; 0-based) in which a region whose nodes have the topological
+/// coordinates `topology` may keep a cell under `filter`: the range's, narrowed to those where
+/// a layer block under the region's cells may pass (ValueFilterSet::LayerBlocksMayPass); one
+/// layer of the range when none may (its cells are masked then). `dims`: the grid's.
+std::array<int32_t, 2> FilterLayers(
+  const CellFilter& filter, const std::vector<std::array<float, 2>>& topology, const std::array<int64_t, 3>& dims);
+
 /// The values a region's filter reads: the tables' values over a box of cells.
 struct CellBox
 {

@@ -286,15 +286,15 @@ void UseOriginalSideFaces(RegionMesh& mesh)
 RegionDrawBuffers LoadRegionDrawBuffers(const MultiresolutionFile& file, std::size_t region,
   const std::array<double, 3>& origin, int handedness, int32_t layer, bool exactSides, const CellFilter* filter)
 {
-  // Not ReadRegionSurfaces: the buffers need positions. One layer, or a range of some layers,
-  // needs only theirs (their cells and faces; the stored surfaces are extracted again).
-  const int32_t layers = static_cast<int32_t>(file.Header().dims[2]);
-  const std::array<int32_t, 2> window = layer >= 0 ? std::array<int32_t, 2>{ layer, layer }
-    : filter ? std::array<int32_t, 2>{ int32_t(std::clamp<int64_t>(filter->range.lo[2], 0, layers - 1)),
-        int32_t(std::clamp<int64_t>(filter->range.hi[2], 0, layers - 1)) }
-             : std::array<int32_t, 2>{ 0, layers - 1 };
-  RegionMesh mesh = window[0] > 0 || window[1] < layers - 1 ? file.ReadRegionLayers(region, window[0], window[1])
-                                                            : file.ReadRegion(region);
+  // Not ReadRegionSurfaces: the buffers need positions. One layer, or the layers a filter may
+  // keep, need only theirs (their cells and faces; the stored surfaces are extracted again).
+  const auto& dims = file.Header().dims;
+  const auto filterLayers = [&](const std::vector<std::array<float, 2>>& topology) {
+    return FilterLayers(*filter, topology, dims);
+  };
+  RegionMesh mesh = layer >= 0 ? file.ReadRegionLayers(region, layer, layer)
+    : filter                   ? file.ReadRegionLayers(region, filterLayers)
+                               : file.ReadRegion(region);
   const std::array<float, 4> footprint = RegionFootprint(mesh);
   if (layer >= 0)
   {

@@ -2192,6 +2192,7 @@ void TestValueFilters(const Model& model)
   const int handedness = TopologyHandedness(*model.file);
   std::size_t crossedLeaves = 0, triangles = 0, exposed = 0, coarseCells = 0, keptCoarse = 0;
   std::array<std::size_t, 2> mergedSides{ 0, 0 }; // exact side quads, merged quads
+  std::size_t narrowed = 0;                       // crossed leaves decoded in fewer layers
   for (const std::array<float, 2> quantiles : { std::array<float, 2>{ 0.5f, 1.f }, { 0.2f, 0.4f } })
   {
     std::vector<float> sorted;
@@ -2305,6 +2306,11 @@ void TestValueFilters(const Model& model)
         for (int64_t k = 0; k < dims[2]; ++k)
           if (mesh.active[c * std::size_t(dims[2]) + std::size_t(k)])
             active.insert({ int64_t(mesh.ColumnCell(c)[0]), int64_t(mesh.ColumnCell(c)[1]), k });
+      // The layers decoded for the filter hold every passing cell of the leaf.
+      const std::array<int32_t, 2> decoded = FilterLayers(cells, mesh.topology, dims);
+      narrowed += decoded[1] - decoded[0] + 1 < dims[2];
+      for (const auto& cell : active)
+        CHECK(!filter.Passes(value(cell[0], cell[1], cell[2])) || (cell[2] >= decoded[0] && cell[2] <= decoded[1]));
       for (const auto& cell : active)
       {
         if (!filter.Passes(value(cell[0], cell[1], cell[2])))
@@ -2326,7 +2332,9 @@ void TestValueFilters(const Model& model)
               "regions keep %zu of %zu active coarse cells\n",
     crossedLeaves, triangles, exposed, keptCoarse, coarseCells);
   CHECK(crossedLeaves > 0 && exposed > 0 && keptCoarse > 0 && keptCoarse < coarseCells);
-  std::printf("  masked coarse sides: %zu quads merged in K to %zu\n", mergedSides[0], mergedSides[1]);
+  std::printf("  masked coarse sides: %zu quads merged in K to %zu; %zu crossed leaves decoded in fewer layers\n",
+    mergedSides[0], mergedSides[1], narrowed);
+  CHECK(narrowed > 0);
   CHECK(mergedSides[1] > 0 && mergedSides[1] < mergedSides[0]);
 }
 
