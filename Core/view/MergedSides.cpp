@@ -1,3 +1,5 @@
+// The side of a masked coarse region merged in K (ours, see MergedSides.h; after the paper's
+// simplified side, Sec. 4.3).
 #include "MergedSides.h"
 
 #include <algorithm>
