@@ -267,20 +267,23 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
   mesh.active.resize(static_cast<std::size_t>(columns) * kept);
   mesh.openSides.resize(mesh.active.size());
   int64_t activeCells = 0;
-  for (std::size_t i = 0; i < static_cast<std::size_t>(columns) * layers; ++i)
+  for (std::size_t c = 0; c < columns; ++c)
   {
-    if (flags[i] >> 5)
+    for (std::size_t k = 0; k < layers; ++k)
     {
-      throw FileFormatError(
-        in.Where() + ": cell flags " + std::to_string(flags[i]) + " of cell " + std::to_string(i) + " are not valid");
-    }
-    activeCells += flags[i] & 1;
-    const std::size_t k = i % layers;
-    if (k >= static_cast<std::size_t>(first) && k - first < kept)
-    {
-      const std::size_t at = (i / layers) * kept + (k - first);
-      mesh.openSides[at] = flags[i] >> 1;
-      mesh.active[at] = flags[i] & 1;
+      const std::size_t i = c * layers + k;
+      if (flags[i] >> 5)
+      {
+        throw FileFormatError(
+          in.Where() + ": cell flags " + std::to_string(flags[i]) + " of cell " + std::to_string(i) + " are not valid");
+      }
+      activeCells += flags[i] & 1;
+      if (k >= static_cast<std::size_t>(first) && k - first < kept)
+      {
+        const std::size_t at = c * kept + (k - first);
+        mesh.openSides[at] = flags[i] >> 1;
+        mesh.active[at] = flags[i] & 1;
+      }
     }
   }
   if (activeCells != record.activeCells)
