@@ -453,7 +453,10 @@ std::vector<BlockSummary> PropertyFile::ReadLayerBlocks(std::size_t table) const
   const uint64_t count = static_cast<uint64_t>(blocks[0] * blocks[1] * this->Dims[2]);
   const auto floats = this->ReadValues(t.layerBlocks, count * 3, place);
   std::vector<BlockSummary> summaries(count);
-  std::memcpy(summaries.data(), floats.data(), floats.size() * 4);
+  for (std::size_t b = 0; b < summaries.size(); ++b)
+  {
+    summaries[b] = { floats[3 * b], floats[3 * b + 1], floats[3 * b + 2] };
+  }
   for (std::size_t b = 0; b < summaries.size(); ++b)
   {
     const BlockSummary& s = summaries[b];
@@ -469,7 +472,7 @@ std::vector<BlockSummary> PropertyFile::ReadLayerBlocks(std::size_t table) const
 std::vector<float> PropertyFile::ReadBox(
   std::size_t table, const std::array<int64_t, 3>& lo, const std::array<int64_t, 3>& hi) const
 {
-  this->Entries.at(table);
+  static_cast<void>(this->Entries.at(table)); // throws for a table the file lacks
   for (int a = 0; a < 3; ++a)
   {
     if (lo[a] < 0 || hi[a] >= this->Dims[a] || lo[a] > hi[a])
@@ -519,7 +522,7 @@ int64_t PropertyFile::ColumnsIn(int64_t bi) const
 
 ChunkRef PropertyFile::LayerBand(std::size_t table, int64_t k, int64_t band) const
 {
-  this->Entries.at(table);
+  static_cast<void>(this->Entries.at(table)); // throws for a table the file lacks
   if (k < 0 || k >= this->Dims[2] || band < 0 || band >= this->Bands())
   {
     throw std::out_of_range(
@@ -594,7 +597,7 @@ std::vector<float> PropertyFile::ReadPlane(std::size_t table, int axis, int64_t 
 
 float PropertyFile::ReadCell(std::size_t table, const std::array<int64_t, 3>& cell) const
 {
-  this->Entries.at(table);
+  static_cast<void>(this->Entries.at(table)); // throws for a table the file lacks
   for (int a = 0; a < 3; ++a)
   {
     if (cell[a] < 0 || cell[a] >= this->Dims[a])
