@@ -263,6 +263,15 @@ int MultiresolutionInfo(const char* path, bool listRegions)
       level.rawBytes += c.raw;
     }
     level.meshBytes += r.chunks[resmr::RegionRecord::Mesh].stored;
+    if (r.layerGroups > 0)
+    {
+      // The layer groups' chunks, written back to back just before the mesh chunk: the
+      // positions, 12 bytes a vertex.
+      const uint64_t groups = r.chunks[resmr::RegionRecord::Mesh].offset - r.layerGroups;
+      level.bytes += groups;
+      level.rawBytes += 12 * static_cast<uint64_t>(r.vertices);
+      level.meshBytes += groups;
+    }
     level.error = std::max<double>(level.error, r.error);
   }
   const double cells = double(h.dims[0]) * double(h.dims[1]) * double(h.dims[2]);

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -86,24 +87,29 @@ int32_t Predict(int axis, std::size_t k, const std::array<int32_t, 3>& above, co
   return above[axis];
 }
 
-void PutPositions(ByteWriter& out, const RegionMesh& mesh, const MultiresolutionHeader& header)
+/// Interfaces [from, from + count) of every node, node by node, each value its difference from
+/// the prediction, zig-zagged, in four byte planes. A layer group restarts the prediction (its
+/// first interface predicted by the node before's), so it decodes without the groups above.
+void PutPositions(
+  ByteWriter& out, const RegionMesh& mesh, const MultiresolutionHeader& header, std::size_t from, std::size_t count)
 {
   const std::size_t interfaces = static_cast<std::size_t>(mesh.layers) + 1;
-  const std::size_t count = mesh.positions.size();
-  std::vector<uint32_t> coded(count);
+  const std::size_t nodes = static_cast<std::size_t>(mesh.NodeCount());
+  const std::size_t values = nodes * count * 3;
+  std::vector<uint32_t> coded(values);
   std::array<int32_t, 3> previousFirst{ 0, 0, 0 };
-  for (std::size_t node = 0; node < static_cast<std::size_t>(mesh.NodeCount()); ++node)
+  for (std::size_t node = 0; node < nodes; ++node)
   {
     std::array<int32_t, 3> above = previousFirst, twoAbove = previousFirst;
-    for (std::size_t k = 0; k < interfaces; ++k)
+    for (std::size_t k = 0; k < count; ++k)
     {
-      const std::size_t at = (node * interfaces + k) * 3;
+      const std::size_t at = (node * interfaces + from + k) * 3;
       std::array<int32_t, 3> q;
       for (int axis = 0; axis < 3; ++axis)
       {
         q[axis] = Quantise(mesh.positions[at + axis], header.latticeOrigin[axis], header.latticeStep[axis]);
         const int32_t predicted = Predict(axis, k, above, twoAbove);
-        coded[at + axis] =
+        coded[(node * count + k) * 3 + axis] =
           ZigZag(static_cast<int32_t>(static_cast<uint32_t>(q[axis]) - static_cast<uint32_t>(predicted)));
       }
       if (k == 0)
@@ -115,52 +121,49 @@ void PutPositions(ByteWriter& out, const RegionMesh& mesh, const Multiresolution
     }
   }
   const std::size_t start = out.Bytes.size();
-  out.Bytes.resize(start + count * 4);
+  out.Bytes.resize(start + values * 4);
   for (int plane = 0; plane < 4; ++plane)
   {
-    uint8_t* bytes = &out.Bytes[start + plane * count];
-    for (std::size_t i = 0; i < count; ++i)
+    uint8_t* bytes = &out.Bytes[start + plane * values];
+    for (std::size_t i = 0; i < values; ++i)
     {
       bytes[i] = static_cast<uint8_t>(coded[i] >> (8 * plane));
     }
   }
 }
 
-/// Decodes the positions of interfaces [mesh.firstLayer, mesh.firstLayer + mesh.layers] of a
-/// chunk holding `interfaces` per node; the interfaces above the window are decoded (each is
-/// predicted from the two above it) but not kept, those below are skipped.
-void GetPositions(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header, std::size_t interfaces)
+/// Decodes interfaces [from, from + count) of every node from a group's byte planes (`planes`,
+/// PutPositions' layout), keeping those of the window [mesh.firstLayer, mesh.firstLayer +
+/// mesh.layers]: the group's interfaces above the window are decoded (each is predicted from
+/// the two above it) but not kept, those below are skipped.
+void GetPositions(
+  const uint8_t* planes, RegionMesh& mesh, const MultiresolutionHeader& header, std::size_t from, std::size_t count)
 {
-  const std::size_t count = static_cast<std::size_t>(mesh.NodeCount()) * interfaces * 3;
-  if (count * 4 > in.Left())
-  {
-    throw FileFormatError(in.Where() + ": " + std::to_string(mesh.NodeCount()) + " nodes do not fit in the chunk");
-  }
-  const uint8_t* planes = in.Skip(count * 4);
+  const std::size_t nodes = static_cast<std::size_t>(mesh.NodeCount());
+  const std::size_t values = nodes * count * 3;
   const std::size_t first = static_cast<std::size_t>(mesh.firstLayer);
   const std::size_t kept = static_cast<std::size_t>(mesh.layers) + 1;
-  mesh.positions.resize(static_cast<std::size_t>(mesh.NodeCount()) * kept * 3);
+  // The first interface of the next node is predicted from this one's: always decoded.
+  const std::size_t end = std::clamp<std::size_t>(first + kept, from + 1, from + count) - from;
   std::array<int32_t, 3> previousFirst{ 0, 0, 0 };
-  for (std::size_t node = 0; node < static_cast<std::size_t>(mesh.NodeCount()); ++node)
+  for (std::size_t node = 0; node < nodes; ++node)
   {
     std::array<int32_t, 3> above = previousFirst, twoAbove = previousFirst;
-    // The first interface of the next node is predicted from this one's: always decoded.
-    const std::size_t end = std::max<std::size_t>(first + kept, 1);
     for (std::size_t k = 0; k < end; ++k)
     {
-      const std::size_t at = (node * interfaces + k) * 3;
+      const std::size_t at = (node * count + k) * 3;
       std::array<int32_t, 3> q;
       for (int axis = 0; axis < 3; ++axis)
       {
         const std::size_t i = at + axis;
-        const uint32_t coded = uint32_t(planes[i]) | uint32_t(planes[count + i]) << 8 |
-          uint32_t(planes[2 * count + i]) << 16 | uint32_t(planes[3 * count + i]) << 24;
+        const uint32_t coded = uint32_t(planes[i]) | uint32_t(planes[values + i]) << 8 |
+          uint32_t(planes[2 * values + i]) << 16 | uint32_t(planes[3 * values + i]) << 24;
         q[axis] = static_cast<int32_t>(
           static_cast<uint32_t>(Predict(axis, k, above, twoAbove)) + static_cast<uint32_t>(UnZigZag(coded)));
       }
-      if (k >= first)
+      if (from + k >= first && from + k - first < kept)
       {
-        double* out = &mesh.positions[(node * kept + (k - first)) * 3];
+        double* out = &mesh.positions[(node * kept + (from + k - first)) * 3];
         for (int axis = 0; axis < 3; ++axis)
         {
           out[axis] = header.latticeOrigin[axis] + q[axis] * header.latticeStep[axis];
@@ -176,15 +179,49 @@ void GetPositions(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader&
   }
 }
 
-std::vector<uint8_t> EncodeMesh(const RegionMesh& mesh, const MultiresolutionHeader& header)
+/// Interfaces a layer group of a mesh chunk holds (LayerGroupsVersion): a window of a few
+/// layers decompresses an eighth or so of a 100-layer region's positions, most of its bytes.
+constexpr uint32_t GroupInterfaces = 8;
+
+/// Layer groups of a mesh of `interfaces` interfaces a node, `each` a group.
+std::size_t GroupCount(std::size_t interfaces, std::size_t each)
+{
+  return (interfaces + each - 1) / each;
+}
+
+/// The positions' layer groups, top down, each to be its own chunk.
+std::vector<std::vector<uint8_t>> EncodeLayerGroups(const RegionMesh& mesh, const MultiresolutionHeader& header)
+{
+  const std::size_t interfaces = static_cast<std::size_t>(mesh.layers) + 1;
+  std::vector<std::vector<uint8_t>> groups(GroupCount(interfaces, GroupInterfaces));
+  for (std::size_t g = 0; g < groups.size(); ++g)
+  {
+    ByteWriter out;
+    const std::size_t from = g * GroupInterfaces;
+    PutPositions(out, mesh, header, from, std::min<std::size_t>(GroupInterfaces, interfaces - from));
+    groups[g] = std::move(out.Bytes);
+  }
+  return groups;
+}
+
+/// The mesh chunk; its layer groups' chunks (`groups`: stored bytes, raw bytes, CRC) lie back
+/// to back from the record's layerGroups.
+std::vector<uint8_t> EncodeMesh(const RegionMesh& mesh, const std::vector<ChunkRef>& groups)
 {
   ByteWriter out;
   out.Put(MeshMagic);
   out.Put(static_cast<uint32_t>(mesh.layers));
   out.Put(static_cast<uint32_t>(mesh.NodeCount()));
   out.Put(static_cast<uint32_t>(mesh.ColumnCount()));
+  out.Put(GroupInterfaces);
+  out.Put(static_cast<uint32_t>(groups.size()));
+  for (const ChunkRef& group : groups)
+  {
+    out.Put(group.stored);
+    out.Put(group.raw);
+    out.Put(group.crc);
+  }
   out.PutBytes(mesh.topology.data(), mesh.topology.size() * sizeof(mesh.topology[0]));
-  PutPositions(out, mesh, header);
   out.PutBytes(mesh.corners.data(), mesh.corners.size() * sizeof(mesh.corners[0]));
   // One byte a cell: bit 0 active, bits 1-4 open sides.
   std::vector<uint8_t> cells(mesh.active.size());
@@ -213,10 +250,77 @@ void CheckIndices(const ByteReader& in, const std::vector<Polygon>& polygons, ui
   }
 }
 
+/// Reads a layer group's chunk (DecodeRegion: decompressed and checked, errors naming it).
+using LayerGroupReader = std::function<std::vector<uint8_t>(const ChunkRef&, std::size_t group)>;
+
+/// The layer groups' table of a mesh chunk (LayerGroupsVersion): where each group's chunk lies
+/// (back to back from the record's layerGroups) and its sizes, checked against the counts.
+std::vector<ChunkRef> GetLayerGroups(
+  ByteReader& in, const RegionRecord& record, std::size_t interfaces, uint32_t nodes, uint32_t& each)
+{
+  each = in.Get<uint32_t>();
+  const uint32_t count = in.Get<uint32_t>();
+  if (each < 1 || count != GroupCount(interfaces, each) || uint64_t(count) * 12 > in.Left())
+  {
+    throw FileFormatError(in.Where() + ": " + std::to_string(count) + " layer groups of " + std::to_string(each) +
+      " interfaces for " + std::to_string(interfaces) + " interfaces a node");
+  }
+  std::vector<ChunkRef> groups(count);
+  uint64_t offset = record.layerGroups;
+  for (std::size_t g = 0; g < groups.size(); ++g)
+  {
+    ChunkRef& group = groups[g];
+    group.offset = offset;
+    group.stored = in.Get<uint32_t>();
+    group.raw = in.Get<uint32_t>();
+    group.crc = in.Get<uint32_t>();
+    const uint64_t raw = uint64_t(nodes) * std::min<uint64_t>(each, interfaces - g * each) * 12;
+    if (group.raw != raw)
+    {
+      throw FileFormatError(in.Where() + ": layer group " + std::to_string(g) + " of " + std::to_string(group.raw) +
+        " bytes, not the " + std::to_string(raw) + " of its interfaces");
+    }
+    offset += group.stored;
+  }
+  return groups;
+}
+
+/// The positions of the mesh's window of layers (mesh.firstLayer, mesh.layers), from the layer
+/// `groups` it reaches (of `each` interfaces), or without groups (before LayerGroupsVersion)
+/// from the chunk's one plane set, next in `in`.
+void GetWindowPositions(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header,
+  const std::vector<ChunkRef>& groups, uint32_t each, std::size_t interfaces, const LayerGroupReader& readGroup)
+{
+  const std::size_t nodes = static_cast<std::size_t>(mesh.NodeCount());
+  const std::size_t first = static_cast<std::size_t>(mesh.firstLayer);
+  const std::size_t kept = static_cast<std::size_t>(mesh.layers) + 1;
+  if (groups.empty())
+  {
+    const std::size_t values = nodes * interfaces * 3;
+    if (values * 4 > in.Left())
+    {
+      throw FileFormatError(in.Where() + ": " + std::to_string(nodes) + " nodes do not fit in the chunk");
+    }
+    mesh.positions.resize(nodes * kept * 3);
+    GetPositions(in.Skip(values * 4), mesh, header, 0, interfaces);
+    return;
+  }
+  mesh.positions.resize(nodes * kept * 3);
+  for (std::size_t g = 0; g < groups.size(); ++g)
+  {
+    const std::size_t from = g * each, count = std::min<std::size_t>(each, interfaces - from);
+    if (from < first + kept && from + count > first)
+    {
+      const std::vector<uint8_t> raw = readGroup(groups[g], g);
+      GetPositions(raw.data(), mesh, header, from, count);
+    }
+  }
+}
+
 /// Decodes a mesh chunk, keeping the layers `choose` gives from the nodes' topological
 /// coordinates (clamped to the model's; null: every layer).
 void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& header, const RegionRecord& record,
-  const LayerWindowChooser* choose)
+  const LayerWindowChooser* choose, const LayerGroupReader& readGroup)
 {
   const uint32_t magic = in.Get<uint32_t>();
   const uint32_t layers = in.Get<uint32_t>(), nodes = in.Get<uint32_t>(), columns = in.Get<uint32_t>();
@@ -232,6 +336,10 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
   }
   // The stored surfaces were extracted with this rule; readers extract them again.
   mesh.sealedPinchThickness = header.version >= 5 && record.level != header.leafLevel ? record.ownError : 0;
+  uint32_t each = 0;
+  const std::vector<ChunkRef> groups = header.version >= MultiresolutionHeader::LayerGroupsVersion
+    ? GetLayerGroups(in, record, static_cast<std::size_t>(layers) + 1, nodes, each)
+    : std::vector<ChunkRef>{};
   if (static_cast<uint64_t>(nodes) * 8 > in.Left())
   {
     throw FileFormatError(in.Where() + ": " + std::to_string(nodes) + " nodes do not fit in the chunk");
@@ -252,7 +360,7 @@ void DecodeMesh(ByteReader& in, RegionMesh& mesh, const MultiresolutionHeader& h
   const int32_t last = std::clamp<int32_t>(window[1], first - 1, static_cast<int32_t>(layers) - 1);
   mesh.firstLayer = first;
   mesh.layers = last - first + 1;
-  GetPositions(in, mesh, header, static_cast<std::size_t>(layers) + 1);
+  GetWindowPositions(in, mesh, header, groups, each, static_cast<std::size_t>(layers) + 1, readGroup);
   if (static_cast<uint64_t>(columns) * (16 + layers + 1) != in.Left())
   {
     throw FileFormatError(in.Where() + ": column data of " + std::to_string(in.Left()) + " bytes for " +
@@ -415,6 +523,7 @@ void PutRecord(ByteWriter& out, const RegionRecord& r)
     out.Put(c.raw);
     out.Put(c.crc);
   }
+  out.Put(r.layerGroups);
   out.Bytes.resize(start + RecordBytes, 0);
 }
 
@@ -449,9 +558,14 @@ RegionRecord GetRecord(ByteReader& in, uint32_t version, bool& reservedZero)
     c.raw = in.Get<uint32_t>();
     c.crc = in.Get<uint32_t>();
   }
-  uint8_t padding[RecordBytes - 4 - 4 - 8 * 4 - 24 - 8 - 32 - 4 * 20];
-  in.GetBytes(padding, sizeof(padding));
-  reservedZero = reserved == 0 && std::all_of(padding, padding + sizeof(padding), [](uint8_t b) { return b == 0; });
+  static_assert(RecordBytes == 4 + 4 + 8 * 4 + 24 + 8 + 32 + 4 * 20 + 8, "a record ends with its layer groups' offset");
+  r.layerGroups = in.Get<uint64_t>();
+  if (version < MultiresolutionHeader::LayerGroupsVersion)
+  {
+    reserved |= r.layerGroups != 0;
+    r.layerGroups = 0;
+  }
+  reservedZero = reserved == 0;
   return r;
 }
 } // namespace
@@ -474,7 +588,10 @@ RegionMesh DecodeRegion(const uint8_t* data, uint64_t size, const std::string& p
   {
     const auto raw = chunk(RegionRecord::Mesh);
     ByteReader in(raw.data(), raw.size(), region + ChunkNames[0]);
-    DecodeMesh(in, mesh, header, record, choose);
+    DecodeMesh(in, mesh, header, record, choose, [&](const ChunkRef& group, std::size_t g) {
+      return DecompressChunk(data, size, group,
+        region + "mesh layer group " + std::to_string(g) + " at byte " + std::to_string(group.offset));
+    });
   }
   if (mesh.layers < header.dims[2])
   {
@@ -794,44 +911,70 @@ ChunkFile::~ChunkFile()
   }
 }
 
-ChunkRef ChunkFile::Put(const std::vector<uint8_t>& raw, const std::string& what)
+ChunkFile::Stored ChunkFile::Compress(const std::vector<uint8_t>& raw, const std::string& what) const
 {
   if (raw.size() >= MaxChunkBytes)
   {
     throw FileFormatError(
       this->FilePath + ": " + what + " of " + std::to_string(raw.size()) + " bytes is too big for a chunk");
   }
-  const std::vector<uint8_t> stored = CompressChunk(raw);
-  const std::size_t length = stored.size();
-  ChunkRef ref;
-  ref.stored = static_cast<uint32_t>(length);
-  ref.raw = static_cast<uint32_t>(raw.size());
-  ref.crc = Crc32(stored.data(), length);
+  Stored chunk{ CompressChunk(raw), ChunkRef{} };
+  chunk.second.stored = static_cast<uint32_t>(chunk.first.size());
+  chunk.second.raw = static_cast<uint32_t>(raw.size());
+  chunk.second.crc = Crc32(chunk.first.data(), chunk.first.size());
+  return chunk;
+}
+
+void ChunkFile::Append(std::vector<Stored>& run, const std::string& what)
+{
   std::lock_guard<std::mutex> guard(this->Lock);
-  ref.offset = this->Offset;
-  std::size_t done = 0;
-  while (done < length)
+  for (Stored& chunk : run)
   {
-    const ssize_t written =
-      pwrite(this->Descriptor, stored.data() + done, length - done, static_cast<off_t>(this->Offset + done));
-    if (written <= 0)
+    chunk.second.offset = this->Offset;
+    const std::size_t length = chunk.first.size();
+    std::size_t done = 0;
+    while (done < length)
     {
-      throw FileFormatError(this->FilePath + ": writing the " + what + " at byte " +
-        std::to_string(this->Offset + done) + " failed: " + std::strerror(errno));
+      const ssize_t written =
+        pwrite(this->Descriptor, chunk.first.data() + done, length - done, static_cast<off_t>(this->Offset + done));
+      if (written <= 0)
+      {
+        throw FileFormatError(this->FilePath + ": writing the " + what + " at byte " +
+          std::to_string(this->Offset + done) + " failed: " + std::strerror(errno));
+      }
+      done += static_cast<std::size_t>(written);
     }
-    done += static_cast<std::size_t>(written);
+    this->Offset += length;
   }
-  this->Offset += length;
-  return ref;
+}
+
+ChunkRef ChunkFile::Put(const std::vector<uint8_t>& raw, const std::string& what)
+{
+  std::vector<Stored> run{ this->Compress(raw, what) };
+  this->Append(run, what);
+  return run.front().second;
 }
 
 void ChunkFile::AddRegion(const RegionMesh& mesh, const MultiresolutionHeader& header, RegionRecord& record)
 {
-  const std::vector<uint8_t> raw[RegionRecord::ChunkCount] = { EncodeMesh(mesh, header), EncodeSurface(mesh.top),
-    EncodeSurface(mesh.bottom), EncodeTriangles(mesh.sideTriangles) };
   const std::string region =
     "region (level " + std::to_string(record.level) + ", index " + std::to_string(record.index) + ") ";
-  for (int c = 0; c < RegionRecord::ChunkCount; ++c)
+  // The layer groups are compressed first, for the mesh chunk to hold their sizes and CRCs,
+  // and written back to back before it.
+  std::vector<Stored> run;
+  std::vector<ChunkRef> groups;
+  for (const std::vector<uint8_t>& raw : EncodeLayerGroups(mesh, header))
+  {
+    run.push_back(this->Compress(raw, region + "mesh layer group"));
+    groups.push_back(run.back().second);
+  }
+  run.push_back(this->Compress(EncodeMesh(mesh, groups), region + ChunkNames[RegionRecord::Mesh]));
+  this->Append(run, region + ChunkNames[RegionRecord::Mesh]);
+  record.layerGroups = run.front().second.offset;
+  record.chunks[RegionRecord::Mesh] = run.back().second;
+  const std::vector<uint8_t> raw[RegionRecord::ChunkCount] = { {}, EncodeSurface(mesh.top), EncodeSurface(mesh.bottom),
+    EncodeTriangles(mesh.sideTriangles) };
+  for (int c = RegionRecord::Top; c < RegionRecord::ChunkCount; ++c)
   {
     record.chunks[c] = this->Put(raw[c], region + ChunkNames[c]);
   }
@@ -948,6 +1091,9 @@ void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader 
     {
       c = moved(r.part, c);
     }
+    ChunkRef groups;
+    groups.offset = record.layerGroups;
+    record.layerGroups = moved(r.part, groups).offset;
     PutRecord(index, record);
   }
   for (const auto& m : model)
@@ -1075,6 +1221,12 @@ void MultiresolutionFile::ReadIndex(uint64_t indexOffset, uint64_t indexSize)
     for (int c = 0; c < RegionRecord::ChunkCount; ++c)
     {
       checkChunk(r.chunks[c], place + ": " + ChunkNames[c]);
+    }
+    if (this->Head.version >= MultiresolutionHeader::LayerGroupsVersion &&
+      (r.layerGroups < HeaderBytes || r.layerGroups > indexOffset))
+    {
+      throw FileFormatError(place + ": layer groups at byte " + std::to_string(r.layerGroups) +
+        " lie outside the data part of the file (corrupt)");
     }
     deepest = std::max(deepest, r.level);
     digest.Add(r);

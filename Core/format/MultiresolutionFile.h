@@ -56,7 +56,7 @@ namespace resmr
 
 struct MultiresolutionHeader
 {
-  static constexpr uint32_t Version = 9;
+  static constexpr uint32_t Version = 10;
   static constexpr uint32_t OldestVersion = 3; ///< older files are refused
   /// The first version whose simplified sides paint every cell in place (see above).
   static constexpr uint32_t SidesInPlaceVersion = 6;
@@ -64,6 +64,9 @@ struct MultiresolutionHeader
   static constexpr uint32_t TypicalErrorVersion = 8;
   /// From this version on `resmr build` writes the regions' footprints (ModelChunk::Footprints).
   static constexpr uint32_t FootprintsVersion = 9;
+  /// From this version on a mesh chunk's positions lie in chunks of a few layers each
+  /// (RegionRecord::layerGroups), so a window of layers decompresses only those it reaches.
+  static constexpr uint32_t LayerGroupsVersion = 10;
   uint32_t version = Version; ///< the file's, when read
   std::array<int64_t, 3> dims{};
   std::array<double, 4> box{};           ///< hierarchy box: xmin, ymin, xmax, ymax
@@ -113,6 +116,9 @@ struct RegionRecord
   float typicalError = -1;
   std::array<float, 4> topCone{}, bottomCone{};
   std::array<ChunkRef, ChunkCount> chunks{};
+  /// From LayerGroupsVersion on: the file offset where the mesh's layer-group chunks begin,
+  /// back to back (the mesh chunk holds their sizes and checksums); 0 before.
+  uint64_t layerGroups = 0;
 };
 
 /// A chunk of the grid rather than of a region.
@@ -185,6 +191,12 @@ public:
   const std::string& Path() const { return this->FilePath; }
 
 private:
+  /// A compressed chunk and its reference (offset set once appended).
+  using Stored = std::pair<std::vector<uint8_t>, ChunkRef>;
+  Stored Compress(const std::vector<uint8_t>& raw, const std::string& what) const;
+  /// Appends chunks back to back, others' never in between, and sets their offsets.
+  void Append(std::vector<Stored>& run, const std::string& what);
+
   std::string FilePath;
   int Descriptor = -1;
   std::mutex Lock;

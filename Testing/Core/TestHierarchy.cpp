@@ -51,6 +51,39 @@ SyntheticParameters SmallModel()
   return p;
 }
 
+/// `part` holds the cells and interfaces of `whole` from its first layer on, numbered from it,
+/// and no stored surface unless it holds every layer.
+bool SameAsWindow(const RegionMesh& whole, const RegionMesh& part)
+{
+  const int32_t first = part.firstLayer;
+  bool same = part.topology == whole.topology && part.corners == whole.corners && part.cutEdges == whole.cutEdges &&
+    first >= 0 && first + part.layers <= whole.layers &&
+    part.positions.size() == std::size_t(whole.NodeCount()) * (part.layers + 1) * 3 &&
+    part.active.size() == whole.corners.size() * std::size_t(part.layers) &&
+    part.top.quads.empty() == (part.layers < whole.layers);
+  for (std::size_t node = 0; same && node < std::size_t(whole.NodeCount()); ++node)
+  {
+    for (int32_t k = 0; k <= part.layers; ++k)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        same = same &&
+          part.positions[(node * (part.layers + 1) + k) * 3 + a] ==
+            whole.positions[(node * (whole.layers + 1) + first + k) * 3 + a];
+      }
+    }
+  }
+  for (std::size_t c = 0; same && c < whole.corners.size(); ++c)
+  {
+    for (int32_t k = 0; k < part.layers; ++k)
+    {
+      same = same && part.active[c * part.layers + k] == whole.active[c * whole.layers + first + k] &&
+        part.openSides[c * part.layers + k] == whole.openSides[c * whole.layers + first + k];
+    }
+  }
+  return same;
+}
+
 void TestDiamondTree()
 {
   const DiamondHierarchy tree(100, 200, 500, 400, 6);
@@ -533,6 +566,58 @@ HierarchyOptions SmallOptions()
   return options;
 }
 
+/// Layer groups (format version 10): a window decodes the groups it reaches and no other, each
+/// window across the groups' borders equal to the whole mesh sliced.
+void TestLayerGroups()
+{
+  SyntheticParameters p;
+  p.nx = 24;
+  p.ny = 20;
+  p.nz = 20; // 21 interfaces: groups of 8, 8 and 5
+  p.seed = 5;
+  const std::string path = TempPath("groups.resmr");
+  HierarchyOptions options = SmallOptions();
+  SyntheticLayerSource source(p, "synth:groups");
+  BuildHierarchy(source, path, options);
+  std::string bytes;
+  {
+    const MultiresolutionFile file(path);
+    CHECK(file.Header().version == MultiresolutionHeader::LayerGroupsVersion);
+    for (std::size_t i = 0; i < file.Regions().size(); ++i)
+    {
+      const RegionRecord& r = file.Regions()[i];
+      // Written back to back just before the mesh chunk.
+      CHECK(r.layerGroups > 0 && r.layerGroups < r.chunks[RegionRecord::Mesh].offset);
+      const RegionMesh whole = file.ReadRegion(i);
+      for (const std::array<int32_t, 2> window : { std::array<int32_t, 2>{ 0, 6 }, { 6, 7 }, { 7, 8 }, { 8, 8 },
+             { 14, 16 }, { 16, 19 }, { 19, 19 }, { 3, 17 }, { 20, 25 } })
+      {
+        const RegionMesh part = file.ReadRegionLayers(i, window[0], window[1]);
+        CHECK(part.firstLayer == std::min(window[0], 20) && SameAsWindow(whole, part));
+      }
+    }
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }
+  // The last group (interfaces 16 to 20) damaged: windows above it still read, whole.
+  const MultiresolutionFile clean(path);
+  const RegionRecord& victim = clean.Regions().front();
+  bytes[victim.chunks[RegionRecord::Mesh].offset - 3] ^= 0x5a;
+  const std::string damaged = TempPath("groups-damaged.resmr");
+  {
+    std::ofstream out(damaged, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  const MultiresolutionFile file(damaged);
+  const RegionMesh whole = clean.ReadRegion(0);
+  CHECK(SameAsWindow(whole, file.ReadRegionLayers(0, 0, 14)));
+  CHECK(SameAsWindow(whole, file.ReadRegionLayers(0, 8, 9)));
+  resmr_testing::ExpectError<FileFormatError>("damaged layer group", [&] { file.ReadRegion(0); },
+    { damaged, "level " + std::to_string(victim.level), "mesh layer group 2", "checksum" });
+  resmr_testing::ExpectError<FileFormatError>("window in a damaged layer group",
+    [&] { file.ReadRegionLayers(0, 15, 16); }, { damaged, "mesh layer group 2", "checksum" });
+}
+
 void TestHierarchyFile()
 {
   const SyntheticParameters p = SmallModel();
@@ -594,31 +679,7 @@ void TestHierarchyFile()
       const RegionMesh part = file.ReadRegionLayers(i, window[0], window[1]);
       const int32_t first = std::max(window[0], 0), last = std::min(window[1], nz - 1);
       CHECK(part.firstLayer == first && part.layers == last - first + 1);
-      CHECK(part.topology == whole.topology && part.corners == whole.corners && part.cutEdges == whole.cutEdges);
-      bool same = part.positions.size() == std::size_t(whole.NodeCount()) * (part.layers + 1) * 3 &&
-        part.active.size() == whole.corners.size() * std::size_t(part.layers) &&
-        part.top.quads.empty() == (part.layers < nz);
-      for (std::size_t node = 0; same && node < std::size_t(whole.NodeCount()); ++node)
-      {
-        for (int32_t k = 0; k <= part.layers; ++k)
-        {
-          for (int a = 0; a < 3; ++a)
-          {
-            same = same &&
-              part.positions[(node * (part.layers + 1) + k) * 3 + a] ==
-                whole.positions[(node * (whole.layers + 1) + first + k) * 3 + a];
-          }
-        }
-      }
-      for (std::size_t c = 0; same && c < whole.corners.size(); ++c)
-      {
-        for (int32_t k = 0; k < part.layers; ++k)
-        {
-          same = same && part.active[c * part.layers + k] == whole.active[c * whole.layers + first + k] &&
-            part.openSides[c * part.layers + k] == whole.openSides[c * whole.layers + first + k];
-        }
-      }
-      CHECK(same);
+      CHECK(SameAsWindow(whole, part));
     }
   }
   const auto original = OriginalFaces(p);
@@ -1103,23 +1164,32 @@ void TestMapAxesInFile()
     CHECK(!CornerPointGeometry::PlacementTransform(f.Header().map, transform));
   }
 
-  // Version 3 (no map placement) still reads, as grid coordinates.
+  // Version 3 (no map placement) still reads, as grid coordinates. Files before version 10
+  // keep a mesh's positions in its mesh chunk: older versions are made from the committed
+  // version 8 seed (the fuzz corpus's), newer ones from this file.
   std::ifstream in(path, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string seedPath = std::string(RESMR_FUZZ_SEEDS) + "/valid_synth_9x8x2_cmax16_v8.resmr";
+  std::ifstream seedIn(seedPath, std::ios::binary);
+  const std::string seed((std::istreambuf_iterator<char>(seedIn)), std::istreambuf_iterator<char>());
+  const MultiresolutionFile eight(seedPath);
+  CHECK(eight.Header().version == 8);
   const std::string damaged = TempPath("map-damaged.resmr");
   const auto writeBytes = [&](const std::string& content) {
     std::ofstream out(damaged, std::ios::binary | std::ios::trunc);
     out.write(content.data(), static_cast<std::streamsize>(content.size()));
   };
   const auto withVersion = [&](uint32_t version) {
-    std::vector<uint8_t> b(bytes.begin(), bytes.end());
+    const bool old = version < MultiresolutionHeader::LayerGroupsVersion;
+    std::vector<uint8_t> b =
+      old ? std::vector<uint8_t>(seed.begin(), seed.end()) : std::vector<uint8_t>(bytes.begin(), bytes.end());
     std::memcpy(&b[8], &version, 4);
     std::fill(b.begin() + 184, b.begin() + 252, 0);
     if (version < MultiresolutionHeader::TypicalErrorVersion)
     {
       // The typical error's bytes were reserved (zero) before; the index CRC follows them.
       const auto index = resmr_fuzz::Load<uint64_t>(b, b.size() - IndexTrailerBytes);
-      for (std::size_t r = 0; r < file.Regions().size(); ++r)
+      for (std::size_t r = 0; r < eight.Regions().size(); ++r)
       {
         resmr_fuzz::Store<float>(b, static_cast<std::size_t>(index) + r * 192 + 4, 0.f);
       }
@@ -1132,15 +1202,21 @@ void TestMapAxesInFile()
     const MultiresolutionFile old(damaged);
     CHECK(old.Header().version == 3 && !old.Header().map.hasMapAxes && old.Header().map.mapUnits.empty());
     CHECK(!CornerPointGeometry::PlacementTransform(old.Header().map, transform));
-    CHECK(old.Regions().size() == file.Regions().size() && old.Header().geometryId == file.Header().geometryId);
+    CHECK(old.Regions().size() == eight.Regions().size() && old.Header().geometryId == eight.Header().geometryId);
     // Its regions' typical errors are unknown (the view estimates from their own errors).
     CHECK(std::all_of(
       old.Regions().begin(), old.Regions().end(), [](const RegionRecord& r) { return r.typicalError < 0; }));
+    for (std::size_t r = 0; r < old.Regions().size(); ++r)
+    {
+      const RegionMesh mesh = old.ReadRegion(r);
+      CHECK(mesh.VertexCount() == old.Regions()[r].vertices);
+      CHECK(SameAsWindow(mesh, old.ReadRegionLayers(r, 1, 1)));
+    }
   }
   // Versions this build does not know are refused by number.
   writeBytes(withVersion(2));
   resmr_testing::ExpectError<FileFormatError>("version 2", [&] { MultiresolutionFile f(damaged); },
-    { damaged, "format version 2", "versions 3 to 9", "resmr build" });
+    { damaged, "format version 2", "versions 3 to " + std::to_string(MultiresolutionHeader::Version), "resmr build" });
   const std::string newer = std::to_string(MultiresolutionHeader::Version + 1);
   writeBytes(withVersion(MultiresolutionHeader::Version + 1));
   resmr_testing::ExpectError<FileFormatError>(
@@ -1149,7 +1225,7 @@ void TestMapAxesInFile()
   writeBytes(withVersion(5));
   {
     MultiresolutionFile five(damaged);
-    CHECK(five.Header().version == 5 && five.Regions().size() == file.Regions().size());
+    CHECK(five.Header().version == 5 && five.Regions().size() == eight.Regions().size());
   }
   // A placement that cannot be right, under a good checksum, is named; a flipped byte there
   // fails the checksum.
@@ -1359,6 +1435,7 @@ int main()
   TestDiamondTree();
   TestBuildSchedule();
   TestHierarchyFile();
+  TestLayerGroups();
   TestWallDepths();
   TestWeldedFaults();
   TestMapAxesInFile();

@@ -130,7 +130,7 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
   const auto& h = file.Header();
   const uint64_t slots = uint64_t(h.hashTableSides[0]) * h.hashTableSides[1] * h.hashTableSides[2];
 
-  ExpectGeometryRefused("version 10", valid, "format version 10", Set<uint32_t>(Version, 10));
+  ExpectGeometryRefused("version 11", valid, "format version 11", Set<uint32_t>(Version, 11));
   ExpectGeometryRefused("version 2", valid, "format version 2", Set<uint32_t>(Version, 2));
   ExpectGeometryRefused("header size", valid, "'header size'", Set<uint32_t>(HeaderSize, 255));
   ExpectGeometryRefused("nx 0", valid, "'dimensions (nx)' is 0", Set<int64_t>(Dims, 0));
@@ -190,7 +190,9 @@ void GeometryFields(const Bytes& valid, const std::string& validPath)
     const std::size_t at = static_cast<std::size_t>(IndexAt(f)) + 2 * 192;
     Store<float>(f, at + 4, 2 * Load<float>(f, at + 68) + 1);
   });
-  ExpectGeometryRefused("record padding", valid, "reserved bytes", SetRecord<uint8_t>(0, 190, 1));
+  ExpectGeometryRefused("record layer groups", valid, "layer groups at byte", SetRecord<uint64_t>(0, 184, 1));
+  ExpectGeometryRefused(
+    "record layer groups past the data", valid, "layer groups at byte", SetRecord<uint64_t>(0, 184, 1ull << 40));
   ExpectGeometryRefused("record index", valid, "level or region index", SetRecord<int64_t>(0, 8, 4));
   ExpectGeometryRefused("record columns 0", valid, "0 columns", SetRecord<int64_t>(0, 16, 0));
   ExpectGeometryRefused("record active cells", valid, "-1 active cells", SetRecord<int64_t>(0, 24, -1));
@@ -268,6 +270,29 @@ void RegionContents(const Bytes& valid)
   Bytes layers = unpacked;
   Store<uint32_t>(layers, static_cast<std::size_t>(mesh + 4), 3);
   ExpectRegionRefused("layers", resmr_fuzz::Repair(layers.data(), layers.size(), layout), 2, "3 layers");
+  // Then the layer groups' table: interfaces a group, groups, and per group its stored bytes,
+  // raw bytes and CRC (the groups' chunks stay packed in the unpacked form). 2 layers: one group.
+  Bytes each = unpacked;
+  Store<uint32_t>(each, static_cast<std::size_t>(mesh + 16), 0);
+  ExpectRegionRefused("interfaces a group", resmr_fuzz::Repair(each.data(), each.size(), layout), 2,
+    "1 layer groups of 0 interfaces for 3 interfaces a node");
+  Bytes groups = unpacked;
+  Store<uint32_t>(groups, static_cast<std::size_t>(mesh + 20), 2);
+  ExpectRegionRefused(
+    "layer groups", resmr_fuzz::Repair(groups.data(), groups.size(), layout), 2, "2 layer groups of 8");
+  Bytes raw = unpacked;
+  Store<uint32_t>(
+    raw, static_cast<std::size_t>(mesh + 28), Load<uint32_t>(raw, static_cast<std::size_t>(mesh + 28)) + 12);
+  ExpectRegionRefused("layer group size", resmr_fuzz::Repair(raw.data(), raw.size(), layout), 2, "layer group 0 of");
+  Bytes crc = unpacked;
+  Store<uint32_t>(
+    crc, static_cast<std::size_t>(mesh + 32), Load<uint32_t>(crc, static_cast<std::size_t>(mesh + 32)) ^ 1);
+  ExpectRegionRefused(
+    "layer group checksum", resmr_fuzz::Repair(crc.data(), crc.size(), layout), 2, "mesh layer group 0 at byte");
+  ExpectRegionRefused("layer groups moved",
+    Changed(valid, layout,
+      SetRecord<uint64_t>(2, 184, Load<uint64_t>(valid, static_cast<std::size_t>(IndexAt(valid)) + 2 * 192 + 184) + 1)),
+    2, "checksum mismatch");
   // Unchanged, the unpacked form packs into a file that reads as the original.
   const Bytes repacked = resmr_fuzz::Repair(unpacked.data(), unpacked.size(), layout);
   Spill(Temp + "/repacked.resmr", repacked);
@@ -275,6 +300,28 @@ void RegionContents(const Bytes& valid)
   for (std::size_t r = 0; r < file.Regions().size(); ++r)
   {
     CHECK(file.ReadRegion(r).VertexCount() == file.Regions()[r].vertices);
+  }
+}
+
+/// A file of version 8 (the fuzz corpus's seed of the same model: positions in the mesh chunk)
+/// reads as this build's file of version 10 (positions in layer groups) does, whole and by
+/// windows of layers.
+void OlderVersionReadsTheSame(const std::string& geometry, const std::string& seed)
+{
+  const MultiresolutionFile now(geometry), eight(seed);
+  CHECK(eight.Header().version == 8 && now.Header().version == MultiresolutionHeader::LayerGroupsVersion);
+  CHECK(now.Regions().size() == eight.Regions().size());
+  for (std::size_t r = 0; r < now.Regions().size() && r < eight.Regions().size(); ++r)
+  {
+    for (const std::array<int32_t, 2> window : { std::array<int32_t, 2>{ 0, 1 }, { 0, 0 }, { 1, 1 } })
+    {
+      const RegionMesh a = now.ReadRegionLayers(r, window[0], window[1]);
+      const RegionMesh b = eight.ReadRegionLayers(r, window[0], window[1]);
+      CHECK(a.firstLayer == b.firstLayer && a.layers == b.layers && a.positions == b.positions &&
+        a.topology == b.topology && a.corners == b.corners && a.active == b.active && a.openSides == b.openSides &&
+        a.cutEdges == b.cutEdges && a.top.quads == b.top.quads && a.bottom.quads == b.bottom.quads &&
+        a.sideTriangles == b.sideTriangles);
+    }
   }
 }
 
@@ -436,9 +483,9 @@ void ToolRefusesFlatModel(const Bytes& valid)
 
 int main(int argc, char** argv)
 {
-  if (argc != 3)
+  if (argc != 4)
   {
-    std::fprintf(stderr, "usage: %s RESMR_TOOL TEMP_DIR\n", argv[0]);
+    std::fprintf(stderr, "usage: %s RESMR_TOOL TEMP_DIR SEED_DIR\n", argv[0]);
     return 2;
   }
   Tool = argv[1];
@@ -460,6 +507,8 @@ int main(int argc, char** argv)
   const bool ok = resmr_testing::RunNamedTests({
     { "geometry header and index fields", [&] { GeometryFields(validGeometry, geometry); } },
     { "region decoder against the index", [&] { RegionContents(validGeometry); } },
+    { "version 8 reads as version 10",
+      [&] { OlderVersionReadsTheSame(geometry, std::string(argv[3]) + "/valid_synth_9x8x2_cmax16_v8.resmr"); } },
     { "property header and index fields", [&] { PropertyFields(validProperties, properties, geometry); } },
     { "resmr info refuses a flat lattice", [&] { ToolRefusesFlatModel(validGeometry); } },
   });
