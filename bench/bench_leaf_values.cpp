@@ -11,6 +11,7 @@
 // warm one), and whether both layouts gave the same values.
 #include "MultiresolutionFile.h"
 #include "PropertyFile.h"
+#include "bench_pages.h"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -49,18 +50,6 @@ std::pair<std::array<int64_t, 3>, std::array<int64_t, 3>> LeafBox(const Multires
     boxHi[a] = std::clamp<int64_t>(static_cast<int64_t>(std::ceil(hi[a])), 0, dims[a] - 1);
   }
   return { boxLo, boxHi };
-}
-
-/// Drops the file's pages from the page cache (a cold read), as far as the kernel lets us.
-void DropPages(const std::string& path)
-{
-  const int fd = open(path.c_str(), O_RDONLY);
-  if (fd >= 0)
-  {
-    fdatasync(fd);
-    posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
-    close(fd);
-  }
 }
 
 /// Writes table `table` of `from` alone into a new file at `path`, its layers cut into bands of
