@@ -263,7 +263,7 @@ int MultiresolutionInfo(const char* path, bool listRegions)
       level.rawBytes += c.raw;
     }
     level.meshBytes += r.chunks[resmr::RegionRecord::Mesh].stored;
-    if (r.layerGroups > 0)
+    if (r.layerGroups > 0 && r.layerGroups <= r.chunks[resmr::RegionRecord::Mesh].offset)
     {
       // The layer groups' chunks, written back to back just before the mesh chunk: the
       // positions, 12 bytes a vertex.
