@@ -42,6 +42,7 @@ pqMultiresolutionReadout pqMultiresolutionReadout::Pull(vtkSMProxy* surface)
   readout.Substituted = vtkSMPropertyHelper(surface, "RegionsSubstituted").GetAsInt();
   readout.FrameMs = vtkSMPropertyHelper(surface, "LastFrameMs").GetAsDouble();
   readout.LoadsPending = vtkSMPropertyHelper(surface, "LoadsPending").GetAsInt() != 0;
+  readout.RefreshWaitMs = vtkSMPropertyHelper(surface, "RefreshWaitMs").GetAsDouble();
   const char* error = vtkSMPropertyHelper(surface, "LastError").GetAsString();
   readout.Error = QString::fromUtf8(error ? error : "");
   return readout;

@@ -21,6 +21,7 @@ struct pqMultiresolutionReadout
   int Substituted = 0;
   double FrameMs = 0;
   bool LoadsPending = false;
+  double RefreshWaitMs = 30; ///< while loads are pending, the wait before the next refresh
   QString Error;
 
   /// The Multiresolution Surface sub-proxy of a representation shown as one, else nullptr.

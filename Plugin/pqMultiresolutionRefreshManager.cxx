@@ -19,10 +19,8 @@ namespace
 // Long enough to let the loader threads land a few meshes between frames, short enough that
 // detail streams in visibly.
 constexpr int RefreshDelayMs = 30;
-// At a fixed tolerance, a refresh also waits as long as the last frame took, up to this: a
-// software rasterizer's frame of a million triangles takes a few hundred ms of every core,
-// and such frames back to back left the loaders (below the render thread's priority) almost
-// nothing; waiting a frame's time leaves them at least half the machine.
+// At a fixed tolerance, a refresh while loads are pending waits what the surface says
+// (RefreshWaitMs: the last frame's time while its loaders read), up to this.
 constexpr int LongestRefreshDelayMs = 1000;
 // A frame lowering the tolerance by less than this counts as settled (the controller's
 // smallest refining step is 2%).
@@ -112,7 +110,7 @@ void pqMultiresolutionRefreshManager::onRenderEnded()
     again = again || readout.LoadsPending || (readout.Substituted > 0 && changed) || readout.RenderScale < 1;
     if (readout.TargetFrameRate <= 0 && readout.LoadsPending)
     {
-      delayMs = std::max(delayMs, std::min(LongestRefreshDelayMs, static_cast<int>(readout.FrameMs)));
+      delayMs = std::max(delayMs, std::min(LongestRefreshDelayMs, static_cast<int>(readout.RefreshWaitMs)));
     }
     if (readout.TargetFrameRate > 0)
     {

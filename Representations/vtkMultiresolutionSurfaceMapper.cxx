@@ -187,6 +187,7 @@ struct vtkMultiresolutionSurfaceMapper::Internals
   int Drawn = 0, Substituted = 0;
   double FrameMs = 0;
   bool Pending = false;
+  bool LoadersBusy = false; ///< the cache still reads what the last frame wanted
   std::chrono::steady_clock::time_point FrameStart;
   bool HaveFrameStart = false;
 
@@ -337,6 +338,10 @@ double vtkMultiresolutionSurfaceMapper::GetLastFrameMs() const
 bool vtkMultiresolutionSurfaceMapper::GetLoadsPending() const
 {
   return this->Internal->Pending;
+}
+double vtkMultiresolutionSurfaceMapper::GetRefreshWaitMs() const
+{
+  return resmr::RefreshWaitMs(this->Internal->FrameMs, this->Internal->LoadersBusy);
 }
 void vtkMultiresolutionSurfaceMapper::PickAt(double x, double y)
 {
@@ -1505,7 +1510,8 @@ void vtkMultiresolutionSurfaceMapper::FinishFrame(Frame& frame)
     return std::any_of(frame.selection.wanted.begin(), frame.selection.wanted.end(),
       [&](std::size_t region) { return !in.Regions.Ready(region) && cache.IsResident(region); });
   };
-  in.Pending = cache.Pending() || in.UploadsDeferred || arrivedLate();
+  in.LoadersBusy = cache.Pending();
+  in.Pending = in.LoadersBusy || in.UploadsDeferred || arrivedLate();
   // The loader thread's errors (a damaged region or property table: the frame draws what it
   // can) go to the output window too, each once, not only to the LastError readout.
   const std::string loadError = cache.LastError();

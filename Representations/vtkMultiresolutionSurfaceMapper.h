@@ -141,6 +141,10 @@ public:
   double GetLastFrameMs() const;
   /// Whether meshes or tables the view wants are still loading.
   bool GetLoadsPending() const;
+  /// How long a still view's refresh waits before the next frame while loads are pending
+  /// (resmr::RefreshWaitMs: the last frame's time while the loaders read, 30 ms when only
+  /// copies to the GPU remain).
+  double GetRefreshWaitMs() const;
   ///@}
 
   /// Why the files could not be used, empty if they could.

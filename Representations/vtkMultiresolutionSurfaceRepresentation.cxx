@@ -340,6 +340,10 @@ int vtkMultiresolutionSurfaceRepresentation::GetLoadsPending()
 {
   return this->Mapper->GetLoadsPending() ? 1 : 0;
 }
+double vtkMultiresolutionSurfaceRepresentation::GetRefreshWaitMs()
+{
+  return this->Mapper->GetRefreshWaitMs();
+}
 const char* vtkMultiresolutionSurfaceRepresentation::GetLastError()
 {
   return this->Error.empty() ? this->Mapper->GetLastError() : this->Error.c_str();

@@ -93,6 +93,7 @@ public:
   int GetRegionsSubstituted();
   double GetLastFrameMs();
   int GetLoadsPending();
+  double GetRefreshWaitMs();
   const char* GetLastError();
   /// Picking: display pixel (x, y) picked at the next render (see the mapper), and what the
   /// last pick found. The copies are the representation's, so the server's pull reads them.

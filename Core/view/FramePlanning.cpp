@@ -25,6 +25,12 @@ double CapScale(double budgetMs)
 }
 } // namespace
 
+double RefreshWaitMs(double lastFrameMs, bool loadersBusy)
+{
+  const double frame = std::isfinite(lastFrameMs) ? lastFrameMs : 0.0;
+  return loadersBusy ? std::clamp(frame, RefreshWaitFloorMs, RefreshWaitCeilingMs) : RefreshWaitFloorMs;
+}
+
 std::size_t UploadByteCap(double budgetMs)
 {
   return static_cast<std::size_t>(CapScale(budgetMs) * static_cast<double>(UploadBytesPerFrame));

@@ -93,6 +93,17 @@ constexpr int FloorPasses = 3;
 ViewSelection SelectWithinFloor(const ViewSelector& selector, FrameRateController& controller, ViewParameters& view,
   const std::function<bool(std::size_t)>& resident);
 
+/// The wait (ms) between a still view's refreshes while work is pending (ours; the GUI's
+/// refresh and scripts follow it, readout RefreshWaitMs): while the loaders read, as long as
+/// the last frame took (`lastFrameMs`), within [RefreshWaitFloorMs, RefreshWaitCeilingMs]: a
+/// software rasterizer's frame of a million triangles takes a few hundred ms of every core,
+/// and such frames back to back left the loaders (below the render thread's priority) almost
+/// nothing. When the loaders are idle (`loadersBusy` false) and only copies to the GPU remain,
+/// which happen in frames, the floor: waiting then only delays the picture.
+constexpr double RefreshWaitFloorMs = 30.0;
+constexpr double RefreshWaitCeilingMs = 1000.0;
+double RefreshWaitMs(double lastFrameMs, bool loadersBusy);
+
 /// The frame time (ms) the frame-rate controller is told. The whole frame is what the user
 /// waits for: the frame's own time (`frameMs`), the renderer's time for it (`rendererMs`) and,
 /// while frames come back to back (an interval under 3 target frame times), the interval

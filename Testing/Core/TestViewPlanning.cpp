@@ -234,6 +234,10 @@ void TestControllerInputs()
   CHECK(MeasuredFrameMs(5, 12, 150, 30, false) == 12);
   CHECK(MeasuredFrameMs(20, 12, 150, 30, false) == 20);
   CHECK(MeasuredFrameMs(5, 12, 40, 30, true) == 5); // after an allocation: its own time
+  // A still view's refresh: a frame's time while the loaders read (30 ms to 1 s), 30 ms when
+  // only copies to the GPU remain, however slow the frame.
+  CHECK(RefreshWaitMs(350, true) == 350 && RefreshWaitMs(5, true) == 30 && RefreshWaitMs(4000, true) == 1000);
+  CHECK(RefreshWaitMs(350, false) == 30 && RefreshWaitMs(NAN, true) == 30);
 }
 
 void TestResidency()

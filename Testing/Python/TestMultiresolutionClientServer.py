@@ -137,7 +137,7 @@ def readout(display):
     display.UpdatePropertyInformation()
     return {name: display.GetPropertyValue(name) for name in
             ("CurrentTolerance", "ResidentMB", "TrianglesDrawn", "RegionsDrawn", "RegionsSubstituted",
-             "LastFrameMs", "LoadsPending", "LastError", "LayerRange")}
+             "LastFrameMs", "LoadsPending", "RefreshWaitMs", "LastError", "LayerRange")}
 
 
 simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
@@ -209,7 +209,7 @@ for set_tolerance, values in zip((0.0, 12.0), remote_readouts):
         rt.fail(f"readout at {set_tolerance} px is not the server's frame: {values['TrianglesDrawn']:.0f} "
                 f"triangles, {values['RegionsDrawn']} regions vs {logged[1]}, {logged[0]} in its log")
     if abs(values["CurrentTolerance"] - set_tolerance) > 1e-9 or not values["ResidentMB"] > 0 \
-            or values["LoadsPending"] != 0 or values["LastFrameMs"] <= 0:
+            or values["LoadsPending"] != 0 or values["LastFrameMs"] <= 0 or values["RefreshWaitMs"] != 30:
         rt.fail(f"readout at {set_tolerance} px: {values}")
 if list(remote_readouts[0]["LayerRange"]) != [0, 8]:
     rt.fail(f"LayerRange through pvserver: {remote_readouts[0]['LayerRange']}, not [0, 8]")
