@@ -40,18 +40,13 @@ for n, model in enumerate(args.models):
             row["file"] = os.path.basename(row["file"])
             rows.append(row)
             print(json.dumps(row), flush=True)
-machine = bench_machine.machine()
-with open(args.out + ".json", "w") as out_file:
-    json.dump({"machine": machine, "rows": rows}, out_file, indent=1)
-with open(args.out + ".md", "w") as md:
-    md.write(f"# A leaf region read for a window of layers, by mesh layout\n\n"
-             f"Machine: {machine['cpu']}, {machine['cores']} cores, {machine['memory_gb']} GB. Every leaf region read "
-             f"with MultiresolutionFile::ReadRegionLayers for 2 layers and with ReadRegion whole, one pass cold "
-             f"(pages dropped), one warm; format 10 keeps positions in layer groups of 8 interfaces, format 9 in "
-             f"the mesh chunk.\n\n")
-    md.write("| model | file | format | leaves | mesh bytes a leaf | layers (from 1) | window cold ms | window warm ms "
-             "| whole cold ms | whole warm ms |\n|---|---|---|---|---|---|---|---|---|---|\n")
-    for r in rows:
-        md.write(f"| {r['model']} | {r['file']} | {r['version']} | {r['leaves']} | {r['mesh_bytes_per_leaf']:,.0f} | "
-                 f"{r['layers'][0]}-{r['layers'][1]} of {r['nk']} | {r['window_cold_ms']} | {r['window_warm_ms']} | "
-                 f"{r['whole_cold_ms']} | {r['whole_warm_ms']} |\n")
+bench_machine.write_results(
+    args.out, rows, "A leaf region read for a window of layers, by mesh layout",
+    "Every leaf region read with MultiresolutionFile::ReadRegionLayers for 2 layers and with ReadRegion whole, "
+    "one pass cold (pages dropped), one warm; format 10 keeps positions in layer groups of 8 interfaces, format "
+    "9 in the mesh chunk.",
+    ["model", "file", "format", "leaves", "mesh bytes a leaf", "layers (from 1)", "window cold ms",
+     "window warm ms", "whole cold ms", "whole warm ms"],
+    lambda r: [r["model"], r["file"], r["version"], r["leaves"], f"{r['mesh_bytes_per_leaf']:,.0f}",
+               f"{r['layers'][0]}-{r['layers'][1]} of {r['nk']}", r["window_cold_ms"], r["window_warm_ms"],
+               r["whole_cold_ms"], r["whole_warm_ms"]])

@@ -32,17 +32,12 @@ for model in args.models:
         row = dict(json.loads(line), model=os.path.basename(model), table=f"{args.table} step {args.step}")
         rows.append(row)
         print(json.dumps(row), flush=True)
-machine = bench_machine.machine()
-with open(args.out + ".json", "w") as out_file:
-    json.dump({"machine": machine, "rows": rows}, out_file, indent=1)
-with open(args.out + ".md", "w") as md:
-    md.write(f"# A filtered leaf region's property values: tiles against bands of whole rows\n\n"
-             f"Machine: {machine['cpu']}, {machine['cores']} cores, {machine['memory_gb']} GB. Every leaf region's "
-             f"box of cells over all layers read with PropertyFile::ReadBox, one pass cold (pages dropped), "
-             f"one warm.\n\n")
-    md.write("| model | table | layout | band | leaves | cells read | layer bytes | cold ms a leaf | warm ms a leaf "
-             "| same values |\n|---|---|---|---|---|---|---|---|---|---|\n")
-    for r in rows:
-        md.write(f"| {r['model']} | {r['table']} | {r['layout']} | {r['band_rows']} x {r['band_columns']} | "
-                 f"{r['leaves']} | {r['cells']:,} | {r['layer_bytes']:,} | {r['cold_ms_per_leaf']} | "
-                 f"{r['warm_ms_per_leaf']} | {r['same_values']} |\n")
+bench_machine.write_results(
+    args.out, rows, "A filtered leaf region's property values: tiles against bands of whole rows",
+    "Every leaf region's box of cells over all layers read with PropertyFile::ReadBox, one pass cold (pages "
+    "dropped), one warm.",
+    ["model", "table", "layout", "band", "leaves", "cells read", "layer bytes", "cold ms a leaf", "warm ms a leaf",
+     "same values"],
+    lambda r: [r["model"], r["table"], r["layout"], f"{r['band_rows']} x {r['band_columns']}", r["leaves"],
+               f"{r['cells']:,}", f"{r['layer_bytes']:,}", r["cold_ms_per_leaf"], r["warm_ms_per_leaf"],
+               r["same_values"]])
