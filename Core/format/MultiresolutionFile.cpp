@@ -1,4 +1,5 @@
-// The .resmr file: compressed region meshes, index and checks (paper Sec. 6.1).
+// The .resmr file: compressed region meshes, index and checks (paper Sec. 6.1). Ours: the
+// checks, and the positions' layer groups (version 10; MultiresolutionFile.h).
 #include "MultiresolutionFile.h"
 
 #include "AtomicOutputFile.h"

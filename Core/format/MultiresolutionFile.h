@@ -25,6 +25,12 @@
 // against the file; each chunk is checked (CRC, exact decompressed size, every reference in
 // range) when read. Any failure throws FileFormatError naming the file and the place.
 //
+// Ours, from version 10 on: a region's positions, most of its bytes, lie in layer groups of a
+// few interfaces, each its own chunk whose prediction restarts, written back to back before
+// its mesh chunk (which holds their sizes and CRCs; the record says where they begin), so a
+// window of layers (an I/J/K range's, a property filter's) decompresses only the groups it
+// reaches. Older versions keep the positions in the mesh chunk and still read.
+//
 // Positions are stored on one lattice for the whole model (origin + integer * step), so a
 // vertex two regions share decodes to the same bits in both, at every level (no cracks);
 // steps are 2^-22 of the lateral extent and 2^-20 of the depth range (see ChooseLattice). Topological coordinates are
