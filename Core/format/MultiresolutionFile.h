@@ -2,11 +2,12 @@
 // LZO-compressed one chunk each and concatenated, with an index of offsets, sizes, bounding
 // volumes, errors and normal cones, laid out for memory mapping.
 //
-// Layout (little-endian), version 7 (the same bytes as 4 to 6 but for one more kind of model
-// chunk; from 5 on, the builder seals pinched-out runs when it extracts surfaces and readers
-// must too, see RegionMesh.h; from 6 on, each simplified side paints every cell within the
-// region's error of its place, SideSurfaceSimplification.h, so viewers may draw it in place
-// of the exact side; from 7 on, a wall depth table, WallDepthTable.h):
+// Layout (little-endian), version 10 (docs/file-formats.md gives each version's bytes: from 5
+// on, the builder seals pinched-out runs when it extracts surfaces and readers must too, see
+// RegionMesh.h; from 6 on, each simplified side paints every cell within the region's error of
+// its place, SideSurfaceSimplification.h, so viewers may draw it in place of the exact side;
+// from 7 on, a wall depth table, WallDepthTable.h; from 8 on, typical errors; from 9 on,
+// footprints; from 10 on, layer groups, below):
 //   header (256 bytes, CRC-32 at its end): magic, version, grid dimensions, hierarchy box,
 //     position lattice, leaf level, Cmax, region and model-chunk counts, perfect-hash sizes,
 //     geometry id, then the input's map placement (flags, MAPAXES' 6 values, MAPUNITS and
