@@ -19,9 +19,6 @@ namespace
 // Long enough to let the loader threads land a few meshes between frames, short enough that
 // detail streams in visibly.
 constexpr int RefreshDelayMs = 30;
-// At a fixed tolerance, a refresh while loads are pending waits what the surface says
-// (RefreshWaitMs: the last frame's time while its loaders read), up to this.
-constexpr int LongestRefreshDelayMs = 1000;
 // A frame lowering the tolerance by less than this counts as settled (the controller's
 // smallest refining step is 2%).
 constexpr double RefiningStep = 0.99;
@@ -110,7 +107,9 @@ void pqMultiresolutionRefreshManager::onRenderEnded()
     again = again || readout.LoadsPending || (readout.Substituted > 0 && changed) || readout.RenderScale < 1;
     if (readout.TargetFrameRate <= 0 && readout.LoadsPending)
     {
-      delayMs = std::max(delayMs, std::min(LongestRefreshDelayMs, static_cast<int>(readout.RefreshWaitMs)));
+      // What the surface says (resmr::RefreshWaitMs, at most 1 s): the last frame's time while
+      // its loaders read, so that slow frames leave them the machine.
+      delayMs = std::max(delayMs, static_cast<int>(readout.RefreshWaitMs));
     }
     if (readout.TargetFrameRate > 0)
     {

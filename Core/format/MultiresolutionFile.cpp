@@ -295,18 +295,16 @@ void GetWindowPositions(ByteReader& in, RegionMesh& mesh, const MultiresolutionH
   const std::size_t nodes = static_cast<std::size_t>(mesh.NodeCount());
   const std::size_t first = static_cast<std::size_t>(mesh.firstLayer);
   const std::size_t kept = static_cast<std::size_t>(mesh.layers) + 1;
-  if (groups.empty())
+  if (groups.empty() && nodes * interfaces * 12 > in.Left())
   {
-    const std::size_t values = nodes * interfaces * 3;
-    if (values * 4 > in.Left())
-    {
-      throw FileFormatError(in.Where() + ": " + std::to_string(nodes) + " nodes do not fit in the chunk");
-    }
-    mesh.positions.resize(nodes * kept * 3);
-    GetPositions(in.Skip(values * 4), mesh, header, 0, interfaces);
-    return;
+    throw FileFormatError(in.Where() + ": " + std::to_string(nodes) + " nodes do not fit in the chunk");
   }
   mesh.positions.resize(nodes * kept * 3);
+  if (groups.empty())
+  {
+    GetPositions(in.Skip(nodes * interfaces * 12), mesh, header, 0, interfaces);
+    return;
+  }
   for (std::size_t g = 0; g < groups.size(); ++g)
   {
     const std::size_t from = g * each, count = std::min<std::size_t>(each, interfaces - from);
@@ -1092,9 +1090,7 @@ void AssembleMultiresolutionFile(const std::string& path, MultiresolutionHeader 
     {
       c = moved(r.part, c);
     }
-    ChunkRef groups;
-    groups.offset = record.layerGroups;
-    record.layerGroups = moved(r.part, groups).offset;
+    record.layerGroups = moved(r.part, ChunkRef{ record.layerGroups }).offset;
     PutRecord(index, record);
   }
   for (const auto& m : model)
